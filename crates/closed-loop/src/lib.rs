@@ -1,0 +1,392 @@
+//! The closed loop of the tail-sitter plant ([`tailsitter_physics::Plant`]) and
+//! any [`FlightController`], without FMI: the same wiring and timing a
+//! co-simulation master uses (DESIGN.md §2 Timing), for tests, analysis
+//! campaigns and benchmarks of the controller libraries.
+//!
+//! Frames: NED earth axes for positions, velocities and wind; SI units.
+
+use flight_mission::{
+    Command, ControllerInput, Diagnostics, FlightController, Measurement, MissionParams, Notice, Phase,
+};
+use nalgebra::Vector3;
+use tailsitter_physics::{idx, InputVector, Plant, StateVector};
+
+/// How the master orders the two units within a communication step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Ordering {
+    /// Controller samples the plant outputs at t, then the plant steps with
+    /// that command (the reference master).
+    #[default]
+    GaussSeidel,
+    /// Both step on values from t: the plant flies the command of the
+    /// previous sample (one sample of extra delay).
+    Jacobi,
+}
+
+/// Earth-frame wind profile [m/s], NED.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Wind {
+    #[default]
+    Calm,
+    /// The same wind all the time.
+    Constant(Vector3<f64>),
+    /// Zero before `t_start`, `wind` from then on.
+    Step { t_start: f64, wind: Vector3<f64> },
+    /// 1 − cos gust: `amplitude · (1 − cos(2π (t − t_start)/duration)) / 2` inside the gust.
+    OneMinusCosine { t_start: f64, duration: f64, amplitude: Vector3<f64> },
+}
+
+impl Wind {
+    /// Wind at time `t`.
+    pub fn at(&self, t: f64) -> Vector3<f64> {
+        match *self {
+            Wind::Calm => Vector3::zeros(),
+            Wind::Constant(w) => w,
+            Wind::Step { t_start, wind } => {
+                if t >= t_start {
+                    wind
+                } else {
+                    Vector3::zeros()
+                }
+            }
+            Wind::OneMinusCosine { t_start, duration, amplitude } => {
+                let s = (t - t_start) / duration;
+                if (0.0..=1.0).contains(&s) {
+                    amplitude * (0.5 * (1.0 - (2.0 * std::f64::consts::PI * s).cos()))
+                } else {
+                    Vector3::zeros()
+                }
+            }
+        }
+    }
+}
+
+/// One closed-loop run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scenario {
+    /// The mission the controller flies (used here for phases and the stop time).
+    pub mission: MissionParams,
+    /// End of the run [s].
+    pub stop_time: f64,
+    /// Communication step of the master [s].
+    pub comm_step: f64,
+    pub ordering: Ordering,
+    pub wind: Wind,
+    /// `(t, offset)`: from `t` on the reference offset is `offset` (NED, m).
+    pub ref_offset_steps: Vec<(f64, Vector3<f64>)>,
+}
+
+impl Scenario {
+    /// The default mission flown by the reference master at `sample_time`.
+    pub fn mission(mission: MissionParams) -> Self {
+        Self {
+            mission,
+            stop_time: mission.end_time(),
+            comm_step: mission.sample_time,
+            ordering: Ordering::GaussSeidel,
+            wind: Wind::Calm,
+            ref_offset_steps: Vec::new(),
+        }
+    }
+
+    /// Reference offset at time `t`.
+    pub fn ref_offset(&self, t: f64) -> Vector3<f64> {
+        let mut offset = Vector3::zeros();
+        for (t_step, value) in &self.ref_offset_steps {
+            if t + 1e-9 >= *t_step {
+                offset = *value;
+            }
+        }
+        offset
+    }
+}
+
+/// What the controller would measure: the plant outputs of the same names.
+pub fn measure(plant: &Plant, x: &StateVector, u: &InputVector, wind: &Vector3<f64>) -> Measurement {
+    let y = plant.outputs(x, u, wind);
+    Measurement {
+        pos_ned: Vector3::new(x[idx::POS_N], x[idx::POS_E], x[idx::POS_D]),
+        vel_ned: y.vel_ned,
+        vel_body: Vector3::new(x[idx::U], x[idx::V], x[idx::W]),
+        rates: Vector3::new(x[idx::P], x[idx::Q], x[idx::R]),
+        quat: x.fixed_rows::<4>(idx::Q1).into_owned(),
+        airspeed: y.airspeed,
+        alpha: y.alpha,
+        beta: y.beta,
+        thrust: x[idx::THRUST],
+        surfaces: [
+            x[idx::ELEVATOR],
+            x[idx::AILERON],
+            x[idx::RUDDER],
+            x[idx::FLAP_COLLECTIVE],
+            x[idx::FLAP_DIFFERENTIAL],
+            x[idx::VERTICAL_FLAP],
+        ],
+        specific_force_body: y.specific_force_body,
+        induced_velocity: y.induced_velocity,
+    }
+}
+
+/// The plant input vector of a command.
+pub fn plant_inputs(c: &Command) -> InputVector {
+    let mut u = InputVector::zeros();
+    u[idx::THRUST_CMD] = c.thrust;
+    u[idx::ELEVATOR_CMD] = c.elevator;
+    u[idx::AILERON_CMD] = c.aileron;
+    u[idx::RUDDER_CMD] = c.rudder;
+    u[idx::FLAP_COLLECTIVE_CMD] = c.flap_collective;
+    u[idx::FLAP_DIFFERENTIAL_CMD] = c.flap_differential;
+    u[idx::VERTICAL_FLAP_CMD] = c.vertical_flap;
+    u
+}
+
+/// The closed loop at one communication point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sample {
+    /// Time [s].
+    pub t: f64,
+    /// Plant state at `t`.
+    pub x: StateVector,
+    /// What the controller measured at `t`.
+    pub measurement: Measurement,
+    /// Command the plant flies over [t, t + h).
+    pub command: Command,
+    /// Controller diagnostics of its sample at `t`.
+    pub diagnostics: Diagnostics,
+    /// Wind at `t` [m/s], NED.
+    pub wind: Vector3<f64>,
+    /// Pitch θ of the 3-2-1 Euler angles [rad] (well defined near 90°: from the DCM).
+    pub theta: f64,
+}
+
+impl Sample {
+    /// |position − reference position| [m].
+    pub fn pos_error(&self) -> f64 {
+        (self.measurement.pos_ned - self.diagnostics.ref_pos_ned).norm()
+    }
+}
+
+/// The record of a run.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Trace {
+    pub samples: Vec<Sample>,
+    /// Why the run stopped before `stop_time`, if it did.
+    pub failure: Option<String>,
+    /// Warnings the controller raised (time, notice).
+    pub notices: Vec<(f64, Notice)>,
+}
+
+/// Position error statistics of one phase.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PhaseErrors {
+    pub samples: usize,
+    /// Maximum position error [m].
+    pub max: f64,
+    /// RMS position error [m].
+    pub rms: f64,
+}
+
+impl Trace {
+    /// Whether the run reached its stop time.
+    pub fn completed(&self) -> bool {
+        self.failure.is_none()
+    }
+
+    /// Position-error statistics per phase, in [`Phase`] order.
+    pub fn phase_errors(&self) -> [PhaseErrors; 5] {
+        let mut out = [PhaseErrors::default(); 5];
+        let mut sums = [0.0; 5];
+        for s in &self.samples {
+            let k = s.diagnostics.phase as usize;
+            let e = s.pos_error();
+            out[k].samples += 1;
+            out[k].max = out[k].max.max(e);
+            sums[k] += e * e;
+        }
+        for (o, sum) in out.iter_mut().zip(sums) {
+            if o.samples > 0 {
+                o.rms = (sum / o.samples as f64).sqrt();
+            }
+        }
+        out
+    }
+
+    /// Maximum position error over the whole run [m].
+    pub fn max_pos_error(&self) -> f64 {
+        self.samples.iter().map(Sample::pos_error).fold(0.0, f64::max)
+    }
+
+    /// Samples with `t0 ≤ t < t1`.
+    pub fn window(&self, t0: f64, t1: f64) -> impl Iterator<Item = &Sample> {
+        self.samples.iter().filter(move |s| s.t >= t0 - 1e-9 && s.t < t1 - 1e-9)
+    }
+
+    /// Maximum angle of attack [rad] with `t0 ≤ t < t1`.
+    pub fn max_alpha(&self, t0: f64, t1: f64) -> f64 {
+        self.window(t0, t1).map(|s| s.measurement.alpha).fold(f64::NEG_INFINITY, f64::max)
+    }
+}
+
+/// The acceptance criteria of the controller issues, evaluated on a trace.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MissionCheck {
+    /// Max |airspeed − v_level| over the last 5 s of level flight [m/s].
+    pub level_airspeed_error: f64,
+    /// Max |θ − θ_trim| over the last 5 s of level flight [rad].
+    pub level_pitch_error: f64,
+    /// |θ − 90°| at the end [rad].
+    pub final_pitch_error: f64,
+    /// Every sampled value finite.
+    pub all_finite: bool,
+    /// Per-phase position errors.
+    pub phase_errors: [PhaseErrors; 5],
+}
+
+impl MissionCheck {
+    /// Evaluate `trace` of `mission`; `theta_level_trim` is the plant's trimmed
+    /// pitch in level flight at `v_level` [rad].
+    pub fn of(trace: &Trace, mission: &MissionParams, theta_level_trim: f64) -> Self {
+        let s = mission.phase_starts();
+        let (t0, t1) = ((s[3] - 5.0).max(s[2]), s[3]);
+        let mut level_airspeed_error: f64 = 0.0;
+        let mut level_pitch_error: f64 = 0.0;
+        for sample in trace.window(t0, t1) {
+            level_airspeed_error = level_airspeed_error.max((sample.measurement.airspeed - mission.v_level).abs());
+            level_pitch_error = level_pitch_error.max((sample.theta - theta_level_trim).abs());
+        }
+        let final_pitch_error =
+            trace.samples.last().map_or(f64::INFINITY, |s| (s.theta - std::f64::consts::FRAC_PI_2).abs());
+        let all_finite = trace.samples.iter().all(|s| s.x.iter().all(|v| v.is_finite()) && s.command.is_finite());
+        Self {
+            level_airspeed_error,
+            level_pitch_error,
+            final_pitch_error,
+            all_finite,
+            phase_errors: trace.phase_errors(),
+        }
+    }
+
+    /// The issue's criteria: airspeed within 1 m/s and pitch within 5° over the
+    /// last 5 s of level flight, within 10° of vertical at the end, all finite.
+    pub fn passed(&self) -> bool {
+        self.all_finite
+            && self.level_airspeed_error <= 1.0
+            && self.level_pitch_error <= 5f64.to_radians()
+            && self.final_pitch_error <= 10f64.to_radians()
+    }
+}
+
+impl std::fmt::Display for MissionCheck {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        writeln!(
+            f,
+            "level: airspeed err {:.3} m/s, pitch err {:.2} deg; final pitch err {:.2} deg; finite {}",
+            self.level_airspeed_error,
+            self.level_pitch_error.to_degrees(),
+            self.final_pitch_error.to_degrees(),
+            self.all_finite
+        )?;
+        const NAMES: [&str; 5] = ["vertical 1", "transition 1", "level", "transition 2", "vertical 2"];
+        for (name, e) in NAMES.iter().zip(self.phase_errors.iter()) {
+            writeln!(f, "  {name:>12}: max {:.3} m, rms {:.3} m ({} samples)", e.max, e.rms, e.samples)?;
+        }
+        Ok(())
+    }
+}
+
+/// Pitch θ (3-2-1) from the quaternion through DCM element (1,3) = −sin θ (A.2.5),
+/// well defined at θ = 90°.
+pub fn pitch(x: &StateVector) -> f64 {
+    let q = x.fixed_rows::<4>(idx::Q1).into_owned();
+    (-tailsitter_physics::dcm_earth_to_body(&q)[(0, 2)]).clamp(-1.0, 1.0).asin()
+}
+
+/// Fly `controller` with `plant` from state `x0` through `scenario`.
+///
+/// Timing (DESIGN.md §2): at each communication point t the controller is
+/// handed the plant outputs at t; it samples when its own clock is due (here:
+/// every multiple of `mission.sample_time`, the first at t = 0) and holds its
+/// command otherwise. The plant then advances over [t, t + h) with the
+/// command of this sample (Gauss-Seidel) or of the previous communication
+/// point (Jacobi). The run stops early, with `failure` set, if the
+/// controller fails or the plant leaves its envelope.
+pub fn fly<C: FlightController>(plant: &Plant, x0: StateVector, controller: &mut C, scenario: &Scenario) -> Trace {
+    let h = scenario.comm_step;
+    let n = (scenario.stop_time / h).round() as usize;
+    let mut trace = Trace { samples: Vec::with_capacity(n + 1), failure: None, notices: Vec::new() };
+    let mut clock = flight_mission::SampleClock::new(scenario.mission.sample_time, 0.0);
+    let mut x = x0;
+    let mut held: Option<flight_mission::ControllerOutput> = None;
+    let mut previous_command: Option<Command> = None;
+    for k in 0..=n {
+        let t = k as f64 * h;
+        let wind = scenario.wind.at(t);
+        let u_now = previous_command.map(|c| plant_inputs(&c)).unwrap_or_else(InputVector::zeros);
+        let measurement = measure(plant, &x, &u_now, &wind);
+        if clock.take(t) || held.is_none() {
+            let input = ControllerInput { t, measurement, ref_offset_ned: scenario.ref_offset(t) };
+            match controller.update(&input) {
+                Ok(out) => {
+                    if let Some(notice) = out.notice {
+                        trace.notices.push((t, notice));
+                    }
+                    if !out.command.is_finite() {
+                        trace.failure = Some(format!("controller returned a non-finite command at t = {t}"));
+                        break;
+                    }
+                    held = Some(out);
+                }
+                Err(e) => {
+                    trace.failure = Some(format!("controller failed at t = {t}: {e}"));
+                    break;
+                }
+            }
+        }
+        let out = held.expect("set above");
+        let flown = match scenario.ordering {
+            Ordering::GaussSeidel => out.command,
+            Ordering::Jacobi => previous_command.unwrap_or(out.command),
+        };
+        trace.samples.push(Sample {
+            t,
+            x,
+            measurement,
+            command: flown,
+            diagnostics: out.diagnostics,
+            wind,
+            theta: pitch(&x),
+        });
+        previous_command = Some(out.command);
+        if k == n {
+            break;
+        }
+        if let Err(e) = plant.advance(&mut x, &plant_inputs(&flown), &wind, h) {
+            trace.failure = Some(format!("plant failed after t = {t}: {e}"));
+            break;
+        }
+    }
+    trace
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gust_shape() {
+        let g = Wind::OneMinusCosine { t_start: 1.0, duration: 2.0, amplitude: Vector3::new(4.0, 0.0, 0.0) };
+        assert_eq!(g.at(0.5), Vector3::zeros());
+        assert!((g.at(2.0).x - 4.0).abs() < 1e-12);
+        assert!((g.at(1.5).x - 2.0).abs() < 1e-12);
+        assert_eq!(g.at(3.5), Vector3::zeros());
+    }
+
+    #[test]
+    fn offsets_hold_from_their_time() {
+        let mut s = Scenario::mission(MissionParams::default());
+        s.ref_offset_steps = vec![(2.0, Vector3::new(5.0, 0.0, 0.0)), (4.0, Vector3::new(0.0, 5.0, 0.0))];
+        assert_eq!(s.ref_offset(1.0), Vector3::zeros());
+        assert_eq!(s.ref_offset(2.0).x, 5.0);
+        assert_eq!(s.ref_offset(5.0), Vector3::new(0.0, 5.0, 0.0));
+    }
+}

@@ -1,0 +1,458 @@
+//! The 20-state plant: state derivatives (§2.2, §2.3, App. D.5), fixed-step RK4, outputs,
+//! trims and linearisation.
+
+use nalgebra::{SMatrix, Vector3, Vector4};
+
+use crate::aero::{ForcesMoments, Surfaces};
+use crate::airframe::Airframe;
+use crate::attitude::{dcm_earth_to_body, euler_321_from_quat, quat_derivative, quat_from_euler_321};
+use crate::error::PhysicsError;
+use crate::idx::{self, *};
+use crate::{InputVector, StateVector, N_INPUTS, N_STATES};
+
+/// Limits of the sane envelope checked by [`Plant::advance`] after every RK4 substep.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Envelope {
+    /// Maximum inertial speed |(u, v, w)| and airspeed [m/s].
+    pub max_speed: f64,
+    /// Maximum |p|, |q|, |r| [rad/s].
+    pub max_rate: f64,
+    /// Maximum |position component| [m].
+    pub max_position: f64,
+}
+
+impl Default for Envelope {
+    fn default() -> Self {
+        Self { max_speed: 200.0, max_rate: 50.0, max_position: 1e6 }
+    }
+}
+
+/// The nonlinear plant: airframe parameters and the integrator's maximum step.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Plant {
+    /// Airframe parameters.
+    pub airframe: Airframe,
+    /// Maximum internal RK4 step [s] (default 0.001 s). [`Plant::advance`] splits a
+    /// communication step h into ⌈h / integration_step⌉ equal substeps.
+    pub integration_step: f64,
+    /// Envelope checked after every substep.
+    pub envelope: Envelope,
+}
+
+/// Outputs of the plant beyond the raw states.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Outputs {
+    /// Inertial velocity in earth (NED) axes [m/s].
+    pub vel_ned: Vector3<f64>,
+    /// 3-2-1 Euler angles (φ, θ, ψ) [rad].
+    pub euler_321: Vector3<f64>,
+    /// Airspeed V̄ [m/s].
+    pub airspeed: f64,
+    /// Angle of attack α = atan2(w_a, u_a) (2.2.12) [rad]; 0 when V̄ ≈ 0.
+    pub alpha: f64,
+    /// Sideslip β = asin(v_a / V̄) (2.2.13) [rad]; 0 when V̄ ≈ 0.
+    pub beta: f64,
+    /// Specific force (aero + thrust)/m in body axes: what an accelerometer reads [m/s²].
+    pub specific_force_body: Vector3<f64>,
+    /// Propeller induced velocity w (2.3.21) [m/s].
+    pub induced_velocity: f64,
+    /// Slip-stream speed V̄ + 2w [m/s].
+    pub slipstream_speed: f64,
+}
+
+/// A trimmed (steady) flight condition.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Trim {
+    /// The trimmed state (at the origin, heading north, wings level).
+    pub state: StateVector,
+    /// The commands holding it (thrust state = T_c, servos = commands).
+    pub inputs: InputVector,
+    /// Angle of attack [rad].
+    pub alpha: f64,
+    /// 3-2-1 pitch angle θ [rad] (π/2 in vertical flight with C_m0 = 0).
+    pub theta: f64,
+    /// Thrust [N].
+    pub thrust: f64,
+    /// Elevator deflection [rad].
+    pub elevator: f64,
+    /// Induced velocity w [m/s].
+    pub induced_velocity: f64,
+    /// Airspeed [m/s].
+    pub airspeed: f64,
+    /// max |ẋ| over every state except position at the trim.
+    pub residual: f64,
+}
+
+impl Plant {
+    /// Plant with `integration_step` = 0.001 s and the default envelope.
+    pub fn new(airframe: Airframe) -> Self {
+        Self { airframe, integration_step: 0.001, envelope: Envelope::default() }
+    }
+
+    /// Surfaces of the state vector.
+    #[inline]
+    fn surfaces(x: &StateVector) -> Surfaces {
+        Surfaces::from_array([
+            x[ELEVATOR],
+            x[AILERON],
+            x[RUDDER],
+            x[FLAP_COLLECTIVE],
+            x[FLAP_DIFFERENTIAL],
+            x[VERTICAL_FLAP],
+        ])
+    }
+
+    /// Forces/moments and DCM at a state.
+    #[inline]
+    fn eval(&self, x: &StateVector, wind_ned: &Vector3<f64>) -> (ForcesMoments, nalgebra::Matrix3<f64>) {
+        let q = Vector4::new(x[Q1], x[Q2], x[Q3], x[Q4]);
+        let c = dcm_earth_to_body(&q);
+        let v = Vector3::new(x[U], x[V], x[W]);
+        let omega = Vector3::new(x[P], x[Q], x[R]);
+        let v_air = v - c * wind_ned;
+        (self.airframe.forces_moments(&v_air, &omega, x[THRUST], &Self::surfaces(x)), c)
+    }
+
+    /// State derivatives ẋ = f(x, u, wind).
+    ///
+    /// * Position: Ṗ = (DCM^BE)ᵀ (u, v, w) (2.2.14 with the inertial velocity).
+    /// * Velocity (2.2.19–2.2.21): u̇ = X/m + r v − q w, v̇ = Y/m + p w − r u,
+    ///   ẇ = Z/m + q u − p v, with (X, Y, Z) = aero + thrust ([`Airframe::forces_moments`])
+    ///   + gravity DCM^BE (0, 0, m g) (2.3.14).
+    /// * Quaternion (2.2.3).
+    /// * Rates (2.5.26): ω̇ = I⁻¹(M − ω × I ω), I diagonal (2.2.17), i.e. (2.2.22–2.2.24).
+    /// * Thrust lag (2.3.16): Ṫ = (sat(T_c) − T)/τ_T, sat to [thrust_min, thrust_max].
+    /// * Servos (App. D.5): δ̇ = sat_rate((sat_δ(δ_c) − δ)/τ_s).
+    ///
+    /// Air-relative velocity = inertial velocity − DCM^BE·wind_ned. Pure: no allocation.
+    #[inline]
+    pub fn derivatives(&self, x: &StateVector, u: &InputVector, wind_ned: &Vector3<f64>) -> StateVector {
+        let a = &self.airframe;
+        let (fm, c) = self.eval(x, wind_ned);
+        let v = Vector3::new(x[U], x[V], x[W]);
+        let omega = Vector3::new(x[P], x[Q], x[R]);
+        let q = Vector4::new(x[Q1], x[Q2], x[Q3], x[Q4]);
+
+        let g_body = Vector3::new(c[(0, 2)], c[(1, 2)], c[(2, 2)]) * a.gravity;
+        let vdot = fm.force_body / a.mass + g_body - omega.cross(&v);
+        let i = Vector3::new(a.i_xx, a.i_yy, a.i_zz);
+        let h = omega.component_mul(&i);
+        let wdot = (fm.moment_body - omega.cross(&h)).component_div(&i);
+        let qdot = quat_derivative(&q, &omega);
+        let pdot = c.tr_mul(&v);
+
+        let mut dx = StateVector::zeros();
+        dx[POS_N] = pdot.x;
+        dx[POS_E] = pdot.y;
+        dx[POS_D] = pdot.z;
+        dx[U] = vdot.x;
+        dx[V] = vdot.y;
+        dx[W] = vdot.z;
+        dx[Q1] = qdot[0];
+        dx[Q2] = qdot[1];
+        dx[Q3] = qdot[2];
+        dx[Q4] = qdot[3];
+        dx[P] = wdot.x;
+        dx[Q] = wdot.y;
+        dx[R] = wdot.z;
+        let tc = u[THRUST_CMD].max(a.thrust_min).min(a.thrust_max);
+        dx[THRUST] = (tc - x[THRUST]) / a.tau_thrust;
+        let lim = a.deflection_limit;
+        let rate = a.servo_rate_limit;
+        for k in 0..6 {
+            let cmd = u[SURFACES_CMD + k].max(-lim).min(lim);
+            dx[SURFACES + k] = ((cmd - x[SURFACES + k]) / a.servo_tau).max(-rate).min(rate);
+        }
+        dx
+    }
+
+    /// Advance the state by `h` seconds with the commands `u` and wind held constant:
+    /// classical RK4 with n = ⌈h / integration_step⌉ equal substeps (so 1, 10 and 20 ms
+    /// communication steps give the same trajectory to rounding when h is a multiple of the
+    /// step). After each substep: quaternion renormalised, thrust clamped to its limits and
+    /// deflections to ±deflection_limit, every state checked finite and inside the
+    /// [`Envelope`]. On error `x` keeps the last good substep. Does not allocate.
+    pub fn advance(
+        &self,
+        x: &mut StateVector,
+        u: &InputVector,
+        wind_ned: &Vector3<f64>,
+        h: f64,
+    ) -> Result<(), PhysicsError> {
+        for k in 0..N_INPUTS {
+            if !u[k].is_finite() {
+                return Err(PhysicsError::NonFiniteInput { input: idx::INPUT_NAMES[k], value: u[k] });
+            }
+        }
+        const WIND: [&str; 3] = ["wind_n", "wind_e", "wind_d"];
+        for k in 0..3 {
+            if !wind_ned[k].is_finite() {
+                return Err(PhysicsError::NonFiniteInput { input: WIND[k], value: wind_ned[k] });
+            }
+        }
+        if !(h.is_finite() && h >= 0.0) {
+            return Err(PhysicsError::InvalidArgument { name: "step size h", value: h, requirement: "finite, >= 0" });
+        }
+        let step = self.integration_step;
+        if !(step.is_finite() && step > 0.0) {
+            return Err(PhysicsError::InvalidArgument {
+                name: "integration_step",
+                value: step,
+                requirement: "finite, > 0",
+            });
+        }
+        self.check(x, wind_ned)?;
+        if h == 0.0 {
+            return Ok(());
+        }
+        let n = ((h / step) * (1.0 - 1e-12)).ceil().max(1.0);
+        if n > 1e9 {
+            return Err(PhysicsError::InvalidArgument {
+                name: "step size h",
+                value: h,
+                requirement: "at most 1e9 integration steps",
+            });
+        }
+        let n = n as u64;
+        let dt = h / n as f64;
+        let mut s = *x;
+        for _ in 0..n {
+            let k1 = self.derivatives(&s, u, wind_ned);
+            let k2 = self.derivatives(&(s + k1 * (0.5 * dt)), u, wind_ned);
+            let k3 = self.derivatives(&(s + k2 * (0.5 * dt)), u, wind_ned);
+            let k4 = self.derivatives(&(s + k3 * dt), u, wind_ned);
+            s += (k1 + (k2 + k3) * 2.0 + k4) * (dt / 6.0);
+            self.project(&mut s);
+            self.check(&s, wind_ned)?;
+            *x = s;
+        }
+        Ok(())
+    }
+
+    /// Renormalise the quaternion, clamp thrust and deflections.
+    #[inline]
+    fn project(&self, s: &mut StateVector) {
+        let a = &self.airframe;
+        let n = (s[Q1] * s[Q1] + s[Q2] * s[Q2] + s[Q3] * s[Q3] + s[Q4] * s[Q4]).sqrt();
+        if n > 0.0 && n.is_finite() {
+            for k in Q1..=Q4 {
+                s[k] /= n;
+            }
+        }
+        s[THRUST] = s[THRUST].max(a.thrust_min).min(a.thrust_max);
+        let lim = a.deflection_limit;
+        for k in SURFACES..SURFACES + 6 {
+            s[k] = s[k].max(-lim).min(lim);
+        }
+    }
+
+    /// Every state finite, quaternion non-zero, speeds, rates and positions inside the envelope.
+    fn check(&self, s: &StateVector, wind_ned: &Vector3<f64>) -> Result<(), PhysicsError> {
+        for k in 0..N_STATES {
+            if !s[k].is_finite() {
+                return Err(PhysicsError::NonFiniteState { state: idx::STATE_NAMES[k], value: s[k] });
+            }
+        }
+        let e = &self.envelope;
+        let qn = (s[Q1] * s[Q1] + s[Q2] * s[Q2] + s[Q3] * s[Q3] + s[Q4] * s[Q4]).sqrt();
+        if qn < 1e-6 {
+            return Err(PhysicsError::Envelope { quantity: "quaternion norm", value: qn, limit: 1e-6, unit: "" });
+        }
+        let speed = (s[U] * s[U] + s[V] * s[V] + s[W] * s[W]).sqrt();
+        if speed > e.max_speed {
+            return Err(PhysicsError::Envelope { quantity: "speed", value: speed, limit: e.max_speed, unit: "m/s" });
+        }
+        let q = Vector4::new(s[Q1], s[Q2], s[Q3], s[Q4]);
+        let v_air = Vector3::new(s[U], s[V], s[W]) - dcm_earth_to_body(&q) * wind_ned;
+        let airspeed = v_air.norm();
+        if airspeed > e.max_speed {
+            return Err(PhysicsError::Envelope {
+                quantity: "airspeed",
+                value: airspeed,
+                limit: e.max_speed,
+                unit: "m/s",
+            });
+        }
+        for k in P..=R {
+            if s[k].abs() > e.max_rate {
+                return Err(PhysicsError::Envelope {
+                    quantity: idx::STATE_NAMES[k],
+                    value: s[k],
+                    limit: e.max_rate,
+                    unit: "rad/s",
+                });
+            }
+        }
+        for k in POS_N..=POS_D {
+            if s[k].abs() > e.max_position {
+                return Err(PhysicsError::Envelope {
+                    quantity: idx::STATE_NAMES[k],
+                    value: s[k],
+                    limit: e.max_position,
+                    unit: "m",
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Outputs at a state. The commands `u` are not used (no direct feedthrough) but are
+    /// part of the signature for symmetry with [`Plant::derivatives`].
+    pub fn outputs(&self, x: &StateVector, _u: &InputVector, wind_ned: &Vector3<f64>) -> Outputs {
+        let (fm, c) = self.eval(x, wind_ned);
+        let q = Vector4::new(x[Q1], x[Q2], x[Q3], x[Q4]);
+        Outputs {
+            vel_ned: c.tr_mul(&Vector3::new(x[U], x[V], x[W])),
+            euler_321: euler_321_from_quat(&q),
+            airspeed: fm.airspeed,
+            alpha: fm.alpha,
+            beta: fm.beta,
+            specific_force_body: fm.force_body / self.airframe.mass,
+            induced_velocity: fm.induced_velocity,
+            slipstream_speed: fm.slipstream_speed,
+        }
+    }
+
+    /// Jacobians (A, B) of [`Plant::derivatives`] at (x, u) by central differences
+    /// (perturbation 1e-6·max(1, |value|)).
+    pub fn linearize(
+        &self,
+        x: &StateVector,
+        u: &InputVector,
+        wind_ned: &Vector3<f64>,
+    ) -> (SMatrix<f64, N_STATES, N_STATES>, SMatrix<f64, N_STATES, N_INPUTS>) {
+        let mut a = SMatrix::<f64, N_STATES, N_STATES>::zeros();
+        let mut b = SMatrix::<f64, N_STATES, N_INPUTS>::zeros();
+        for j in 0..N_STATES {
+            let d = 1e-6 * x[j].abs().max(1.0);
+            let mut xp = *x;
+            let mut xm = *x;
+            xp[j] += d;
+            xm[j] -= d;
+            let col = (self.derivatives(&xp, u, wind_ned) - self.derivatives(&xm, u, wind_ned)) / (2.0 * d);
+            a.set_column(j, &col);
+        }
+        for j in 0..N_INPUTS {
+            let d = 1e-6 * u[j].abs().max(1.0);
+            let mut up = *u;
+            let mut um = *u;
+            up[j] += d;
+            um[j] -= d;
+            let col = (self.derivatives(x, &up, wind_ned) - self.derivatives(x, &um, wind_ned)) / (2.0 * d);
+            b.set_column(j, &col);
+        }
+        (a, b)
+    }
+
+    /// Steady, wings-level, straight flight at `airspeed` heading north in still air:
+    /// flight-path angle 0, solves θ (= α), δe and T (other surfaces 0).
+    pub fn trim_level(&self, airspeed: f64) -> Result<Trim, PhysicsError> {
+        if !(airspeed.is_finite() && airspeed > 0.0) {
+            return Err(PhysicsError::InvalidArgument { name: "airspeed", value: airspeed, requirement: "positive" });
+        }
+        self.trim_steady(&Vector3::new(airspeed, 0.0, 0.0), 0.1)
+    }
+
+    /// Steady vertical climb at `climb_speed` ≥ 0 (0 = hover), nose up (θ = 90°), belly
+    /// north (3-2-1 ψ = 0, φ = 0), still air: solves T, δe and the pitch attitude (exactly
+    /// 90° when C_m0 = 0). The quaternion is built directly, not from Euler extraction.
+    pub fn trim_vertical_climb(&self, climb_speed: f64) -> Result<Trim, PhysicsError> {
+        if !(climb_speed.is_finite() && climb_speed >= 0.0) {
+            return Err(PhysicsError::InvalidArgument {
+                name: "climb_speed",
+                value: climb_speed,
+                requirement: "finite and >= 0",
+            });
+        }
+        self.trim_steady(&Vector3::new(0.0, 0.0, -climb_speed), core::f64::consts::FRAC_PI_2)
+    }
+
+    /// Trim state for unknowns z = (θ, δe, T) with inertial velocity `v_ned`.
+    fn trim_point(&self, v_ned: &Vector3<f64>, z: &[f64; 3]) -> (StateVector, InputVector) {
+        let q = quat_from_euler_321(0.0, z[0], 0.0);
+        let v = dcm_earth_to_body(&q) * v_ned;
+        let mut x = StateVector::zeros();
+        x[U] = v.x;
+        x[V] = v.y;
+        x[W] = v.z;
+        x.fixed_rows_mut::<4>(Q1).copy_from(&q);
+        x[THRUST] = z[2];
+        x[ELEVATOR] = z[1];
+        let mut u = InputVector::zeros();
+        u[THRUST_CMD] = z[2];
+        u[ELEVATOR_CMD] = z[1];
+        (x, u)
+    }
+
+    fn trim_residual(&self, v_ned: &Vector3<f64>, z: &[f64; 3]) -> Vector3<f64> {
+        let (x, u) = self.trim_point(v_ned, z);
+        let d = self.derivatives(&x, &u, &Vector3::zeros());
+        Vector3::new(d[U], d[W], d[Q])
+    }
+
+    /// Newton iteration with a central-difference Jacobian on (u̇, ẇ, q̇) = 0.
+    fn trim_steady(&self, v_ned: &Vector3<f64>, theta0: f64) -> Result<Trim, PhysicsError> {
+        self.airframe.validate()?;
+        let a = &self.airframe;
+        let mut z = [theta0, 0.0, a.mass * a.gravity];
+        let mut converged = false;
+        for _ in 0..100 {
+            let r = self.trim_residual(v_ned, &z);
+            if r.amax() < 1e-12 {
+                converged = true;
+                break;
+            }
+            let mut jac = nalgebra::Matrix3::<f64>::zeros();
+            for j in 0..3 {
+                let d = 1e-6 * z[j].abs().max(1.0);
+                let mut zp = z;
+                let mut zm = z;
+                zp[j] += d;
+                zm[j] -= d;
+                let col = (self.trim_residual(v_ned, &zp) - self.trim_residual(v_ned, &zm)) / (2.0 * d);
+                jac.set_column(j, &col);
+            }
+            let Some(dz) = jac.lu().solve(&r) else {
+                return Err(PhysicsError::Trim(format!("singular trim Jacobian at θ = {}, δe = {}, T = {}", z[0], z[1], z[2])));
+            };
+            // Damped step: at most 0.2 rad in θ and δe.
+            let scale = (0.2 / dz[0].abs().max(dz[1].abs()).max(1e-300)).min(1.0);
+            for k in 0..3 {
+                z[k] -= scale * dz[k];
+            }
+            if !z.iter().all(|v| v.is_finite()) {
+                return Err(PhysicsError::Trim("Newton iteration diverged".into()));
+            }
+        }
+        let (x, u) = self.trim_point(v_ned, &z);
+        let d = self.derivatives(&x, &u, &Vector3::zeros());
+        let residual = d.rows(U, N_STATES - U).amax();
+        if !converged || residual > 1e-8 {
+            return Err(PhysicsError::Trim(format!("no convergence: residual {residual:e} (θ = {}, δe = {}, T = {})", z[0], z[1], z[2])));
+        }
+        if z[2] < a.thrust_min || z[2] > a.thrust_max {
+            return Err(PhysicsError::Trim(format!(
+                "needs thrust {} N outside [{}, {}] N",
+                z[2], a.thrust_min, a.thrust_max
+            )));
+        }
+        if z[1].abs() > a.deflection_limit {
+            return Err(PhysicsError::Trim(format!(
+                "needs elevator {} rad beyond the deflection limit {} rad",
+                z[1], a.deflection_limit
+            )));
+        }
+        let y = self.outputs(&x, &u, &Vector3::zeros());
+        Ok(Trim {
+            state: x,
+            inputs: u,
+            alpha: y.alpha,
+            theta: z[0],
+            thrust: z[2],
+            elevator: z[1],
+            induced_velocity: y.induced_velocity,
+            airspeed: y.airspeed,
+            residual,
+        })
+    }
+}

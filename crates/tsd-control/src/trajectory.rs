@@ -1,0 +1,231 @@
+//! Kinematic reference trajectory of the TSD controller (thesis §4.3.3).
+//!
+//! The mission (vertical climb → quarter loop → level → quarter loop → vertical) is
+//! described purely kinematically: position, velocity, specific acceleration and the
+//! flight-path angle, all in the NED earth frame, heading north, in the north–down plane.
+//!
+//! Corrections to the printed equations (derived from first principles):
+//! * (4.3.33–4.3.40) start the transition with θ = 0 while the velocity of (4.3.37) is then
+//!   horizontal; here the *turned angle* φ = s/r runs from 0 to π/2 and the flight-path
+//!   angle is γ = π/2 − φ in the first (push-over) transition and γ = φ in the second
+//!   (pull-up) one.
+//! * The radius is fixed so that the loop ends exactly level (or vertical): the arc
+//!   length flown in the transition with linear airspeed (4.3.31–4.3.32) is
+//!   s(T) = (V_V + V_L)·T/2, and a quarter loop needs s(T) = r·π/2, hence
+//!   r = (V_V + V_L)·T/π (≈ 35.7 m for T = 4 s, 44.6 m for T = 5 s).
+//! * (4.3.35–4.3.36): the specific acceleration is Σ = a − g with
+//!   a = A_V·t̂ + (V̄²/r)·n̂ (tangential plus centripetal, n̂ towards the centre of the loop)
+//!   and g = (0, 0, g) in NED; the printed component signs depend on the (undefined)
+//!   figure 4.11 and are replaced by this vector form.
+//! * (4.3.39–4.3.40): positions are the integrals of the velocities, continuous at every
+//!   phase boundary; a vertical climb at V_V precedes and follows the loops.
+
+use core::f64::consts::FRAC_PI_2;
+use flight_mission::{MissionParams, Phase};
+use nalgebra::Vector3;
+
+/// The reference at one instant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Reference {
+    /// Mission phase.
+    pub phase: Phase,
+    /// Position, NED [m] (without the user offset).
+    pub pos: Vector3<f64>,
+    /// Inertial velocity, NED [m/s].
+    pub vel: Vector3<f64>,
+    /// Specific acceleration Σ^RE = a − g, NED [m/s²] (4.3.35–4.3.36).
+    pub specific_accel: Vector3<f64>,
+    /// Reference airspeed V̄ [m/s] (4.3.31–4.3.32).
+    pub airspeed: f64,
+    /// Flight-path angle γ [rad] (π/2 climbing vertically, 0 level).
+    pub gamma: f64,
+}
+
+impl Reference {
+    /// Unit tangent t̂ = (cos γ, 0, −sin γ), NED.
+    pub fn tangent(&self) -> Vector3<f64> {
+        Vector3::new(self.gamma.cos(), 0.0, -self.gamma.sin())
+    }
+
+    /// The prescribed normal vector k^Wc of §4.3.2.1: the wind z axis of wings-level
+    /// flight along the reference path, k = (sin γ, 0, cos γ) (belly north in the
+    /// vertical climb, down in level flight).
+    pub fn prescribed_normal(&self) -> Vector3<f64> {
+        Vector3::new(self.gamma.sin(), 0.0, self.gamma.cos())
+    }
+}
+
+/// The kinematic trajectory of a mission.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Trajectory {
+    mission: MissionParams,
+    gravity: f64,
+    /// Radii of the two quarter loops [m].
+    r1: f64,
+    r2: f64,
+    /// Start positions of phases 1..4 (NED).
+    starts: [Vector3<f64>; 5],
+}
+
+impl Trajectory {
+    /// The trajectory of `mission` starting at the origin at t = 0; `gravity` in m/s².
+    pub fn new(mission: MissionParams, gravity: f64) -> Self {
+        let (vv, vl) = (mission.v_vertical, mission.v_level);
+        let r1 = Self::radius(vv, vl, mission.t_transition_1);
+        let r2 = Self::radius(vv, vl, mission.t_transition_2);
+        let p0 = Vector3::zeros();
+        let p1 = p0 + Vector3::new(0.0, 0.0, -vv * mission.t_vertical_1);
+        let p2 = p1 + Vector3::new(r1, 0.0, -r1);
+        let p3 = p2 + Vector3::new(vl * mission.t_level, 0.0, 0.0);
+        let p4 = p3 + Vector3::new(r2, 0.0, -r2);
+        Self { mission, gravity, r1, r2, starts: [p0, p1, p2, p3, p4] }
+    }
+
+    /// Radius of a quarter loop flown in `duration` with airspeed changing linearly between
+    /// `v_vertical` and `v_level`: r = (V_V + V_L)·T/π, so that s(T)/r = π/2 exactly.
+    pub fn radius(v_vertical: f64, v_level: f64, duration: f64) -> f64 {
+        (v_vertical + v_level) * duration / core::f64::consts::PI
+    }
+
+    /// Radii (r1, r2) of the two quarter loops [m].
+    pub fn radii(&self) -> (f64, f64) {
+        (self.r1, self.r2)
+    }
+
+    /// The mission this trajectory flies.
+    pub fn mission(&self) -> &MissionParams {
+        &self.mission
+    }
+
+    /// The reference at mission time `t`.
+    pub fn at(&self, t: f64) -> Reference {
+        let m = &self.mission;
+        let (vv, vl) = (m.v_vertical, m.v_level);
+        let g = Vector3::new(0.0, 0.0, self.gravity);
+        let (phase, tau) = m.phase_at(t);
+        let tau = tau.max(0.0);
+        let climb = |p0: Vector3<f64>| Reference {
+            phase,
+            pos: p0 + Vector3::new(0.0, 0.0, -vv * tau),
+            vel: Vector3::new(0.0, 0.0, -vv),
+            specific_accel: -g,
+            airspeed: vv,
+            gamma: FRAC_PI_2,
+        };
+        match phase {
+            Phase::Vertical1 => climb(self.starts[0]),
+            Phase::Vertical2 => climb(self.starts[4]),
+            Phase::Level => Reference {
+                phase,
+                pos: self.starts[2] + Vector3::new(vl * tau, 0.0, 0.0),
+                vel: Vector3::new(vl, 0.0, 0.0),
+                specific_accel: -g,
+                airspeed: vl,
+                gamma: 0.0,
+            },
+            Phase::TransitionToLevel => {
+                // (4.3.31), (4.3.33): push-over, γ = π/2 − φ.
+                let tt = m.t_transition_1;
+                let tau = tau.min(tt);
+                let av = (vl - vv) / tt;
+                let v = vv + av * tau;
+                let s = vv * tau + 0.5 * av * tau * tau;
+                let phi = s / self.r1;
+                let (sp, cp) = phi.sin_cos();
+                let tangent = Vector3::new(sp, 0.0, -cp);
+                let normal = Vector3::new(cp, 0.0, sp); // dt̂/dφ, towards the centre
+                let a = tangent * av + normal * (v * v / self.r1);
+                Reference {
+                    phase,
+                    pos: self.starts[1] + Vector3::new(self.r1 * (1.0 - cp), 0.0, -self.r1 * sp),
+                    vel: tangent * v,
+                    specific_accel: a - g,
+                    airspeed: v,
+                    gamma: FRAC_PI_2 - phi,
+                }
+            }
+            Phase::TransitionToVertical => {
+                // (4.3.32), (4.3.34): pull-up, γ = φ.
+                let tt = m.t_transition_2;
+                let tau = tau.min(tt);
+                let av = (vv - vl) / tt;
+                let v = vl + av * tau;
+                let s = vl * tau + 0.5 * av * tau * tau;
+                let phi = s / self.r2;
+                let (sp, cp) = phi.sin_cos();
+                let tangent = Vector3::new(cp, 0.0, -sp);
+                let normal = Vector3::new(-sp, 0.0, -cp);
+                let a = tangent * av + normal * (v * v / self.r2);
+                Reference {
+                    phase,
+                    pos: self.starts[3] + Vector3::new(self.r2 * sp, 0.0, -self.r2 * (1.0 - cp)),
+                    vel: tangent * v,
+                    specific_accel: a - g,
+                    airspeed: v,
+                    gamma: phi,
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn close(a: Vector3<f64>, b: Vector3<f64>, tol: f64) -> bool {
+        (a - b).norm() <= tol
+    }
+
+    #[test]
+    fn radius_of_the_issue_physics_check() {
+        let r = Trajectory::radius(3.0, 25.0, 4.0);
+        assert!((r - 35.65).abs() < 0.05, "{r}");
+        // Lift at the start of the pull-up: V²/r + g ≈ 2.8 g.
+        let n = (25.0 * 25.0 / r + 9.81) / 9.81;
+        assert!((n - 2.79).abs() < 0.02, "{n}");
+    }
+
+    #[test]
+    fn loops_end_exactly_level_and_vertical_and_are_continuous() {
+        for (t1, t2) in [(5.0, 10.0), (3.0, 4.0)] {
+            let m = MissionParams { t_transition_1: t1, t_transition_2: t2, ..Default::default() };
+            let tr = Trajectory::new(m, 9.81);
+            let s = m.phase_starts();
+            let eps = 1e-9;
+            for &tb in &s[1..5] {
+                let before = tr.at(tb - eps);
+                let after = tr.at(tb);
+                assert!(close(before.pos, after.pos, 1e-6), "pos jump at {tb}");
+                assert!(close(before.vel, after.vel, 1e-6), "vel jump at {tb}: {:?} {:?}", before.vel, after.vel);
+                assert!((before.gamma - after.gamma).abs() < 1e-6);
+                assert!((before.airspeed - after.airspeed).abs() < 1e-6);
+            }
+            let end1 = tr.at(s[2] - 1e-12);
+            assert!(end1.gamma.abs() < 1e-9 && end1.vel.z.abs() < 1e-9, "{end1:?}");
+            let end2 = tr.at(s[4] - 1e-12);
+            assert!((end2.gamma - FRAC_PI_2).abs() < 1e-9 && end2.vel.x.abs() < 1e-9, "{end2:?}");
+        }
+    }
+
+    #[test]
+    fn velocity_is_the_derivative_of_position_and_accel_of_velocity() {
+        let m = MissionParams { t_transition_1: 3.0, t_transition_2: 4.0, ..Default::default() };
+        let tr = Trajectory::new(m, 9.81);
+        let g = Vector3::new(0.0, 0.0, 9.81);
+        let h = 1e-5;
+        let mut t = 0.013;
+        while t < m.end_time() {
+            let (a, b) = (tr.at(t - h), tr.at(t + h));
+            if a.phase == b.phase {
+                let r = tr.at(t);
+                assert!(close((b.pos - a.pos) / (2.0 * h), r.vel, 1e-4), "t={t}");
+                assert!(close((b.vel - a.vel) / (2.0 * h), r.specific_accel + g, 1e-3), "t={t}");
+                assert!((r.vel.norm() - r.airspeed).abs() < 1e-9);
+                assert!(close(r.tangent() * r.airspeed, r.vel, 1e-9));
+                assert!(r.prescribed_normal().dot(&r.tangent()).abs() < 1e-12);
+            }
+            t += 0.1;
+        }
+    }
+}

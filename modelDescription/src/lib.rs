@@ -1,0 +1,462 @@
+//! Variable declarations of the tail-sitter FMUs — the single source of truth —
+//! and the generators built on them.
+//!
+//! Each FMU's variables (name, causality, variability, type, unit, start,
+//! min/max, description) are declared once, in `modelDescription/<modelIdentifier>.json`
+//! (with shared fragments pulled in through `"include"`). From that one
+//! declaration this crate produces
+//! - `modelDescription.xml` ([`xml::model_description`]), written with quick-xml;
+//! - the Rust accessors of the FMU ([`rust::variables_module`]): a struct with one
+//!   named field per variable implementing `fmi2_export::VariableStore`, value
+//!   reference constants, and conversions into the physics/controller parameter
+//!   structs ("groups");
+//! - the HTML variable tables of `documentation/index.html` ([`html::variable_tables`]).
+//!
+//! The top-level `build.rs` runs the first two for every `fmu-*` crate; the
+//! packager runs the first and the last. A reviewable copy of each XML is kept in
+//! `modelDescription/generated/` and a test fails when it drifts.
+
+pub mod html;
+pub mod rust;
+pub mod units;
+pub mod xml;
+
+use serde::Deserialize;
+use std::collections::{BTreeMap, BTreeSet};
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// Error while loading or checking a declaration.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DeclError(pub String);
+
+impl fmt::Display for DeclError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for DeclError {}
+
+fn err<T>(msg: impl Into<String>) -> Result<T, DeclError> {
+    Err(DeclError(msg.into()))
+}
+
+/// FMI 2.0 base type.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+pub enum VarType {
+    #[default]
+    Real,
+    Integer,
+    Boolean,
+    String,
+}
+
+/// FMI 2.0 causality, spelled as in modelDescription.xml.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub enum Causality {
+    Parameter,
+    CalculatedParameter,
+    Input,
+    Output,
+    Local,
+}
+
+impl Causality {
+    /// The attribute value in modelDescription.xml.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Parameter => "parameter",
+            Self::CalculatedParameter => "calculatedParameter",
+            Self::Input => "input",
+            Self::Output => "output",
+            Self::Local => "local",
+        }
+    }
+
+    /// The enum variant name in `fmi2_export::Causality`.
+    pub fn rust_variant(self) -> &'static str {
+        match self {
+            Self::Parameter => "Parameter",
+            Self::CalculatedParameter => "CalculatedParameter",
+            Self::Input => "Input",
+            Self::Output => "Output",
+            Self::Local => "Local",
+        }
+    }
+}
+
+/// FMI 2.0 variability, spelled as in modelDescription.xml.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub enum Variability {
+    Constant,
+    Fixed,
+    Tunable,
+    Discrete,
+    Continuous,
+}
+
+impl Variability {
+    /// The attribute value in modelDescription.xml.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Constant => "constant",
+            Self::Fixed => "fixed",
+            Self::Tunable => "tunable",
+            Self::Discrete => "discrete",
+            Self::Continuous => "continuous",
+        }
+    }
+
+    /// The enum variant name in `fmi2_export::Variability`.
+    pub fn rust_variant(self) -> &'static str {
+        match self {
+            Self::Constant => "Constant",
+            Self::Fixed => "Fixed",
+            Self::Tunable => "Tunable",
+            Self::Discrete => "Discrete",
+            Self::Continuous => "Continuous",
+        }
+    }
+}
+
+/// A start value, typed by [`VarType`].
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(untagged)]
+pub enum Start {
+    Bool(bool),
+    Number(f64),
+    Text(String),
+}
+
+/// One variable as written in the JSON declaration.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, rename_all = "camelCase")]
+pub struct VariableDecl {
+    /// Variable name; also the Rust field name, so it must be a Rust identifier.
+    pub name: String,
+    #[serde(default, rename = "type")]
+    pub var_type: VarType,
+    pub causality: Causality,
+    /// Defaults: parameters `fixed`, Real inputs/outputs `continuous`, other types `discrete`.
+    #[serde(default)]
+    pub variability: Option<Variability>,
+    #[serde(default)]
+    pub start: Option<Start>,
+    #[serde(default)]
+    pub min: Option<f64>,
+    #[serde(default)]
+    pub max: Option<f64>,
+    /// Unit name from [`units::UNITS`] (Real only).
+    #[serde(default)]
+    pub unit: Option<String>,
+    /// Display unit; `rad` defaults to `deg`, `rad/s` to `deg/s`.
+    #[serde(default)]
+    pub display_unit: Option<String>,
+    pub description: String,
+    /// Outputs only: names of the inputs this output depends on directly
+    /// (direct feedthrough). Empty = depends on states only.
+    #[serde(default)]
+    pub depends_on: Vec<String>,
+    /// Name of a parameter group (see [`ModelDecl::groups`]) this variable is a field of.
+    #[serde(default)]
+    pub group: Option<String>,
+}
+
+/// The default experiment of the model description.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, rename_all = "camelCase")]
+pub struct DefaultExperiment {
+    pub start_time: f64,
+    pub stop_time: f64,
+    pub step_size: f64,
+}
+
+/// A JSON declaration file: a model, or a fragment that models include.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, rename_all = "camelCase")]
+pub struct DeclFile {
+    #[serde(default)]
+    pub model_identifier: Option<String>,
+    #[serde(default)]
+    pub model_name: Option<String>,
+    #[serde(default)]
+    pub description: Option<String>,
+    #[serde(default)]
+    pub default_experiment: Option<DefaultExperiment>,
+    /// Group name → Rust struct path. The generator emits
+    /// `Variables::<group>() -> <path>` built field by field from the
+    /// variables of that group, so the struct and the declaration cannot drift
+    /// without a compile error.
+    #[serde(default)]
+    pub groups: BTreeMap<String, String>,
+    /// Other declaration files (relative paths) whose variables are inserted first.
+    #[serde(default)]
+    pub include: Vec<String>,
+    #[serde(default)]
+    pub variables: Vec<VariableDecl>,
+}
+
+/// A fully resolved variable: declaration plus value reference and defaults applied.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Variable {
+    pub decl: VariableDecl,
+    pub value_reference: u32,
+    pub variability: Variability,
+    pub display_unit: Option<String>,
+}
+
+impl Variable {
+    pub fn name(&self) -> &str {
+        &self.decl.name
+    }
+
+    /// Whether the XML carries a `start` attribute for this variable.
+    pub fn has_start(&self) -> bool {
+        self.decl.start.is_some()
+    }
+}
+
+/// A fully resolved model declaration.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Model {
+    pub model_identifier: String,
+    pub model_name: String,
+    pub description: String,
+    pub version: String,
+    pub default_experiment: DefaultExperiment,
+    pub groups: BTreeMap<String, String>,
+    pub variables: Vec<Variable>,
+    /// Every file read, for `cargo:rerun-if-changed`.
+    pub sources: Vec<PathBuf>,
+    /// Name-based UUID (v5) over the interface: changes whenever any variable,
+    /// the identifier or the version changes.
+    pub guid: String,
+}
+
+/// Generation tool recorded in the XML.
+pub const GENERATION_TOOL: &str = "tailsitter-fmus model-description generator";
+/// Author recorded in the XML.
+pub const AUTHOR: &str = "Tail-sitter FMU developers";
+/// Log categories the export layer understands (kept equal to
+/// `fmi2_export::LOG_CATEGORIES` by a test in each FMU crate).
+pub const LOG_CATEGORIES: &[(&str, &str)] = &[
+    ("logStatusWarning", "Warnings: saturation, fallbacks, recoverable problems"),
+    ("logStatusError", "Errors: illegal calls, bad arguments, failed steps"),
+    ("logAll", "Everything, including debug messages"),
+];
+
+/// Load `<dir>/<model_identifier>.json`, resolve includes, assign value
+/// references in declaration order, apply defaults and check everything.
+pub fn load(dir: &Path, model_identifier: &str, version: &str) -> Result<Model, DeclError> {
+    let path = dir.join(format!("{model_identifier}.json"));
+    let mut sources = Vec::new();
+    let root = read_decl(&path, &mut sources)?;
+    let mut groups = BTreeMap::new();
+    let mut decls = Vec::new();
+    collect(dir, &root, &mut sources, &mut groups, &mut decls, 0)?;
+    let id = root
+        .model_identifier
+        .clone()
+        .ok_or_else(|| DeclError(format!("{}: missing modelIdentifier", path.display())))?;
+    if id != model_identifier {
+        return err(format!("{}: modelIdentifier '{id}' does not match the file name", path.display()));
+    }
+    let variables = decls
+        .into_iter()
+        .enumerate()
+        .map(|(i, decl)| resolve(decl, i as u32))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut model = Model {
+        model_identifier: id,
+        model_name: root.model_name.clone().unwrap_or_else(|| model_identifier.to_string()),
+        description: root.description.clone().unwrap_or_default(),
+        version: version.to_string(),
+        default_experiment: root
+            .default_experiment
+            .clone()
+            .ok_or_else(|| DeclError(format!("{}: missing defaultExperiment", path.display())))?,
+        groups,
+        variables,
+        sources,
+        guid: String::new(),
+    };
+    check(&model)?;
+    model.guid = guid_of(&model);
+    Ok(model)
+}
+
+fn read_decl(path: &Path, sources: &mut Vec<PathBuf>) -> Result<DeclFile, DeclError> {
+    let text = std::fs::read_to_string(path).map_err(|e| DeclError(format!("{}: {e}", path.display())))?;
+    sources.push(path.to_path_buf());
+    serde_json::from_str(&text).map_err(|e| DeclError(format!("{}: {e}", path.display())))
+}
+
+fn collect(
+    dir: &Path,
+    file: &DeclFile,
+    sources: &mut Vec<PathBuf>,
+    groups: &mut BTreeMap<String, String>,
+    out: &mut Vec<VariableDecl>,
+    depth: usize,
+) -> Result<(), DeclError> {
+    if depth > 8 {
+        return err("include nesting deeper than 8 (a cycle?)");
+    }
+    for inc in &file.include {
+        let sub = read_decl(&dir.join(inc), sources)?;
+        collect(dir, &sub, sources, groups, out, depth + 1)?;
+    }
+    for (k, v) in &file.groups {
+        if let Some(old) = groups.insert(k.clone(), v.clone()) {
+            if &old != v {
+                return err(format!("group '{k}' declared as both {old} and {v}"));
+            }
+        }
+    }
+    out.extend(file.variables.iter().cloned());
+    Ok(())
+}
+
+fn resolve(decl: VariableDecl, value_reference: u32) -> Result<Variable, DeclError> {
+    let variability = decl.variability.unwrap_or(match (decl.causality, decl.var_type) {
+        (Causality::Parameter | Causality::CalculatedParameter, _) => Variability::Fixed,
+        (_, VarType::Real) => Variability::Continuous,
+        _ => Variability::Discrete,
+    });
+    let display_unit = decl.display_unit.clone().or_else(|| match decl.unit.as_deref() {
+        Some("rad") => Some("deg".to_string()),
+        Some("rad/s") => Some("deg/s".to_string()),
+        _ => None,
+    });
+    Ok(Variable { decl, value_reference, variability, display_unit })
+}
+
+fn is_rust_identifier(s: &str) -> bool {
+    let mut chars = s.chars();
+    matches!(chars.next(), Some(c) if c.is_ascii_alphabetic() || c == '_')
+        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
+        && !matches!(s, "type" | "fn" | "struct" | "impl" | "self" | "Self" | "move" | "ref" | "mod" | "use" | "let")
+}
+
+/// Check the rules of FMI 2.0 (start/initial per causality, min ≤ start ≤ max, units known)
+/// and our own (names are Rust identifiers, unique; dependencies name inputs; groups declared).
+fn check(model: &Model) -> Result<(), DeclError> {
+    let mut names = BTreeSet::new();
+    let inputs: BTreeSet<&str> =
+        model.variables.iter().filter(|v| v.decl.causality == Causality::Input).map(|v| v.name()).collect();
+    for v in &model.variables {
+        let d = &v.decl;
+        let n = &d.name;
+        if !is_rust_identifier(n) {
+            return err(format!("variable '{n}': name must be a Rust identifier"));
+        }
+        if !names.insert(n.as_str()) {
+            return err(format!("variable '{n}' declared twice"));
+        }
+        if d.description.trim().is_empty() {
+            return err(format!("variable '{n}': empty description"));
+        }
+        let needs_start = matches!(d.causality, Causality::Parameter | Causality::Input);
+        let forbids_start = matches!(d.causality, Causality::CalculatedParameter | Causality::Output);
+        if needs_start && d.start.is_none() {
+            return err(format!("variable '{n}': {} needs a start value", d.causality.as_str()));
+        }
+        if forbids_start && d.start.is_some() {
+            return err(format!("variable '{n}': {} is calculated and takes no start value", d.causality.as_str()));
+        }
+        match (d.causality, v.variability) {
+            (Causality::Parameter | Causality::CalculatedParameter, Variability::Fixed | Variability::Tunable) => {}
+            (Causality::Parameter | Causality::CalculatedParameter, other) => {
+                return err(format!("variable '{n}': a parameter cannot be {}", other.as_str()));
+            }
+            (_, Variability::Fixed | Variability::Tunable) => {
+                return err(format!("variable '{n}': only parameters are fixed or tunable"));
+            }
+            (_, Variability::Continuous) if d.var_type != VarType::Real => {
+                return err(format!("variable '{n}': only Real variables can be continuous"));
+            }
+            _ => {}
+        }
+        match (&d.start, d.var_type) {
+            (None, _) | (Some(Start::Number(_)), VarType::Real) | (Some(Start::Bool(_)), VarType::Boolean) => {}
+            (Some(Start::Number(x)), VarType::Integer) if x.fract() == 0.0 && x.abs() <= i32::MAX as f64 => {}
+            (Some(Start::Text(_)), VarType::String) => {}
+            (Some(s), t) => return err(format!("variable '{n}': start {s:?} does not fit type {t:?}")),
+        }
+        if let (Some(lo), Some(hi)) = (d.min, d.max) {
+            if lo > hi {
+                return err(format!("variable '{n}': min {lo} > max {hi}"));
+            }
+        }
+        if let Some(Start::Number(x)) = &d.start {
+            if !x.is_finite() || d.min.is_some_and(|lo| *x < lo) || d.max.is_some_and(|hi| *x > hi) {
+                return err(format!("variable '{n}': start {x} outside [min, max]"));
+            }
+        }
+        if (d.min.is_some() || d.max.is_some()) && !matches!(d.var_type, VarType::Real | VarType::Integer) {
+            return err(format!("variable '{n}': min/max only for Real and Integer"));
+        }
+        if let Some(u) = &d.unit {
+            if d.var_type != VarType::Real {
+                return err(format!("variable '{n}': unit only for Real"));
+            }
+            let unit = units::find(u).ok_or_else(|| DeclError(format!("variable '{n}': unknown unit '{u}'")))?;
+            if let Some(du) = &v.display_unit {
+                if !unit.display_units.iter().any(|x| x.name == du) {
+                    return err(format!("variable '{n}': unit '{u}' has no display unit '{du}'"));
+                }
+            }
+        } else if v.display_unit.is_some() {
+            return err(format!("variable '{n}': displayUnit without unit"));
+        }
+        if !d.depends_on.is_empty() && d.causality != Causality::Output {
+            return err(format!("variable '{n}': dependsOn only for outputs"));
+        }
+        for dep in &d.depends_on {
+            if !inputs.contains(dep.as_str()) {
+                return err(format!("variable '{n}': dependsOn '{dep}' is not an input"));
+            }
+        }
+        if let Some(g) = &d.group {
+            if !model.groups.contains_key(g) {
+                return err(format!("variable '{n}': group '{g}' not declared in \"groups\""));
+            }
+            if d.causality != Causality::Parameter {
+                return err(format!("variable '{n}': only parameters can belong to a group"));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A canonical text of the interface, hashed into the GUID.
+fn guid_of(model: &Model) -> String {
+    let mut text = format!("{}\n{}\n", model.model_identifier, model.version);
+    for v in &model.variables {
+        let d = &v.decl;
+        text.push_str(&format!(
+            "{}|{}|{:?}|{}|{}|{:?}|{:?}|{:?}|{:?}\n",
+            v.value_reference,
+            d.name,
+            d.var_type,
+            d.causality.as_str(),
+            v.variability.as_str(),
+            d.start,
+            d.min,
+            d.max,
+            d.unit
+        ));
+    }
+    let namespace = uuid::Uuid::NAMESPACE_URL;
+    format!("{{{}}}", uuid::Uuid::new_v5(&namespace, text.as_bytes()))
+}
+
+/// Formats a number the way both the XML and the generated Rust need it:
+/// the shortest text that parses back to the same `f64`.
+pub fn fmt_f64(x: f64) -> String {
+    // `{:?}` gives e.g. "1e-5" or "88.376": both valid xs:double and Rust literals.
+    format!("{x:?}")
+}

@@ -1,0 +1,48 @@
+//! SI units known to the declarations, with their base-unit exponents and
+//! display units (FMI 2.0 `UnitDefinitions`).
+
+/// A display unit: `value_display = factor * value + offset`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DisplayUnit {
+    pub name: &'static str,
+    pub factor: f64,
+}
+
+/// A unit and its SI base-unit exponents.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Unit {
+    pub name: &'static str,
+    pub kg: i32,
+    pub m: i32,
+    pub s: i32,
+    pub rad: i32,
+    pub display_units: &'static [DisplayUnit],
+}
+
+const DEG: DisplayUnit = DisplayUnit { name: "deg", factor: 57.295_779_513_082_32 };
+const DEG_PER_S: DisplayUnit = DisplayUnit { name: "deg/s", factor: 57.295_779_513_082_32 };
+
+const fn unit(name: &'static str, kg: i32, m: i32, s: i32, rad: i32) -> Unit {
+    Unit { name, kg, m, s, rad, display_units: &[] }
+}
+
+/// Every unit a declaration may use.
+pub const UNITS: &[Unit] = &[
+    unit("m", 0, 1, 0, 0),
+    unit("m/s", 0, 1, -1, 0),
+    unit("m/s2", 0, 1, -2, 0),
+    unit("m2", 0, 2, 0, 0),
+    unit("s", 0, 0, 1, 0),
+    unit("1/s", 0, 0, -1, 0),
+    unit("kg", 1, 0, 0, 0),
+    unit("kg.m2", 1, 2, 0, 0),
+    unit("kg/m3", 1, -3, 0, 0),
+    unit("N", 1, 1, -2, 0),
+    Unit { name: "rad", kg: 0, m: 0, s: 0, rad: 1, display_units: &[DEG] },
+    Unit { name: "rad/s", kg: 0, m: 0, s: -1, rad: 1, display_units: &[DEG_PER_S] },
+];
+
+/// Look a unit up by name.
+pub fn find(name: &str) -> Option<&'static Unit> {
+    UNITS.iter().find(|u| u.name == name)
+}

@@ -1,0 +1,216 @@
+//! modelDescription.xml (FMI 2.0 Co-Simulation) written with quick-xml.
+//!
+//! Element order follows fmi2ModelDescription.xsd: CoSimulation,
+//! UnitDefinitions, LogCategories, DefaultExperiment, ModelVariables,
+//! ModelStructure. No timestamp is written, so the output is reproducible and
+//! can be compared byte for byte with the reviewed copy in the repository.
+
+use crate::{fmt_f64, units, Causality, Model, Start, VarType, Variable, AUTHOR, GENERATION_TOOL, LOG_CATEGORIES};
+use quick_xml::events::{BytesDecl, Event};
+use quick_xml::Writer;
+use std::collections::BTreeSet;
+use std::io::{Cursor, Result};
+
+/// The complete modelDescription.xml of `model`.
+pub fn model_description(model: &Model) -> String {
+    let mut w = Writer::new_with_indent(Cursor::new(Vec::new()), b' ', 2);
+    write_all(&mut w, model).expect("writing XML into memory cannot fail");
+    let mut text = String::from_utf8(w.into_inner().into_inner()).expect("quick-xml writes UTF-8");
+    text.push('\n');
+    text
+}
+
+type W = Writer<Cursor<Vec<u8>>>;
+
+fn write_all(w: &mut W, model: &Model) -> Result<()> {
+    w.write_event(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None)))?;
+    let n_events = "0";
+    w.create_element("fmiModelDescription")
+        .with_attributes([
+            ("fmiVersion", "2.0"),
+            ("modelName", model.model_name.as_str()),
+            ("guid", model.guid.as_str()),
+            ("description", model.description.as_str()),
+            ("author", AUTHOR),
+            ("version", model.version.as_str()),
+            ("generationTool", GENERATION_TOOL),
+            ("variableNamingConvention", "flat"),
+            ("numberOfEventIndicators", n_events),
+        ])
+        .write_inner_content(|w| {
+            co_simulation(w, model)?;
+            unit_definitions(w, model)?;
+            log_categories(w)?;
+            let e = &model.default_experiment;
+            w.create_element("DefaultExperiment")
+                .with_attributes([
+                    ("startTime", fmt_f64(e.start_time).as_str()),
+                    ("stopTime", fmt_f64(e.stop_time).as_str()),
+                    ("stepSize", fmt_f64(e.step_size).as_str()),
+                ])
+                .write_empty()?;
+            w.create_element("ModelVariables").write_inner_content(|w| {
+                for v in &model.variables {
+                    scalar_variable(w, v)?;
+                }
+                Ok(())
+            })?;
+            model_structure(w, model)
+        })?;
+    Ok(())
+}
+
+fn co_simulation(w: &mut W, model: &Model) -> Result<()> {
+    w.create_element("CoSimulation")
+        .with_attributes([
+            ("modelIdentifier", model.model_identifier.as_str()),
+            ("needsExecutionTool", "false"),
+            ("canHandleVariableCommunicationStepSize", "true"),
+            ("canInterpolateInputs", "false"),
+            ("maxOutputDerivativeOrder", "0"),
+            ("canRunAsynchronuously", "false"),
+            ("canBeInstantiatedOnlyOncePerProcess", "false"),
+            ("canNotUseMemoryManagementFunctions", "true"),
+            ("canGetAndSetFMUstate", "true"),
+            ("canSerializeFMUstate", "true"),
+            ("providesDirectionalDerivative", "false"),
+        ])
+        .write_empty()?;
+    Ok(())
+}
+
+/// The units actually used, in the order of [`units::UNITS`].
+pub fn used_units(model: &Model) -> Vec<&'static units::Unit> {
+    let used: BTreeSet<&str> = model.variables.iter().filter_map(|v| v.decl.unit.as_deref()).collect();
+    units::UNITS.iter().filter(|u| used.contains(u.name)).collect()
+}
+
+fn unit_definitions(w: &mut W, model: &Model) -> Result<()> {
+    let used = used_units(model);
+    if used.is_empty() {
+        return Ok(());
+    }
+    w.create_element("UnitDefinitions").write_inner_content(|w| {
+        for u in used {
+            w.create_element("Unit").with_attribute(("name", u.name)).write_inner_content(|w| {
+                let mut base = w.create_element("BaseUnit");
+                for (name, exp) in [("kg", u.kg), ("m", u.m), ("s", u.s), ("rad", u.rad)] {
+                    if exp != 0 {
+                        base = base.with_attribute((name, exp.to_string().as_str()));
+                    }
+                }
+                base.write_empty()?;
+                for d in u.display_units {
+                    w.create_element("DisplayUnit")
+                        .with_attributes([("name", d.name), ("factor", fmt_f64(d.factor).as_str())])
+                        .write_empty()?;
+                }
+                Ok(())
+            })?;
+        }
+        Ok(())
+    })?;
+    Ok(())
+}
+
+fn log_categories(w: &mut W) -> Result<()> {
+    w.create_element("LogCategories").write_inner_content(|w| {
+        for (name, description) in LOG_CATEGORIES {
+            w.create_element("Category")
+                .with_attributes([("name", *name), ("description", *description)])
+                .write_empty()?;
+        }
+        Ok(())
+    })?;
+    Ok(())
+}
+
+fn scalar_variable(w: &mut W, v: &Variable) -> Result<()> {
+    let d = &v.decl;
+    let vr = v.value_reference.to_string();
+    w.create_element("ScalarVariable")
+        .with_attributes([
+            ("name", d.name.as_str()),
+            ("valueReference", vr.as_str()),
+            ("description", d.description.as_str()),
+            ("causality", d.causality.as_str()),
+            ("variability", v.variability.as_str()),
+        ])
+        .write_inner_content(|w| {
+            let tag = match d.var_type {
+                VarType::Real => "Real",
+                VarType::Integer => "Integer",
+                VarType::Boolean => "Boolean",
+                VarType::String => "String",
+            };
+            let mut attrs: Vec<(&str, String)> = Vec::new();
+            if let Some(u) = &d.unit {
+                attrs.push(("unit", u.clone()));
+            }
+            if let Some(du) = &v.display_unit {
+                attrs.push(("displayUnit", du.clone()));
+            }
+            let number = |x: f64| match d.var_type {
+                VarType::Integer => format!("{}", x as i64),
+                _ => fmt_f64(x),
+            };
+            if let Some(lo) = d.min {
+                attrs.push(("min", number(lo)));
+            }
+            if let Some(hi) = d.max {
+                attrs.push(("max", number(hi)));
+            }
+            match &d.start {
+                Some(Start::Number(x)) => attrs.push(("start", number(*x))),
+                Some(Start::Bool(b)) => attrs.push(("start", b.to_string())),
+                Some(Start::Text(s)) => attrs.push(("start", s.clone())),
+                None => {}
+            }
+            w.create_element(tag).with_attributes(attrs.iter().map(|(k, v)| (*k, v.as_str()))).write_empty()?;
+            Ok(())
+        })?;
+    Ok(())
+}
+
+/// 1-based index of a variable in ModelVariables.
+fn index_of(model: &Model, name: &str) -> usize {
+    model.variables.iter().position(|v| v.name() == name).map(|i| i + 1).expect("checked at load")
+}
+
+fn model_structure(w: &mut W, model: &Model) -> Result<()> {
+    let outputs: Vec<&Variable> =
+        model.variables.iter().filter(|v| v.decl.causality == Causality::Output).collect();
+    let initial: Vec<&Variable> = model
+        .variables
+        .iter()
+        .filter(|v| matches!(v.decl.causality, Causality::Output | Causality::CalculatedParameter))
+        .collect();
+    w.create_element("ModelStructure").write_inner_content(|w| {
+        if !outputs.is_empty() {
+            w.create_element("Outputs").write_inner_content(|w| {
+                for v in &outputs {
+                    let deps: Vec<String> =
+                        v.decl.depends_on.iter().map(|n| index_of(model, n).to_string()).collect();
+                    let index = index_of(model, v.name()).to_string();
+                    let deps = deps.join(" ");
+                    w.create_element("Unknown")
+                        .with_attributes([("index", index.as_str()), ("dependencies", deps.as_str())])
+                        .write_empty()?;
+                }
+                Ok(())
+            })?;
+        }
+        if !initial.is_empty() {
+            // No `dependencies` attribute: an initial unknown may depend on every known.
+            w.create_element("InitialUnknowns").write_inner_content(|w| {
+                for v in &initial {
+                    let index = index_of(model, v.name()).to_string();
+                    w.create_element("Unknown").with_attribute(("index", index.as_str())).write_empty()?;
+                }
+                Ok(())
+            })?;
+        }
+        Ok(())
+    })?;
+    Ok(())
+}

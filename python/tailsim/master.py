@@ -1,0 +1,304 @@
+"""A co-simulation master for the tail-sitter FMUs (fmpy's FMU2Slave underneath).
+
+Timing follows DESIGN.md §2. Gauss-Seidel (the reference): at each
+communication point t the controller inputs are set from the plant outputs at
+t, the controller steps, the plant inputs are set from the controller outputs,
+the plant steps. Jacobi: both units are set from values at t before either
+steps, so the plant flies the command of the previous sample.
+"""
+
+from __future__ import annotations
+
+import math
+import pathlib
+import shutil
+import tempfile
+from dataclasses import dataclass, field
+from typing import Callable, Mapping
+
+import numpy as np
+from fmpy import extract, read_model_description
+from fmpy.fmi2 import FMU2Slave
+
+Vector3 = tuple[float, float, float]
+TimeFunction = Callable[[float], Vector3]
+
+
+def step(t_step: float, value: Vector3) -> TimeFunction:
+    """A profile that is zero before `t_step` and `value` from then on."""
+
+    def f(t: float) -> Vector3:
+        return value if t >= t_step - 1e-9 else (0.0, 0.0, 0.0)
+
+    return f
+
+
+def one_minus_cosine_gust(t_start: float, duration: float, amplitude: Vector3) -> TimeFunction:
+    """The 1 − cos gust: amplitude · (1 − cos(2π(t − t_start)/duration))/2 inside the gust."""
+
+    def f(t: float) -> Vector3:
+        s = (t - t_start) / duration
+        if 0.0 <= s <= 1.0:
+            k = 0.5 * (1.0 - math.cos(2.0 * math.pi * s))
+            return (amplitude[0] * k, amplitude[1] * k, amplitude[2] * k)
+        return (0.0, 0.0, 0.0)
+
+    return f
+
+
+class Fmu:
+    """An FMU extracted once; `instantiate` gives fresh fmpy slaves of it."""
+
+    def __init__(self, path: str | pathlib.Path, workdir: str | pathlib.Path | None = None):
+        self.path = pathlib.Path(path)
+        self.md = read_model_description(str(self.path))
+        self._tmp = None if workdir else tempfile.mkdtemp(prefix="tailsim-")
+        target = pathlib.Path(workdir or self._tmp) / self.md.coSimulation.modelIdentifier
+        self.dir = extract(str(self.path), unzipdir=str(target))
+        self.variables = {v.name: v for v in self.md.modelVariables}
+        self.identifier = self.md.coSimulation.modelIdentifier
+
+    def names(self, causality: str) -> list[str]:
+        return [v.name for v in self.md.modelVariables if v.causality == causality]
+
+    def instantiate(self, name: str, callbacks=None) -> FMU2Slave:
+        slave = FMU2Slave(
+            guid=self.md.guid, unzipDirectory=self.dir, modelIdentifier=self.identifier, instanceName=name
+        )
+        slave.instantiate(callbacks=callbacks)
+        return slave
+
+    def set(self, slave: FMU2Slave, values: Mapping[str, float | int | bool]) -> None:
+        """Set values by name, each through the setter of its declared type."""
+        by_type: dict[str, tuple[list[int], list]] = {}
+        for name, value in values.items():
+            if name not in self.variables:
+                raise KeyError(f"{self.identifier} has no variable '{name}'")
+            v = self.variables[name]
+            vrs, vals = by_type.setdefault(v.type, ([], []))
+            vrs.append(v.valueReference)
+            vals.append(value)
+        for type_, (vrs, vals) in by_type.items():
+            if type_ == "Real":
+                slave.setReal(vrs, [float(x) for x in vals])
+            elif type_ == "Integer":
+                slave.setInteger(vrs, [int(x) for x in vals])
+            elif type_ == "Boolean":
+                slave.setBoolean(vrs, [bool(x) for x in vals])
+            else:
+                slave.setString(vrs, [str(x) for x in vals])
+
+    def cleanup(self) -> None:
+        if self._tmp:
+            shutil.rmtree(self._tmp, ignore_errors=True)
+
+
+@dataclass
+class RunResult:
+    """Every recorded signal by name (numpy arrays over `time`) with its unit."""
+
+    signals: dict[str, np.ndarray]
+    units: dict[str, str]
+    plant: str
+    controller: str
+    ordering: str
+    wall_time_controller: float = 0.0
+    wall_time_plant: float = 0.0
+    steps: int = 0
+    log: list[tuple[str, str, str]] = field(default_factory=list)
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        return self.signals[name]
+
+    @property
+    def time(self) -> np.ndarray:
+        return self.signals["time"]
+
+    def write_csv(self, path: str | pathlib.Path) -> None:
+        """CSV with a header `name [unit]`."""
+        names = list(self.signals)
+        header = ",".join(f"{n} [{self.units.get(n, '')}]" if self.units.get(n) else n for n in names)
+        data = np.column_stack([self.signals[n] for n in names])
+        np.savetxt(path, data, delimiter=",", header=header, comments="", fmt="%.10g")
+
+
+class ClosedLoop:
+    """Plant + controller, wired by port name.
+
+    plant_params / controller_params: start values set in initialisation mode
+    (parameters and inputs, by name). `wind` and `ref_offset` are functions of
+    time giving (n, e, d); they drive the plant's `wind_*` and the controller's
+    `ref_offset_*` inputs.
+    """
+
+    def __init__(
+        self,
+        plant: Fmu,
+        controller: Fmu,
+        plant_params: Mapping[str, float] | None = None,
+        controller_params: Mapping[str, float] | None = None,
+        ordering: str = "gauss-seidel",
+        callbacks=None,
+    ):
+        if ordering not in ("gauss-seidel", "jacobi"):
+            raise ValueError(f"ordering must be 'gauss-seidel' or 'jacobi', not {ordering!r}")
+        self.plant, self.controller = plant, controller
+        self.plant_params = dict(plant_params or {})
+        self.controller_params = dict(controller_params or {})
+        self.ordering = ordering
+        self.callbacks = callbacks
+        p_out = set(plant.names("output"))
+        p_in = set(plant.names("input"))
+        # Wiring by name: controller input ← plant output, controller output → plant input.
+        self.to_controller = [n for n in controller.names("input") if n in p_out]
+        self.to_plant = [n for n in controller.names("output") if n in p_in]
+        missing = [n for n in p_in if n.endswith("_cmd") and n not in self.to_plant]
+        if missing:
+            raise ValueError(f"{controller.identifier} does not drive plant inputs {missing}")
+        self._p_vr_out = [plant.variables[n].valueReference for n in self.to_controller]
+        self._c_vr_in = [controller.variables[n].valueReference for n in self.to_controller]
+        self._c_vr_out = [controller.variables[n].valueReference for n in self.to_plant]
+        self._p_vr_in = [plant.variables[n].valueReference for n in self.to_plant]
+        self.plant_outputs = [n for n in plant.names("output")]
+        self.controller_outputs = [n for n in controller.names("output") if controller.variables[n].type == "Real"]
+        self.controller_int_outputs = [
+            n for n in controller.names("output") if controller.variables[n].type == "Integer"
+        ]
+
+    def run(
+        self,
+        stop_time: float | None = None,
+        step_size: float | None = None,
+        wind: TimeFunction | None = None,
+        ref_offset: TimeFunction | None = None,
+        progress: bool = False,
+        description: str = "",
+    ) -> RunResult:
+        import time as wall
+
+        c_md = self.controller.md
+        h = float(step_size or self.controller_params.get("sample_time") or c_md.defaultExperiment.stepSize)
+        stop = float(stop_time if stop_time is not None else c_md.defaultExperiment.stopTime)
+        n = int(round(stop / h))
+        wind = wind or (lambda t: (0.0, 0.0, 0.0))
+        ref_offset = ref_offset or (lambda t: (0.0, 0.0, 0.0))
+        p = self.plant.instantiate("plant", self.callbacks)
+        c = self.controller.instantiate("controller", self.callbacks)
+        pv, cv = self.plant.variables, self.controller.variables
+        wind_vr = [pv[f"wind_{k}"].valueReference for k in "ned"]
+        offset_vr = [cv[f"ref_offset_{k}"].valueReference for k in "ned"]
+        rec_p = [pv[n].valueReference for n in self.plant_outputs]
+        rec_c = [cv[n].valueReference for n in self.controller_outputs]
+        rec_ci = [cv[n].valueReference for n in self.controller_int_outputs]
+        names = ["time"] + self.plant_outputs + self.controller_outputs + self.controller_int_outputs
+        names += ["wind_n", "wind_e", "wind_d", "ref_offset_n", "ref_offset_e", "ref_offset_d"]
+        data = np.full((n + 1, len(names)), np.nan)
+        t_ctrl = t_plant = 0.0
+        try:
+            for s in (p, c):
+                s.setupExperiment(startTime=0.0)
+                s.enterInitializationMode()
+            self.plant.set(p, self.plant_params)
+            p.setReal(wind_vr, list(wind(0.0)))
+            p.exitInitializationMode()
+            self.controller.set(c, self.controller_params)
+            c.setReal(self._c_vr_in, p.getReal(self._p_vr_out))
+            c.setReal(offset_vr, list(ref_offset(0.0)))
+            c.exitInitializationMode()
+            iterator = range(n + 1)
+            if progress:
+                from tqdm import tqdm
+
+                iterator = tqdm(iterator, desc=description or f"{self.controller.identifier}", unit="step", leave=False)
+            for k in iterator:
+                t = k * h
+                w, off = wind(t), ref_offset(t)
+                y_p = p.getReal(self._p_vr_out)
+                if self.ordering == "jacobi":
+                    u_c = c.getReal(self._c_vr_out)  # command of the previous sample
+                c.setReal(self._c_vr_in, y_p)
+                c.setReal(offset_vr, list(off))
+                p.setReal(wind_vr, list(w))
+                if k < n:
+                    t0 = wall.perf_counter()
+                    c.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+                    t_ctrl += wall.perf_counter() - t0
+                if self.ordering == "gauss-seidel":
+                    u_c = c.getReal(self._c_vr_out)
+                p.setReal(self._p_vr_in, u_c)
+                data[k, 0] = t
+                col = 1
+                for vals in (p.getReal(rec_p), c.getReal(rec_c), c.getInteger(rec_ci) if rec_ci else []):
+                    data[k, col : col + len(vals)] = vals
+                    col += len(vals)
+                data[k, col : col + 6] = list(w) + list(off)
+                if k < n:
+                    t0 = wall.perf_counter()
+                    p.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+                    t_plant += wall.perf_counter() - t0
+            for s in (p, c):
+                s.terminate()
+        finally:
+            for s in (p, c):
+                try:
+                    s.freeInstance()
+                except Exception:  # noqa: BLE001 - already failed; free what can be freed
+                    pass
+        units = {"time": "s"}
+        for name in self.plant_outputs:
+            units[name] = pv[name].unit or ""
+        for name in self.controller_outputs:
+            units[name] = cv[name].unit or ""
+        for name in ["wind_n", "wind_e", "wind_d", "ref_offset_n", "ref_offset_e", "ref_offset_d"]:
+            units[name] = "m/s" if name.startswith("wind") else "m"
+        signals = {name: data[:, i].copy() for i, name in enumerate(names)}
+        # The command the plant flew over [t, t+h) under this ordering.
+        return RunResult(
+            signals=signals,
+            units=units,
+            plant=self.plant.identifier,
+            controller=self.controller.identifier,
+            ordering=self.ordering,
+            wall_time_controller=t_ctrl,
+            wall_time_plant=t_plant,
+            steps=n,
+        )
+
+
+def phase_slices(result: RunResult) -> dict[int, np.ndarray]:
+    """Boolean masks of the samples in each phase (controller's `phase` output)."""
+    phase = result["phase"]
+    return {k: phase == k for k in range(5)}
+
+
+def pos_error(result: RunResult) -> np.ndarray:
+    return np.sqrt(
+        (result["pos_n"] - result["ref_pos_n"]) ** 2
+        + (result["pos_e"] - result["ref_pos_e"]) ** 2
+        + (result["pos_d"] - result["ref_pos_d"]) ** 2
+    )
+
+
+def settling_time(t: np.ndarray, error: np.ndarray, t_step: float, band: float = 0.5) -> float:
+    """Time after `t_step` from which `error` stays below `band` (inf if it never does)."""
+    after = t >= t_step
+    te, ee = t[after], error[after]
+    outside = np.nonzero(ee >= band)[0]
+    if len(outside) == 0:
+        return 0.0
+    last = outside[-1]
+    if last == len(ee) - 1:
+        return math.inf
+    return float(te[last + 1] - t_step)
+
+
+__all__ = [
+    "ClosedLoop",
+    "Fmu",
+    "RunResult",
+    "one_minus_cosine_gust",
+    "phase_slices",
+    "pos_error",
+    "settling_time",
+    "step",
+]

@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# Set up a fresh machine: system packages (libclang for fmi-sys' bindgen),
+# the Rust crates (fetched by cargo on first build) and the pinned Python venv.
+# Idempotent: re-running only checks.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+if ! ldconfig -p 2>/dev/null | grep -q 'libclang.*\.so'; then
+    echo "== installing libclang-dev (needed by fmi-sys' bindgen)"
+    SUDO=""; [ "$(id -u)" = 0 ] || SUDO="sudo"
+    $SUDO apt-get update -qq
+    $SUDO DEBIAN_FRONTEND=noninteractive apt-get install -y -qq libclang-dev >/dev/null
+fi
+
+if [ ! -x .venv/bin/python ] || ! cmp -s tests/requirements.txt .venv/requirements.installed; then
+    echo "== creating Python venv .venv (pinned: tests/requirements.txt)"
+    python3 -m venv .venv
+    .venv/bin/pip install -q --upgrade pip
+    .venv/bin/pip install -q -r tests/requirements.txt
+    cp tests/requirements.txt .venv/requirements.installed
+fi

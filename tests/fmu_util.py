@@ -1,0 +1,75 @@
+"""Small helpers for the fmpy tests: open a packaged FMU as FMU2Slave with a
+logger that records every message (formatted by fmpy's C logger proxy)."""
+
+from __future__ import annotations
+
+import pathlib
+from ctypes import byref
+from dataclasses import dataclass, field
+
+from fmpy import extract, read_model_description
+from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
+from fmpy.logging import addLoggerProxy
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+DIST = ROOT / "dist"
+STATUS = ["OK", "Warning", "Discard", "Error", "Fatal", "Pending"]
+
+
+def fmu_path(model_identifier: str) -> pathlib.Path:
+    path = DIST / f"{model_identifier}.fmu"
+    assert path.exists(), f"{path} missing: run `cargo xtask dist` first"
+    return path
+
+
+@dataclass
+class LogRecorder:
+    """Keeps (status, category, message) of every log call."""
+
+    messages: list[tuple[str, str, str]] = field(default_factory=list)
+
+    def __post_init__(self):
+        def log(_env, _instance, status, category, message):
+            self.messages.append((STATUS[status], category.decode(), message.decode()))
+
+        self._callback = fmi2CallbackLoggerTYPE(log)
+        self.callbacks = fmi2CallbackFunctions()
+        self.callbacks.logger = self._callback
+        addLoggerProxy(byref(self.callbacks))
+
+    def errors(self) -> list[str]:
+        return [m for s, _, m in self.messages if s == "Error"]
+
+    def clear(self) -> None:
+        self.messages.clear()
+
+
+class Unpacked:
+    """An extracted FMU: model description, name → value reference, slave factory."""
+
+    def __init__(self, model_identifier: str, tmp: pathlib.Path):
+        self.path = fmu_path(model_identifier)
+        self.md = read_model_description(str(self.path))
+        self.dir = extract(str(self.path), unzipdir=str(tmp / model_identifier))
+        self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
+        self.var = {v.name: v for v in self.md.modelVariables}
+
+    def slave(self, name: str = "instance", log: LogRecorder | None = None, init: bool = True) -> FMU2Slave:
+        s = FMU2Slave(
+            guid=self.md.guid,
+            unzipDirectory=self.dir,
+            modelIdentifier=self.md.coSimulation.modelIdentifier,
+            instanceName=name,
+        )
+        s.instantiate(callbacks=(log.callbacks if log else None))
+        if init:
+            s.setupExperiment(startTime=0.0)
+            s.enterInitializationMode()
+            s.exitInitializationMode()
+        return s
+
+    def get(self, slave: FMU2Slave, *names: str) -> list[float]:
+        return slave.getReal([self.vr[n] for n in names])
+
+    def set(self, slave: FMU2Slave, **values: float) -> None:
+        slave.setReal([self.vr[n] for n in values], list(values.values()))

@@ -1,0 +1,205 @@
+"""tailsitter_plant.fmu under fmpy: validation, the default experiment, the
+trimmed climb, instance independence, communication-step independence, FMU
+state, and errors instead of crashes."""
+
+import math
+import zipfile
+
+import numpy as np
+import pytest
+from fmpy import simulate_fmu
+from fmpy.validation import validate_fmu
+
+from fmu_util import ROOT, LogRecorder
+
+OUTPUTS = ["pos_n", "pos_e", "pos_d", "vel_d", "theta", "airspeed", "alpha", "thrust", "elevator", "q"]
+
+
+def test_fmpy_validate_reports_nothing(plant):
+    assert validate_fmu(str(plant.path)) == []
+
+
+def test_packaged_xml_is_the_reviewed_generated_one(plant):
+    with zipfile.ZipFile(plant.path) as z:
+        packaged = z.read("modelDescription.xml").decode()
+        names = set(z.namelist())
+        doc = z.read("documentation/index.html").decode()
+    reviewed = (ROOT / "modelDescription" / "generated" / "tailsitter_plant.xml").read_text()
+    assert packaged == reviewed
+    assert {"binaries/linux64/tailsitter_plant.so", "documentation/index.html"} <= names
+    for v in plant.md.modelVariables:
+        assert f"<code>{v.name}</code>" in doc, f"{v.name} undocumented"
+
+
+def test_default_experiment_climbs_steadily(plant):
+    result = simulate_fmu(str(plant.path), fmi_type="CoSimulation", output=OUTPUTS)
+    de = plant.md.defaultExperiment
+    assert result["time"][-1] == pytest.approx(float(de.stopTime))
+    for name in OUTPUTS:
+        assert np.all(np.isfinite(result[name])), name
+    # Trimmed 3 m/s vertical climb with the default inputs (DESIGN.md §3).
+    assert np.max(np.abs(result["vel_d"] + 3.0)) < 1e-6
+    assert np.max(np.abs(result["theta"] - math.pi / 2)) < 1e-6
+    assert np.max(np.abs(result["pos_n"])) < 1e-6
+    assert result["pos_d"][-1] == pytest.approx(-3.0 * float(de.stopTime), abs=1e-5)
+    assert np.max(np.abs(result["alpha"])) < 1e-6
+
+
+def test_thrust_start_value_is_the_climb_trim(plant):
+    s = plant.slave()
+    trim_thrust, thrust_cmd = plant.get(s, "trim_thrust", "thrust_cmd")
+    assert thrust_cmd == pytest.approx(trim_thrust, rel=1e-12, abs=1e-12)
+    s.terminate()
+    s.freeInstance()
+
+
+def run(plant, slave, t0, t1, h):
+    """Step from t0 to t1 with steps h; return the chosen outputs at t1."""
+    n = round((t1 - t0) / h)
+    for k in range(n):
+        slave.doStep(currentCommunicationPoint=t0 + k * h, communicationStepSize=h)
+    return np.array(plant.get(slave, *OUTPUTS))
+
+
+def manoeuvre(plant, slave):
+    """Something that excites every state: thrust step, elevator and aileron kicks, wind."""
+    plant.set(slave, thrust_cmd=110.0, elevator_cmd=0.1, aileron_cmd=-0.05, rudder_cmd=0.03, wind_e=2.0)
+
+
+def test_communication_steps_agree(plant):
+    finals = {}
+    for h in (0.001, 0.01, 0.02):
+        s = plant.slave(f"h{h}")
+        manoeuvre(plant, s)
+        finals[h] = run(plant, s, 0.0, 1.0, h)
+        s.terminate()
+        s.freeInstance()
+    ref = finals[0.001]
+    for h in (0.01, 0.02):
+        assert np.max(np.abs(finals[h] - ref)) < 1e-6, (h, finals[h] - ref)
+    # and the manoeuvre really moved the aircraft
+    assert abs(ref[OUTPUTS.index("q")]) > 1e-3
+
+
+def test_two_instances_are_independent(plant):
+    a = plant.slave("a")
+    b = plant.slave("b")
+    manoeuvre(plant, b)
+    ya = run(plant, a, 0.0, 0.5, 0.02)
+    yb = run(plant, b, 0.0, 0.5, 0.02)
+    solo = plant.slave("solo")
+    ys = run(plant, solo, 0.0, 0.5, 0.02)
+    assert np.array_equal(ya, ys)
+    assert not np.allclose(ya, yb)
+    for s in (a, b, solo):
+        s.terminate()
+        s.freeInstance()
+
+
+def test_fmu_state_get_set_and_serialize_continue_bit_identically(plant):
+    s = plant.slave("state")
+    manoeuvre(plant, s)
+    run(plant, s, 0.0, 0.3, 0.02)
+    state = s.getFMUstate()
+    blob = s.serializeFMUstate(state)
+    original = run(plant, s, 0.3, 0.8, 0.02)
+
+    s.setFMUstate(state)
+    restored = run(plant, s, 0.3, 0.8, 0.02)
+    assert np.array_equal(original, restored)
+
+    other = plant.slave("other")  # a fresh instance receiving the serialized state
+    other_state = other.deSerializeFMUstate(blob)
+    other.setFMUstate(other_state)
+    assert np.array_equal(original, run(plant, other, 0.3, 0.8, 0.02))
+    s.freeFMUstate(state)
+    other.freeFMUstate(other_state)
+    for x in (s, other):
+        x.terminate()
+        x.freeInstance()
+
+
+def test_corrupt_serialized_state_is_rejected(plant):
+    log = LogRecorder()
+    s = plant.slave("corrupt", log)
+    state = s.getFMUstate()
+    blob = bytearray(s.serializeFMUstate(state))
+    for bad in (bytes(blob[: len(blob) // 2]), bytes(blob[:-1]), bytes([blob[0] ^ 0xFF]) + bytes(blob[1:]), b""):
+        with pytest.raises(Exception):
+            s.deSerializeFMUstate(bad if bad else b"\0")
+    assert log.errors(), "rejections must be logged"
+    flipped = bytearray(blob)
+    flipped[len(flipped) // 2] ^= 0x01
+    with pytest.raises(Exception):
+        s.deSerializeFMUstate(bytes(flipped))
+    # the instance is still usable
+    run(plant, s, 0.0, 0.1, 0.02)
+    s.freeFMUstate(state)
+    s.terminate()
+    s.freeInstance()
+
+
+def test_bad_input_gives_errors_not_crashes(plant):
+    log = LogRecorder()
+    s = plant.slave("bad", log)
+    with pytest.raises(Exception):
+        plant.set(s, thrust_cmd=float("nan"))
+    assert any("thrust_cmd" in m for m in log.errors()), log.messages
+    log.clear()
+    with pytest.raises(Exception):
+        s.getReal([999_999])
+    assert any("999999" in m for m in log.errors()), log.messages
+    log.clear()
+    with pytest.raises(Exception):  # a fixed parameter after initialisation
+        plant.set(s, mass=10.0)
+    assert any("mass" in m for m in log.errors()), log.messages
+    with pytest.raises(Exception):  # an output
+        plant.set(s, pos_n=1.0)
+    # the NaN was not applied: the instance still flies the trim
+    y = run(plant, s, 0.0, 0.2, 0.02)
+    assert np.all(np.isfinite(y))
+    assert y[OUTPUTS.index("vel_d")] == pytest.approx(-3.0, abs=1e-6)
+    s.terminate()
+    s.freeInstance()
+
+
+def test_illegal_call_order_is_an_error(plant):
+    log = LogRecorder()
+    s = plant.slave("order", log, init=False)
+    with pytest.raises(Exception):
+        s.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.02)
+    assert any("fmi2DoStep" in m for m in log.errors()), log.messages
+    s.setupExperiment(startTime=0.0)
+    s.enterInitializationMode()
+    s.exitInitializationMode()
+    with pytest.raises(Exception):  # wrong communication point
+        s.doStep(currentCommunicationPoint=1.0, communicationStepSize=0.02)
+    with pytest.raises(Exception):  # non-positive step
+        s.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.0)
+    s.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.02)
+    s.terminate()
+    s.freeInstance()
+
+
+def test_out_of_range_parameter_is_rejected_at_set(plant):
+    log = LogRecorder()
+    s = plant.slave("range", log, init=False)
+    with pytest.raises(Exception):
+        plant.set(s, mass=-1.0)
+    assert any("mass" in m for m in log.errors())
+    s.freeInstance()
+
+
+def test_divergence_is_reported_as_an_error(plant):
+    """Absurd commands/parameters must end in fmi2Error naming the state, not NaN outputs."""
+    log = LogRecorder()
+    s = plant.slave("diverge", log, init=False)
+    s.setupExperiment(startTime=0.0)
+    s.enterInitializationMode()
+    plant.set(s, i_xx=1e-4, i_yy=1e-4, i_zz=1e-4)  # featherweight inertia
+    s.exitInitializationMode()
+    plant.set(s, aileron_cmd=0.4, elevator_cmd=0.4, rudder_cmd=0.4)
+    with pytest.raises(Exception):
+        run(plant, s, 0.0, 10.0, 0.02)
+    assert any("envelope" in m for m in log.errors()), log.messages
+    s.freeInstance()
