@@ -15,9 +15,14 @@ fn main() {
     let package = std::env::var("CARGO_PKG_NAME").expect("set by cargo");
     let version = std::env::var("CARGO_PKG_VERSION").expect("set by cargo");
     let out = PathBuf::from(std::env::var("OUT_DIR").expect("set by cargo"));
-    let short = package.strip_prefix("fmu-").expect("build.rs serves the fmu-* crates only");
+    let short = package
+        .strip_prefix("fmu-")
+        .expect("build.rs serves the fmu-* crates only");
     let model_identifier = format!("tailsitter_{short}");
-    let declarations = manifest.parent().expect("crate inside the workspace").join("modelDescription");
+    let declarations = manifest
+        .parent()
+        .expect("crate inside the workspace")
+        .join("modelDescription");
 
     let model = match model_description::load(&declarations, &model_identifier, &version) {
         Ok(m) => m,

@@ -11,7 +11,7 @@
 //! [`std::panic::catch_unwind`]; a panic becomes fmi2Error plus a log message.
 #![allow(clippy::missing_safety_doc)]
 
-use crate::instance::{mask, FmiState, Fmi2Error, Fmi2Result, Instance, Snapshot, StateMask};
+use crate::instance::{mask, Fmi2Error, Fmi2Result, FmiState, Instance, Snapshot, StateMask};
 use crate::logger::{Level, LogSink};
 use crate::model::FmuModel;
 use crate::variables::{ValueType, VariableStore};
@@ -73,7 +73,9 @@ unsafe fn call<M: FmuModel>(
     f: impl FnOnce(&mut Instance<M>) -> Fmi2Result,
 ) -> fmi2Status {
     // SAFETY: contract of the caller.
-    let Some(inst) = (unsafe { instance::<M>(c) }) else { return ERROR };
+    let Some(inst) = (unsafe { instance::<M>(c) }) else {
+        return ERROR;
+    };
     guard(ERROR, || {
         let result = catch_unwind(AssertUnwindSafe(|| {
             inst.check_state(allowed)?;
@@ -89,7 +91,10 @@ unsafe fn call<M: FmuModel>(
                 if inst.machine.state == FmiState::StepInProgress {
                     inst.machine.state = FmiState::StepFailed;
                 }
-                inst.log(Level::Error, &format_args!("{function}: internal error (panic): {}", panic_message(&*payload)));
+                inst.log(
+                    Level::Error,
+                    &format_args!("{function}: internal error (panic): {}", panic_message(&*payload)),
+                );
                 ERROR
             }
         }
@@ -152,10 +157,14 @@ pub unsafe fn set_debug_logging<M: FmuModel>(
             let mut names = Vec::with_capacity(cats.len());
             for &p in cats {
                 let name = c_str(p).ok_or_else(|| Fmi2Error::error("a category name is NULL"))?;
-                let name = name.to_str().map_err(|_| Fmi2Error::error("a category name is not UTF-8"))?;
+                let name = name
+                    .to_str()
+                    .map_err(|_| Fmi2Error::error("a category name is not UTF-8"))?;
                 if !crate::LOG_CATEGORIES.iter().any(|(n, _)| *n == name) {
                     let known: Vec<&str> = crate::LOG_CATEGORIES.iter().map(|(n, _)| *n).collect();
-                    return Err(Fmi2Error::error(format!("unknown log category {name:?} (known: {known:?})")));
+                    return Err(Fmi2Error::error(format!(
+                        "unknown log category {name:?} (known: {known:?})"
+                    )));
                 }
                 names.push(name);
             }
@@ -190,7 +199,9 @@ pub unsafe fn instantiate<M: FmuModel>(
             return std::ptr::null_mut();
         }
         // SAFETY: NUL-terminated if non-NULL.
-        let name = unsafe { c_str(instance_name) }.map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let name = unsafe { c_str(instance_name) }
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
         let sink = LogSink::new(callbacks.logger, callbacks.componentEnvironment, &name, logging_on != 0);
         let fail = |msg: String| {
             sink.log(Level::Error, &format_args!("fmi2Instantiate: {msg}"));
@@ -206,7 +217,9 @@ pub unsafe fn instantiate<M: FmuModel>(
             ));
         }
         // SAFETY: NUL-terminated if non-NULL.
-        let Some(guid) = (unsafe { c_str(guid) }) else { return fail("fmuGUID is NULL".into()) };
+        let Some(guid) = (unsafe { c_str(guid) }) else {
+            return fail("fmuGUID is NULL".into());
+        };
         if guid.to_bytes() != M::GUID.as_bytes() {
             return fail(format!(
                 "GUID mismatch: got {:?}, this binary of {} has {:?}",
@@ -216,14 +229,18 @@ pub unsafe fn instantiate<M: FmuModel>(
             ));
         }
         // SAFETY: NUL-terminated if non-NULL.
-        let resources =
-            unsafe { c_str(resource_location) }.map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let resources = unsafe { c_str(resource_location) }
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
         match catch_unwind(AssertUnwindSafe(|| Instance::<M>::new(sink, resources))) {
             Ok(inst) => Box::into_raw(Box::new(inst)).cast(),
             Err(payload) => {
                 // The sink moved into the closure; build a fresh one for the report.
                 let sink = LogSink::new(callbacks.logger, callbacks.componentEnvironment, &name, true);
-                sink.log(Level::Error, &format_args!("fmi2Instantiate: panic: {}", panic_message(&*payload)));
+                sink.log(
+                    Level::Error,
+                    &format_args!("fmi2Instantiate: panic: {}", panic_message(&*payload)),
+                );
                 std::ptr::null_mut()
             }
         }
@@ -232,7 +249,9 @@ pub unsafe fn instantiate<M: FmuModel>(
 
 pub unsafe fn free_instance<M: FmuModel>(c: fmi2Component) {
     // SAFETY: contract of the caller.
-    let Some(inst) = (unsafe { instance::<M>(c) }) else { return };
+    let Some(inst) = (unsafe { instance::<M>(c) }) else {
+        return;
+    };
     inst.tag = 0;
     // SAFETY: `c` came from Box::into_raw in `instantiate`; the tag was cleared
     // so a second free of the same pointer is (likely) detected.
@@ -260,11 +279,19 @@ pub unsafe fn setup_experiment<M: FmuModel>(
 }
 
 pub unsafe fn enter_initialization_mode<M: FmuModel>(c: fmi2Component) -> fmi2Status {
-    unsafe { call::<M>(c, "fmi2EnterInitializationMode", mask::INSTANTIATED, |i| i.enter_initialization_mode()) }
+    unsafe {
+        call::<M>(c, "fmi2EnterInitializationMode", mask::INSTANTIATED, |i| {
+            i.enter_initialization_mode()
+        })
+    }
 }
 
 pub unsafe fn exit_initialization_mode<M: FmuModel>(c: fmi2Component) -> fmi2Status {
-    unsafe { call::<M>(c, "fmi2ExitInitializationMode", mask::INITIALIZATION_MODE, |i| i.exit_initialization_mode()) }
+    unsafe {
+        call::<M>(c, "fmi2ExitInitializationMode", mask::INITIALIZATION_MODE, |i| {
+            i.exit_initialization_mode()
+        })
+    }
 }
 
 pub unsafe fn terminate<M: FmuModel>(c: fmi2Component) -> fmi2Status {
@@ -322,7 +349,9 @@ pub unsafe fn get_boolean<M: FmuModel>(
         call::<M>(c, "fmi2GetBoolean", mask::GET, |inst| {
             let vrs = slice(vr, nvr, "vr")?;
             let out = slice_mut(value, nvr, "value")?;
-            inst.get_values(vrs, out, ValueType::Boolean, |v, r| v.get_boolean(r).map(fmi2Boolean::from))
+            inst.get_values(vrs, out, ValueType::Boolean, |v, r| {
+                v.get_boolean(r).map(fmi2Boolean::from)
+            })
         })
     }
 }
@@ -367,7 +396,13 @@ pub unsafe fn set_integer<M: FmuModel>(
         call::<M>(c, "fmi2SetInteger", mask::SET, |inst| {
             let vrs = slice(vr, nvr, "vr")?;
             let values = slice(value, nvr, "value")?;
-            inst.set_values(vrs, values, ValueType::Integer, |x| Some(f64::from(*x)), |v, r, x| v.set_integer(r, x))
+            inst.set_values(
+                vrs,
+                values,
+                ValueType::Integer,
+                |x| Some(f64::from(*x)),
+                |v, r, x| v.set_integer(r, x),
+            )
         })
     }
 }
@@ -382,7 +417,13 @@ pub unsafe fn set_boolean<M: FmuModel>(
         call::<M>(c, "fmi2SetBoolean", mask::SET, |inst| {
             let vrs = slice(vr, nvr, "vr")?;
             let values = slice(value, nvr, "value")?;
-            inst.set_values(vrs, values, ValueType::Boolean, |_| None, |v, r, x| v.set_boolean(r, x != 0))
+            inst.set_values(
+                vrs,
+                values,
+                ValueType::Boolean,
+                |_| None,
+                |v, r, x| v.set_boolean(r, x != 0),
+            )
         })
     }
 }
@@ -486,7 +527,10 @@ pub unsafe fn serialize_fmu_state<M: FmuModel>(
         call::<M>(c, "fmi2SerializeFMUstate", mask::ANY, |_| {
             let bytes = snapshot::<M>(state)?.serialize();
             if size < bytes.len() {
-                return Err(Fmi2Error::error(format!("buffer of {size} bytes too small for {} bytes", bytes.len())));
+                return Err(Fmi2Error::error(format!(
+                    "buffer of {size} bytes too small for {} bytes",
+                    bytes.len()
+                )));
             }
             let out = slice_mut(serialized.cast::<u8>(), bytes.len(), "serializedState")?;
             out.copy_from_slice(&bytes);
@@ -623,7 +667,11 @@ pub unsafe fn get_string_status<M: FmuModel>(
 
 /// Log "`function`: not supported (`why`)" and return fmi2Error.
 pub unsafe fn not_supported<M: FmuModel>(c: fmi2Component, function: &str, why: &str) -> fmi2Status {
-    unsafe { call::<M>(c, function, mask::ANY, |_| Err(Fmi2Error::error(format!("not supported ({why})")))) }
+    unsafe {
+        call::<M>(c, function, mask::ANY, |_| {
+            Err(Fmi2Error::error(format!("not supported ({why})")))
+        })
+    }
 }
 
 /// A Model Exchange function: this layer exports Co-Simulation only.

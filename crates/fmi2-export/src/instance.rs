@@ -100,11 +100,17 @@ pub struct Fmi2Error {
 impl Fmi2Error {
     /// → fmi2Error.
     pub fn error(message: impl Into<String>) -> Self {
-        Self { level: Level::Error, message: message.into() }
+        Self {
+            level: Level::Error,
+            message: message.into(),
+        }
     }
     /// → fmi2Discard.
     pub fn discard(message: impl Into<String>) -> Self {
-        Self { level: Level::Discard, message: message.into() }
+        Self {
+            level: Level::Discard,
+            message: message.into(),
+        }
     }
 }
 
@@ -165,7 +171,9 @@ impl Machine {
         let code = r.u8()?;
         let state = match FmiState::from_u8(code) {
             Some(StepInProgress) | None => {
-                return Err(StateError::invalid(format!("state code {code} is not a restorable FMI state")))
+                return Err(StateError::invalid(format!(
+                    "state code {code} is not a restorable FMI state"
+                )))
             }
             Some(s) => s,
         };
@@ -232,7 +240,12 @@ impl<M: FmuModel> Snapshot<M> {
         let mut model = M::new(&vars);
         model.read_state(&mut r)?;
         r.finish()?;
-        Ok(Self { tag: Self::tag(), machine, model, vars })
+        Ok(Self {
+            tag: Self::tag(),
+            machine,
+            model,
+            vars,
+        })
     }
 }
 
@@ -286,7 +299,10 @@ impl<M: FmuModel> Instance<M> {
         if mask.contains(self.machine.state) {
             Ok(())
         } else {
-            Err(Fmi2Error::error(format!("illegal call in state {}", self.machine.state)))
+            Err(Fmi2Error::error(format!(
+                "illegal call in state {}",
+                self.machine.state
+            )))
         }
     }
 
@@ -303,7 +319,9 @@ impl<M: FmuModel> Instance<M> {
         }
         if let Some(stop) = stop {
             if !stop.is_finite() || stop < start {
-                return Err(Fmi2Error::error(format!("stopTime = {stop} must be finite and >= startTime = {start}")));
+                return Err(Fmi2Error::error(format!(
+                    "stopTime = {stop} must be finite and >= startTime = {start}"
+                )));
             }
         }
         if let Some(tol) = tolerance {
@@ -384,9 +402,8 @@ impl<M: FmuModel> Instance<M> {
         self.refresh()?;
         for (vr, slot) in vrs.iter().zip(out.iter_mut()) {
             let spec = Self::spec_for(*vr, ty)?;
-            *slot = get(&self.vars, *vr).ok_or_else(|| {
-                Fmi2Error::error(format!("value reference {vr} ({}) has no {ty:?} value", spec.name))
-            })?;
+            *slot = get(&self.vars, *vr)
+                .ok_or_else(|| Fmi2Error::error(format!("value reference {vr} ({}) has no {ty:?} value", spec.name)))?;
         }
         Ok(())
     }
@@ -396,7 +413,9 @@ impl<M: FmuModel> Instance<M> {
         let mut strings = Vec::with_capacity(vrs.len());
         {
             let mut tmp: Vec<String> = vec![String::new(); vrs.len()];
-            self.get_values(vrs, &mut tmp, ValueType::String, |v, vr| v.get_string(vr).map(str::to_string))?;
+            self.get_values(vrs, &mut tmp, ValueType::String, |v, vr| {
+                v.get_string(vr).map(str::to_string)
+            })?;
             for s in tmp {
                 strings.push(crate::logger::to_cstring(&s));
             }
@@ -424,8 +443,14 @@ impl<M: FmuModel> Instance<M> {
         }
         let what = match (spec.causality, spec.variability) {
             (_, Variability::Constant) => "a constant".to_string(),
-            (Causality::Parameter, v) => format!("a {v:?} parameter, not settable in state {state}").to_lowercase(),
-            (c, _) => format!("{c:?}").to_lowercase().replace("calculatedparameter", "calculatedParameter"),
+            (Causality::Parameter, v) => {
+                format!(
+                    "a {} parameter, not settable in state {state}",
+                    format!("{v:?}").to_lowercase()
+                )
+            }
+            (Causality::CalculatedParameter, _) => "a calculatedParameter".to_string(),
+            (c, _) => format!("an {}", format!("{c:?}").to_lowercase()),
         };
         Err(Fmi2Error::error(format!(
             "variable {} (value reference {}) cannot be set: it is {what}",
@@ -468,7 +493,9 @@ impl<M: FmuModel> Instance<M> {
         }
         for (vr, value) in vrs.iter().zip(values) {
             if !set(&mut self.vars, *vr, *value) {
-                return Err(Fmi2Error::error(format!("value reference {vr} could not be set as {ty:?}")));
+                return Err(Fmi2Error::error(format!(
+                    "value reference {vr} could not be set as {ty:?}"
+                )));
             }
         }
         if !vrs.is_empty() {
@@ -489,7 +516,9 @@ impl<M: FmuModel> Instance<M> {
             )));
         }
         if !(h.is_finite() && h > 0.0) {
-            return Err(Fmi2Error::error(format!("communicationStepSize = {h} s must be finite and > 0")));
+            return Err(Fmi2Error::error(format!(
+                "communicationStepSize = {h} s must be finite and > 0"
+            )));
         }
         if let Some(stop) = self.machine.stop_time {
             if t + h > stop + 1e-9 * stop.abs().max(1.0) {
@@ -509,13 +538,20 @@ impl<M: FmuModel> Instance<M> {
             }
             Err(e) => {
                 self.machine.state = StepFailed;
-                Err(Fmi2Error::error(format!("step from t = {t} s by h = {h} s failed: {e}")))
+                Err(Fmi2Error::error(format!(
+                    "step from t = {t} s by h = {h} s failed: {e}"
+                )))
             }
         }
     }
 
     pub fn snapshot(&self) -> Snapshot<M> {
-        Snapshot { tag: Snapshot::<M>::tag(), machine: self.machine, model: self.model.clone(), vars: self.vars.clone() }
+        Snapshot {
+            tag: Snapshot::<M>::tag(),
+            machine: self.machine,
+            model: self.model.clone(),
+            vars: self.vars.clone(),
+        }
     }
 
     /// Overwrite `snap` in place (fmi2GetFMUstate with a non-NULL state).

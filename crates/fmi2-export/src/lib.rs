@@ -17,7 +17,7 @@ pub mod variables;
 #[doc(hidden)]
 pub use fmi_sys;
 
-pub use instance::{FmiState, Fmi2Error, Fmi2Result, Instance, Snapshot};
+pub use instance::{Fmi2Error, Fmi2Result, FmiState, Instance, Snapshot};
 pub use logger::{Level, LogSink, Logger};
 pub use model::{FmuModel, ModelError};
 pub use state::{StateError, StateReader, StateWriter};
@@ -26,7 +26,10 @@ pub use variables::{Causality, ValueType, Variability, VariableSpec, VariableSto
 /// Log categories of every FMU built on this layer (name, description), in
 /// the order of `<LogCategories>` in modelDescription.xml.
 pub const LOG_CATEGORIES: &[(&str, &str)] = &[
-    ("logStatusWarning", "Warnings: saturation, fallbacks, recoverable problems"),
+    (
+        "logStatusWarning",
+        "Warnings: saturation, fallbacks, recoverable problems",
+    ),
     ("logStatusError", "Errors: illegal calls, bad arguments, failed steps"),
     ("logAll", "Everything, including debug messages"),
 ];

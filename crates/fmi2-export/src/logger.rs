@@ -54,7 +54,12 @@ impl LogSink {
         instance_name: &str,
         logging_on: bool,
     ) -> Self {
-        Self { callback, env, instance_name: to_cstring(instance_name), enabled: [logging_on; N_CATEGORIES] }
+        Self {
+            callback,
+            env,
+            instance_name: to_cstring(instance_name),
+            enabled: [logging_on; N_CATEGORIES],
+        }
     }
 
     /// A sink that drops every message.
@@ -109,7 +114,14 @@ impl LogSink {
         // NUL-terminated string that outlives the call; "%s" consumes exactly
         // the one variadic argument supplied.
         unsafe {
-            callback(self.env, self.instance_name.as_ptr(), status, category.as_ptr(), c"%s".as_ptr(), text.as_ptr());
+            callback(
+                self.env,
+                self.instance_name.as_ptr(),
+                status,
+                category.as_ptr(),
+                c"%s".as_ptr(),
+                text.as_ptr(),
+            );
         }
     }
 }

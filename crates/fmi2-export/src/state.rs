@@ -28,7 +28,11 @@ pub const FORMAT_VERSION: u32 = 1;
 #[non_exhaustive]
 pub enum StateError {
     /// The buffer ended while reading `what`.
-    Truncated { what: &'static str, needed: usize, available: usize },
+    Truncated {
+        what: &'static str,
+        needed: usize,
+        available: usize,
+    },
     /// The buffer does not start with [`MAGIC`].
     BadMagic,
     /// The buffer was written by an unsupported format version.
@@ -59,21 +63,37 @@ impl StateError {
 impl fmt::Display for StateError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Self::Truncated { what, needed, available } => {
+            Self::Truncated {
+                what,
+                needed,
+                available,
+            } => {
                 write!(f, "FMU state truncated: {what} needs {needed} bytes, {available} left")
             }
             Self::BadMagic => f.write_str("not a serialized FMU state of this export layer (bad magic bytes)"),
             Self::UnsupportedVersion(v) => {
-                write!(f, "unsupported FMU state format version {v} (this FMU reads version {FORMAT_VERSION})")
+                write!(
+                    f,
+                    "unsupported FMU state format version {v} (this FMU reads version {FORMAT_VERSION})"
+                )
             }
             Self::GuidMismatch { expected, found } => {
-                write!(f, "FMU state belongs to another model: GUID {found:?}, expected {expected:?}")
+                write!(
+                    f,
+                    "FMU state belongs to another model: GUID {found:?}, expected {expected:?}"
+                )
             }
             Self::LengthMismatch { declared, available } => {
-                write!(f, "FMU state payload length {declared} does not match the {available} bytes available")
+                write!(
+                    f,
+                    "FMU state payload length {declared} does not match the {available} bytes available"
+                )
             }
             Self::Checksum { stored, computed } => {
-                write!(f, "FMU state checksum mismatch (stored {stored:#018x}, computed {computed:#018x}): corrupt buffer")
+                write!(
+                    f,
+                    "FMU state checksum mismatch (stored {stored:#018x}, computed {computed:#018x}): corrupt buffer"
+                )
             }
             Self::TrailingBytes(n) => write!(f, "FMU state has {n} unexpected trailing bytes"),
             Self::InvalidBool(b) => write!(f, "FMU state holds invalid boolean byte {b}"),
@@ -163,7 +183,11 @@ impl<'a> StateReader<'a> {
     pub fn take(&mut self, n: usize, what: &'static str) -> Result<&'a [u8], StateError> {
         let available = self.remaining();
         if n > available {
-            return Err(StateError::Truncated { what, needed: n, available });
+            return Err(StateError::Truncated {
+                what,
+                needed: n,
+                available,
+            });
         }
         let s = &self.buf[self.pos..self.pos + n];
         self.pos += n;
@@ -219,7 +243,9 @@ impl<'a> StateReader<'a> {
 
 /// Wrap `payload` into the envelope for the model with this GUID.
 pub fn seal(guid: &str, payload: &[u8]) -> Vec<u8> {
-    let mut w = StateWriter { buf: Vec::with_capacity(payload.len() + guid.len() + 40) };
+    let mut w = StateWriter {
+        buf: Vec::with_capacity(payload.len() + guid.len() + 40),
+    };
     w.bytes(MAGIC);
     w.u32(FORMAT_VERSION);
     w.str(guid);
@@ -242,7 +268,10 @@ pub fn open<'a>(guid: &str, buf: &'a [u8]) -> Result<&'a [u8], StateError> {
     }
     let found = r.str()?;
     if found != guid {
-        return Err(StateError::GuidMismatch { expected: guid.to_string(), found: found.to_string() });
+        return Err(StateError::GuidMismatch {
+            expected: guid.to_string(),
+            found: found.to_string(),
+        });
     }
     let declared = r.u64()?;
     let available = r.remaining().saturating_sub(8);
@@ -306,6 +335,9 @@ mod tests {
     #[test]
     fn invalid_bool_and_utf8() {
         assert_eq!(StateReader::new(&[2]).bool(), Err(StateError::InvalidBool(2)));
-        assert_eq!(StateReader::new(&[1, 0, 0, 0, 0xff]).str(), Err(StateError::InvalidUtf8));
+        assert_eq!(
+            StateReader::new(&[1, 0, 0, 0, 0xff]).str(),
+            Err(StateError::InvalidUtf8)
+        );
     }
 }

@@ -25,10 +25,10 @@ use nalgebra::Vector3;
 
 use crate::airframe::{Airframe, Coefficients};
 
-/// Below this airspeed [m/s] α, β are defined as 0 and the wind axes as the body axes.
+/// Below this airspeed (m/s) α, β are defined as 0 and the wind axes as the body axes.
 pub const AIRSPEED_EPS: f64 = 1e-9;
 
-/// The six surface deflections [rad]; positive deflection gives a negative moment (§2.3.1).
+/// The six surface deflections (rad); positive deflection gives a negative moment (§2.3.1).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Surfaces {
     /// δe, in the slip-stream.
@@ -62,7 +62,14 @@ impl Surfaces {
     /// `[δe, δa, δr, δfc, δfd, δv]`.
     #[inline]
     pub fn to_array(&self) -> [f64; 6] {
-        [self.elevator, self.aileron, self.rudder, self.flap_collective, self.flap_differential, self.vertical_flap]
+        [
+            self.elevator,
+            self.aileron,
+            self.rudder,
+            self.flap_collective,
+            self.flap_differential,
+            self.vertical_flap,
+        ]
     }
 }
 
@@ -76,19 +83,19 @@ impl From<[f64; 6]> for Surfaces {
 /// in body axes (no gravity), and the air-data quantities used to compute them.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ForcesMoments {
-    /// Aerodynamic + thrust force, body axes [N]. Divide by m for the specific force.
+    /// Aerodynamic + thrust force, body axes (N). Divide by m for the specific force.
     pub force_body: Vector3<f64>,
-    /// Aerodynamic moment about the CG, body axes (L, M, N) [N m].
+    /// Aerodynamic moment about the CG, body axes (L, M, N) (N m).
     pub moment_body: Vector3<f64>,
-    /// Propeller induced velocity w (2.3.21) [m/s].
+    /// Propeller induced velocity w (2.3.21) (m/s).
     pub induced_velocity: f64,
-    /// Airspeed V̄ [m/s].
+    /// Airspeed V̄ (m/s).
     pub airspeed: f64,
-    /// Angle of attack α (2.2.12) [rad], 0 when V̄ ≈ 0.
+    /// Angle of attack α (2.2.12) (rad), 0 when V̄ ≈ 0.
     pub alpha: f64,
-    /// Sideslip β (2.2.13) [rad], 0 when V̄ ≈ 0.
+    /// Sideslip β (2.2.13) (rad), 0 when V̄ ≈ 0.
     pub beta: f64,
-    /// Slip-stream speed V̄ + 2w over the surfaces behind the propellers [m/s].
+    /// Slip-stream speed V̄ + 2w over the surfaces behind the propellers (m/s).
     pub slipstream_speed: f64,
 }
 
@@ -109,7 +116,7 @@ fn wind_axes(v: &Vector3<f64>, speed: f64) -> (Vector3<f64>, Vector3<f64>, Vecto
 }
 
 impl Airframe {
-    /// Induced velocity w ≥ 0 [m/s] of the propellers from momentum theory, the positive
+    /// Induced velocity w ≥ 0 (m/s) of the propellers from momentum theory, the positive
     /// root of (2.3.19–2.3.21) generalised to sideslip:
     ///
     /// `T = 2ρA w V'`, `V'² = (V_x + w)² + (V̄² − V_x²) = w² + 2V_x w + V̄²`
@@ -135,23 +142,24 @@ impl Airframe {
             let der = 4.0 * w2 * w + 6.0 * vx * w2 + 2.0 * v2 * w;
             (val, der)
         };
-        // Upper bound: at w_hi = √k + max(0, −V_x), w (w + V_x) ≥ k, so w V' ≥ k.
+        // Start at the axial-flow root of w (w + V_x) = k, w_ax = (−V_x + √(V_x² + 4k))/2 (exact
+        // when V̄ = |V_x|; hover √k). Since V'² = (w + V_x)² + (V̄² − V_x²) ≥ (w + V_x)² and
+        // w_ax + V_x ≥ 0, f(w_ax) ≥ 0: it is an upper bound of the root, Newton comes down.
         let mut lo = 0.0;
-        let mut hi = k.sqrt() + (-vx).max(0.0);
-        // Tighter start from the asymptotic forms: hover √k, fast flight k / V̄.
-        let mut w = hi.min(if airspeed > 0.0 { (k / airspeed).max(k.sqrt()) } else { hi });
-        if f(w).0 < 0.0 {
-            w = hi;
-        }
+        let mut hi = 0.5 * (-vx + (vx * vx + 4.0 * k).sqrt());
+        let mut w = hi;
         for _ in 0..100 {
             let (val, der) = f(w);
+            if val == 0.0 {
+                break;
+            }
             if val > 0.0 {
                 hi = w;
             } else {
                 lo = w;
             }
             let mut next = if der > 0.0 { w - val / der } else { f64::NAN };
-            if !(next > lo && next < hi) {
+            if !(next >= lo && next <= hi) {
                 next = 0.5 * (lo + hi);
             }
             let step = (next - w).abs();
@@ -163,13 +171,25 @@ impl Airframe {
         w
     }
 
+    /// Induced velocity for purely axial flow at `axial_airspeed` V₀ (any sign), the closed-form
+    /// root of (2.3.18) `T = ρA(V₀ + w)2w`: w = (−V₀ + √(V₀² + 2T/(ρA)))/2 (0 for T ≤ 0).
+    /// Equal to [`Airframe::induced_velocity`]`(|V₀|, V₀, T)`.
+    pub fn induced_velocity_axial(&self, axial_airspeed: f64, thrust: f64) -> f64 {
+        let denom = 2.0 * self.air_density * self.prop_disc_area;
+        if thrust <= 0.0 || denom <= 0.0 || !thrust.is_finite() {
+            return 0.0;
+        }
+        let v0 = axial_airspeed;
+        0.5 * (-v0 + (v0 * v0 + 4.0 * thrust / denom).sqrt())
+    }
+
     /// Aerodynamic plus thrust force and moment in body axes, without gravity (§2.3).
     ///
     /// * `v_air_body`: air-relative velocity of the CG in body axes, i.e. inertial velocity
-    ///   minus wind, both in body axes [m/s].
-    /// * `omega_body`: body rates (p, q, r) [rad/s].
-    /// * `thrust`: total thrust T of both propellers [N] (the thrust *state*, not the command).
-    /// * `surfaces`: actual deflections [rad].
+    ///   minus wind, both in body axes (m/s).
+    /// * `omega_body`: body rates (p, q, r) (rad/s).
+    /// * `thrust`: total thrust T of both propellers (N) (the thrust *state*, not the command).
+    /// * `surfaces`: actual deflections (rad).
     ///
     /// The model (see module docs and README): lift L, drag D, side force Y computed in the
     /// wind axes and rotated exactly to body axes with `DCM^BW` (A.2.7);
@@ -189,6 +209,18 @@ impl Airframe {
     /// force components are (−D, Y, −L) (2.3.6–2.3.8). Thrust adds (T, 0, 0).
     /// The induced drag uses C_L of (2.3.12) (control lift at the free-stream pressure), so
     /// it vanishes in hover.
+    ///
+    /// ```
+    /// use nalgebra::Vector3;
+    /// use tailsitter_physics::{Airframe, Surfaces};
+    /// let a = Airframe::default();
+    /// // Hover: no airspeed, the elevator still pitches the aircraft through the slip-stream.
+    /// let s = Surfaces { elevator: 0.1, ..Surfaces::default() };
+    /// let fm = a.forces_moments(&Vector3::zeros(), &Vector3::zeros(), a.mass * a.gravity, &s);
+    /// assert_eq!((fm.airspeed, fm.alpha, fm.beta), (0.0, 0.0, 0.0));
+    /// assert!(fm.moment_body.y < 0.0); // positive deflection, negative moment (§2.3.1)
+    /// assert!(fm.induced_velocity > 11.0 && fm.slipstream_speed > 23.0);
+    /// ```
     #[inline]
     pub fn forces_moments(
         &self,
@@ -244,7 +276,11 @@ impl Airframe {
         let n_s = qss * b * (c.c_n_dr * d.rudder + c.c_n_dfd * d.flap_differential + c.c_n_dv * d.vertical_flap);
 
         // DCM^BW (A.2.7): body = x_w X_w + y_w Y_w + z_w Z_w.
-        let force_body = xw * (-drag) + yw * side_fs + zw * (-lift_fs) + ys * side_s + zs * (-lift_s)
+        let force_body = xw * (-drag)
+            + yw * side_fs
+            + zw * (-lift_fs)
+            + ys * side_s
+            + zs * (-lift_s)
             + Vector3::new(thrust, 0.0, 0.0);
         let moment_body = xw * l_fs + yw * m_fs + zw * n_fs + xs * l_s + ys * m_s + zs * n_s;
 

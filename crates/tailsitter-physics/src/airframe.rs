@@ -15,19 +15,19 @@ use core::fmt;
 #[allow(non_snake_case)]
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Airframe {
-    /// Aircraft mass m (C.1.1). [kg]
+    /// Aircraft mass m (C.1.1). (kg)
     pub mass: f64,
-    /// Moment of inertia about body x (Table C.1). [kg.m2]
+    /// Moment of inertia about body x (Table C.1). (kg.m2)
     pub i_xx: f64,
-    /// Moment of inertia about body y (Table C.1). [kg.m2]
+    /// Moment of inertia about body y (Table C.1). (kg.m2)
     pub i_yy: f64,
-    /// Moment of inertia about body z (Table C.1). [kg.m2]
+    /// Moment of inertia about body z (Table C.1). (kg.m2)
     pub i_zz: f64,
-    /// Reference wing area S (Table C.2). [m2]
+    /// Reference wing area S (Table C.2). (m2)
     pub wing_area: f64,
-    /// Mean aerodynamic chord c, reference length for pitch (Table C.2). [m]
+    /// Mean aerodynamic chord c, reference length for pitch (Table C.2). (m)
     pub mean_chord: f64,
-    /// Wing span b = S / c (rectangular wing), reference length for roll and yaw. [m]
+    /// Wing span b = S / c (rectangular wing), reference length for roll and yaw. (m)
     pub wing_span: f64,
     /// Aspect ratio A = b^2 / S used in the induced drag (2.3.13).
     pub aspect_ratio: f64,
@@ -39,27 +39,27 @@ pub struct Airframe {
     pub c_L0: f64,
     /// Pitching-moment coefficient at zero angle of attack C_m0 (C.2.1).
     pub c_m0: f64,
-    /// Air density rho (sea level). [kg/m3]
+    /// Air density rho (sea level). (kg/m3)
     pub air_density: f64,
-    /// Gravitational acceleration g. [m/s2]
+    /// Gravitational acceleration g. (m/s2)
     pub gravity: f64,
-    /// Propeller disc area A of both propellers (two 16-inch propellers) in (2.3.21). [m2]
+    /// Propeller disc area A of both propellers (two 16-inch propellers) in (2.3.21). (m2)
     pub prop_disc_area: f64,
-    /// Thrust time constant tau_T of the first-order motor lag (2.3.16). [s]
+    /// Thrust time constant tau_T of the first-order motor lag (2.3.16). (s)
     pub tau_thrust: f64,
-    /// Lower thrust limit (no reverse thrust). [N]
+    /// Lower thrust limit (no reverse thrust). (N)
     pub thrust_min: f64,
-    /// Upper thrust limit (thrust-to-weight about 1.7). [N]
+    /// Upper thrust limit (thrust-to-weight about 1.7). (N)
     pub thrust_max: f64,
-    /// Servo first-order time constant (App. D.5). [s]
+    /// Servo first-order time constant (App. D.5). (s)
     pub servo_tau: f64,
-    /// Servo slew-rate limit (App. D.5). [rad/s]
+    /// Servo slew-rate limit (App. D.5). (rad/s)
     pub servo_rate_limit: f64,
-    /// Deflection limit of every surface, +/- (App. D.5). [rad]
+    /// Deflection limit of every surface, +/- (App. D.5). (rad)
     pub deflection_limit: f64,
-    /// Angle of attack of the second column of Tables C.3/C.4 (the first column is alpha = 0); derivatives are interpolated linearly in alpha. [rad]
+    /// Angle of attack of the second column of Tables C.3/C.4 (the first column is alpha = 0); derivatives are interpolated linearly in alpha. (rad)
     pub alpha_1: f64,
-    /// The alpha used to interpolate the derivatives is clamped to +/- this value (2 x alpha_1 by default). [rad]
+    /// The alpha used to interpolate the derivatives is clamped to +/- this value (2 x alpha_1 by default). (rad)
     pub alpha_interp_limit: f64,
     /// C_L_alpha, lift per rad of angle of attack, at alpha = 0 (Table C.3).
     pub c_L_alpha_a0: f64,
@@ -389,7 +389,13 @@ impl Airframe {
     /// disc area, time constants, servo rate and the interpolation angle positive; gravity,
     /// deflection limit and interpolation limit non-negative; `thrust_min <= thrust_max`.
     pub fn validate(&self) -> Result<(), InvalidParameter> {
-        let bad = |name, value, requirement| Err(InvalidParameter { name, value, requirement });
+        let bad = |name, value, requirement| {
+            Err(InvalidParameter {
+                name,
+                value,
+                requirement,
+            })
+        };
         for (name, value) in self.named_values() {
             if !value.is_finite() {
                 return bad(name, value, "finite");

@@ -54,10 +54,19 @@ impl fmt::Display for PhysicsError {
         match self {
             Self::NonFiniteState { state, value } => write!(f, "state {state} is {}", nonfinite(*value)),
             Self::NonFiniteInput { input, value } => write!(f, "input {input} is {}", nonfinite(*value)),
-            Self::Envelope { quantity, value, limit, unit } => {
+            Self::Envelope {
+                quantity,
+                value,
+                limit,
+                unit,
+            } => {
                 write!(f, "{quantity} {value:.6} {unit} exceeds envelope ({limit} {unit})")
             }
-            Self::InvalidArgument { name, value, requirement } => write!(f, "{name} = {value} must be {requirement}"),
+            Self::InvalidArgument {
+                name,
+                value,
+                requirement,
+            } => write!(f, "{name} = {value} must be {requirement}"),
             Self::Airframe(p) => write!(f, "invalid airframe: {p}"),
             Self::Trim(msg) => write!(f, "trim failed: {msg}"),
         }

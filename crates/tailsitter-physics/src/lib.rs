@@ -42,17 +42,17 @@ pub type InputVector = SVector<f64, N_INPUTS>;
 
 /// Indices into [`StateVector`] and [`InputVector`].
 pub mod idx {
-    /// North position of the CG [m] (earth, NED).
+    /// North position of the CG (m) (earth, NED).
     pub const POS_N: usize = 0;
-    /// East position [m].
+    /// East position (m).
     pub const POS_E: usize = 1;
-    /// Down position [m].
+    /// Down position (m).
     pub const POS_D: usize = 2;
-    /// Inertial velocity, body x component [m/s].
+    /// Inertial velocity, body x component (m/s).
     pub const U: usize = 3;
-    /// Inertial velocity, body y component [m/s].
+    /// Inertial velocity, body y component (m/s).
     pub const V: usize = 4;
-    /// Inertial velocity, body z component [m/s].
+    /// Inertial velocity, body z component (m/s).
     pub const W: usize = 5;
     /// Quaternion q1 (A.2.8, vector part x).
     pub const Q1: usize = 6;
@@ -62,42 +62,42 @@ pub mod idx {
     pub const Q3: usize = 8;
     /// Quaternion q4 (scalar part).
     pub const Q4: usize = 9;
-    /// Roll rate p [rad/s].
+    /// Roll rate p (rad/s).
     pub const P: usize = 10;
-    /// Pitch rate q [rad/s].
+    /// Pitch rate q (rad/s).
     pub const Q: usize = 11;
-    /// Yaw rate r [rad/s].
+    /// Yaw rate r (rad/s).
     pub const R: usize = 12;
-    /// Thrust state T [N] (2.3.16).
+    /// Thrust state T (N) (2.3.16).
     pub const THRUST: usize = 13;
-    /// Elevator deflection δe [rad].
+    /// Elevator deflection δe (rad).
     pub const ELEVATOR: usize = 14;
-    /// Aileron deflection δa [rad].
+    /// Aileron deflection δa (rad).
     pub const AILERON: usize = 15;
-    /// Rudder deflection δr [rad].
+    /// Rudder deflection δr (rad).
     pub const RUDDER: usize = 16;
-    /// Collective flap deflection δfc [rad].
+    /// Collective flap deflection δfc (rad).
     pub const FLAP_COLLECTIVE: usize = 17;
-    /// Differential flap deflection δfd [rad].
+    /// Differential flap deflection δfd (rad).
     pub const FLAP_DIFFERENTIAL: usize = 18;
-    /// Vertical flap deflection δv [rad].
+    /// Vertical flap deflection δv (rad).
     pub const VERTICAL_FLAP: usize = 19;
     /// First of the six servo states (δe, δa, δr, δfc, δfd, δv consecutive).
     pub const SURFACES: usize = ELEVATOR;
 
-    /// Commanded thrust T_c [N].
+    /// Commanded thrust T_c (N).
     pub const THRUST_CMD: usize = 0;
-    /// Commanded δe [rad].
+    /// Commanded δe (rad).
     pub const ELEVATOR_CMD: usize = 1;
-    /// Commanded δa [rad].
+    /// Commanded δa (rad).
     pub const AILERON_CMD: usize = 2;
-    /// Commanded δr [rad].
+    /// Commanded δr (rad).
     pub const RUDDER_CMD: usize = 3;
-    /// Commanded δfc [rad].
+    /// Commanded δfc (rad).
     pub const FLAP_COLLECTIVE_CMD: usize = 4;
-    /// Commanded δfd [rad].
+    /// Commanded δfd (rad).
     pub const FLAP_DIFFERENTIAL_CMD: usize = 5;
-    /// Commanded δv [rad].
+    /// Commanded δv (rad).
     pub const VERTICAL_FLAP_CMD: usize = 6;
     /// First of the six surface commands.
     pub const SURFACES_CMD: usize = ELEVATOR_CMD;

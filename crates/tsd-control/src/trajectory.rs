@@ -78,7 +78,13 @@ impl Trajectory {
         let p2 = p1 + Vector3::new(r1, 0.0, -r1);
         let p3 = p2 + Vector3::new(vl * mission.t_level, 0.0, 0.0);
         let p4 = p3 + Vector3::new(r2, 0.0, -r2);
-        Self { mission, gravity, r1, r2, starts: [p0, p1, p2, p3, p4] }
+        Self {
+            mission,
+            gravity,
+            r1,
+            r2,
+            starts: [p0, p1, p2, p3, p4],
+        }
     }
 
     /// Radius of a quarter loop flown in `duration` with airspeed changing linearly between
@@ -189,7 +195,11 @@ mod tests {
     #[test]
     fn loops_end_exactly_level_and_vertical_and_are_continuous() {
         for (t1, t2) in [(5.0, 10.0), (3.0, 4.0)] {
-            let m = MissionParams { t_transition_1: t1, t_transition_2: t2, ..Default::default() };
+            let m = MissionParams {
+                t_transition_1: t1,
+                t_transition_2: t2,
+                ..Default::default()
+            };
             let tr = Trajectory::new(m, 9.81);
             let s = m.phase_starts();
             let eps = 1e-9;
@@ -197,20 +207,32 @@ mod tests {
                 let before = tr.at(tb - eps);
                 let after = tr.at(tb);
                 assert!(close(before.pos, after.pos, 1e-6), "pos jump at {tb}");
-                assert!(close(before.vel, after.vel, 1e-6), "vel jump at {tb}: {:?} {:?}", before.vel, after.vel);
+                assert!(
+                    close(before.vel, after.vel, 1e-6),
+                    "vel jump at {tb}: {:?} {:?}",
+                    before.vel,
+                    after.vel
+                );
                 assert!((before.gamma - after.gamma).abs() < 1e-6);
                 assert!((before.airspeed - after.airspeed).abs() < 1e-6);
             }
             let end1 = tr.at(s[2] - 1e-12);
             assert!(end1.gamma.abs() < 1e-9 && end1.vel.z.abs() < 1e-9, "{end1:?}");
             let end2 = tr.at(s[4] - 1e-12);
-            assert!((end2.gamma - FRAC_PI_2).abs() < 1e-9 && end2.vel.x.abs() < 1e-9, "{end2:?}");
+            assert!(
+                (end2.gamma - FRAC_PI_2).abs() < 1e-9 && end2.vel.x.abs() < 1e-9,
+                "{end2:?}"
+            );
         }
     }
 
     #[test]
     fn velocity_is_the_derivative_of_position_and_accel_of_velocity() {
-        let m = MissionParams { t_transition_1: 3.0, t_transition_2: 4.0, ..Default::default() };
+        let m = MissionParams {
+            t_transition_1: 3.0,
+            t_transition_2: 4.0,
+            ..Default::default()
+        };
         let tr = Trajectory::new(m, 9.81);
         let g = Vector3::new(0.0, 0.0, 9.81);
         let h = 1e-5;

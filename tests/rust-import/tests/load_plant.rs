@@ -8,13 +8,19 @@ use fmi::traits::FmiImport;
 use std::path::PathBuf;
 
 fn fmu(id: &str) -> PathBuf {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../dist").join(format!("{id}.fmu"));
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../dist")
+        .join(format!("{id}.fmu"));
     assert!(p.exists(), "{} missing: run `cargo xtask dist` first", p.display());
     p
 }
 
 fn vr(import: &Fmi2Import, name: &str) -> u32 {
-    import.model_description().model_variable_by_name(name).unwrap_or_else(|_| panic!("no variable {name}")).value_reference
+    import
+        .model_description()
+        .model_variable_by_name(name)
+        .unwrap_or_else(|_| panic!("no variable {name}"))
+        .value_reference
 }
 
 fn get(inst: &mut fmi::fmi2::instance::InstanceCS, vr: u32) -> f64 {
@@ -27,8 +33,12 @@ fn get(inst: &mut fmi::fmi2::instance::InstanceCS, vr: u32) -> f64 {
 fn plant_fmu_climbs_at_3_m_per_s_through_the_fmi_crate() {
     let import: Fmi2Import = fmi::import::from_path(fmu("tailsitter_plant")).expect("load FMU");
     assert_eq!(import.model_description().fmi_version, "2.0");
-    let (pos_d, vel_d, theta, airspeed) =
-        (vr(&import, "pos_d"), vr(&import, "vel_d"), vr(&import, "theta"), vr(&import, "airspeed"));
+    let (pos_d, vel_d, theta, airspeed) = (
+        vr(&import, "pos_d"),
+        vr(&import, "vel_d"),
+        vr(&import, "theta"),
+        vr(&import, "airspeed"),
+    );
     let mut inst = import.instantiate_cs("plant", false, false).expect("instantiate");
     assert_eq!(Common::get_version(&inst), "2.0");
     Common::setup_experiment(&mut inst, None, 0.0, None).unwrap();
@@ -39,8 +49,16 @@ fn plant_fmu_climbs_at_3_m_per_s_through_the_fmi_crate() {
         inst.do_step(k as f64 * h, h, true).expect("do_step");
     }
     // Trimmed vertical climb at 3 m/s, nose up: 15 m up after 5 s.
-    assert!((get(&mut inst, vel_d) + 3.0).abs() < 1e-3, "vel_d = {}", get(&mut inst, vel_d));
-    assert!((get(&mut inst, pos_d) + 15.0).abs() < 1e-2, "pos_d = {}", get(&mut inst, pos_d));
+    assert!(
+        (get(&mut inst, vel_d) + 3.0).abs() < 1e-3,
+        "vel_d = {}",
+        get(&mut inst, vel_d)
+    );
+    assert!(
+        (get(&mut inst, pos_d) + 15.0).abs() < 1e-2,
+        "pos_d = {}",
+        get(&mut inst, pos_d)
+    );
     assert!((get(&mut inst, theta) - std::f64::consts::FRAC_PI_2).abs() < 1e-3);
     assert!((get(&mut inst, airspeed) - 3.0).abs() < 1e-3);
 
@@ -63,8 +81,12 @@ fn plant_fmu_climbs_at_3_m_per_s_through_the_fmi_crate() {
 #[test]
 fn plant_fmu_starts_in_level_flight_when_asked() {
     let import: Fmi2Import = fmi::import::from_path(fmu("tailsitter_plant")).expect("load FMU");
-    let (speed, trim_thrust, trim_alpha, airspeed) =
-        (vr(&import, "initial_speed"), vr(&import, "trim_thrust"), vr(&import, "trim_alpha"), vr(&import, "airspeed"));
+    let (speed, trim_thrust, trim_alpha, airspeed) = (
+        vr(&import, "initial_speed"),
+        vr(&import, "trim_thrust"),
+        vr(&import, "trim_alpha"),
+        vr(&import, "airspeed"),
+    );
     let condition = vr(&import, "initial_condition");
     let mut inst = import.instantiate_cs("plant", false, false).expect("instantiate");
     Common::setup_experiment(&mut inst, None, 0.0, None).unwrap();

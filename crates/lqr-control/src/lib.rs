@@ -1,0 +1,497 @@
+//! Gain-scheduled LQR flight controller of S.C. Kriel's tail-sitter thesis (chapter 3),
+//! pure Rust, independent of FMI.
+//!
+//! * [`model`]: the full-state Euler model for control (§2.4, candidate 2 of §3.2.3) on the
+//!   physics crate's force model, linearised numerically (3.2.7–3.2.9).
+//! * [`linalg`]: zero-order-hold discretisation (replacing (3.2.10–3.2.11)), the steady-state
+//!   DARE by structured doubling, the thesis's N-step backward iteration (3.1.3–3.1.5).
+//! * [`trajectory`]: the reference trajectory of §3.3.
+//! * [`weights`]: Table 3.4 weights per phase (3.4.1–3.4.3), blended between phases.
+//! * [`LqrController`]: implements [`flight_mission::FlightController`]:
+//!   every `relinearisation_period` it relinearises about the current estimated state and
+//!   the trajectory's inputs, discretises, adds the airspeed integrator (3.2.12–3.2.14) and
+//!   solves for K; every sample it applies `u = u_t − K [∫ΔV; x − x_t]`.
+//!
+//! See README.md for the equations and the design choices.
+
+pub mod linalg;
+pub mod model;
+pub mod trajectory;
+pub mod weights;
+
+use flight_mission::{
+    Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, FlightController, MissionParams, Notice,
+};
+use nalgebra::{SMatrix, SVector, Vector3};
+use tailsitter_physics::Airframe;
+
+use linalg::{
+    dare_residual, dare_sda, discretise_zoh, lqr_gain, riccati_backward, spectral_radius_bound, RiccatiError,
+};
+use model::{ix, linearise, state_of, wrap_pi, EulerRep, NA, NU, NX, U, X};
+use trajectory::{TrajPoint, Trajectory, TrajectoryMode, TrajectoryOptions};
+use weights::{load_set, WeightSchedule, Weights, DEFAULT_WEIGHTS_JSON};
+
+/// Size of the augmented ZOH exponential: states + integrator + inputs.
+const NM: usize = NA + NU;
+
+/// The gain matrix K (inputs × [integrator, model states]).
+pub type Gain = SMatrix<f64, NU, NA>;
+
+/// Tuning parameters of the LQR (FMU parameter group `lqr`; field names are the FMU
+/// parameter names).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LqrParams {
+    /// T_l: period of relinearisation and gain computation [s] (§3.1.3, §3.2.4: 0.2 s).
+    pub relinearisation_period: f64,
+    /// 0 = exact steady-state DARE (structured doubling), 1 = the thesis's backward
+    /// iteration over `riccati_horizon` steps (3.1.3–3.1.5).
+    pub riccati_method: i32,
+    /// N of the backward iteration (thesis: 200).
+    pub riccati_horizon: i32,
+    /// Extra factor on every phase's control-weight scale R (3.4.2).
+    pub r_scale: f64,
+    /// Index of the weight set in the weights JSON (0 = thesis Table 3.4).
+    pub weight_set: i32,
+    /// Time over which the weights blend from one phase's table to the next [s].
+    pub weight_blend_time: f64,
+    /// Reference 3-2-1 pitch above which the 2-3-1 Euler set is used [rad].
+    pub euler_switch_pitch: f64,
+    /// Limit of the airspeed-error integrator |∫ΔV dt| [m].
+    pub integrator_limit: f64,
+    /// Leak λ of the airspeed integrator, ẋ_I = V − V_t − λ x_I [1/s]. Must be > 0: with
+    /// λ = 0 the integrator minus the along-track position is an uncontrollable mode at
+    /// z = 1 (ẋ_I = ΔV = along-track Δṗ in straight flight) and no stabilising DARE
+    /// solution exists.
+    pub integrator_leak: f64,
+    /// Trajectory: 0 = thesis closed forms (3.3.3–3.3.4, 3.3.13–3.3.17), 1 = force balance.
+    pub trajectory_mode: i32,
+    /// α_max of (3.3.4) [rad] (trajectory_mode 0 only).
+    pub alpha_max: f64,
+    /// Banked-turn radius ρ in the level segment [m] (3.3.18–3.3.21); 0 = straight, < 0 left.
+    pub turn_radius: f64,
+}
+
+impl Default for LqrParams {
+    fn default() -> Self {
+        Self {
+            relinearisation_period: 0.2,
+            riccati_method: 0,
+            riccati_horizon: 200,
+            r_scale: 1.0,
+            weight_set: 1,
+            weight_blend_time: 1.0,
+            euler_switch_pitch: 50f64.to_radians(),
+            integrator_limit: 10.0,
+            integrator_leak: 0.1,
+            trajectory_mode: 1,
+            alpha_max: 15f64.to_radians(),
+            turn_radius: 0.0,
+        }
+    }
+}
+
+/// Counters of the gain computations (for reports and benchmarks).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct GainStats {
+    pub solves: u64,
+    pub fallbacks: u64,
+    /// Spectral-radius bound of the last accepted closed loop Φ − ΓK.
+    pub last_spectral_radius: f64,
+}
+
+/// The LQR flight controller.
+#[derive(Debug, Clone)]
+pub struct LqrController {
+    airframe: Airframe,
+    mission: MissionParams,
+    params: LqrParams,
+    trajectory: Trajectory,
+    schedule: WeightSchedule,
+    // ---- state ----
+    origin: Option<Vector3<f64>>,
+    integrator: f64,
+    gain: Gain,
+    have_gain: bool,
+    rep: EulerRep,
+    next_relinearisation: f64,
+    stats: GainStats,
+}
+
+/// Names of the commands, for [`Notice::Saturated`].
+const COMMAND_NAMES: [&str; NU] = [
+    "thrust_cmd",
+    "elevator_cmd",
+    "aileron_cmd",
+    "rudder_cmd",
+    "flap_collective_cmd",
+    "flap_differential_cmd",
+    "vertical_flap_cmd",
+];
+
+/// The result of one gain computation.
+#[derive(Debug, Clone, Copy)]
+pub struct GainSolution {
+    pub gain: Gain,
+    pub phi: SMatrix<f64, NA, NA>,
+    pub gamma: SMatrix<f64, NA, NU>,
+    pub spectral_radius: f64,
+}
+
+impl LqrController {
+    /// A controller with the controller's own airframe `airframe` (may differ from the
+    /// plant's), the mission and the tuning. Builds the trajectory table and the weight
+    /// schedule (the only allocations).
+    pub fn new(airframe: Airframe, mission: MissionParams, params: LqrParams) -> Result<Self, ControlError> {
+        Self::with_weights_json(airframe, mission, params, DEFAULT_WEIGHTS_JSON)
+    }
+
+    /// As [`Self::new`] with the weight tables of a JSON document (format of
+    /// `resources/weights.json`); `params.weight_set` picks the set.
+    pub fn with_weights_json(
+        airframe: Airframe,
+        mission: MissionParams,
+        params: LqrParams,
+        weights_json: &str,
+    ) -> Result<Self, ControlError> {
+        airframe
+            .validate()
+            .map_err(|e| ControlError(format!("controller airframe: {e}")))?;
+        mission.validate().map_err(|e| ControlError(e.0))?;
+        let positive = [
+            ("relinearisation_period", params.relinearisation_period),
+            ("r_scale", params.r_scale),
+            ("integrator_limit", params.integrator_limit),
+            ("integrator_leak", params.integrator_leak),
+        ];
+        for (name, v) in positive {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(ControlError(format!("{name} = {v}: must be finite and > 0")));
+            }
+        }
+        if !(params.euler_switch_pitch > 0.1 && params.euler_switch_pitch < 1.47) {
+            return Err(ControlError(format!(
+                "euler_switch_pitch = {}: must lie in (0.1, 1.47) rad, away from both Euler singularities",
+                params.euler_switch_pitch
+            )));
+        }
+        if !(0..=1).contains(&params.riccati_method) {
+            return Err(ControlError(format!(
+                "riccati_method = {}: expected 0 (DARE) or 1 (backward)",
+                params.riccati_method
+            )));
+        }
+        if params.riccati_horizon < 1 {
+            return Err(ControlError(format!(
+                "riccati_horizon = {}: must be >= 1",
+                params.riccati_horizon
+            )));
+        }
+        let mode = match params.trajectory_mode {
+            0 => TrajectoryMode::Thesis,
+            1 => TrajectoryMode::ForceBalance,
+            m => {
+                return Err(ControlError(format!(
+                    "trajectory_mode = {m}: expected 0 (thesis) or 1 (force balance)"
+                )))
+            }
+        };
+        let json = weights_json;
+        let index = usize::try_from(params.weight_set).map_err(|_| ControlError("weight_set must be >= 0".into()))?;
+        let set = load_set(json, index).map_err(ControlError)?;
+        let schedule = WeightSchedule::new(&set, params.r_scale, params.weight_blend_time).map_err(ControlError)?;
+        let trajectory = Trajectory::new(
+            &airframe,
+            &mission,
+            &TrajectoryOptions {
+                mode,
+                alpha_max: params.alpha_max,
+                turn_radius: params.turn_radius,
+            },
+        )
+        .map_err(ControlError)?;
+        let mut c = Self {
+            airframe,
+            mission,
+            params,
+            trajectory,
+            schedule,
+            origin: None,
+            integrator: 0.0,
+            gain: Gain::zeros(),
+            have_gain: false,
+            rep: EulerRep::E231,
+            next_relinearisation: 0.0,
+            stats: GainStats::default(),
+        };
+        // Initial gains on the trajectory's start point, so a failure shows at construction.
+        let p0 = c.trajectory.at(0.0);
+        let rep = c.rep_for(&p0);
+        let sol = c.solve_gain(rep, &p0.state(rep), &p0.u, 0.0).map_err(|e| {
+            ControlError(format!(
+                "gain computation at the start of the trajectory failed: {}",
+                e.describe()
+            ))
+        })?;
+        c.gain = sol.gain;
+        c.rep = rep;
+        c.have_gain = true;
+        Ok(c)
+    }
+
+    /// The reference trajectory.
+    pub fn trajectory(&self) -> &Trajectory {
+        &self.trajectory
+    }
+
+    /// The current gain matrix and the Euler set it belongs to.
+    pub fn gain(&self) -> (&Gain, EulerRep) {
+        (&self.gain, self.rep)
+    }
+
+    /// Gain computation counters.
+    pub fn stats(&self) -> GainStats {
+        self.stats
+    }
+
+    /// The weight schedule.
+    pub fn schedule(&self) -> &WeightSchedule {
+        &self.schedule
+    }
+
+    /// The Euler set for a reference point: 2-3-1 when the reference 3-2-1 pitch exceeds
+    /// `euler_switch_pitch` (vertical flight and the nose-high parts of the transitions,
+    /// where 3-2-1 is singular), 3-2-1 otherwise (§2.2.1, §3.2.3.2).
+    fn rep_for(&self, p: &TrajPoint) -> EulerRep {
+        if p.euler_321.y.abs() > self.params.euler_switch_pitch {
+            EulerRep::E231
+        } else {
+            EulerRep::E321
+        }
+    }
+
+    /// Linearise about (x, u_t), discretise by ZOH with the airspeed integrator, and solve
+    /// for the gain with the weights of time t. No allocation.
+    ///
+    /// Integrator (3.2.12–3.2.14), derived in continuous time and discretised with the
+    /// model: `ẋ_I = V − V_t − λ x_I = H_I x_p − λ x_I`, so the augmented system is
+    /// `[ẋ_I; ẋ_p] = [−λ H_I; 0 F] [x_I; x_p] + [0; G] u_p`, and ZOH gives
+    /// `Φ_I = [e^{−λT_s} ∫H_I e^{Fτ}dτ; 0 Φ]`, `Γ_I = [·; Γ]` — to first order in T_s and
+    /// for λ = 0 `Φ_I ≈ [1 T_s H_I; 0 Φ]`; the printed (3.2.13) has T_s in the (1,1)
+    /// position and Γ_I's first row is not zero but O(T_s²). The small leak λ
+    /// (`integrator_leak`) makes the augmented pair stabilisable (see [`LqrParams`]).
+    pub fn solve_gain(&self, rep: EulerRep, x: &X, u: &U, t: f64) -> Result<GainSolution, RiccatiError> {
+        let mut xl = *x;
+        // Keep the linearisation point inside the model's domain (V > 0, away from the
+        // Euler singularity the rep choice avoids anyway).
+        xl[ix::V] = xl[ix::V].max(1.0);
+        let (f, g) = linearise(&self.airframe, rep, &xl, u);
+        let mut a = SMatrix::<f64, NA, NA>::zeros();
+        a[(0, 0)] = -self.params.integrator_leak;
+        a[(0, 1 + ix::V)] = 1.0;
+        a.fixed_view_mut::<NX, NX>(1, 1).copy_from(&f);
+        let mut b = SMatrix::<f64, NA, NU>::zeros();
+        b.fixed_view_mut::<NX, NU>(1, 0).copy_from(&g);
+        if !a.iter().chain(b.iter()).all(|v| v.is_finite()) {
+            return Err(RiccatiError::NonFinite);
+        }
+        let (phi, gamma) = discretise_zoh::<NA, NU, NM>(&a, &b, self.mission.sample_time);
+        let w: Weights = self.schedule.at(&self.mission, t);
+        let q = SMatrix::<f64, NA, NA>::from_diagonal(&w.q);
+        let r: SVector<f64, NU> = w.r;
+        let k = if self.params.riccati_method == 0 {
+            let p = dare_sda(&phi, &gamma, &q, &r)?;
+            let k = lqr_gain(&phi, &gamma, &p, &r)?;
+            let res = dare_residual(&phi, &gamma, &q, &p, &k);
+            if res.is_nan() || res >= 1e-6 {
+                return Err(RiccatiError::Residual(res));
+            }
+            k
+        } else {
+            riccati_backward(&phi, &gamma, &q, &r, self.params.riccati_horizon as usize, None)?.0
+        };
+        let rho = spectral_radius_bound(&(phi - gamma * k));
+        if rho.is_nan() || rho >= 1.0 {
+            return Err(RiccatiError::Unstable(rho));
+        }
+        Ok(GainSolution {
+            gain: k,
+            phi,
+            gamma,
+            spectral_radius: rho,
+        })
+    }
+
+    /// Append the controller's state (everything `update` depends on besides its
+    /// construction parameters) as f64s.
+    pub fn save(&self, out: &mut impl FnMut(f64)) {
+        let origin = self
+            .origin
+            .unwrap_or_else(|| Vector3::new(f64::NAN, f64::NAN, f64::NAN));
+        out(if self.origin.is_some() { 1.0 } else { 0.0 });
+        for v in origin.iter() {
+            out(*v);
+        }
+        out(self.integrator);
+        out(if self.have_gain { 1.0 } else { 0.0 });
+        out(self.rep as i32 as f64);
+        out(self.next_relinearisation);
+        out(self.stats.solves as f64);
+        out(self.stats.fallbacks as f64);
+        out(self.stats.last_spectral_radius);
+        for v in self.gain.iter() {
+            out(*v);
+        }
+    }
+
+    /// Restore what [`Self::save`] wrote; `None` from `next` = truncated state.
+    pub fn restore(&mut self, next: &mut impl FnMut() -> Option<f64>) -> Result<(), ControlError> {
+        let mut take = || next().ok_or_else(|| ControlError("truncated LQR controller state".into()));
+        let has_origin = take()? != 0.0;
+        let o = Vector3::new(take()?, take()?, take()?);
+        self.origin = if has_origin { Some(o) } else { None };
+        self.integrator = take()?;
+        self.have_gain = take()? != 0.0;
+        self.rep = if take()? == 0.0 { EulerRep::E321 } else { EulerRep::E231 };
+        self.next_relinearisation = take()?;
+        self.stats.solves = take()? as u64;
+        self.stats.fallbacks = take()? as u64;
+        self.stats.last_spectral_radius = take()?;
+        for v in self.gain.iter_mut() {
+            *v = take()?;
+        }
+        Ok(())
+    }
+}
+
+impl FlightController for LqrController {
+    fn update(&mut self, input: &ControllerInput) -> Result<ControllerOutput, ControlError> {
+        let m = &input.measurement;
+        if let Some(name) = m.first_non_finite() {
+            return Err(ControlError(format!("measurement {name} is not finite")));
+        }
+        let t = input.t;
+        if !t.is_finite() {
+            return Err(ControlError(format!("sample time t = {t} is not finite")));
+        }
+        let origin = *self
+            .origin
+            .get_or_insert(Vector3::new(m.pos_ned.x, m.pos_ned.y, -m.pos_ned.z));
+        let reference = self.trajectory.at(t);
+        let off = &input.ref_offset_ned;
+        // Reference position: start + trajectory + offset, as (N, E, h).
+        let ref_neh = origin + reference.pos_neh + Vector3::new(off.x, off.y, -off.z);
+        let rep = self.rep_for(&reference);
+
+        let mut x = state_of(
+            rep, m.airspeed, m.alpha, m.beta, &m.rates, &m.quat, &m.pos_ned, m.thrust,
+        );
+        let mut xt = reference.state(rep);
+        xt[ix::N] = ref_neh.x;
+        xt[ix::E] = ref_neh.y;
+        xt[ix::H] = ref_neh.z;
+
+        let mut notice = None;
+        let due = t + 1e-9 >= self.next_relinearisation;
+        if !self.have_gain || rep != self.rep || due {
+            // Relinearise about the current estimated state with the trajectory's inputs
+            // (§3.1.3, 3.2.7–3.2.9); positions do not enter the model.
+            match self.solve_gain(rep, &x, &reference.u, t) {
+                Ok(sol) => {
+                    self.gain = sol.gain;
+                    self.have_gain = true;
+                    self.stats.last_spectral_radius = sol.spectral_radius;
+                }
+                Err(e) => {
+                    self.stats.fallbacks += 1;
+                    notice = Some(Notice::GainFallback(e.describe()));
+                    if rep != self.rep {
+                        // The old gains belong to the other Euler set: they cannot be reused
+                        // on this state vector. Keep the old representation until a solve succeeds.
+                        x = state_of(
+                            self.rep, m.airspeed, m.alpha, m.beta, &m.rates, &m.quat, &m.pos_ned, m.thrust,
+                        );
+                        xt = reference.state(self.rep);
+                        xt[ix::N] = ref_neh.x;
+                        xt[ix::E] = ref_neh.y;
+                        xt[ix::H] = ref_neh.z;
+                    }
+                }
+            }
+            if notice.is_none() {
+                self.rep = rep;
+            }
+            self.stats.solves += 1;
+            if due {
+                self.next_relinearisation = t + self.params.relinearisation_period;
+            }
+        }
+
+        let mut dx = SVector::<f64, NA>::zeros();
+        dx[0] = self.integrator;
+        for i in 0..NX {
+            let d = x[i] - xt[i];
+            dx[1 + i] = if (ix::PHI..=ix::PSI).contains(&i) {
+                wrap_pi(d)
+            } else {
+                d
+            };
+        }
+        let mut u = reference.u - self.gain * dx;
+        // Limits of the plant: thrust range, deflection limit.
+        let af = &self.airframe;
+        let mut thrust_saturated = 0.0;
+        for i in 0..NU {
+            let (lo, hi) = if i == 0 {
+                (af.thrust_min, af.thrust_max)
+            } else {
+                (-af.deflection_limit, af.deflection_limit)
+            };
+            if u[i] < lo || u[i] > hi {
+                if i == 0 {
+                    thrust_saturated = if u[i] > hi { 1.0 } else { -1.0 };
+                }
+                u[i] = u[i].clamp(lo, hi);
+                if notice.is_none() {
+                    notice = Some(Notice::Saturated(COMMAND_NAMES[i]));
+                }
+            }
+        }
+        if !u.iter().all(|v| v.is_finite()) {
+            return Err(ControlError(format!("non-finite command at t = {t}")));
+        }
+        // Integrator x_I(k+1) = x_I(k) + T_s (V − V_t) (3.2.12–3.2.14), with anti-windup:
+        // not integrated further into a thrust limit, and bounded.
+        let dv = x[ix::V] - xt[ix::V];
+        // Negative airspeed error asks for more thrust (K row of T_c on x_I is negative).
+        let pushes_up = dv < 0.0;
+        if !(thrust_saturated > 0.0 && pushes_up || thrust_saturated < 0.0 && !pushes_up) {
+            let lim = self.params.integrator_limit;
+            let ts = self.mission.sample_time;
+            let decay = (-self.params.integrator_leak * ts).exp();
+            self.integrator = (decay * self.integrator + ts * dv).clamp(-lim, lim);
+        }
+
+        let pos = Vector3::new(m.pos_ned.x, m.pos_ned.y, -m.pos_ned.z);
+        let diagnostics = Diagnostics {
+            ref_pos_ned: Vector3::new(ref_neh.x, ref_neh.y, -ref_neh.z),
+            ref_airspeed: reference.v,
+            phase: self.mission.phase_at(t).0,
+            pos_error: (pos - ref_neh).norm(),
+        };
+        let command = Command {
+            thrust: u[0],
+            elevator: u[1],
+            aileron: u[2],
+            rudder: u[3],
+            flap_collective: u[4],
+            flap_differential: u[5],
+            vertical_flap: u[6],
+        };
+        Ok(ControllerOutput {
+            command,
+            diagnostics,
+            notice,
+        })
+    }
+}

@@ -1,0 +1,267 @@
+//! The LQR's model for control (thesis §2.4, candidate 2 of §3.2.3): the full-state
+//! Euler-angle model
+//!
+//! ```text
+//! x = [V α β p q r φ θ ψ N E h T]ᵀ,   u = [T_c δe δa δr δfc δfd δv]ᵀ
+//! ```
+//!
+//! built on the same force model as the plant ([`Airframe::forces_moments`], §2.3) with
+//! the controller's own [`Airframe`], and rigid-body equations written here from first
+//! principles instead of the printed (2.4.6–2.4.29) (which carry typos, DESIGN.md §5):
+//!
+//! * body velocity `v = V (cα cβ, sβ, sα cβ)` (inverse of (2.2.12–2.2.13), no wind);
+//! * `v̇ = F/m + DCM^BE (0, 0, g) − ω × v` ((2.2.19–2.2.21), gravity (2.3.14));
+//! * `V̇ = v·v̇ / V`, `α̇ = (u ẇ − w u̇)/(u² + w²)`, `β̇ = (v̇ − sβ V̇)/(V cβ)`;
+//! * `I ω̇ = M − ω × I ω` with diagonal inertia ((2.2.22–2.2.24), (2.2.17));
+//! * Euler kinematics 3-2-1 (2.2.1)/(2.4.16–2.4.18) or 2-3-1, re-derived (the printed
+//!   (2.2.2), (2.4.19–2.4.21) are wrong): for `DCM^BE = T¹_φ T³_θ T²_ψ` (A.2.6),
+//!   `p = φ̇ + sθ ψ̇`, `q = cφ cθ ψ̇ + sφ θ̇`, `r = −sφ cθ ψ̇ + cφ θ̇`, hence
+//!   `φ̇ = p − tanθ (q cφ − r sφ)`, `θ̇ = q sφ + r cφ`, `ψ̇ = (q cφ − r sφ)/cθ`;
+//! * position (2.4.22–2.4.24) as `(Ṅ, Ė, −ḣ) = DCM^BEᵀ v`;
+//! * thrust lag (2.3.16)/(2.4.28) with τ_T: `Ṫ = (T_c − T)/τ_T`.
+//!
+//! The surfaces are taken as direct inputs (the servo lag of App. D.5 is not modelled,
+//! as in the thesis). Linearisation (3.2.7–3.2.9) is by central differences.
+
+use nalgebra::{Matrix3, SMatrix, SVector, Vector3, Vector4};
+use tailsitter_physics::{
+    dcm_earth_to_body, dcm_from_euler_231, euler_231_from_quat, euler_321_from_quat, Airframe, Surfaces,
+};
+
+/// Number of model states.
+pub const NX: usize = 13;
+/// Number of inputs.
+pub const NU: usize = 7;
+/// Model states plus the airspeed integrator (3.2.12–3.2.14).
+pub const NA: usize = NX + 1;
+
+/// Model state vector.
+pub type X = SVector<f64, NX>;
+/// Input vector.
+pub type U = SVector<f64, NU>;
+
+/// Indices into [`X`].
+pub mod ix {
+    pub const V: usize = 0;
+    pub const ALPHA: usize = 1;
+    pub const BETA: usize = 2;
+    pub const P: usize = 3;
+    pub const Q: usize = 4;
+    pub const R: usize = 5;
+    pub const PHI: usize = 6;
+    pub const THETA: usize = 7;
+    pub const PSI: usize = 8;
+    pub const N: usize = 9;
+    pub const E: usize = 10;
+    pub const H: usize = 11;
+    pub const T: usize = 12;
+}
+
+/// The Euler sequence of the attitude states (§2.2.1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EulerRep {
+    /// 3-2-1 (ψ about z, θ about y, φ about x), (A.2.5): level flight and transitions.
+    E321 = 0,
+    /// 2-3-1 (ψ about y, θ about z, φ about x), (A.2.6): vertical flight.
+    E231 = 1,
+}
+
+impl EulerRep {
+    /// `DCM^BE` of the angles `[φ, θ, ψ]` in this sequence.
+    pub fn dcm(self, a: &Vector3<f64>) -> Matrix3<f64> {
+        match self {
+            EulerRep::E321 => {
+                tailsitter_physics::attitude::rot_x(a.x)
+                    * tailsitter_physics::attitude::rot_y(a.y)
+                    * tailsitter_physics::attitude::rot_z(a.z)
+            }
+            EulerRep::E231 => dcm_from_euler_231(a.x, a.y, a.z),
+        }
+    }
+
+    /// The angles `[φ, θ, ψ]` of a quaternion (A.2.8, scalar last) in this sequence.
+    pub fn angles(self, q: &Vector4<f64>) -> Vector3<f64> {
+        match self {
+            EulerRep::E321 => euler_321_from_quat(q),
+            EulerRep::E231 => euler_231_from_quat(q),
+        }
+    }
+
+    /// The angles of a `DCM^BE` in this sequence.
+    pub fn angles_of_dcm(self, c: &Matrix3<f64>) -> Vector3<f64> {
+        self.angles(&tailsitter_physics::quat_from_dcm(c))
+    }
+
+    /// Euler-angle rates from body rates: (2.2.1) for 3-2-1; the re-derived 2-3-1 form
+    /// (module docs) replacing the printed (2.2.2)/(2.4.19–2.4.21).
+    pub fn rates(self, a: &Vector3<f64>, w: &Vector3<f64>) -> Vector3<f64> {
+        let (sf, cf) = a.x.sin_cos();
+        let (st, ct) = a.y.sin_cos();
+        let (p, q, r) = (w.x, w.y, w.z);
+        match self {
+            EulerRep::E321 => {
+                let k = q * sf + r * cf;
+                Vector3::new(p + k * st / ct, q * cf - r * sf, k / ct)
+            }
+            EulerRep::E231 => {
+                let k = q * cf - r * sf;
+                Vector3::new(p - k * st / ct, q * sf + r * cf, k / ct)
+            }
+        }
+    }
+}
+
+/// Wrap an angle difference to (−π, π].
+pub fn wrap_pi(a: f64) -> f64 {
+    let t = core::f64::consts::TAU;
+    let mut x = a % t;
+    if x > core::f64::consts::PI {
+        x -= t;
+    } else if x <= -core::f64::consts::PI {
+        x += t;
+    }
+    x
+}
+
+/// Body velocity of airspeed, α, β (inverse of (2.2.12–2.2.13)).
+#[inline]
+pub fn body_velocity(v: f64, alpha: f64, beta: f64) -> Vector3<f64> {
+    let (sa, ca) = alpha.sin_cos();
+    let (sb, cb) = beta.sin_cos();
+    Vector3::new(v * ca * cb, v * sb, v * sa * cb)
+}
+
+/// State derivative `ẋ = f(x) + g(x) u` (2.4.1) of the model for control (module docs).
+pub fn derivatives(af: &Airframe, rep: EulerRep, x: &X, u: &U) -> X {
+    let speed = x[ix::V];
+    let (alpha, beta) = (x[ix::ALPHA], x[ix::BETA]);
+    let w = Vector3::new(x[ix::P], x[ix::Q], x[ix::R]);
+    let ang = Vector3::new(x[ix::PHI], x[ix::THETA], x[ix::PSI]);
+    let thrust = x[ix::T];
+    let vb = body_velocity(speed, alpha, beta);
+    let surfaces = Surfaces::from_array([u[1], u[2], u[3], u[4], u[5], u[6]]);
+    let fm = af.forces_moments(&vb, &w, thrust, &surfaces);
+    let c = rep.dcm(&ang);
+    let g_body = c * Vector3::new(0.0, 0.0, af.gravity);
+    let a = fm.force_body / af.mass + g_body - w.cross(&vb);
+    let vdot = vb.dot(&a) / speed;
+    let uw2 = vb.x * vb.x + vb.z * vb.z;
+    let alpha_dot = (vb.x * a.z - vb.z * a.x) / uw2;
+    let beta_dot = (a.y - beta.sin() * vdot) / (speed * beta.cos());
+    let inertia = Vector3::new(af.i_xx, af.i_yy, af.i_zz);
+    let iw = inertia.component_mul(&w);
+    let wdot = (fm.moment_body - w.cross(&iw)).component_div(&inertia);
+    let angdot = rep.rates(&ang, &w);
+    let vel_ned = c.transpose() * vb;
+    let tdot = (u[0] - thrust) / af.tau_thrust;
+    X::from_column_slice(&[
+        vdot, alpha_dot, beta_dot, wdot.x, wdot.y, wdot.z, angdot.x, angdot.y, angdot.z, vel_ned.x, vel_ned.y,
+        -vel_ned.z, tdot,
+    ])
+}
+
+/// Jacobians `F = ∂ẋ/∂x`, `G = ∂ẋ/∂u` at (x, u) (3.2.8–3.2.9), central differences.
+pub fn linearise(af: &Airframe, rep: EulerRep, x: &X, u: &U) -> (SMatrix<f64, NX, NX>, SMatrix<f64, NX, NU>) {
+    let mut f = SMatrix::<f64, NX, NX>::zeros();
+    let mut g = SMatrix::<f64, NX, NU>::zeros();
+    for j in 0..NX {
+        // Positions do not enter the dynamics: their columns are exactly zero.
+        if j == ix::N || j == ix::E || j == ix::H {
+            continue;
+        }
+        let h = 1e-6 * (1.0 + x[j].abs());
+        let mut xp = *x;
+        let mut xm = *x;
+        xp[j] += h;
+        xm[j] -= h;
+        let d = (derivatives(af, rep, &xp, u) - derivatives(af, rep, &xm, u)) / (2.0 * h);
+        f.set_column(j, &d);
+    }
+    for j in 0..NU {
+        let h = 1e-6 * (1.0 + u[j].abs());
+        let mut up = *u;
+        let mut um = *u;
+        up[j] += h;
+        um[j] -= h;
+        let d = (derivatives(af, rep, x, &up) - derivatives(af, rep, x, &um)) / (2.0 * h);
+        g.set_column(j, &d);
+    }
+    (f, g)
+}
+
+/// The model state of a measured quaternion attitude and the other measured quantities,
+/// attitude in the sequence `rep`.
+#[allow(clippy::too_many_arguments)]
+pub fn state_of(
+    rep: EulerRep,
+    airspeed: f64,
+    alpha: f64,
+    beta: f64,
+    rates: &Vector3<f64>,
+    quat: &Vector4<f64>,
+    pos_ned: &Vector3<f64>,
+    thrust: f64,
+) -> X {
+    let a = rep.angles(quat);
+    X::from_column_slice(&[
+        airspeed, alpha, beta, rates.x, rates.y, rates.z, a.x, a.y, a.z, pos_ned.x, pos_ned.y, -pos_ned.z, thrust,
+    ])
+}
+
+/// Quaternion → DCM shorthand.
+pub fn dcm_of_quat(q: &Vector4<f64>) -> Matrix3<f64> {
+    dcm_earth_to_body(q)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tailsitter_physics::{quat_from_euler_321, Plant};
+
+    #[test]
+    fn euler_rates_match_the_dcm_derivative() {
+        // Ċ = −[ω×] C for C = DCM^BE; check both sequences' kinematics by finite differences.
+        let w = Vector3::new(0.3, -0.5, 0.7);
+        for rep in [EulerRep::E321, EulerRep::E231] {
+            for a in [
+                Vector3::new(0.2, 0.4, -0.3),
+                Vector3::new(-0.1, 1.2, 0.5),
+                Vector3::new(0.05, -0.3, 1.4),
+            ] {
+                let c = rep.dcm(&a);
+                let dt = 1e-6;
+                let c2 = rep.dcm(&(a + rep.rates(&a, &w) * dt));
+                let cdot = (c2 - c) / dt;
+                let wx = Matrix3::new(0.0, -w.z, w.y, w.z, 0.0, -w.x, -w.y, w.x, 0.0);
+                assert!((cdot + wx * c).norm() < 1e-5, "{rep:?} {a}");
+                // angles round trip
+                let back = rep.angles_of_dcm(&c);
+                assert!((back - a).norm() < 1e-12, "{rep:?}: {back} vs {a}");
+            }
+        }
+    }
+
+    #[test]
+    fn trimmed_level_flight_is_an_equilibrium_of_the_model() {
+        let af = Airframe::default();
+        let plant = Plant::new(af);
+        let trim = plant.trim_level(25.0).unwrap();
+        let q = quat_from_euler_321(0.0, trim.theta, 0.0);
+        let x = state_of(
+            EulerRep::E321,
+            25.0,
+            trim.alpha,
+            0.0,
+            &Vector3::zeros(),
+            &q,
+            &Vector3::zeros(),
+            trim.thrust,
+        );
+        let u = U::from_column_slice(trim.inputs.as_slice());
+        let d = derivatives(&af, EulerRep::E321, &x, &u);
+        for i in 0..ix::N {
+            assert!(d[i].abs() < 1e-6, "state {i}: {}", d[i]);
+        }
+        assert!((d[ix::N] - 25.0).abs() < 1e-6);
+    }
+}

@@ -1,0 +1,561 @@
+//! Trajectory generator (thesis §3.3): the reference state x_t and input u_t of the
+//! mission vertical → level → vertical, precomputed once at construction into a table
+//! (step [`TABLE_STEP`]) shared between clones, interpolated linearly in the sample path.
+//!
+//! Flight-path (wind-axis) pitch γ and airspeed V are the thesis's cosine blends, with the
+//! `t` the printed (3.3.1–3.3.2) miss restored (τ = time in the transition):
+//!
+//! ```text
+//! V₁(τ) = V_V + (V_L − V_V)/2 · [1 − cos(π τ/T₁)]              (3.3.1)
+//! V₂(τ) = V_L + (V_V − V_L)/2 · [1 − cos(π τ/T₂)]              (3.3.2)
+//! γ₁(τ) = (γ_V − γ_L)/2 · [1 + cos(π τ/T₁)] + γ_L              (3.3.5 without α)
+//! γ₂(τ) = (γ_V − γ_L)/2 · [1 − cos(π τ/T₂)] + γ_L              (3.3.6 without α)
+//! ```
+//!
+//! with γ_V = 90°, γ_L = 0. The body pitch is θ = γ + α (3.3.5–3.3.6), q = θ̇ (3.3.7–3.3.8),
+//! N, h by integrating V cos γ, V sin γ (3.3.9–3.3.12; "θ − α" = γ there).
+//!
+//! α, T and δe come in two modes ([`TrajectoryMode`]):
+//! * `Thesis`: α by (3.3.3–3.3.4) with α_L the level trim and α_max a parameter; T by
+//!   (3.3.13–3.3.14); δe by the moment balance (3.3.15–3.3.17) including the slip-stream
+//!   scaling ((V/(V + 2w))², w from (2.3.21)).
+//! * `ForceBalance` (default): α, T and δe solved at every table point from the model for
+//!   control itself so that V̇, γ̇ (i.e. α̇ = q − γ̇) and q̇ = θ̈ are those of the reference:
+//!   the "mathematically calculated" trajectory of §3.3.1 option 1. It contains (3.3.13–3.3.17)
+//!   as its small-angle, drag-only special case and coincides with the physics crate's trims
+//!   in the vertical and level segments. The thesis names trajectory accuracy as the
+//!   limiting factor of the LQR (§3.5.1); this removes the α guesswork of (3.3.3–3.3.4).
+//!
+//! Banked turn (3.3.18–3.3.21), level segment only, `turn_radius` ρ ≠ 0: heading rate
+//! ω = V/ρ (3.3.19) ramped in and out with cosine blends over [`TURN_RAMP`] s, bank
+//! φ = atan(V ω / g) (3.3.18 with ω = V/ρ), body rates from the exact 3-2-1 kinematics
+//! (which reduce to q = ω sin φ, r = ω cos φ (3.3.20–3.3.21) at θ = 0).
+//! Thrust command leads the thrust state by the motor lag: T_c = T + τ_T Ṫ (2.3.16).
+
+use std::sync::Arc;
+
+use flight_mission::{MissionParams, Phase};
+use nalgebra::{Matrix3, Vector3, Vector4};
+use tailsitter_physics::{quat_from_euler_321, Airframe};
+
+use crate::model::{derivatives, ix, EulerRep, U, X};
+
+/// Table step [s].
+pub const TABLE_STEP: f64 = 0.01;
+/// Ramp time of the turn rate at the start and the end of the level segment [s].
+pub const TURN_RAMP: f64 = 2.0;
+const FRAC_PI_2: f64 = core::f64::consts::FRAC_PI_2;
+const PI: f64 = core::f64::consts::PI;
+
+/// How α, T and δe of the reference are found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TrajectoryMode {
+    /// The thesis's closed forms (3.3.3–3.3.4), (3.3.13–3.3.14), (3.3.17).
+    Thesis = 0,
+    /// Solved from the model for control (default).
+    ForceBalance = 1,
+}
+
+/// Options of the trajectory generator.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrajectoryOptions {
+    pub mode: TrajectoryMode,
+    /// α_max of (3.3.4) [rad] (Thesis mode only).
+    pub alpha_max: f64,
+    /// Turn radius ρ [m] of the level segment (3.3.18–3.3.21); 0 = straight, < 0 left.
+    pub turn_radius: f64,
+}
+
+impl Default for TrajectoryOptions {
+    fn default() -> Self {
+        Self {
+            mode: TrajectoryMode::ForceBalance,
+            alpha_max: 15f64.to_radians(),
+            turn_radius: 0.0,
+        }
+    }
+}
+
+/// One reference point: state x_t and input u_t (positions relative to the start).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrajPoint {
+    /// Mission time [s].
+    pub t: f64,
+    /// Airspeed V [m/s].
+    pub v: f64,
+    /// α [rad].
+    pub alpha: f64,
+    /// Flight-path angle γ (wind-axis pitch) [rad].
+    pub gamma: f64,
+    /// 3-2-1 Euler angles φ, θ, ψ [rad] (ψ not wrapped).
+    pub euler_321: Vector3<f64>,
+    /// Body rates p, q, r [rad/s].
+    pub rates: Vector3<f64>,
+    /// North, east, height relative to the start [m].
+    pub pos_neh: Vector3<f64>,
+    /// Thrust state T [N].
+    pub thrust: f64,
+    /// Reference inputs u_t = [T_c δe δa δr δfc δfd δv].
+    pub u: U,
+}
+
+impl TrajPoint {
+    fn lerp(&self, o: &TrajPoint, s: f64) -> TrajPoint {
+        let l = |a: f64, b: f64| a + (b - a) * s;
+        TrajPoint {
+            t: l(self.t, o.t),
+            v: l(self.v, o.v),
+            alpha: l(self.alpha, o.alpha),
+            gamma: l(self.gamma, o.gamma),
+            euler_321: self.euler_321.lerp(&o.euler_321, s),
+            rates: self.rates.lerp(&o.rates, s),
+            pos_neh: self.pos_neh.lerp(&o.pos_neh, s),
+            thrust: l(self.thrust, o.thrust),
+            u: self.u.lerp(&o.u, s),
+        }
+    }
+
+    /// Attitude quaternion (A.2.8) of the reference.
+    pub fn quat(&self) -> Vector4<f64> {
+        quat_from_euler_321(self.euler_321.x, self.euler_321.y, self.euler_321.z)
+    }
+
+    /// The reference as a model state in sequence `rep` (positions relative to the start).
+    pub fn state(&self, rep: EulerRep) -> X {
+        let a = rep.angles(&self.quat());
+        X::from_column_slice(&[
+            self.v,
+            self.alpha,
+            0.0,
+            self.rates.x,
+            self.rates.y,
+            self.rates.z,
+            a.x,
+            a.y,
+            a.z,
+            self.pos_neh.x,
+            self.pos_neh.y,
+            self.pos_neh.z,
+            self.thrust,
+        ])
+    }
+}
+
+/// The precomputed reference trajectory.
+#[derive(Debug, Clone)]
+pub struct Trajectory {
+    points: Arc<[TrajPoint]>,
+    mission: MissionParams,
+}
+
+/// Kinematic reference of the flight path at τ: (V, V̇, γ, γ̇, γ̈).
+fn path(m: &MissionParams, t: f64) -> (Phase, [f64; 5]) {
+    let (phase, tau) = m.phase_at(t);
+    let dv = m.v_level - m.v_vertical;
+    let r = match phase {
+        Phase::Vertical1 | Phase::Vertical2 => [m.v_vertical, 0.0, FRAC_PI_2, 0.0, 0.0],
+        Phase::Level => [m.v_level, 0.0, 0.0, 0.0, 0.0],
+        Phase::TransitionToLevel => {
+            let w = PI / m.t_transition_1;
+            let (s, c) = (w * tau).sin_cos();
+            let g = FRAC_PI_2 / 2.0;
+            [
+                m.v_vertical + dv / 2.0 * (1.0 - c),
+                dv / 2.0 * w * s,
+                g * (1.0 + c),
+                -g * w * s,
+                -g * w * w * c,
+            ]
+        }
+        Phase::TransitionToVertical => {
+            let w = PI / m.t_transition_2;
+            let (s, c) = (w * tau).sin_cos();
+            let g = FRAC_PI_2 / 2.0;
+            [
+                m.v_level - dv / 2.0 * (1.0 - c),
+                -dv / 2.0 * w * s,
+                g * (1.0 - c),
+                g * w * s,
+                g * w * w * c,
+            ]
+        }
+    };
+    (phase, r)
+}
+
+/// Thesis α (3.3.3–3.3.4).
+fn alpha_thesis(m: &MissionParams, t: f64, alpha_level: f64, alpha_max: f64) -> f64 {
+    let (phase, tau) = m.phase_at(t);
+    match phase {
+        Phase::Vertical1 | Phase::Vertical2 => 0.0,
+        Phase::Level => alpha_level,
+        Phase::TransitionToLevel => alpha_level * (tau / m.t_transition_1 * FRAC_PI_2).sin(),
+        Phase::TransitionToVertical => {
+            let t2 = m.t_transition_2;
+            if tau < t2 / 3.0 {
+                alpha_level + (alpha_max - alpha_level) / 2.0 * (1.0 - (tau / (t2 / 3.0) * PI).cos())
+            } else {
+                alpha_max / 2.0 * (1.0 + (tau / (2.0 * t2 / 3.0) * PI - FRAC_PI_2).cos())
+            }
+        }
+    }
+}
+
+/// Turn: heading rate and its derivative at t (level segment only).
+fn turn_rate(m: &MissionParams, t: f64, radius: f64) -> (f64, f64) {
+    if radius == 0.0 || !radius.is_finite() {
+        return (0.0, 0.0);
+    }
+    let (phase, tau) = m.phase_at(t);
+    if phase != Phase::Level {
+        return (0.0, 0.0);
+    }
+    let w = m.v_level / radius; // (3.3.19)
+    let ramp = TURN_RAMP.min(0.5 * m.t_level).max(1e-6);
+    let k = PI / ramp;
+    if tau < ramp {
+        let (s, c) = (k * tau).sin_cos();
+        (w * 0.5 * (1.0 - c), w * 0.5 * k * s)
+    } else if tau > m.t_level - ramp {
+        let x = m.t_level - tau;
+        let (s, c) = (k * x).sin_cos();
+        (w * 0.5 * (1.0 - c), -w * 0.5 * k * s)
+    } else {
+        (w, 0.0)
+    }
+}
+
+/// The model state and input of a longitudinal point for the force-balance solve.
+#[allow(clippy::too_many_arguments)]
+fn point_state(
+    v: f64,
+    alpha: f64,
+    gamma: f64,
+    phi: f64,
+    psi: f64,
+    rates: &Vector3<f64>,
+    thrust: f64,
+    de: f64,
+) -> (X, U) {
+    let mut x = X::zeros();
+    x[ix::V] = v;
+    x[ix::ALPHA] = alpha;
+    x[ix::P] = rates.x;
+    x[ix::Q] = rates.y;
+    x[ix::R] = rates.z;
+    x[ix::PHI] = phi;
+    x[ix::THETA] = gamma + alpha;
+    x[ix::PSI] = psi;
+    x[ix::T] = thrust;
+    let mut u = U::zeros();
+    u[0] = thrust;
+    u[1] = de;
+    (x, u)
+}
+
+impl Trajectory {
+    /// Build the table for `mission` with the controller's airframe `af`.
+    pub fn new(af: &Airframe, mission: &MissionParams, opt: &TrajectoryOptions) -> Result<Self, String> {
+        mission.validate().map_err(|e| e.0)?;
+        let end = mission.end_time() + 1.0;
+        let n = (end / TABLE_STEP).ceil() as usize + 2;
+        let g = af.gravity;
+        // Level trim α for the thesis mode (and the solve's initial guesses).
+        let level = tailsitter_physics::Plant::new(*af)
+            .trim_level(mission.v_level)
+            .map_err(|e| format!("level trim at v_level = {} failed: {e}", mission.v_level))?;
+
+        // Pass 0: kinematic path, heading, bank.
+        let mut pts: Vec<TrajPoint> = Vec::with_capacity(n);
+        let mut psi = 0.0;
+        let mut alphas = Vec::with_capacity(n);
+        for i in 0..n {
+            let t = i as f64 * TABLE_STEP;
+            let (_, [v, _, gamma, _, _]) = path(mission, t);
+            if i > 0 {
+                let (w0, _) = turn_rate(mission, t - TABLE_STEP, opt.turn_radius);
+                let (w1, _) = turn_rate(mission, t, opt.turn_radius);
+                psi += 0.5 * (w0 + w1) * TABLE_STEP;
+            }
+            let alpha = match opt.mode {
+                TrajectoryMode::Thesis => alpha_thesis(mission, t, level.alpha, opt.alpha_max),
+                TrajectoryMode::ForceBalance => 0.0,
+            };
+            alphas.push(alpha);
+            pts.push(TrajPoint {
+                t,
+                v,
+                alpha,
+                gamma,
+                euler_321: Vector3::new(0.0, gamma + alpha, psi),
+                rates: Vector3::zeros(),
+                pos_neh: Vector3::zeros(),
+                thrust: 0.0,
+                u: U::zeros(),
+            });
+        }
+
+        // Passes: body rates from θ̇, ψ̇, φ̇; then α, T, δe; twice for the force balance
+        // (the second pass uses α̇, α̈ of the first).
+        let passes = if opt.mode == TrajectoryMode::ForceBalance { 2 } else { 1 };
+        let mut z_prev = [0.0, af.mass * g, 0.0];
+        for pass in 0..passes {
+            // α̇ has kinks where γ̈ of the cosine blends steps (phase boundaries); a
+            // 0.2 s moving average keeps α̈ (→ q̇ → δe) free of finite-difference spikes.
+            let alpha_dot = smooth(&derivative(&alphas), 10);
+            let alpha_ddot = smooth(&derivative(&alpha_dot), 10);
+            for i in 0..n {
+                let t = pts[i].t;
+                let (_, [v, vdot, gamma, gdot, gddot]) = path(mission, t);
+                let (w, wdot) = turn_rate(mission, t, opt.turn_radius);
+                let phi = (v * w / g).atan(); // (3.3.18)
+                let psi = pts[i].euler_321.z;
+                let theta_dot = gdot + alpha_dot[i];
+                let theta_ddot = gddot + alpha_ddot[i];
+                // φ̇ from the derivative of atan(V ω / g).
+                let k = v * w / g;
+                let phi_dot = (vdot * w + v * wdot) / g / (1.0 + k * k);
+                let rates_of = |alpha: f64| {
+                    let th = gamma + alpha;
+                    let (sf, cf) = phi.sin_cos();
+                    let (st, ct) = th.sin_cos();
+                    // 3-2-1: p = φ̇ − ψ̇ sθ, q = θ̇ cφ + ψ̇ sφ cθ, r = −θ̇ sφ + ψ̇ cφ cθ.
+                    Vector3::new(
+                        phi_dot - w * st,
+                        theta_dot * cf + w * sf * ct,
+                        -theta_dot * sf + w * cf * ct,
+                    )
+                };
+                match opt.mode {
+                    TrajectoryMode::Thesis => {
+                        let alpha = alphas[i];
+                        let rates = rates_of(alpha);
+                        // (3.3.13–3.3.14).
+                        let thrust = af.mass * vdot
+                            + af.mass * g * gamma.sin()
+                            + 0.5 * af.air_density * v * v * af.wing_area * af.c_D0;
+                        // (3.3.15–3.3.17) with the slip-stream scaling.
+                        let c = af.coefficients(alpha);
+                        let wi = af.induced_velocity(v, v * alpha.cos(), thrust);
+                        let qbar = 0.5 * af.air_density * v * v * af.wing_area * af.mean_chord;
+                        let de = (af.i_yy * theta_ddot / qbar
+                            - af.c_m0
+                            - c.c_m_alpha * alpha
+                            - af.mean_chord / (2.0 * v) * c.c_m_q * rates.y)
+                            / c.c_m_de
+                            * (v / (v + 2.0 * wi)).powi(2);
+                        let p = &mut pts[i];
+                        p.rates = rates;
+                        p.thrust = thrust;
+                        p.u[1] = de;
+                        p.euler_321 = Vector3::new(phi, gamma + alpha, psi);
+                    }
+                    TrajectoryMode::ForceBalance => {
+                        let target = Vector3::new(vdot, alpha_dot[i], theta_ddot);
+                        let resid = |z: &[f64; 3]| {
+                            let rates = rates_of(z[0]);
+                            let (x, u) = point_state(v, z[0], gamma, phi, psi, &rates, z[1], z[2]);
+                            let d = derivatives(af, EulerRep::E321, &x, &u);
+                            Vector3::new(d[ix::V], d[ix::ALPHA], d[ix::Q]) - target
+                        };
+                        let mut z = if i == 0 || pass > 0 {
+                            [alphas[i], pts[i].thrust.max(1.0), pts[i].u[1]]
+                        } else {
+                            z_prev
+                        };
+                        if pass == 0 && i == 0 {
+                            z = [0.0, af.mass * g, 0.0];
+                        }
+                        let mut ok = false;
+                        for _ in 0..50 {
+                            let r = resid(&z);
+                            if r.amax() < 1e-10 {
+                                ok = true;
+                                break;
+                            }
+                            let mut jac = Matrix3::zeros();
+                            for j in 0..3 {
+                                let h = 1e-7 * (1.0 + z[j].abs());
+                                let mut zp = z;
+                                let mut zm = z;
+                                zp[j] += h;
+                                zm[j] -= h;
+                                jac.set_column(j, &((resid(&zp) - resid(&zm)) / (2.0 * h)));
+                            }
+                            let dz = jac
+                                .lu()
+                                .solve(&r)
+                                .ok_or_else(|| format!("singular trajectory solve at t = {t}"))?;
+                            let scale = (0.1 / dz[0].abs().max(dz[2].abs()).max(1e-300)).min(1.0);
+                            for k in 0..3 {
+                                z[k] -= scale * dz[k];
+                            }
+                        }
+                        if !ok {
+                            return Err(format!("trajectory force balance did not converge at t = {t:.2} s (pass {pass}, z = {z:?}, residual {:?})", resid(&z)));
+                        }
+                        z_prev = z;
+                        alphas[i] = z[0];
+                        let p = &mut pts[i];
+                        p.alpha = z[0];
+                        p.rates = rates_of(z[0]);
+                        p.thrust = z[1];
+                        p.u[1] = z[2];
+                        p.euler_321 = Vector3::new(phi, gamma + z[0], psi);
+                    }
+                }
+            }
+        }
+        // Thrust command leads the state by the lag (2.3.16); positions (3.3.9–3.3.12).
+        let thrusts: Vec<f64> = pts.iter().map(|p| p.thrust).collect();
+        let tdot = derivative(&thrusts);
+        let mut pos = Vector3::zeros();
+        for i in 0..n {
+            if i > 0 {
+                let vel = |p: &TrajPoint| {
+                    let (sg, cg) = p.gamma.sin_cos();
+                    let (sp, cp) = p.euler_321.z.sin_cos();
+                    Vector3::new(p.v * cg * cp, p.v * cg * sp, p.v * sg)
+                };
+                pos += 0.5 * (vel(&pts[i - 1]) + vel(&pts[i])) * TABLE_STEP;
+            }
+            let p = &mut pts[i];
+            p.pos_neh = pos;
+            p.u[0] = (p.thrust + af.tau_thrust * tdot[i]).clamp(af.thrust_min, af.thrust_max);
+            if opt.mode == TrajectoryMode::Thesis {
+                p.alpha = alphas[i];
+            }
+        }
+        if pts
+            .iter()
+            .any(|p| !(p.v.is_finite() && p.u.iter().all(|x| x.is_finite()) && p.pos_neh.iter().all(|x| x.is_finite())))
+        {
+            return Err("non-finite trajectory".into());
+        }
+        Ok(Self {
+            points: pts.into(),
+            mission: *mission,
+        })
+    }
+
+    /// The reference at mission time `t` (linear interpolation; beyond the table the
+    /// last vertical climb continues at `v_vertical`). No allocation.
+    pub fn at(&self, t: f64) -> TrajPoint {
+        let n = self.points.len();
+        let s = (t.max(0.0)) / TABLE_STEP;
+        let i = s.floor() as usize;
+        if i + 1 >= n {
+            let mut p = self.points[n - 1];
+            let dt = t - p.t;
+            let (sg, cg) = p.gamma.sin_cos();
+            let (sp, cp) = p.euler_321.z.sin_cos();
+            p.pos_neh += Vector3::new(cg * cp, cg * sp, sg) * p.v * dt;
+            p.t = t;
+            return p;
+        }
+        self.points[i].lerp(&self.points[i + 1], s - i as f64)
+    }
+
+    /// The mission the table was built for.
+    pub fn mission(&self) -> &MissionParams {
+        &self.mission
+    }
+
+    /// Every table point (for plots and tests).
+    pub fn points(&self) -> &[TrajPoint] {
+        &self.points
+    }
+}
+
+/// Centred moving average over 2·`half` + 1 points (shrinking at the ends).
+fn smooth(y: &[f64], half: usize) -> Vec<f64> {
+    let n = y.len();
+    (0..n)
+        .map(|i| {
+            let (a, b) = (i.saturating_sub(half), (i + half).min(n - 1));
+            y[a..=b].iter().sum::<f64>() / (b - a + 1) as f64
+        })
+        .collect()
+}
+
+/// Central-difference derivative of a table sampled at [`TABLE_STEP`].
+fn derivative(y: &[f64]) -> Vec<f64> {
+    let n = y.len();
+    (0..n)
+        .map(|i| {
+            let (a, b) = (i.saturating_sub(1), (i + 1).min(n - 1));
+            if b > a {
+                (y[b] - y[a]) / ((b - a) as f64 * TABLE_STEP)
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn max_jump(traj: &Trajectory, f: impl Fn(&TrajPoint) -> f64) -> f64 {
+        traj.points()
+            .windows(2)
+            .map(|w| (f(&w[1]) - f(&w[0])).abs())
+            .fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn trajectory_is_continuous_across_phase_boundaries() {
+        let af = Airframe::default();
+        let m = MissionParams::default();
+        for mode in [TrajectoryMode::ForceBalance, TrajectoryMode::Thesis] {
+            let traj = Trajectory::new(
+                &af,
+                &m,
+                &TrajectoryOptions {
+                    mode,
+                    ..Default::default()
+                },
+            )
+            .unwrap();
+            // Per table step (10 ms): no jumps in any reference quantity.
+            assert!(max_jump(&traj, |p| p.v) < 0.1, "{mode:?} V");
+            assert!(max_jump(&traj, |p| p.euler_321.y) < 0.01, "{mode:?} θ");
+            assert!(max_jump(&traj, |p| p.pos_neh.norm()) < 0.3, "{mode:?} pos");
+            assert!(
+                max_jump(&traj, |p| p.u[0]) < 3.0,
+                "{mode:?} T_c: {}",
+                max_jump(&traj, |p| p.u[0])
+            );
+            assert!(
+                max_jump(&traj, |p| p.u[1]) < 0.01,
+                "{mode:?} δe {}",
+                max_jump(&traj, |p| p.u[1])
+            );
+            for b in m.phase_starts() {
+                let before = traj.at(b - 1e-9);
+                let after = traj.at(b + 1e-9);
+                assert!((before.v - after.v).abs() < 1e-6);
+                assert!((before.pos_neh - after.pos_neh).norm() < 1e-6);
+                assert!((before.euler_321 - after.euler_321).norm() < 1e-6);
+            }
+        }
+    }
+
+    #[test]
+    fn force_balance_matches_trims_in_steady_segments() {
+        let af = Airframe::default();
+        let m = MissionParams::default();
+        let traj = Trajectory::new(&af, &m, &TrajectoryOptions::default()).unwrap();
+        let plant = tailsitter_physics::Plant::new(af);
+        let level = plant.trim_level(m.v_level).unwrap();
+        let p = traj.at(15.0);
+        assert!((p.alpha - level.alpha).abs() < 1e-6, "{} vs {}", p.alpha, level.alpha);
+        assert!((p.u[0] - level.thrust).abs() < 1e-3);
+        assert!((p.u[1] - level.elevator).abs() < 1e-6);
+        let climb = plant.trim_vertical_climb(m.v_vertical).unwrap();
+        let p = traj.at(2.0);
+        assert!((p.u[0] - climb.thrust).abs() < 1e-3, "{} vs {}", p.u[0], climb.thrust);
+        assert!((p.pos_neh.z - 6.0).abs() < 1e-9);
+    }
+}

@@ -1,0 +1,642 @@
+//! Time-scale-decoupled (TSD) flight controller of the tail-sitter (S.C. Kriel's thesis,
+//! chapter 4 and appendix B), as a plain Rust struct implementing
+//! [`flight_mission::FlightController`].
+//!
+//! Structure (figures 4.1, 4.2):
+//!
+//! * **Outer loop** (§4.3), slow: the kinematic [`trajectory`] (§4.3.3) gives reference
+//!   position, velocity and specific acceleration; the guidance controller (4.3.24)
+//!   commands an earth-axis specific acceleration Σ, decomposed (4.3.27–4.3.30) into an
+//!   axial command A_Wc, a normal command C_Wc and a commanded normal vector k^Wc; the
+//!   normal-vector-direction (NVD) controller (4.3.1–4.3.6) turns the roll error into a
+//!   roll-rate reference. In vertical flight and the transitions the normal vector is
+//!   prescribed by the trajectory (§4.3.2.1) and the lateral part of Σ goes to the
+//!   directional loop; the switch to the computed normal vector in level flight is a
+//!   linear blend over `normal_vector_blend_time`, so commands stay continuous.
+//! * **Inner loop** (§4.2), fast, gain-scheduled at every sample from the airspeed, the
+//!   thrust and the dynamic pressures q̄ = ½ρV̄² (free stream: wing, ailerons) and
+//!   q̄_s = ½ρ(V̄ + 2w)² (slip-stream: elevator, flaps, rudder):
+//!   axial specific acceleration with thrust (4.2.1–4.2.8, anti-windup §4.2.1);
+//!   normal specific acceleration with the mixed elevator/collective-flap actuator δm
+//!   (4.2.9–4.2.17, Table 4.1) and gravity cancellation δmg (App. B);
+//!   combined roll-rate / NVD loop (4.2.21–4.2.26, 4.3.7–4.3.11) with ailerons and
+//!   differential flaps; directional loop regulating the lateral specific acceleration with
+//!   the mixed rudder/vertical-flap actuator (4.2.27–4.2.31, Table 4.2) and feedback
+//!   linearisation δR_f (the printed (4.2.29) is garbled; derived in the README).
+//!
+//! Every inner loop has integral action. Integrators are stored as their contribution
+//! to the command (u_I = −K_E ∫e), so gain changes between samples cause no bumps;
+//! they are initialised at the first sample so the first command equals the measured
+//! actuator state (bumpless start from the plant's trim), wound back by back-calculation
+//! with the tracking gain (§4.2.1) when a command saturates, and only finite values are
+//! committed. `update` does not allocate (static nalgebra types only).
+//!
+//! Frames: earth NED, body (x nose, y right wing, z belly), wind axes (x along the air
+//! velocity, z in the plane of symmetry). Units SI, angles rad.
+
+pub mod gains;
+pub mod params;
+pub mod trajectory;
+
+pub use params::TsdParams;
+pub use trajectory::{Reference, Trajectory};
+
+use flight_mission::{
+    Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, FlightController, MissionParams, Notice,
+    ParamError, Phase,
+};
+use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+use tailsitter_physics::Airframe;
+
+/// Number of f64 values written by [`TsdController::save`].
+pub const STATE_LEN: usize = 6;
+
+/// Internal signals of the last sample, for tests, plots and tuning.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Internals {
+    /// Guidance command Σ, NED [m/s²] (4.3.24).
+    pub sigma_cmd: Vector3<f64>,
+    /// Axial, lateral, normal specific-acceleration commands A_Wc, B_Wc, C_Wc [m/s²].
+    pub accel_cmd: Vector3<f64>,
+    /// Measured A_W, B_W, C_W [m/s²].
+    pub accel: Vector3<f64>,
+    /// Commanded normal vector k^Wc, NED.
+    pub normal_cmd: Vector3<f64>,
+    /// NVD error angle φ (4.3.5) [rad].
+    pub roll_error: f64,
+    /// Weight of the computed (vs prescribed) normal vector, 0..1.
+    pub normal_weight: f64,
+    /// Schedule variable: 0 at v_vertical, 1 at v_level.
+    pub schedule: f64,
+    /// Mixing ratios (δfc/δe, δv/δr) (4.2.12, Table 4.2).
+    pub mixing: (f64, f64),
+    /// Unsaturated virtual commands (T_c, δm, δA, δR).
+    pub virtual_cmd: [f64; 4],
+}
+
+/// Integrator state of the four inner loops: the thrust contribution [N] and, for the
+/// surface loops, the contribution to the control *acceleration* b·δ [rad/s²] (pitch, roll,
+/// yaw): the command is recovered as u_I/b with the current control effectiveness b, so
+/// a trim held by an integrator stays trimmed when the dynamic pressure over the surfaces
+/// changes (e.g. the slip-stream when thrust comes on) — integrators in the natural units
+/// of a gain-scheduled loop.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+struct Integrators {
+    thrust: f64,
+    normal: f64,
+    roll: f64,
+    directional: f64,
+}
+
+/// The TSD controller.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TsdController {
+    params: TsdParams,
+    mission: MissionParams,
+    airframe: Airframe,
+    trajectory: Trajectory,
+    integrators: Integrators,
+    initialized: bool,
+    /// Bit mask of the saturated commands at the last sample (notices on new saturation only).
+    saturated: u32,
+    internals: Internals,
+}
+
+/// Names of the commands, bit order of the saturation mask.
+const COMMAND_NAMES: [&str; 7] = [
+    "thrust_cmd",
+    "elevator_cmd",
+    "aileron_cmd",
+    "rudder_cmd",
+    "flap_collective_cmd",
+    "flap_differential_cmd",
+    "vertical_flap_cmd",
+];
+
+#[inline]
+fn lerp(a: f64, b: f64, s: f64) -> f64 {
+    a + (b - a) * s
+}
+
+impl TsdController {
+    /// A controller for `mission` with tuning `params`, using `airframe` (its own model of
+    /// the aircraft, not necessarily the plant's) for gains and feedback linearisation.
+    pub fn new(params: TsdParams, mission: MissionParams, airframe: Airframe) -> Result<Self, ParamError> {
+        params.validate()?;
+        mission.validate()?;
+        airframe
+            .validate()
+            .map_err(|e| ParamError(format!("controller airframe: {e}")))?;
+        Ok(Self {
+            params,
+            mission,
+            airframe,
+            trajectory: Trajectory::new(mission, airframe.gravity),
+            integrators: Integrators::default(),
+            initialized: false,
+            saturated: 0,
+            internals: Internals::default(),
+        })
+    }
+
+    /// The nominal airframe and Table 4.3 poles for `mission`.
+    pub fn with_mission(mission: MissionParams) -> Result<Self, ParamError> {
+        Self::new(TsdParams::default(), mission, Airframe::default())
+    }
+
+    /// Tuning parameters.
+    pub fn params(&self) -> &TsdParams {
+        &self.params
+    }
+
+    /// Mission flown.
+    pub fn mission(&self) -> &MissionParams {
+        &self.mission
+    }
+
+    /// The kinematic trajectory.
+    pub fn trajectory(&self) -> &Trajectory {
+        &self.trajectory
+    }
+
+    /// Internal signals of the last sample.
+    pub fn internals(&self) -> &Internals {
+        &self.internals
+    }
+
+    /// Forget integrators: the next sample starts bumplessly from the measured actuators.
+    pub fn reset(&mut self) {
+        self.integrators = Integrators::default();
+        self.initialized = false;
+        self.saturated = 0;
+    }
+
+    /// Write the complete dynamic state ([`STATE_LEN`] values) for FMU-state serialisation.
+    pub fn save(&self, out: &mut impl FnMut(f64)) {
+        out(if self.initialized { 1.0 } else { 0.0 });
+        out(self.integrators.thrust);
+        out(self.integrators.normal);
+        out(self.integrators.roll);
+        out(self.integrators.directional);
+        out(self.saturated as f64);
+    }
+
+    /// Restore what [`Self::save`] wrote; `None` (too few values) leaves `self` unchanged.
+    pub fn restore(&mut self, next: &mut impl FnMut() -> Option<f64>) -> Option<()> {
+        let mut v = [0.0; STATE_LEN];
+        for slot in v.iter_mut() {
+            *slot = next()?;
+        }
+        self.initialized = v[0] != 0.0;
+        self.integrators = Integrators {
+            thrust: v[1],
+            normal: v[2],
+            roll: v[3],
+            directional: v[4],
+        };
+        self.saturated = if v[5].is_finite() && v[5] >= 0.0 {
+            v[5] as u32
+        } else {
+            0
+        };
+        Some(())
+    }
+
+    /// Mixing ratios (r_n, r_v): δfc = r_n·δm, δe = δm (4.2.12–4.2.13, Table 4.1) and
+    /// δv = r_v·δR, δr = δR (Table 4.2), r = −k·(force of the main surface)/(force of the
+    /// flap) so that the mixed actuator's force is −(k − 1) times the main surface's, of
+    /// opposite sign, and the right-half-plane zero of (4.2.11) moves to the left (4.2.14).
+    pub fn mixing_ratios(&self, alpha: f64) -> (f64, f64) {
+        let c = self.airframe.coefficients(alpha);
+        let rn = -self.params.flap_mixing_factor * c.c_L_de / c.c_L_dfc;
+        let rv = -self.params.vertical_flap_mixing_factor * c.c_Y_dr / c.c_Y_dv;
+        (rn, rv)
+    }
+
+    fn err(msg: impl Into<String>) -> ControlError {
+        ControlError(msg.into())
+    }
+}
+
+impl FlightController for TsdController {
+    fn update(&mut self, input: &ControllerInput) -> Result<ControllerOutput, ControlError> {
+        let meas = &input.measurement;
+        if let Some(name) = meas.first_non_finite() {
+            return Err(Self::err(format!(
+                "measurement '{name}' is not finite at t = {} s",
+                input.t
+            )));
+        }
+        if !input.t.is_finite() || !input.ref_offset_ned.iter().all(|v| v.is_finite()) {
+            return Err(Self::err(format!(
+                "non-finite time or reference offset at t = {} s",
+                input.t
+            )));
+        }
+        let p = self.params;
+        let af = self.airframe;
+        let m = af.mass;
+        let g = af.gravity;
+        let ts = self.mission.sample_time;
+        let (vv, vl) = (self.mission.v_vertical, self.mission.v_level);
+
+        // ---- Reference (§4.3.3) ------------------------------------------------------
+        let reference = self.trajectory.at(input.t);
+        let ref_pos = reference.pos + input.ref_offset_ned;
+        let pos_error_vec = meas.pos_ned - ref_pos;
+
+        // ---- Measured wind axes and specific accelerations ----------------------------
+        let q = &meas.quat;
+        let att = UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]));
+        let r_eb = att.to_rotation_matrix(); // body → earth
+                                             // Frame of the specific accelerations: the wind axes (thesis) above
+                                             // `wind_frame_speed_high`, the reference-path axes below `wind_frame_speed_low`
+                                             // (κ = 0), blended between. κ also scales the path-rotation terms of the loop models
+                                             // (a11 C_W, the gravity terms g₁/V̄, g₂/V̄ and their feedback linearisation): at low
+                                             // speed the wind axes turn as fast as the body and the time-scale separation fails.
+        let kappa = ((meas.airspeed - p.wind_frame_speed_low) / (p.wind_frame_speed_high - p.wind_frame_speed_low))
+            .clamp(0.0, 1.0);
+        let (fa, fb) = {
+            let (sa, ca) = meas.alpha.sin_cos();
+            let (sb, cb) = meas.beta.sin_cos();
+            let iw_e = r_eb * Vector3::new(ca * cb, sb, sa * cb);
+            let blend = iw_e * kappa + reference.tangent() * (1.0 - kappa);
+            let i_f = r_eb.transpose() * (if blend.norm() > 1e-6 { blend.normalize() } else { iw_e });
+            (i_f.z.atan2(i_f.x), i_f.y.clamp(-1.0, 1.0).asin())
+        };
+        let (sa, ca) = fa.sin_cos();
+        let (sb, cb) = fb.sin_cos();
+        // Rows of DCM^WB (A.2.7): wind axes in body components.
+        let iw_b = Vector3::new(ca * cb, sb, sa * cb);
+        let jw_b = Vector3::new(-ca * sb, cb, -sa * sb);
+        let kw_b = Vector3::new(-sa, 0.0, ca);
+        let iw = r_eb * iw_b;
+        let jw = r_eb * jw_b;
+        let kw = r_eb * kw_b;
+        let f = meas.specific_force_body;
+        let a_w = iw_b.dot(&f);
+        let b_w = jw_b.dot(&f);
+        let c_w = kw_b.dot(&f);
+        // Gravity direction cosines: e_i3 = (wind axis i)·(down) (4.2.17).
+        let (e13, e23, e33) = (iw.z, jw.z, kw.z);
+        let (pr, qr, rr) = (meas.rates.x, meas.rates.y, meas.rates.z);
+        // Stability-axis roll and yaw rates (≈ P_W of (2.5.27) for small β).
+        let p_s = pr * ca + rr * sa;
+        let r_s = rr * ca - pr * sa;
+
+        // ---- Gain schedule -----------------------------------------------------------
+        let v = meas.airspeed.max(p.min_airspeed);
+        let sched = ((meas.airspeed - vv) / (vl - vv)).clamp(0.0, 1.0);
+        let rho = af.air_density;
+        let (s_ref, b_ref, c_ref) = (af.wing_area, af.wing_span, af.mean_chord);
+        let qbar = 0.5 * rho * v * v;
+        let vs = v + 2.0 * meas.induced_velocity.max(0.0);
+        let qbar_s = 0.5 * rho * vs * vs;
+        let kr = 0.25 * rho * v * s_ref; // q̄S/(2V̄): rate derivatives (2.3.5)
+        let thrust = meas.thrust.max(0.0);
+        let cos_alpha = meas.alpha.cos();
+        let c = af.coefficients(meas.alpha);
+        let (rn, rv) = self.mixing_ratios(meas.alpha);
+        let (ixx, iyy, izz) = (af.i_xx, af.i_yy, af.i_zz);
+        let lim = af.deflection_limit;
+
+        // ---- Guidance (4.3.24) ---------------------------------------------------------
+        let (kp_g, kv_g) = gains::guidance_gains(
+            lerp(p.guidance_pole_re_vertical, p.guidance_pole_re_level, sched),
+            lerp(p.guidance_pole_im_vertical, p.guidance_pole_im_level, sched),
+        );
+        let vel_error = meas.vel_ned - reference.vel;
+        let sigma_ff = if p.feedforward_lead > 0.0 {
+            self.trajectory.at(input.t + p.feedforward_lead).specific_accel
+        } else {
+            reference.specific_accel
+        };
+        let sigma = -pos_error_vec * kp_g - vel_error * kv_g + sigma_ff;
+
+        // ---- Decomposition (4.3.27–4.3.30) and prescribed normal vector (§4.3.2.1) ---
+        let a_cmd = sigma.dot(&iw);
+        let n_vec = sigma - iw * a_cmd;
+        let n_norm = n_vec.norm();
+        let k_pres = reference.prescribed_normal();
+        // Weight of the computed normal vector: 1 inside level flight, ramping over the
+        // blend time at both ends, and faded out when the normal command is too small.
+        let normal_weight = if reference.phase == Phase::Level {
+            let (_, tau) = self.mission.phase_at(input.t);
+            let bt = p.normal_vector_blend_time;
+            let ramp = if bt > 0.0 {
+                (tau / bt).min((self.mission.t_level - tau) / bt).clamp(0.0, 1.0)
+            } else {
+                1.0
+            };
+            let nmin = p.min_normal_accel;
+            let size = if nmin > 0.0 {
+                ((n_norm - nmin) / nmin).clamp(0.0, 1.0)
+            } else {
+                1.0
+            };
+            ramp * size
+        } else {
+            0.0
+        };
+        // Sign of C_Wc (4.3.29): normal flight lifts against the belly.
+        let (c_comp, k_comp) = if n_norm > 1e-9 {
+            if n_vec.dot(&k_pres) <= 0.0 {
+                (-n_norm, -n_vec / n_norm)
+            } else {
+                (n_norm, n_vec / n_norm)
+            }
+        } else {
+            (0.0, k_pres)
+        };
+        let w_n = normal_weight;
+        let c_cmd = (1.0 - w_n) * sigma.dot(&kw) + w_n * c_comp;
+        let b_cmd = (1.0 - w_n) * sigma.dot(&jw);
+        let k_blend = k_pres * (1.0 - w_n) + k_comp * w_n;
+        let k_cmd = if k_blend.norm() > 1e-9 {
+            k_blend.normalize()
+        } else {
+            k_pres
+        };
+        // NVD error angle (4.3.3–4.3.5): the roll about i^W taking k^W to k^Wc;
+        // k^Wc·j^W = −sin φ, k^Wc·k^W = cos φ (atan2 keeps the sign and the full range).
+        let (sj, ck) = (-k_cmd.dot(&jw), k_cmd.dot(&kw));
+        let roll_error = if sj.hypot(ck) > 0.1 { sj.atan2(ck) } else { 0.0 };
+
+        // ---- Axial loop (4.2.1–4.2.8) --------------------------------------------------
+        let (ka, ke_a) = gains::axial_gains(
+            m,
+            af.tau_thrust,
+            gains::char_poly_2_real(
+                lerp(p.axial_pole_1_vertical, p.axial_pole_1_level, sched),
+                lerp(p.axial_pole_2_vertical, p.axial_pole_2_level, sched),
+            ),
+        );
+        let thrust_p = -ka * a_w;
+
+        // ---- Normal loop (4.2.9–4.2.17) ------------------------------------------------
+        // a11 includes the thrust's normal component −T sin α of (2.5.28): in vertical flight
+        // it is the main normal force.
+        let z_alpha = -(qbar * s_ref * c.c_L_alpha + thrust * cos_alpha) / m; // = V̄ a11
+        let a11_n = z_alpha / v;
+        let a21_n = qbar * s_ref * c_ref * c.c_m_alpha / iyy;
+        let a22_n = kr * c_ref * c_ref * c.c_m_q / iyy;
+        let b2 = qbar_s * s_ref * c_ref * (c.c_m_de + rn * c.c_m_dfc) / iyy;
+        let (an, bn) = gains::normal_model(kappa * a11_n, a21_n, a22_n, b2, z_alpha);
+        let poly_n = gains::char_poly_3(
+            lerp(p.normal_pole_real_vertical, p.normal_pole_real_level, sched),
+            lerp(p.normal_pole_re_vertical, p.normal_pole_re_level, sched),
+            lerp(p.normal_pole_im_vertical, p.normal_pole_im_level, sched),
+        );
+        let k_n = gains::place_3(&an, &bn, poly_n).ok_or_else(|| {
+            Self::err(format!(
+                "normal-acceleration gains not computable at t = {} s (V = {v} m/s)",
+                input.t
+            ))
+        })?;
+        // Gravity along the wind z axis g₁ = g e33 and its rate (4.2.17), from
+        // dk^W/dt = Q_W i^W − P_W j^W with Q_W = −(C_W + g₁)/V̄ (2.5.12).
+        let g1 = kappa * g * e33;
+        let g1_dot = -kappa * g * ((c_w + g * e33) / v * e13 + p_s * e23);
+        let q_prime = qr + g1 / v;
+        // Feedback linearisation (App. B), in the Q′ coordinates: cancels the gravity terms
+        // of Q̇′; equals the printed δmg of (4.2.16) once −K_Q g₁/V̄ is added back.
+        let dm_g = (a22_n * g1 - g1_dot) / (v * b2);
+        let dm_p = -k_n[0] * c_w - k_n[1] * q_prime + dm_g;
+
+        // ---- Roll / NVD (4.2.21–4.2.26, 4.3.7–4.3.11) -----------------------------------
+        // Ailerons (free stream) and differential flaps (slip-stream) deflected together.
+        let a21_r = qbar * s_ref * b_ref * c.c_l_beta / ixx;
+        let a22_r = kr * b_ref * b_ref * c.c_l_p / ixx;
+        let a23_r = kr * b_ref * b_ref * c.c_l_r / ixx;
+        let b21 = s_ref * b_ref * (qbar * c.c_l_da + qbar_s * c.c_l_dfd) / ixx;
+        let poly_r = gains::char_poly_3(
+            lerp(p.nvd_pole_vertical, p.nvd_pole_level, sched),
+            lerp(p.roll_pole_re_vertical, p.roll_pole_re_level, sched),
+            lerp(p.roll_pole_im_vertical, p.roll_pole_im_level, sched),
+        );
+        let (kp_r, ke_r, kphi) = gains::roll_nvd_gains(a22_r, b21, poly_r)
+            .ok_or_else(|| Self::err(format!("roll gains not computable at t = {} s", input.t)))?;
+        let p_ref = kphi * roll_error; // P_R = P_Wc + K_φ φ, P_Wc = 0 (no turns in the mission)
+                                       // (4.2.25): cancel the sideslip and yaw-rate roll moments.
+        let da_f = -(a21_r * meas.beta + a23_r * r_s) / b21;
+        let da_p = -kp_r * p_s + da_f;
+
+        // ---- Directional (4.2.27–4.2.31) -----------------------------------------------
+        let y_beta = (qbar * s_ref * c.c_Y_beta - thrust * cos_alpha) / m; // = V̄ a11
+        let a11_l = y_beta / v;
+        let a31 = qbar * s_ref * b_ref * c.c_n_beta / izz;
+        let a32 = kr * b_ref * b_ref * c.c_n_p / izz;
+        let a33 = kr * b_ref * b_ref * c.c_n_r / izz;
+        let b31 = s_ref * b_ref * (qbar * c.c_n_da + qbar_s * c.c_n_dfd) / izz;
+        let b32 = qbar_s * s_ref * b_ref * (c.c_n_dr + rv * c.c_n_dv) / izz;
+        let (ad, bd) = gains::directional_model(kappa * a11_l, a31, a33, b32, y_beta);
+        let poly_d = gains::char_poly_3(
+            lerp(p.directional_pole_real_vertical, p.directional_pole_real_level, sched),
+            lerp(p.directional_pole_re_vertical, p.directional_pole_re_level, sched),
+            lerp(p.directional_pole_im_vertical, p.directional_pole_im_level, sched),
+        );
+        let k_d = gains::place_3(&ad, &bd, poly_d)
+            .ok_or_else(|| Self::err(format!("directional gains not computable at t = {} s", input.t)))?;
+        // Gravity along the wind y axis g₂ = g e23 and its rate, from dj^W/dt = −R_W i^W +
+        // P_W k^W with R_W = (B_W + g₂)/V̄ (2.5.12).
+        let g2 = kappa * g * e23;
+        let g2_dot = kappa * g * (-(b_w + g * e23) / v * e13 + p_s * e33);
+        let r_prime = r_s - g2 / v;
+
+        // ---- Bumpless start -------------------------------------------------------------
+        let integ = &mut self.integrators;
+        if !self.initialized {
+            let s = meas.surfaces; // δe, δa, δr, δfc, δfd, δv
+            let da_now = s[1];
+            let dr_f0 = -(a32 * p_s + b31 * da_now + a33 * g2 / v - g2_dot / v) / b32;
+            integ.thrust = meas.thrust - thrust_p;
+            integ.normal = b2 * (s[0] - dm_p);
+            integ.roll = b21 * (da_now - da_p);
+            integ.directional = b32 * (s[2] - (-k_d[0] * b_w - k_d[1] * r_prime + dr_f0));
+            self.initialized = true;
+        }
+
+        // ---- Commands ------------------------------------------------------------------
+        let thrust_c = thrust_p + integ.thrust;
+        let dm = dm_p + integ.normal / b2;
+        let da = da_p + integ.roll / b21;
+        // (4.2.29), derived: δR_f = −(a32 P + b31 δA + a33 g₂/V̄ − ġ₂/V̄)/b32 cancels every
+        // term of Ṙ′ outside the (B_W, R′) model.
+        let dr_f = -(a32 * p_s + b31 * da.clamp(-lim, lim) + a33 * g2 / v - g2_dot / v) / b32;
+        let dr = -k_d[0] * b_w - k_d[1] * r_prime + integ.directional / b32 + dr_f;
+
+        let thrust_sat = thrust_c.clamp(af.thrust_min, af.thrust_max);
+        let dm_sat = dm.clamp(-lim, lim);
+        let da_sat = da.clamp(-lim, lim);
+        let dr_sat = dr.clamp(-lim, lim);
+        let command = Command {
+            thrust: thrust_sat,
+            elevator: dm_sat,
+            aileron: da_sat,
+            rudder: dr_sat,
+            flap_collective: (rn * dm).clamp(-lim, lim),
+            flap_differential: da_sat,
+            vertical_flap: (rv * dr).clamp(-lim, lim),
+        };
+        if !command.is_finite() {
+            return Err(Self::err(format!("non-finite command at t = {} s", input.t)));
+        }
+
+        // ---- Integrators with back-calculation anti-windup (§4.2.1) ---------------------
+        let kaw = (p.antiwindup_gain * ts).min(1.0);
+        // u_I ← u_I + b·(−T_s K_E e + k_aw (u_sat − u)), b the control effectiveness.
+        let step = |u_i: &mut f64, b: f64, ke: f64, e: f64, u: f64, u_sat: f64| {
+            let next = *u_i + b * (-ts * ke * e + kaw * (u_sat - u));
+            if next.is_finite() {
+                *u_i = next;
+            }
+        };
+        step(&mut integ.thrust, 1.0, ke_a, a_w - a_cmd, thrust_c, thrust_sat);
+        step(&mut integ.normal, b2, k_n[2], c_w - c_cmd, dm, dm_sat);
+        step(&mut integ.roll, b21, ke_r, p_s - p_ref, da, da_sat);
+        step(&mut integ.directional, b32, k_d[2], b_w - b_cmd, dr, dr_sat);
+
+        // ---- Notices: saturations newly reached ------------------------------------------
+        let values = [
+            (thrust_c, af.thrust_min, af.thrust_max),
+            (dm, -lim, lim),
+            (da, -lim, lim),
+            (dr, -lim, lim),
+            (rn * dm, -lim, lim),
+            (da, -lim, lim),
+            (rv * dr, -lim, lim),
+        ];
+        let mut mask = 0u32;
+        for (k, (x, lo, hi)) in values.iter().enumerate() {
+            if x < lo || x > hi {
+                mask |= 1 << k;
+            }
+        }
+        let fresh = mask & !self.saturated;
+        self.saturated = mask;
+        let notice = (fresh != 0).then(|| Notice::Saturated(COMMAND_NAMES[fresh.trailing_zeros() as usize]));
+
+        self.internals = Internals {
+            sigma_cmd: sigma,
+            accel_cmd: Vector3::new(a_cmd, b_cmd, c_cmd),
+            accel: Vector3::new(a_w, b_w, c_w),
+            normal_cmd: k_cmd,
+            roll_error,
+            normal_weight,
+            schedule: sched,
+            mixing: (rn, rv),
+            virtual_cmd: [thrust_c, dm, da, dr],
+        };
+
+        Ok(ControllerOutput {
+            command,
+            diagnostics: Diagnostics {
+                ref_pos_ned: ref_pos,
+                ref_airspeed: reference.airspeed,
+                phase: reference.phase,
+                pos_error: pos_error_vec.norm(),
+            },
+            notice,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mixing_ratio_of_table_4_1_and_4_2() {
+        let ctl = TsdController::with_mission(MissionParams::default()).unwrap();
+        let (rn, rv) = ctl.mixing_ratios(0.0);
+        let af = Airframe::default();
+        // Table 4.1 uses C_Lδe = 1.246, C_Lδfc = 0.748: r = −1.833; the App. C numbers at α = 0
+        // give −1.1·1.2618/0.7479.
+        assert!((rn - (-1.1 * 1.2618 / 0.7479)).abs() < 1e-12);
+        assert!((-1.1f64 * 1.246 / 0.748 - (-1.833)).abs() < 1e-3);
+        let c_l_mixed = af.c_L_de_a0 + rn * af.c_L_dfc_a0;
+        let c_m_mixed = af.c_m_de_a0 + rn * af.c_m_dfc_a0;
+        // Mixed lift = −0.1 × elevator lift; mixed moment ≈ −1.66 (Table 4.1: −0.1246, −1.657).
+        assert!((c_l_mixed + 0.1 * af.c_L_de_a0).abs() < 1e-12);
+        assert!((c_m_mixed - (-1.657)).abs() < 0.02, "{c_m_mixed}");
+        // Table 4.2: side force −0.101, yaw moment −0.327.
+        let c_y_mixed = af.c_Y_dr_a0 + rv * af.c_Y_dv_a0;
+        let c_n_mixed = af.c_n_dr_a0 + rv * af.c_n_dv_a0;
+        assert!((c_y_mixed + 0.1 * af.c_Y_dr_a0).abs() < 1e-12);
+        assert!((c_n_mixed - (-0.327)).abs() < 0.01, "{c_n_mixed}");
+    }
+
+    /// Zeros of C_W/δ for the short-period model with the direct lift of the surfaces,
+    /// α̇ = a11 α + Q + (Z_δ/V̄) δ, Q̇ = a21 α + a22 Q + b2 δ, C_W = V̄ a11 α + Z_δ δ:
+    /// N(s) = Z_δ (s² − (a11 + a22) s + a11 a22 − a21) + V̄ a11 ((Z_δ/V̄)(s − a22) + b2).
+    fn short_period_zeros(v: f64, w: f64, thrust: f64, c_l: f64, c_m: f64) -> [nalgebra::Complex<f64>; 2] {
+        let af = Airframe::default();
+        let c = af.coefficients(0.0);
+        let (rho, s, cbar, m) = (af.air_density, af.wing_area, af.mean_chord, af.mass);
+        let qbar = 0.5 * rho * v * v;
+        let qbar_s = 0.5 * rho * (v + 2.0 * w).powi(2);
+        let a11 = -(qbar * s * c.c_L_alpha + thrust) / (m * v);
+        let a21 = qbar * s * cbar * c.c_m_alpha / af.i_yy;
+        let a22 = 0.25 * rho * v * s * cbar * cbar * c.c_m_q / af.i_yy;
+        let b2 = qbar_s * s * cbar * c_m / af.i_yy;
+        let zd = -qbar_s * s * c_l / m;
+        // N(s) = n2 s² + n1 s + n0
+        let n2 = zd;
+        let n1 = -zd * (a11 + a22) + a11 * zd;
+        let n0 = zd * (a11 * a22 - a21) + v * a11 * (-(zd / v) * a22 + b2);
+        let disc = nalgebra::Complex::new(n1 * n1 - 4.0 * n2 * n0, 0.0).sqrt();
+        [(-disc - n1) / (2.0 * n2), (disc - n1) / (2.0 * n2)]
+    }
+
+    #[test]
+    fn mixing_moves_the_non_minimum_phase_zero_to_the_left_half_plane() {
+        let ctl = TsdController::with_mission(MissionParams::default()).unwrap();
+        let (rn, _) = ctl.mixing_ratios(0.0);
+        let af = Airframe::default();
+        // Level flight at 25 m/s (w ≈ 1.2 m/s at the trim thrust), compare (4.2.11) and (4.2.14).
+        let elevator = short_period_zeros(25.0, 1.2, 10.0, af.c_L_de_a0, af.c_m_de_a0);
+        assert!(elevator.iter().any(|z| z.re > 0.0), "elevator alone: {elevator:?}");
+        let mixed = short_period_zeros(
+            25.0,
+            1.2,
+            10.0,
+            af.c_L_de_a0 + rn * af.c_L_dfc_a0,
+            af.c_m_de_a0 + rn * af.c_m_dfc_a0,
+        );
+        assert!(mixed.iter().all(|z| z.re < 0.0), "mixed: {mixed:?}");
+        println!("zeros of C_W/δe: {elevator:?}; of C_W/δm: {mixed:?}");
+    }
+
+    #[test]
+    fn save_restore_round_trip() {
+        let mut a = TsdController::with_mission(MissionParams::default()).unwrap();
+        a.integrators = Integrators {
+            thrust: 1.0,
+            normal: 2.0,
+            roll: 3.0,
+            directional: 4.0,
+        };
+        a.initialized = true;
+        a.saturated = 5;
+        let mut buf = Vec::new();
+        a.save(&mut |x| buf.push(x));
+        assert_eq!(buf.len(), STATE_LEN);
+        let mut b = TsdController::with_mission(MissionParams::default()).unwrap();
+        let mut it = buf.into_iter();
+        b.restore(&mut || it.next()).unwrap();
+        assert_eq!(a.integrators, b.integrators);
+        assert_eq!((a.initialized, a.saturated), (b.initialized, b.saturated));
+        let mut empty = std::iter::empty();
+        assert!(b.restore(&mut || empty.next()).is_none());
+    }
+
+    #[test]
+    fn invalid_parameters_are_named() {
+        let p = TsdParams {
+            normal_pole_re_level: 1.0,
+            ..Default::default()
+        };
+        let e = TsdController::new(p, MissionParams::default(), Airframe::default()).unwrap_err();
+        assert!(e.0.contains("normal_pole_re_level"), "{e}");
+    }
+}

@@ -1,0 +1,220 @@
+//! Tuning parameters of the TSD controller (Table 4.3 and §4.2.1, §4.2.2, §4.3.2.1).
+
+use flight_mission::ParamError;
+
+/// Every tuning parameter of the controller. Field names are the FMU parameter names
+/// (group `tsd` of `modelDescription/tailsitter_tsd.json`).
+///
+/// Poles are given per flight phase (vertical / level, Table 4.3) and blended linearly
+/// in the airspeed between `v_vertical` and `v_level` of the mission. A loop's poles are
+/// "real" (a real pole) and "re ± i·im" (a complex pair).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TsdParams {
+    /// Axial specific acceleration, first pole, vertical flight [1/s].
+    pub axial_pole_1_vertical: f64,
+    /// Axial specific acceleration, second pole, vertical flight [1/s].
+    pub axial_pole_2_vertical: f64,
+    /// Axial specific acceleration, first pole, level flight [1/s].
+    pub axial_pole_1_level: f64,
+    /// Axial specific acceleration, second pole, level flight [1/s].
+    pub axial_pole_2_level: f64,
+    /// Roll rate pair, real part, vertical flight [1/s].
+    pub roll_pole_re_vertical: f64,
+    /// Roll rate pair, imaginary part, vertical flight [1/s].
+    pub roll_pole_im_vertical: f64,
+    /// Roll rate pair, real part, level flight [1/s].
+    pub roll_pole_re_level: f64,
+    /// Roll rate pair, imaginary part, level flight [1/s].
+    pub roll_pole_im_level: f64,
+    /// Normal specific acceleration, real pole, vertical flight [1/s].
+    pub normal_pole_real_vertical: f64,
+    /// Normal specific acceleration pair, real part, vertical flight [1/s].
+    pub normal_pole_re_vertical: f64,
+    /// Normal specific acceleration pair, imaginary part, vertical flight [1/s].
+    pub normal_pole_im_vertical: f64,
+    /// Normal specific acceleration, real pole, level flight [1/s].
+    pub normal_pole_real_level: f64,
+    /// Normal specific acceleration pair, real part, level flight [1/s].
+    pub normal_pole_re_level: f64,
+    /// Normal specific acceleration pair, imaginary part, level flight [1/s].
+    pub normal_pole_im_level: f64,
+    /// Directional (lateral specific acceleration), real pole, vertical flight [1/s].
+    pub directional_pole_real_vertical: f64,
+    /// Directional pair, real part, vertical flight [1/s].
+    pub directional_pole_re_vertical: f64,
+    /// Directional pair, imaginary part, vertical flight [1/s].
+    pub directional_pole_im_vertical: f64,
+    /// Directional, real pole, level flight [1/s].
+    pub directional_pole_real_level: f64,
+    /// Directional pair, real part, level flight [1/s].
+    pub directional_pole_re_level: f64,
+    /// Directional pair, imaginary part, level flight [1/s].
+    pub directional_pole_im_level: f64,
+    /// Normal-vector-direction pole, vertical flight [1/s].
+    pub nvd_pole_vertical: f64,
+    /// Normal-vector-direction pole, level flight [1/s].
+    pub nvd_pole_level: f64,
+    /// Guidance pair, real part, vertical flight [1/s].
+    pub guidance_pole_re_vertical: f64,
+    /// Guidance pair, imaginary part, vertical flight [1/s].
+    pub guidance_pole_im_vertical: f64,
+    /// Guidance pair, real part, level flight [1/s].
+    pub guidance_pole_re_level: f64,
+    /// Guidance pair, imaginary part, level flight [1/s].
+    pub guidance_pole_im_level: f64,
+    /// Integrator anti-windup tracking gain of every loop (§4.2.1: 50) [1/s].
+    pub antiwindup_gain: f64,
+    /// Factor k of the elevator/collective-flap mixing r = −k·C_Lδe/C_Lδfc (4.2.12: 1.1).
+    pub flap_mixing_factor: f64,
+    /// Factor k of the rudder/vertical-flap mixing r = −k·C_Yδr/C_Yδv (Table 4.2: 1.1).
+    pub vertical_flap_mixing_factor: f64,
+    /// Airspeed floor of the gain schedule: the loop models divide by V̄ [m/s].
+    pub min_airspeed: f64,
+    /// Time over which the commanded normal vector changes between the prescribed one
+    /// (vertical flight, transitions) and the one from the guidance acceleration (level
+    /// flight, (4.3.27–4.3.30)) at the start and end of level flight [s].
+    pub normal_vector_blend_time: f64,
+    /// Below this normal part of the commanded acceleration the prescribed normal vector is
+    /// used even in level flight (§4.3.2.1) [m/s²].
+    pub min_normal_accel: f64,
+    /// Below this airspeed the specific accelerations are resolved in the reference-path
+    /// frame instead of the wind axes (the wind axes turn as fast as the body at low
+    /// speed, (C_W + g₁)/V̄, and the time-scale separation fails) [m/s].
+    pub wind_frame_speed_low: f64,
+    /// Above this airspeed the wind axes are used, as in the thesis; linear blend between [m/s].
+    pub wind_frame_speed_high: f64,
+    /// Preview of the feed-forward specific acceleration: Σ^RE of (4.3.24) is taken from the
+    /// trajectory this much ahead of the sample, compensating the lag of the inner loops
+    /// (servo, thrust and the specific-acceleration poles) at the acceleration steps of the
+    /// unsmoothed trajectory (§4.3.3) [s].
+    pub feedforward_lead: f64,
+}
+
+impl Default for TsdParams {
+    /// Table 4.3 of the thesis, §4.2.1 (anti-windup 50) and (4.2.12) (mixing 1.1).
+    fn default() -> Self {
+        Self {
+            axial_pole_1_vertical: -10.0,
+            axial_pole_2_vertical: -15.0,
+            axial_pole_1_level: -10.0,
+            axial_pole_2_level: -15.0,
+            roll_pole_re_vertical: -5.5,
+            roll_pole_im_vertical: 3.3,
+            roll_pole_re_level: -9.0,
+            roll_pole_im_level: 4.5,
+            normal_pole_real_vertical: -8.5,
+            normal_pole_re_vertical: -7.2,
+            normal_pole_im_vertical: 3.0,
+            normal_pole_real_level: -14.0,
+            normal_pole_re_level: -15.0,
+            normal_pole_im_level: 5.0,
+            directional_pole_real_vertical: -5.0,
+            directional_pole_re_vertical: -3.5,
+            directional_pole_im_vertical: 1.75,
+            directional_pole_real_level: -10.0,
+            directional_pole_re_level: -7.0,
+            directional_pole_im_level: 3.5,
+            nvd_pole_vertical: -0.5,
+            nvd_pole_level: -3.5,
+            guidance_pole_re_vertical: -0.5,
+            guidance_pole_im_vertical: 0.2,
+            guidance_pole_re_level: -0.75,
+            guidance_pole_im_level: 0.45,
+            antiwindup_gain: 50.0,
+            flap_mixing_factor: 1.1,
+            vertical_flap_mixing_factor: 1.1,
+            min_airspeed: 2.0,
+            normal_vector_blend_time: 1.0,
+            min_normal_accel: 2.0,
+            wind_frame_speed_low: 4.0,
+            wind_frame_speed_high: 10.0,
+            feedforward_lead: 0.15,
+        }
+    }
+}
+
+impl TsdParams {
+    /// Every parameter with its name, in declaration order.
+    pub fn named_values(&self) -> [(&'static str, f64); 35] {
+        [
+            ("axial_pole_1_vertical", self.axial_pole_1_vertical),
+            ("axial_pole_2_vertical", self.axial_pole_2_vertical),
+            ("axial_pole_1_level", self.axial_pole_1_level),
+            ("axial_pole_2_level", self.axial_pole_2_level),
+            ("roll_pole_re_vertical", self.roll_pole_re_vertical),
+            ("roll_pole_im_vertical", self.roll_pole_im_vertical),
+            ("roll_pole_re_level", self.roll_pole_re_level),
+            ("roll_pole_im_level", self.roll_pole_im_level),
+            ("normal_pole_real_vertical", self.normal_pole_real_vertical),
+            ("normal_pole_re_vertical", self.normal_pole_re_vertical),
+            ("normal_pole_im_vertical", self.normal_pole_im_vertical),
+            ("normal_pole_real_level", self.normal_pole_real_level),
+            ("normal_pole_re_level", self.normal_pole_re_level),
+            ("normal_pole_im_level", self.normal_pole_im_level),
+            ("directional_pole_real_vertical", self.directional_pole_real_vertical),
+            ("directional_pole_re_vertical", self.directional_pole_re_vertical),
+            ("directional_pole_im_vertical", self.directional_pole_im_vertical),
+            ("directional_pole_real_level", self.directional_pole_real_level),
+            ("directional_pole_re_level", self.directional_pole_re_level),
+            ("directional_pole_im_level", self.directional_pole_im_level),
+            ("nvd_pole_vertical", self.nvd_pole_vertical),
+            ("nvd_pole_level", self.nvd_pole_level),
+            ("guidance_pole_re_vertical", self.guidance_pole_re_vertical),
+            ("guidance_pole_im_vertical", self.guidance_pole_im_vertical),
+            ("guidance_pole_re_level", self.guidance_pole_re_level),
+            ("guidance_pole_im_level", self.guidance_pole_im_level),
+            ("antiwindup_gain", self.antiwindup_gain),
+            ("flap_mixing_factor", self.flap_mixing_factor),
+            ("vertical_flap_mixing_factor", self.vertical_flap_mixing_factor),
+            ("min_airspeed", self.min_airspeed),
+            ("normal_vector_blend_time", self.normal_vector_blend_time),
+            ("min_normal_accel", self.min_normal_accel),
+            ("wind_frame_speed_low", self.wind_frame_speed_low),
+            ("wind_frame_speed_high", self.wind_frame_speed_high),
+            ("feedforward_lead", self.feedforward_lead),
+        ]
+    }
+
+    /// All finite; every pole's real part negative (stable design); anti-windup gain,
+    /// mixing factors, airspeed floor positive; blend time and minimum normal
+    /// acceleration non-negative.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        for (name, value) in self.named_values() {
+            if !value.is_finite() {
+                return Err(ParamError(format!("{name} = {value}: must be finite")));
+            }
+            let is_real_part = name.contains("_pole_") && !name.contains("_im_");
+            if is_real_part && value >= 0.0 {
+                return Err(ParamError(format!(
+                    "{name} = {value}: a pole's real part must be negative"
+                )));
+            }
+        }
+        for (name, value) in [
+            ("antiwindup_gain", self.antiwindup_gain),
+            ("flap_mixing_factor", self.flap_mixing_factor),
+            ("vertical_flap_mixing_factor", self.vertical_flap_mixing_factor),
+            ("min_airspeed", self.min_airspeed),
+        ] {
+            if value <= 0.0 {
+                return Err(ParamError(format!("{name} = {value}: must be > 0")));
+            }
+        }
+        for (name, value) in [
+            ("normal_vector_blend_time", self.normal_vector_blend_time),
+            ("min_normal_accel", self.min_normal_accel),
+            ("feedforward_lead", self.feedforward_lead),
+        ] {
+            if value < 0.0 {
+                return Err(ParamError(format!("{name} = {value}: must be ≥ 0")));
+            }
+        }
+        if self.wind_frame_speed_low < 0.0 || self.wind_frame_speed_high <= self.wind_frame_speed_low {
+            return Err(ParamError(format!(
+                "wind_frame_speed_low = {}, wind_frame_speed_high = {}: need 0 ≤ low < high",
+                self.wind_frame_speed_low, self.wind_frame_speed_high
+            )));
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,198 @@
+//! Closed-loop acceptance of the TSD controller with the nonlinear plant
+//! (tailsitter-physics) through the reference master of `closed-loop`
+//! (Gauss-Seidel: the controller samples the plant outputs at t, then the plant
+//! advances 20 ms). The plant starts in its trimmed 3 m/s vertical climb.
+//!
+//! Run with `cargo test --release -p tsd-control -- --nocapture` to see the numbers.
+
+use closed_loop::{fly, MissionCheck, Ordering, Scenario, Trace};
+use flight_mission::MissionParams;
+use nalgebra::Vector3;
+use tailsitter_physics::{Airframe, Plant, StateVector};
+use tsd_control::TsdController;
+
+fn plant() -> Plant {
+    Plant::new(Airframe::default())
+}
+
+fn climb_trim(plant: &Plant, v: f64) -> StateVector {
+    plant.trim_vertical_climb(v).expect("vertical climb trim").state
+}
+
+fn level_trim_theta(plant: &Plant, v: f64) -> f64 {
+    plant.trim_level(v).expect("level trim").theta
+}
+
+fn run(mission: MissionParams, ordering: Ordering) -> (Trace, MissionCheck) {
+    let plant = plant();
+    let x0 = climb_trim(&plant, mission.v_vertical);
+    let mut ctl = TsdController::with_mission(mission).unwrap();
+    let mut scenario = Scenario::mission(mission);
+    scenario.ordering = ordering;
+    let trace = fly(&plant, x0, &mut ctl, &scenario);
+    let check = MissionCheck::of(&trace, &mission, level_trim_theta(&plant, mission.v_level));
+    (trace, check)
+}
+
+fn report(name: &str, trace: &Trace, check: &MissionCheck, mission: &MissionParams) {
+    println!("=== TSD {name} ===");
+    if let Some(f) = &trace.failure {
+        println!("FAILED: {f}");
+    }
+    print!("{check}");
+    println!(
+        "  max alpha over the mission: {:.2} deg",
+        trace.max_alpha(0.0, mission.end_time() + 1.0).to_degrees()
+    );
+    let min_alpha = trace
+        .samples
+        .iter()
+        .map(|s| s.measurement.alpha)
+        .fold(f64::INFINITY, f64::min);
+    println!("  min alpha over the mission: {:.2} deg", min_alpha.to_degrees());
+    let max_dev_d = trace
+        .samples
+        .iter()
+        .map(|s| (s.measurement.pos_ned.z - s.diagnostics.ref_pos_ned.z).abs())
+        .fold(0.0, f64::max);
+    println!("  max altitude deviation: {max_dev_d:.3} m");
+}
+
+#[test]
+fn default_mission_gauss_seidel() {
+    let mission = MissionParams::default();
+    let (trace, check) = run(mission, Ordering::GaussSeidel);
+    report(
+        "default mission (T1 = 5 s, T2 = 10 s), Gauss-Seidel",
+        &trace,
+        &check,
+        &mission,
+    );
+    assert!(trace.completed(), "{:?}", trace.failure);
+    assert!(check.passed(), "{check}");
+}
+
+#[test]
+fn fast_mission_gauss_seidel() {
+    let mission = MissionParams {
+        t_transition_1: 3.0,
+        t_transition_2: 4.0,
+        ..Default::default()
+    };
+    let (trace, check) = run(mission, Ordering::GaussSeidel);
+    report(
+        "fast mission (T1 = 3 s, T2 = 4 s), Gauss-Seidel",
+        &trace,
+        &check,
+        &mission,
+    );
+    assert!(trace.completed(), "{:?}", trace.failure);
+    assert!(check.all_finite);
+    let max_alpha = trace.max_alpha(0.0, mission.end_time() + 1.0);
+    assert!(
+        max_alpha < 20f64.to_radians(),
+        "max alpha {:.2} deg",
+        max_alpha.to_degrees()
+    );
+    assert!(check.passed(), "{check}");
+}
+
+#[test]
+fn default_mission_jacobi() {
+    let mission = MissionParams::default();
+    let (trace, check) = run(mission, Ordering::Jacobi);
+    report(
+        "default mission, Jacobi (one sample extra delay)",
+        &trace,
+        &check,
+        &mission,
+    );
+    assert!(trace.completed(), "{:?}", trace.failure);
+    assert!(check.passed(), "{check}");
+}
+
+/// A 5 m step of the reference offset at `t_step` in a long phase; returns the settling
+/// time (last time the error to the new reference exceeds 0.5 m, after the step) and the
+/// final error.
+fn step_response(mission: MissionParams, t_step: f64, offset: Vector3<f64>, t_end: f64) -> (Trace, f64, f64) {
+    let plant = plant();
+    let x0 = climb_trim(&plant, mission.v_vertical);
+    let mut ctl = TsdController::with_mission(mission).unwrap();
+    let mut scenario = Scenario::mission(mission);
+    scenario.stop_time = t_end;
+    scenario.ref_offset_steps = vec![(t_step, offset)];
+    let trace = fly(&plant, x0, &mut ctl, &scenario);
+    let mut last_out = t_step;
+    let mut final_err = f64::NAN;
+    for s in trace.window(t_step, t_end + 1.0) {
+        let e = s.pos_error();
+        if e > 0.5 {
+            last_out = s.t;
+        }
+        final_err = e;
+    }
+    (trace, last_out - t_step, final_err)
+}
+
+#[test]
+fn position_steps_settle() {
+    // Vertical: a long first vertical phase. Level: a long level phase.
+    let vertical = MissionParams {
+        t_vertical_1: 40.0,
+        ..Default::default()
+    };
+    let level = MissionParams {
+        t_level: 40.0,
+        ..Default::default()
+    };
+    let cases = [
+        (
+            "vertical, normal (north) 5 m",
+            vertical,
+            5.0,
+            Vector3::new(5.0, 0.0, 0.0),
+            35.0,
+        ),
+        (
+            "vertical, lateral (east) 5 m",
+            vertical,
+            5.0,
+            Vector3::new(0.0, 5.0, 0.0),
+            35.0,
+        ),
+        (
+            "level, normal (down) 5 m",
+            level,
+            15.0,
+            Vector3::new(0.0, 0.0, 5.0),
+            45.0,
+        ),
+        (
+            "level, lateral (east) 5 m",
+            level,
+            15.0,
+            Vector3::new(0.0, 5.0, 0.0),
+            45.0,
+        ),
+    ];
+    let mut failures = Vec::new();
+    for (name, mission, t_step, offset, t_end) in cases {
+        let (trace, settle, final_err) = step_response(mission, t_step, offset, t_end);
+        let max_err = trace
+            .window(t_step, t_end + 1.0)
+            .map(|s| s.pos_error())
+            .fold(0.0, f64::max);
+        println!(
+            "step {name}: settling (< 0.5 m) {settle:.2} s, final error {final_err:.3} m, max error {max_err:.2} m{}",
+            trace
+                .failure
+                .as_ref()
+                .map(|f| format!(" FAILED: {f}"))
+                .unwrap_or_default()
+        );
+        if !trace.completed() || final_err >= 0.5 || settle > t_end - t_step - 1.0 {
+            failures.push(name);
+        }
+    }
+    assert!(failures.is_empty(), "did not settle: {failures:?}");
+}

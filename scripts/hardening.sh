@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# Long-run hardening of the FMU libraries (issue 7). Not part of scripts/test.sh,
+# which runs the short versions (cargo test -p fmi-fuzz: 2500 fuzz sequences,
+# 64-thread check, 10 000-cycle RSS check; pytest test_conformance/test_interop).
+#
+#   scripts/hardening.sh [FUZZ_SECONDS]        default 600
+#
+# Environment: TAILSITTER_FMUS=a,b narrows the FMUs (default: all three);
+# HARDENING_SKIP_DIST=1 skips `cargo xtask dist`; FUZZ_SEED sets the fuzz seed;
+# VALGRIND_CYCLES (default 5) cycles per FMU under valgrind; RSS_CYCLES (default 100000).
+#
+# Steps and what each reports:
+#  1. long call-sequence fuzz through the C ABI: sequences, FMI calls, reset and restore
+#     checks, violations, (function, state, status) coverage table → target/hardening/fuzz.txt
+#  2. valgrind memcheck of instantiate → 50 steps → get/serialize/deserialize/set state →
+#     free cycles of each FMU: the ERROR SUMMARY and LEAK SUMMARY → target/hardening/valgrind.txt
+#     (2b: the same for a few hundred fuzz sequences: error paths, corrupt FMU states)
+#  3. RSS before/after RSS_CYCLES instantiate/initialise/step/state/free cycles per FMU
+#  4. 64 instances stepped concurrently vs. sequentially (the cargo test, with output)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+SECONDS_FUZZ="${1:-600}"
+OUT=target/hardening
+mkdir -p "$OUT"
+
+if [ "${HARDENING_SKIP_DIST:-0}" != 1 ]; then
+    if [ -n "${TAILSITTER_FMUS:-}" ]; then cargo xtask dist --only "$TAILSITTER_FMUS"; else cargo xtask dist; fi
+fi
+cargo build --release -p fmi-fuzz --bin fmi-fuzz
+BIN=target/release/fmi-fuzz
+
+echo "== 1. fuzz for ${SECONDS_FUZZ} s"
+"$BIN" fuzz --seconds "$SECONDS_FUZZ" --seed "${FUZZ_SEED:-24301}" --coverage | tee "$OUT/fuzz.txt"
+
+echo "== 2. valgrind memcheck (${VALGRIND_CYCLES:-5} cycles per FMU)"
+valgrind --tool=memcheck --leak-check=full --show-leak-kinds=definite,indirect,possible \
+    --errors-for-leak-kinds=definite,indirect --track-origins=yes --error-exitcode=99 \
+    "$BIN" cycles --n "${VALGRIND_CYCLES:-5}" 2>&1 | tee "$OUT/valgrind.txt"
+grep -E "ERROR SUMMARY|definitely lost|indirectly lost|possibly lost|still reachable|in use at exit" "$OUT/valgrind.txt"
+echo "== 2b. valgrind memcheck of ${VALGRIND_FUZZ_SEQUENCES:-300} fuzz sequences (error paths, corrupt states)"
+valgrind --tool=memcheck --leak-check=full --errors-for-leak-kinds=definite,indirect --error-exitcode=99 \
+    "$BIN" fuzz --sequences "${VALGRIND_FUZZ_SEQUENCES:-300}" --seconds 3600 2>&1 | tee "$OUT/valgrind-fuzz.txt" \
+    | grep -E "fmi-fuzz:|VIOLATION|ERROR SUMMARY|definitely lost|indirectly lost"
+
+echo "== 3. RSS over ${RSS_CYCLES:-100000} cycles per FMU"
+"$BIN" rss --n "${RSS_CYCLES:-100000}" | tee "$OUT/rss.txt"
+
+echo "== 4. 64 concurrent instances vs. sequential runs"
+cargo test --release -p fmi-fuzz --test threads_memory -- --nocapture --test-threads 1 | tee "$OUT/threads.txt"
+
+echo "== done: reports in $OUT/"

@@ -1,0 +1,89 @@
+//! Long-run driver (see scripts/hardening.sh):
+//!
+//! - `fmi-fuzz fuzz [--seconds N] [--seed S] [--sequences N] [--coverage]`: the call-sequence
+//!   fuzzer over every required FMU until the time or sequence budget is spent;
+//! - `fmi-fuzz cycles [--n N]`: instantiate → simulate → get/serialize/deserialize/set state →
+//!   free, N times per FMU (the valgrind memcheck driver);
+//! - `fmi-fuzz rss [--n N]`: RSS before/after N instantiate/initialise/step/free cycles per FMU.
+//!
+//! `TAILSITTER_FMUS=a,b` narrows the FMUs; exit code 1 on any violation.
+
+use fmi_fuzz::fuzz::{Config, Fuzzer};
+use fmi_fuzz::{cycle, load_required, rss_kib};
+use std::time::{Duration, Instant};
+
+fn arg<T: std::str::FromStr>(args: &[String], name: &str, default: T) -> T {
+    args.iter()
+        .position(|a| a == name)
+        .and_then(|i| args.get(i + 1))
+        .map(|v| v.parse().unwrap_or_else(|_| panic!("bad value for {name}: {v}")))
+        .unwrap_or(default)
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let fmus = load_required();
+    let ids: Vec<&str> = fmus.iter().map(|f| f.id.as_str()).collect();
+    match args.first().map(String::as_str) {
+        Some("fuzz") => {
+            let seconds: u64 = arg(&args, "--seconds", 60);
+            let seed: u64 = arg(&args, "--seed", 0x5eed);
+            let sequences: u64 = arg(&args, "--sequences", u64::MAX);
+            let cfg = Config {
+                seed,
+                sequences,
+                deadline: Some(Instant::now() + Duration::from_secs(seconds)),
+                max_calls: arg(&args, "--max-calls", 60),
+            };
+            let t0 = Instant::now();
+            let report = Fuzzer::new(&fmus, seed).run(&cfg);
+            println!("FMUs {ids:?}, seed {seed:#x}, {:.1} s", t0.elapsed().as_secs_f64());
+            if args.iter().any(|a| a == "--coverage") {
+                report.print_coverage();
+            }
+            report.print();
+            std::process::exit(i32::from(report.violations > 0));
+        }
+        Some("cycles") => {
+            let n: usize = arg(&args, "--n", 20);
+            let mut failures = 0;
+            for fmu in &fmus {
+                for _ in 0..n {
+                    failures += usize::from(!cycle(fmu, 50));
+                }
+                println!(
+                    "{}: {n} cycles of instantiate → 50 steps → state/serialize → free",
+                    fmu.id
+                );
+            }
+            println!("failures: {failures}");
+            std::process::exit(i32::from(failures > 0));
+        }
+        Some("rss") => {
+            let n: usize = arg(&args, "--n", 10_000);
+            for fmu in &fmus {
+                for _ in 0..200 {
+                    cycle(fmu, 1);
+                }
+                let before = rss_kib();
+                let t0 = Instant::now();
+                for i in 0..n {
+                    assert!(cycle(fmu, 1), "{}: cycle {i} failed", fmu.id);
+                }
+                let after = rss_kib();
+                println!(
+                    "{}: RSS {before} KiB → {after} KiB after {n} cycles ({:+} KiB, {:.1} s)",
+                    fmu.id,
+                    after as i64 - before as i64,
+                    t0.elapsed().as_secs_f64()
+                );
+            }
+        }
+        _ => {
+            eprintln!("usage: fmi-fuzz fuzz [--seconds N] [--seed S] [--sequences N] [--max-calls N] [--coverage]");
+            eprintln!("       fmi-fuzz cycles [--n N]");
+            eprintln!("       fmi-fuzz rss [--n N]");
+            std::process::exit(2);
+        }
+    }
+}

@@ -1,0 +1,255 @@
+//! Failure behaviour in flight, through the real C ABI:
+//! - the plant driven out of its envelope (absurd parameters) reports fmi2Error
+//!   with a message naming the state that left the envelope, and stays usable
+//!   (status, outputs, terminate, reset);
+//! - a single enormous communication step returns promptly;
+//! - the controllers never emit non-finite commands on garbage-but-finite inputs.
+
+use fmi_fuzz::model_description_types::{Causality, VarType};
+use fmi_fuzz::{load_required, Fmu, Rng, ERROR, OK};
+use std::time::{Duration, Instant};
+
+/// Plant states (tailsitter_physics::idx::STATE_NAMES) and envelope quantities.
+const STATE_NAMES: [&str; 23] = [
+    "pos_n",
+    "pos_e",
+    "pos_d",
+    "u",
+    "v",
+    "w",
+    "quat_1",
+    "quat_2",
+    "quat_3",
+    "quat_4",
+    "p",
+    "q",
+    "r",
+    "thrust",
+    "elevator",
+    "aileron",
+    "rudder",
+    "flap_collective",
+    "flap_differential",
+    "vertical_flap",
+    "speed",
+    "airspeed",
+    "quaternion norm",
+];
+
+fn plant(fmus: &[Fmu]) -> &Fmu {
+    fmus.iter()
+        .find(|f| f.id == "tailsitter_plant")
+        .expect("tailsitter_plant is required")
+}
+
+/// Fly with `params` (set in Instantiated) and `inputs` (after init) until a step fails.
+fn diverge(fmu: &Fmu, params: &[(&str, f64)], inputs: &[(&str, f64)]) -> (f64, String) {
+    let mut inst = fmu.instantiate("diverge", true).expect("instantiate");
+    assert_eq!(inst.setup(0.0, None), OK);
+    for (name, x) in params {
+        assert_eq!(
+            inst.set_reals(&[fmu.var(name).vr], &[*x]),
+            OK,
+            "set {name}: {:?}",
+            inst.host.records()
+        );
+    }
+    assert_eq!(inst.enter_init(), OK);
+    assert_eq!(inst.exit_init(), OK, "{:?}", inst.host.records());
+    for (name, x) in inputs {
+        assert_eq!(inst.set_reals(&[fmu.var(name).vr], &[*x]), OK, "set {name}");
+    }
+    let h = fmu.default_step;
+    for k in 0..5000 {
+        let t = k as f64 * h;
+        let from = inst.host.len();
+        match inst.step(t, h) {
+            OK => continue,
+            ERROR => {
+                let msgs: Vec<String> = inst
+                    .host
+                    .since(from)
+                    .into_iter()
+                    .filter(|r| r.status == ERROR)
+                    .map(|r| r.message)
+                    .collect();
+                assert!(!msgs.is_empty(), "fmi2Error without a logged message");
+                // Still a well-behaved instance: StepFailed, outputs readable, terminate, reset.
+                let mut status = 0;
+                // SAFETY: live instance, valid out pointer.
+                let s = unsafe {
+                    fmi_fuzz::ffi!(
+                        fmu.api,
+                        get_status(inst.c, fmi_fuzz::fmi2::fmi2StatusKind_fmi2DoStepStatus, &mut status)
+                    )
+                };
+                assert_eq!(
+                    (s, status),
+                    (OK, ERROR),
+                    "fmi2GetStatus(DoStepStatus) after the failure"
+                );
+                assert_eq!(inst.step(t + h, h), ERROR, "DoStep after a failed step must be refused");
+                let (s, _) = inst.get_reals(&inst.all_real_vrs());
+                assert_eq!(s, OK, "outputs readable in StepFailed");
+                assert_eq!(inst.terminate(), OK);
+                assert_eq!(inst.reset(), OK);
+                inst.initialize();
+                assert_eq!(inst.step(0.0, h), OK, "a reset instance flies again");
+                return (t, msgs.join(" | "));
+            }
+            s => panic!("unexpected status {s}"),
+        }
+    }
+    panic!("{}: no divergence with {params:?} {inputs:?}", fmu.id);
+}
+
+fn assert_names_a_state(msg: &str) {
+    assert!(
+        msg.contains("envelope"),
+        "message does not say the plant left its envelope: {msg}"
+    );
+    assert!(
+        STATE_NAMES
+            .iter()
+            .any(|s| msg.contains(&format!("{s} ")) || msg.contains(&format!("state {s}"))),
+        "message names no state: {msg}"
+    );
+}
+
+#[test]
+fn plant_reports_the_state_leaving_the_envelope_on_huge_thrust() {
+    let fmus = load_required();
+    let fmu = plant(&fmus);
+    let (t, msg) = diverge(
+        fmu,
+        &[("mass", 0.1), ("thrust_max", 10_000.0)],
+        &[("thrust_cmd", 10_000.0)],
+    );
+    println!("huge thrust, 0.1 kg: fmi2Error at t = {t:.2} s: {msg}");
+    assert_names_a_state(&msg);
+}
+
+#[test]
+fn plant_reports_the_state_leaving_the_envelope_on_tiny_inertia() {
+    let fmus = load_required();
+    let fmu = plant(&fmus);
+    let (t, msg) = diverge(
+        fmu,
+        &[("i_xx", 1e-4), ("i_zz", 1e-4)],
+        &[("aileron_cmd", 0.4), ("rudder_cmd", -0.4)],
+    );
+    println!("tiny inertia: fmi2Error at t = {t:.2} s: {msg}");
+    assert_names_a_state(&msg);
+}
+
+#[test]
+fn plant_initialises_at_the_smallest_declared_inertia() {
+    // i_yy = 1e-4 lies inside its declared range [1e-4, 1e4]; the trim's Newton
+    // iteration must accept a residual at round-off level (it scales with 1/i_yy).
+    let fmus = load_required();
+    let fmu = plant(&fmus);
+    let mut inst = fmu.instantiate("tiny_iyy", false).expect("instantiate");
+    assert_eq!(inst.setup(0.0, None), OK);
+    assert_eq!(inst.set_reals(&[fmu.var("i_yy").vr], &[1e-4]), OK);
+    assert_eq!(inst.enter_init(), OK);
+    assert_eq!(inst.exit_init(), OK, "{:?}", inst.host.records());
+}
+
+#[test]
+fn an_enormous_communication_step_returns_promptly() {
+    // h = 1e6 s at the 1 ms integration step: must fail (or finish) in bounded time,
+    // not run ~1e9 RK4 substeps inside one fmi2DoStep.
+    let fmus = load_required();
+    for fmu in &fmus {
+        let (tx, rx) = std::sync::mpsc::channel();
+        let fmu: &'static Fmu = Box::leak(Box::new(Fmu::load(&fmu.id).expect("load")));
+        std::thread::spawn(move || {
+            let mut inst = fmu.instantiate("huge", false).expect("instantiate");
+            inst.initialize();
+            let t0 = Instant::now();
+            let s = inst.step(0.0, 1e6);
+            let _ = tx.send((s, t0.elapsed()));
+        });
+        match rx.recv_timeout(Duration::from_secs(10)) {
+            Ok((s, dt)) => println!(
+                "{}: fmi2DoStep(h = 1e6 s) → status {s} in {:.3} s",
+                fmu.id,
+                dt.as_secs_f64()
+            ),
+            Err(_) => panic!("{}: fmi2DoStep(h = 1e6 s) still running after 10 s", fmu.id),
+        }
+    }
+}
+
+#[test]
+fn controllers_never_emit_non_finite_commands_on_garbage_inputs() {
+    let fmus = load_required();
+    let controllers: Vec<&Fmu> = fmus.iter().filter(|f| f.id != "tailsitter_plant").collect();
+    if controllers.is_empty() {
+        println!("no controller FMU in TAILSITTER_FMUS: nothing to check");
+    }
+    for fmu in controllers {
+        let inputs: Vec<_> = fmu
+            .vars_of(VarType::Real)
+            .filter(|v| v.causality == Causality::Input)
+            .cloned()
+            .collect();
+        let outputs: Vec<u32> = fmu
+            .vars_of(VarType::Real)
+            .filter(|v| v.causality == Causality::Output)
+            .map(|v| v.vr)
+            .collect();
+        let mut rng = Rng::new(7);
+        let (mut steps_ok, mut steps_err, mut warnings) = (0, 0, 0);
+        for run in 0..20 {
+            let mut inst = fmu.instantiate(&format!("garbage{run}"), true).expect("instantiate");
+            inst.initialize();
+            let h = fmu.default_step;
+            let mut t = 0.0;
+            for _ in 0..100 {
+                for v in &inputs {
+                    let x = loop {
+                        let x = match rng.below(4) {
+                            0 => rng.wild_f64(),
+                            1 => *rng.pick(&[1e300, -1e300, 1e30, -1e30, 5e-324, 0.0, 1e6, -1e6]),
+                            _ => (rng.unit() - 0.5) * 10f64.powi(rng.below(8) as i32),
+                        };
+                        if x.is_finite() && x >= v.min && x <= v.max {
+                            break x;
+                        }
+                    };
+                    assert_eq!(inst.set_reals(&[v.vr], &[x]), OK, "{}: set {} = {x}", fmu.id, v.name);
+                }
+                let from = inst.host.len();
+                let s = inst.step(t, h);
+                warnings += inst.host.since(from).iter().filter(|r| r.status != OK).count();
+                if s != OK {
+                    steps_err += 1;
+                    assert!(
+                        !inst.host.since(from).is_empty(),
+                        "{}: step status {s} without a message",
+                        fmu.id
+                    );
+                    break;
+                }
+                steps_ok += 1;
+                t += h;
+                let (s, y) = inst.get_reals(&outputs);
+                assert_eq!(s, OK, "{}: get outputs", fmu.id);
+                for (vr, value) in outputs.iter().zip(&y) {
+                    let name = &fmu.vars.iter().find(|v| v.vr == *vr).expect("declared").name;
+                    assert!(
+                        value.is_finite(),
+                        "{}: output {name} = {value} on garbage inputs",
+                        fmu.id
+                    );
+                }
+            }
+        }
+        println!(
+            "{}: garbage inputs: {steps_ok} steps with finite outputs, {steps_err} refused steps, \
+             {warnings} warnings/errors logged",
+            fmu.id
+        );
+    }
+}

@@ -1,0 +1,44 @@
+//! The short deterministic fuzz run of the test suite: a fixed seed and a fixed
+//! number of random FMI call sequences over every FMU library (target/release,
+//! built by `cargo xtask dist`). `FMI_FUZZ_SEQUENCES` / `FMI_FUZZ_SEED` override;
+//! the long run is `cargo run --release -p fmi-fuzz -- fuzz --seconds N`.
+
+use fmi_fuzz::fuzz::{Config, Fuzzer};
+use fmi_fuzz::load_required;
+use std::time::Instant;
+
+fn env<T: std::str::FromStr>(name: &str, default: T) -> T {
+    std::env::var(name).ok().and_then(|v| v.parse().ok()).unwrap_or(default)
+}
+
+#[test]
+fn random_call_sequences_keep_every_invariant() {
+    let fmus = load_required();
+    let seed = env("FMI_FUZZ_SEED", 20_240_607u64);
+    let cfg = Config {
+        seed,
+        sequences: env("FMI_FUZZ_SEQUENCES", 2500),
+        deadline: None,
+        max_calls: 40,
+    };
+    let t0 = Instant::now();
+    let report = Fuzzer::new(&fmus, seed).run(&cfg);
+    println!("{:.1} s", t0.elapsed().as_secs_f64());
+    report.print();
+    let (pairs, _) = report.coverage_summary();
+    assert_eq!(report.violations, 0, "invariant violations (see output)");
+    assert_eq!(report.reset_checks, report.sequences);
+    assert!(
+        report.restore_checks > report.sequences / 2,
+        "restore checks {}",
+        report.restore_checks
+    );
+    assert!(pairs > 150, "only {pairs} (function, state) pairs covered");
+    for must in [
+        "fmi2DoStep @ StepComplete",
+        "fmi2SetFMUstate @ StepFailed",
+        "fmi2DeSerializeFMUstate @ Terminated",
+    ] {
+        assert!(report.coverage.contains_key(must), "{must} never exercised");
+    }
+}
