@@ -66,19 +66,38 @@ def manoeuvre(plant, slave):
     plant.set(slave, thrust_cmd=110.0, elevator_cmd=0.1, aileron_cmd=-0.05, rudder_cmd=0.03, wind_e=2.0)
 
 
-def test_communication_steps_agree(plant):
+def finals_for(plant, steps, **params):
     finals = {}
-    for h in (0.001, 0.01, 0.02):
-        s = plant.slave(f"h{h}")
+    for h in steps:
+        s = plant.slave(f"h{h}", init=False)
+        s.setupExperiment(startTime=0.0)
+        s.enterInitializationMode()
+        plant.set(s, **params)
+        s.exitInitializationMode()
         manoeuvre(plant, s)
         finals[h] = run(plant, s, 0.0, 1.0, h)
         s.terminate()
         s.freeInstance()
-    ref = finals[0.001]
+    return finals
+
+
+def test_communication_steps_agree(plant):
+    # Steps that are multiples of the internal RK4 step (2 ms) use identical substeps.
+    finals = finals_for(plant, (0.002, 0.01, 0.02))
+    ref = finals[0.002]
     for h in (0.01, 0.02):
-        assert np.max(np.abs(finals[h] - ref)) < 1e-6, (h, finals[h] - ref)
+        assert np.max(np.abs(finals[h] - ref)) < 1e-9, (h, finals[h] - ref)
     # and the manoeuvre really moved the aircraft
     assert abs(ref[OUTPUTS.index("q")]) > 1e-3
+    # A 1 ms step integrates with 1 ms substeps: it differs by the RK4 error only,
+    # which this violent manoeuvre (|q| ~ 20 rad/s, servos on their slew limits) makes ~1e-3.
+    one_ms = finals_for(plant, (0.001,))[0.001]
+    assert np.max(np.abs(one_ms - ref)) < 3e-3
+    # With integration_step = 1 ms, steps of 1, 10 and 20 ms agree to round-off.
+    fine = finals_for(plant, (0.001, 0.01, 0.02), integration_step=0.001)
+    for h in (0.01, 0.02):
+        assert np.max(np.abs(fine[h] - fine[0.001])) < 1e-9, (h, fine[h] - fine[0.001])
+    assert np.max(np.abs(fine[0.001] - ref)) < 3e-3
 
 
 def test_two_instances_are_independent(plant):

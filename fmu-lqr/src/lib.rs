@@ -51,7 +51,11 @@ pub struct LqrModel {
 
 impl LqrModel {
     fn config(vars: &Variables) -> Config {
-        Config { mission: vars.mission(), params: vars.lqr(), weights_file: vars.weights_file.clone() }
+        Config {
+            mission: vars.mission(),
+            params: vars.lqr(),
+            weights_file: vars.weights_file.clone(),
+        }
     }
 
     /// A fresh controller for the configuration in `vars` (cached).
@@ -104,7 +108,11 @@ impl LqrModel {
         if !ref_offset_ned.iter().all(|x| x.is_finite()) {
             return Err(ModelError::new(format!("ref_offset_n/e/d not finite at t = {t} s")));
         }
-        Ok(ControllerInput { t, measurement, ref_offset_ned })
+        Ok(ControllerInput {
+            t,
+            measurement,
+            ref_offset_ned,
+        })
     }
 
     fn write_outputs(&self, vars: &mut Variables) {
@@ -129,12 +137,17 @@ impl LqrModel {
     /// One sample at `t`.
     fn sample(&mut self, vars: &Variables, t: f64, log: &mut Logger<'_>) -> Result<(), ModelError> {
         let input = Self::input(vars, t)?;
-        let controller = self.controller.as_mut().ok_or_else(|| ModelError::new("controller not initialised"))?;
-        let out = controller.update(&input).map_err(|e| ModelError::new(format!("LQR at t = {t} s: {e}")))?;
+        let controller = self
+            .controller
+            .as_mut()
+            .ok_or_else(|| ModelError::new("controller not initialised"))?;
+        let out = controller
+            .update(&input)
+            .map_err(|e| ModelError::new(format!("LQR at t = {t} s: {e}")))?;
         match out.notice {
-            Some(Notice::GainFallback(why)) => {
-                log.warning(format_args!("t = {t} s: gain computation failed ({why}); using the last good gains"))
-            }
+            Some(Notice::GainFallback(why)) => log.warning(format_args!(
+                "t = {t} s: gain computation failed ({why}); using the last good gains"
+            )),
             Some(Notice::Saturated(name)) => log.warning(format_args!("t = {t} s: {name} saturated")),
             None => {}
         }
@@ -151,7 +164,8 @@ impl LqrModel {
         if let Some(saved) = self.pending.take() {
             let mut c = self.fresh(vars)?;
             let mut it = saved.into_iter();
-            c.restore(&mut || it.next()).map_err(|e| ModelError::new(format!("restoring the FMU state: {e}")))?;
+            c.restore(&mut || it.next())
+                .map_err(|e| ModelError::new(format!("restoring the FMU state: {e}")))?;
             self.controller = Some(c);
         }
         Ok(())
@@ -219,7 +233,13 @@ impl FmuModel for LqrModel {
                     w.f64(v);
                 }
                 let d = &out.diagnostics;
-                for v in [d.ref_pos_ned.x, d.ref_pos_ned.y, d.ref_pos_ned.z, d.ref_airspeed, d.pos_error] {
+                for v in [
+                    d.ref_pos_ned.x,
+                    d.ref_pos_ned.y,
+                    d.ref_pos_ned.z,
+                    d.ref_airspeed,
+                    d.pos_error,
+                ] {
                     w.f64(v);
                 }
                 w.i32(d.phase.code());
@@ -289,7 +309,10 @@ impl FmuModel for LqrModel {
             self.pending = None;
         } else if let Some(c) = self.controller.as_mut() {
             if n != saved_len(c) {
-                return Err(StateError::invalid(format!("LQR state has {n} values, expected {}", saved_len(c))));
+                return Err(StateError::invalid(format!(
+                    "LQR state has {n} values, expected {}",
+                    saved_len(c)
+                )));
             }
             let mut it = saved.into_iter();
             c.restore(&mut || it.next()).map_err(|e| StateError::invalid(e.0))?;

@@ -32,6 +32,9 @@ use model::{ix, linearise, state_of, wrap_pi, EulerRep, NA, NU, NX, U, X};
 use trajectory::{TrajPoint, Trajectory, TrajectoryMode, TrajectoryOptions};
 use weights::{load_set, WeightSchedule, Weights, DEFAULT_WEIGHTS_JSON};
 
+/// Smallest reference airspeed the (V, α, β) model for control supports [m/s].
+pub const MIN_AIRSPEED: f64 = 0.5;
+
 /// Size of the augmented ZOH exponential: states + integrator + inputs.
 const NM: usize = NA + NU;
 
@@ -158,6 +161,13 @@ impl LqrController {
             .validate()
             .map_err(|e| ControlError(format!("controller airframe: {e}")))?;
         mission.validate().map_err(|e| ControlError(e.0))?;
+        if mission.v_vertical < MIN_AIRSPEED {
+            return Err(ControlError(format!(
+                "v_vertical = {} m/s: the LQR's model uses airspeed, α and β as states (§2.4), undefined in \
+                 hover; use v_vertical >= {MIN_AIRSPEED} m/s",
+                mission.v_vertical
+            )));
+        }
         let positive = [
             ("relinearisation_period", params.relinearisation_period),
             ("r_scale", params.r_scale),

@@ -36,7 +36,7 @@ impl Default for Envelope {
 pub struct Plant {
     /// Airframe parameters.
     pub airframe: Airframe,
-    /// Maximum internal RK4 step (s) (default 0.001 s). [`Plant::advance`] splits a
+    /// Maximum internal RK4 step (s) (default 0.002 s). [`Plant::advance`] splits a
     /// communication step h into ⌈h / integration_step⌉ equal substeps.
     pub integration_step: f64,
     /// Envelope checked after every substep.
@@ -88,11 +88,11 @@ pub struct Trim {
 }
 
 impl Plant {
-    /// Plant with `integration_step` = 0.001 s and the default envelope.
+    /// Plant with `integration_step` = 0.002 s and the default envelope.
     pub fn new(airframe: Airframe) -> Self {
         Self {
             airframe,
-            integration_step: 0.001,
+            integration_step: 0.002,
             envelope: Envelope::default(),
         }
     }

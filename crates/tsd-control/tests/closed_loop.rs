@@ -196,3 +196,41 @@ fn position_steps_settle() {
     }
     assert!(failures.is_empty(), "did not settle: {failures:?}");
 }
+
+/// The controller keeps its nominal model while the plant's C_mα is 20 % larger
+/// (the most sensitive parameter of §5) — and, separately, C_Lα 20 % smaller.
+#[test]
+fn default_mission_with_perturbed_plant() {
+    let mission = MissionParams::default();
+    let nominal = Airframe::default();
+    let cases = [
+        (
+            "plant C_m_alpha x 1.2",
+            Airframe { c_m_alpha_a0: nominal.c_m_alpha_a0 * 1.2, c_m_alpha_a1: nominal.c_m_alpha_a1 * 1.2, ..nominal },
+        ),
+        (
+            "plant C_L_alpha x 0.8",
+            Airframe { c_L_alpha_a0: nominal.c_L_alpha_a0 * 0.8, c_L_alpha_a1: nominal.c_L_alpha_a1 * 0.8, ..nominal },
+        ),
+        (
+            "plant C_m_de x 0.8",
+            Airframe { c_m_de_a0: nominal.c_m_de_a0 * 0.8, c_m_de_a1: nominal.c_m_de_a1 * 0.8, ..nominal },
+        ),
+    ];
+    let mut failures = Vec::new();
+    for (name, airframe) in cases {
+        let plant = Plant::new(airframe);
+        let x0 = climb_trim(&plant, mission.v_vertical);
+        let mut ctl = TsdController::with_mission(mission).unwrap();
+        let trace = fly(&plant, x0, &mut ctl, &Scenario::mission(mission));
+        let check = MissionCheck::of(&trace, &mission, level_trim_theta(&plant, mission.v_level));
+        report(name, &trace, &check, &mission);
+        if !trace.completed() || !check.all_finite || check.final_pitch_error > 10f64.to_radians() {
+            failures.push(name);
+        }
+        if trace.max_pos_error() > 5.0 {
+            failures.push(name);
+        }
+    }
+    assert!(failures.is_empty(), "{failures:?}");
+}

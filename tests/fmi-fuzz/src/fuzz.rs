@@ -252,12 +252,7 @@ struct Live<'a> {
 
 impl<'a> Live<'a> {
     fn new(fmu: &'a Fmu, name: &str, logging_on: bool) -> Self {
-        let inst = fmu.instantiate(name, logging_on).unwrap_or_else(|| {
-            panic!(
-                "{}: fmi2Instantiate with the declared GUID failed (stale build?)",
-                fmu.id
-            )
-        });
+        let inst = fmu.instance(name, logging_on);
         Self {
             inst,
             m: Mirror::fresh(),
@@ -274,7 +269,7 @@ impl<'a> Fuzzer<'a> {
     pub fn new(fmus: &'a [Fmu], seed: u64) -> Self {
         let mut donors = Vec::new();
         for fmu in fmus {
-            let mut inst = fmu.instantiate("donor", false).expect("donor instance");
+            let mut inst = fmu.instance("donor", false);
             inst.initialize();
             let (s, state) = inst.get_state();
             assert_eq!(s, OK, "{}: donor fmi2GetFMUstate", fmu.id);
@@ -412,7 +407,7 @@ impl<'a> Fuzzer<'a> {
         live.m = Mirror::fresh();
         let seed = self.rng.next_u64();
         let after_reset = canonical_run(&mut live.inst, seed);
-        let mut fresh = fmu.instantiate("fresh", false).expect("fresh instance");
+        let mut fresh = fmu.instance("fresh", false);
         let fresh_run = canonical_run(&mut fresh, seed);
         self.report.reset_checks += 1;
         if after_reset.trace != fresh_run.trace {

@@ -271,6 +271,40 @@ impl Fmu {
         self.vars.iter().find(|v| v.vr == vr && v.ty == ty)
     }
 
+    /// [`Fmu::instantiate`], panicking with the FMU's logged reason on failure
+    /// (typically a GUID mismatch: the library is older than `modelDescription/`).
+    pub fn instance(&self, name: &str, logging_on: bool) -> Instance<'_> {
+        self.instantiate(name, logging_on).unwrap_or_else(|| {
+            let host = Host::new();
+            let cname = CString::new(name).expect("no NUL");
+            let guid = CString::new(self.guid.as_str()).expect("no NUL");
+            // SAFETY: valid arguments; a non-NULL result is freed at once.
+            let c = unsafe {
+                ffi!(
+                    self.api,
+                    instantiate(
+                        cname.as_ptr(),
+                        fmi2Type_fmi2CoSimulation,
+                        guid.as_ptr(),
+                        c"".as_ptr(),
+                        &*host.callbacks,
+                        0,
+                        1
+                    )
+                )
+            };
+            if !c.is_null() {
+                // SAFETY: live component.
+                unsafe { ffi!(self.api, free_instance(c)) };
+            }
+            let why: Vec<String> = host.records().into_iter().map(|r| r.message).collect();
+            panic!(
+                "{}: fmi2Instantiate failed: {why:?} (rebuild with `cargo xtask dist` if the declaration changed)",
+                self.id
+            )
+        })
+    }
+
     /// Instantiate with this model's GUID and a fresh recording host.
     pub fn instantiate(&self, name: &str, logging_on: bool) -> Option<Instance<'_>> {
         let host = Host::new();

@@ -44,7 +44,7 @@ fn plant(fmus: &[Fmu]) -> &Fmu {
 
 /// Fly with `params` (set in Instantiated) and `inputs` (after init) until a step fails.
 fn diverge(fmu: &Fmu, params: &[(&str, f64)], inputs: &[(&str, f64)]) -> (f64, String) {
-    let mut inst = fmu.instantiate("diverge", true).expect("instantiate");
+    let mut inst = fmu.instance("diverge", true);
     assert_eq!(inst.setup(0.0, None), OK);
     for (name, x) in params {
         assert_eq!(
@@ -148,7 +148,7 @@ fn plant_initialises_at_the_smallest_declared_inertia() {
     // iteration must accept a residual at round-off level (it scales with 1/i_yy).
     let fmus = load_required();
     let fmu = plant(&fmus);
-    let mut inst = fmu.instantiate("tiny_iyy", false).expect("instantiate");
+    let mut inst = fmu.instance("tiny_iyy", false);
     assert_eq!(inst.setup(0.0, None), OK);
     assert_eq!(inst.set_reals(&[fmu.var("i_yy").vr], &[1e-4]), OK);
     assert_eq!(inst.enter_init(), OK);
@@ -157,99 +157,122 @@ fn plant_initialises_at_the_smallest_declared_inertia() {
 
 #[test]
 fn an_enormous_communication_step_returns_promptly() {
-    // h = 1e6 s at the 1 ms integration step: must fail (or finish) in bounded time,
-    // not run ~1e9 RK4 substeps inside one fmi2DoStep.
-    let fmus = load_required();
-    for fmu in &fmus {
+    // h = 1e6 s (1e9 substeps at a 1 ms integration step): a single fmi2DoStep must
+    // fail (or finish) in bounded time instead of blocking the host for hours.
+    let mut hung = Vec::new();
+    for id in fmi_fuzz::required_models() {
         let (tx, rx) = std::sync::mpsc::channel();
-        let fmu: &'static Fmu = Box::leak(Box::new(Fmu::load(&fmu.id).expect("load")));
+        let fmu: &'static Fmu = Box::leak(Box::new(Fmu::load(&id).expect("load")));
         std::thread::spawn(move || {
-            let mut inst = fmu.instantiate("huge", false).expect("instantiate");
+            let mut inst = fmu.instance("huge", false);
             inst.initialize();
             let t0 = Instant::now();
             let s = inst.step(0.0, 1e6);
             let _ = tx.send((s, t0.elapsed()));
         });
         match rx.recv_timeout(Duration::from_secs(10)) {
-            Ok((s, dt)) => println!(
-                "{}: fmi2DoStep(h = 1e6 s) → status {s} in {:.3} s",
-                fmu.id,
-                dt.as_secs_f64()
-            ),
-            Err(_) => panic!("{}: fmi2DoStep(h = 1e6 s) still running after 10 s", fmu.id),
+            Ok((s, dt)) => println!("{id}: fmi2DoStep(h = 1e6 s) → status {s} in {:.3} s", dt.as_secs_f64()),
+            Err(_) => {
+                println!("{id}: fmi2DoStep(h = 1e6 s) still running after 10 s");
+                hung.push(id);
+            }
         }
     }
+    assert!(hung.is_empty(), "fmi2DoStep(h = 1e6 s) blocks: {hung:?}");
+}
+
+/// Outputs that went non-finite (name → count) over 20 runs of 100 steps with
+/// garbage-but-finite inputs (within the declared ranges; the interface declares
+/// none for the measurements, so ±1e300 is legal).
+fn garbage_runs(fmu: &Fmu) -> std::collections::BTreeMap<String, usize> {
+    let inputs: Vec<_> = fmu
+        .vars_of(VarType::Real)
+        .filter(|v| v.causality == Causality::Input)
+        .cloned()
+        .collect();
+    let outputs: Vec<_> = fmu
+        .vars_of(VarType::Real)
+        .filter(|v| v.causality == Causality::Output)
+        .cloned()
+        .collect();
+    let vrs: Vec<u32> = outputs.iter().map(|v| v.vr).collect();
+    let mut rng = Rng::new(7);
+    let (mut steps_ok, mut steps_err, mut logged) = (0, 0, 0);
+    let mut bad = std::collections::BTreeMap::new();
+    for run in 0..20 {
+        let mut inst = fmu.instance(&format!("garbage{run}"), true);
+        inst.initialize();
+        let h = fmu.default_step;
+        let mut t = 0.0;
+        for _ in 0..100 {
+            for v in &inputs {
+                let x = loop {
+                    let x = match rng.below(4) {
+                        0 => rng.wild_f64(),
+                        1 => *rng.pick(&[1e300, -1e300, 1e30, -1e30, 5e-324, 0.0, 1e6, -1e6]),
+                        _ => (rng.unit() - 0.5) * 10f64.powi(rng.below(8) as i32),
+                    };
+                    if x.is_finite() && x >= v.min && x <= v.max {
+                        break x;
+                    }
+                };
+                assert_eq!(inst.set_reals(&[v.vr], &[x]), OK, "{}: set {} = {x}", fmu.id, v.name);
+            }
+            let from = inst.host.len();
+            let s = inst.step(t, h);
+            logged += inst.host.since(from).iter().filter(|r| r.status != OK).count();
+            if s != OK {
+                steps_err += 1;
+                assert!(
+                    !inst.host.since(from).is_empty(),
+                    "{}: step status {s} without a message",
+                    fmu.id
+                );
+                break;
+            }
+            steps_ok += 1;
+            t += h;
+            let (s, y) = inst.get_reals(&vrs);
+            assert_eq!(s, OK, "{}: get outputs", fmu.id);
+            for (v, value) in outputs.iter().zip(&y) {
+                if !value.is_finite() {
+                    *bad.entry(v.name.clone()).or_insert(0) += 1;
+                }
+            }
+        }
+    }
+    println!(
+        "{}: garbage inputs: {steps_ok} steps, {steps_err} refused steps, {logged} warnings/errors logged, \
+         non-finite outputs: {bad:?}",
+        fmu.id
+    );
+    bad
+}
+
+fn controllers(fmus: &[Fmu]) -> Vec<&Fmu> {
+    let c: Vec<&Fmu> = fmus.iter().filter(|f| f.id != "tailsitter_plant").collect();
+    if c.is_empty() {
+        println!("no controller FMU in TAILSITTER_FMUS: nothing to check");
+    }
+    c
 }
 
 #[test]
 fn controllers_never_emit_non_finite_commands_on_garbage_inputs() {
     let fmus = load_required();
-    let controllers: Vec<&Fmu> = fmus.iter().filter(|f| f.id != "tailsitter_plant").collect();
-    if controllers.is_empty() {
-        println!("no controller FMU in TAILSITTER_FMUS: nothing to check");
+    for fmu in controllers(&fmus) {
+        let bad = garbage_runs(fmu);
+        let commands: Vec<_> = bad.keys().filter(|n| n.ends_with("_cmd")).collect();
+        assert!(commands.is_empty(), "{}: non-finite commands {commands:?}", fmu.id);
     }
-    for fmu in controllers {
-        let inputs: Vec<_> = fmu
-            .vars_of(VarType::Real)
-            .filter(|v| v.causality == Causality::Input)
-            .cloned()
-            .collect();
-        let outputs: Vec<u32> = fmu
-            .vars_of(VarType::Real)
-            .filter(|v| v.causality == Causality::Output)
-            .map(|v| v.vr)
-            .collect();
-        let mut rng = Rng::new(7);
-        let (mut steps_ok, mut steps_err, mut warnings) = (0, 0, 0);
-        for run in 0..20 {
-            let mut inst = fmu.instantiate(&format!("garbage{run}"), true).expect("instantiate");
-            inst.initialize();
-            let h = fmu.default_step;
-            let mut t = 0.0;
-            for _ in 0..100 {
-                for v in &inputs {
-                    let x = loop {
-                        let x = match rng.below(4) {
-                            0 => rng.wild_f64(),
-                            1 => *rng.pick(&[1e300, -1e300, 1e30, -1e30, 5e-324, 0.0, 1e6, -1e6]),
-                            _ => (rng.unit() - 0.5) * 10f64.powi(rng.below(8) as i32),
-                        };
-                        if x.is_finite() && x >= v.min && x <= v.max {
-                            break x;
-                        }
-                    };
-                    assert_eq!(inst.set_reals(&[v.vr], &[x]), OK, "{}: set {} = {x}", fmu.id, v.name);
-                }
-                let from = inst.host.len();
-                let s = inst.step(t, h);
-                warnings += inst.host.since(from).iter().filter(|r| r.status != OK).count();
-                if s != OK {
-                    steps_err += 1;
-                    assert!(
-                        !inst.host.since(from).is_empty(),
-                        "{}: step status {s} without a message",
-                        fmu.id
-                    );
-                    break;
-                }
-                steps_ok += 1;
-                t += h;
-                let (s, y) = inst.get_reals(&outputs);
-                assert_eq!(s, OK, "{}: get outputs", fmu.id);
-                for (vr, value) in outputs.iter().zip(&y) {
-                    let name = &fmu.vars.iter().find(|v| v.vr == *vr).expect("declared").name;
-                    assert!(
-                        value.is_finite(),
-                        "{}: output {name} = {value} on garbage inputs",
-                        fmu.id
-                    );
-                }
-            }
-        }
-        println!(
-            "{}: garbage inputs: {steps_ok} steps with finite outputs, {steps_err} refused steps, \
-             {warnings} warnings/errors logged",
-            fmu.id
-        );
+}
+
+#[test]
+fn controllers_keep_every_output_finite_on_garbage_inputs() {
+    // Diagnostic outputs too (pos_error, references, phase): a host records them.
+    let fmus = load_required();
+    for fmu in controllers(&fmus) {
+        let bad = garbage_runs(fmu);
+        assert!(bad.is_empty(), "{}: non-finite outputs {bad:?}", fmu.id);
     }
 }

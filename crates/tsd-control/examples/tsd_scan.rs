@@ -1,0 +1,62 @@
+//! Scan one tuning parameter over values and print the mission metrics (tuning aid).
+//!
+//! `cargo run --release -p tsd-control --example tsd_scan -- <param> <v1> <v2> ...`
+
+use closed_loop::{fly, MissionCheck, Ordering, Scenario};
+use flight_mission::MissionParams;
+use tailsitter_physics::{Airframe, Plant};
+use tsd_control::{TsdController, TsdParams};
+
+fn set(p: &mut TsdParams, name: &str, value: f64) {
+    let mut found = false;
+    macro_rules! fields {
+        ($($f:ident),*) => { $( if name == stringify!($f) { p.$f = value; found = true; } )* };
+    }
+    fields!(
+        axial_pole_1_vertical, axial_pole_2_vertical, axial_pole_1_level, axial_pole_2_level,
+        roll_pole_re_vertical, roll_pole_im_vertical, roll_pole_re_level, roll_pole_im_level,
+        normal_pole_real_vertical, normal_pole_re_vertical, normal_pole_im_vertical,
+        normal_pole_real_level, normal_pole_re_level, normal_pole_im_level,
+        directional_pole_real_vertical, directional_pole_re_vertical, directional_pole_im_vertical,
+        directional_pole_real_level, directional_pole_re_level, directional_pole_im_level,
+        nvd_pole_vertical, nvd_pole_level, guidance_pole_re_vertical, guidance_pole_im_vertical,
+        guidance_pole_re_level, guidance_pole_im_level, antiwindup_gain, flap_mixing_factor,
+        vertical_flap_mixing_factor, min_airspeed, normal_vector_blend_time, min_normal_accel,
+        wind_frame_speed_low, wind_frame_speed_high, feedforward_lead
+    );
+    assert!(found, "unknown parameter {name}");
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let name = &args[1];
+    let plant = Plant::new(Airframe::default());
+    let theta_trim = plant.trim_level(25.0).unwrap().theta;
+    for v in &args[2..] {
+        let value: f64 = v.parse().unwrap();
+        let mut p = TsdParams::default();
+        set(&mut p, name, value);
+        let mut line = format!("{name} = {value:8.3}:");
+        for (label, t1, t2, ordering) in [
+            ("default", 5.0, 10.0, Ordering::GaussSeidel),
+            ("jacobi", 5.0, 10.0, Ordering::Jacobi),
+            ("fast", 3.0, 4.0, Ordering::GaussSeidel),
+        ] {
+            let mission = MissionParams { t_transition_1: t1, t_transition_2: t2, ..Default::default() };
+            let x0 = plant.trim_vertical_climb(3.0).unwrap().state;
+            let mut ctl = TsdController::new(p, mission, Airframe::default()).unwrap();
+            let mut sc = Scenario::mission(mission);
+            sc.ordering = ordering;
+            let tr = fly(&plant, x0, &mut ctl, &sc);
+            let check = MissionCheck::of(&tr, &mission, theta_trim);
+            line += &format!(
+                "  {label}: {} max {:.2} m, α {:.1}°, pitch {:.1}°",
+                if check.passed() && tr.completed() { "ok" } else { "FAIL" },
+                tr.max_pos_error(),
+                tr.max_alpha(0.0, 100.0).to_degrees(),
+                check.level_pitch_error.to_degrees()
+            );
+        }
+        println!("{line}");
+    }
+}
