@@ -16,13 +16,21 @@ def plant(tmp_path_factory) -> Unpacked:
     return Unpacked("tailsitter_plant", tmp_path_factory.mktemp("fmus"))
 
 
-@pytest.fixture(scope="session")
-def fmus(tmp_path_factory) -> dict[str, Fmu]:
-    """The three packaged FMUs, extracted once."""
-    out = {}
-    tmp = tmp_path_factory.mktemp("closed-loop")
-    for name in ("tailsitter_plant", "tailsitter_lqr", "tailsitter_tsd"):
+class _Fmus(dict):
+    """The packaged FMUs by modelIdentifier, each extracted on first use."""
+
+    def __init__(self, tmp: pathlib.Path):
+        super().__init__()
+        self.tmp = tmp
+
+    def __missing__(self, name: str) -> Fmu:
         path = ROOT / "dist" / f"{name}.fmu"
         assert path.exists(), f"{path} missing: run `cargo xtask dist` first"
-        out[name] = Fmu(path, tmp)
-    return out
+        self[name] = Fmu(path, self.tmp)
+        return self[name]
+
+
+@pytest.fixture(scope="session")
+def fmus(tmp_path_factory) -> dict[str, Fmu]:
+    """The three packaged FMUs (extracted once, on first use)."""
+    return _Fmus(tmp_path_factory.mktemp("closed-loop"))

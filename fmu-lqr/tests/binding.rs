@@ -126,7 +126,11 @@ fn binding_matches_the_library_controller() {
         ]);
         assert!((smp.t - t).abs() < 1e-12);
         assert!((smp.x - x).norm() < 1e-9, "t = {t}: state differs");
-        assert!((uc - u).norm() < 1e-9, "t = {t}: command difference {:e}", (uc - u).norm());
+        assert!(
+            (uc - u).norm() < 1e-9,
+            "t = {t}: command difference {:e}",
+            (uc - u).norm()
+        );
     }
 }
 

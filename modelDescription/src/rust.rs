@@ -133,8 +133,111 @@ pub fn variables_module(model: &Model, xml_file: &str) -> String {
         let _ = writeln!(w, "        self.{} = {call};", v.name());
     }
     let _ = writeln!(w, "        Ok(())\n    }}\n}}");
+    let _ = writeln!(w, "{}", DECLARATION_TESTS);
     s
 }
+
+/// Unit tests emitted into every generated module: the Rust accessors agree
+/// with the generated modelDescription.xml read back through fmi-schema
+/// (names, value references, types, causality, variability, descriptions,
+/// start values) and every variable can be written and read as declared.
+/// Each `fmu-*` crate needs `fmi-schema` as a dev-dependency.
+const DECLARATION_TESTS: &str = r#"
+#[cfg(test)]
+mod declaration_tests {
+    use super::*;
+    use fmi_schema::fmi2::{Fmi2ModelDescription, ScalarVariableElement as E};
+
+    fn others_unchanged(store: &Variables, start: &Variables, except: u32) {
+        for spec in Variables::VARIABLES.iter().filter(|s| s.value_reference != except) {
+            let vr = spec.value_reference;
+            assert_eq!(store.get_real(vr), start.get_real(vr), "{} changed", spec.name);
+            assert_eq!(store.get_integer(vr), start.get_integer(vr), "{} changed", spec.name);
+            assert_eq!(store.get_boolean(vr), start.get_boolean(vr), "{} changed", spec.name);
+            assert_eq!(store.get_string(vr), start.get_string(vr), "{} changed", spec.name);
+        }
+    }
+
+    #[test]
+    fn accessors_agree_with_the_model_description() {
+        let md: Fmi2ModelDescription = fmi_schema::deserialize(MODEL_DESCRIPTION_XML).expect("generated XML parses");
+        assert_eq!(md.guid, GUID);
+        assert_eq!(md.co_simulation.as_ref().expect("CoSimulation").model_identifier, MODEL_IDENTIFIER);
+        let xml: Vec<_> = md.get_model_variables().collect();
+        assert_eq!(xml.len(), Variables::VARIABLES.len());
+        let start = Variables::with_start_values();
+        for (x, spec) in xml.iter().zip(Variables::VARIABLES) {
+            let vr = spec.value_reference;
+            assert_eq!(x.name, spec.name);
+            assert_eq!(x.value_reference, vr, "{}", spec.name);
+            assert_eq!(Variables::index_of(vr).map(|i| Variables::VARIABLES[i].name), Some(spec.name));
+            assert_eq!(x.description.as_deref(), Some(spec.description), "{}", spec.name);
+            assert_eq!(format!("{:?}", x.causality), format!("{:?}", spec.causality), "{}", spec.name);
+            assert_eq!(format!("{:?}", x.variability.expect("variability")), format!("{:?}", spec.variability), "{}", spec.name);
+            let mut store = start.clone();
+            match (&x.elem, spec.value_type) {
+                (E::Real(r), ValueType::Real) => {
+                    if let Some(s) = r.start {
+                        assert_eq!(start.get_real(vr), Some(s), "{} start", spec.name);
+                    }
+                    let v = start.get_real(vr).expect("a Real") + 0.5;
+                    assert!(store.set_real(vr, v), "{}", spec.name);
+                    assert_eq!(store.get_real(vr), Some(v));
+                    assert!(!store.set_integer(vr, 1) && store.get_integer(vr).is_none(), "{} is not an Integer", spec.name);
+                }
+                (E::Integer(i), ValueType::Integer) => {
+                    if let Some(s) = i.start {
+                        assert_eq!(start.get_integer(vr), Some(s), "{} start", spec.name);
+                    }
+                    let v = start.get_integer(vr).expect("an Integer").wrapping_add(1);
+                    assert!(store.set_integer(vr, v), "{}", spec.name);
+                    assert_eq!(store.get_integer(vr), Some(v));
+                    assert!(!store.set_real(vr, 1.0) && store.get_real(vr).is_none(), "{} is not a Real", spec.name);
+                }
+                (E::Boolean(_), ValueType::Boolean) => {
+                    let v = !start.get_boolean(vr).expect("a Boolean");
+                    assert!(store.set_boolean(vr, v));
+                    assert_eq!(store.get_boolean(vr), Some(v));
+                }
+                (E::String, ValueType::String) => {
+                    assert!(store.set_string(vr, "changed"));
+                    assert_eq!(store.get_string(vr), Some("changed"));
+                }
+                (e, t) => panic!("{}: XML element {e:?} but declared {t:?}", spec.name),
+            }
+            others_unchanged(&store, &start, vr);
+        }
+        let unknown = Variables::VARIABLES.len() as u32 + 1000;
+        assert!(Variables::index_of(unknown).is_none());
+        assert!(start.get_real(unknown).is_none() && start.get_integer(unknown).is_none());
+    }
+
+    #[test]
+    fn embedded_xml_is_the_reviewed_copy() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../modelDescription/generated/");
+        let reviewed = std::fs::read_to_string(format!("{path}{MODEL_IDENTIFIER}.xml")).expect("reviewed XML (cargo xtask regen)");
+        assert!(reviewed == MODEL_DESCRIPTION_XML, "modelDescription/generated/{MODEL_IDENTIFIER}.xml drifted: run `cargo xtask regen`");
+    }
+
+    #[test]
+    fn state_round_trips() {
+        let mut a = Variables::with_start_values();
+        for spec in Variables::VARIABLES {
+            if spec.value_type == ValueType::Real {
+                a.set_real(spec.value_reference, spec.value_reference as f64 * 0.25 - 3.0);
+            }
+        }
+        let mut w = StateWriter::new();
+        a.write_state(&mut w);
+        let bytes = w.into_bytes();
+        let mut b = Variables::with_start_values();
+        let mut r = StateReader::new(&bytes);
+        b.read_state(&mut r).expect("read back");
+        r.finish().expect("nothing left over");
+        assert_eq!(a, b);
+    }
+}
+"#;
 
 fn accessors(w: &mut String, model: &Model, t: VarType, suffix: &str, ty: &str, get_expr: &str) {
     let vars: Vec<&Variable> = model.variables.iter().filter(|v| v.decl.var_type == t).collect();

@@ -4,9 +4,20 @@ use lqr_control::trajectory::{Trajectory, TrajectoryMode, TrajectoryOptions};
 use tailsitter_physics::Airframe;
 
 fn main() {
-    let mode = if std::env::args().any(|a| a == "thesis") { TrajectoryMode::Thesis } else { TrajectoryMode::ForceBalance };
-    let traj = Trajectory::new(&Airframe::default(), &MissionParams::default(), &TrajectoryOptions { mode, ..Default::default() })
-        .expect("trajectory");
+    let mode = if std::env::args().any(|a| a == "thesis") {
+        TrajectoryMode::Thesis
+    } else {
+        TrajectoryMode::ForceBalance
+    };
+    let traj = Trajectory::new(
+        &Airframe::default(),
+        &MissionParams::default(),
+        &TrajectoryOptions {
+            mode,
+            ..Default::default()
+        },
+    )
+    .expect("trajectory");
     println!("t,V,alpha_deg,theta_deg,q_degs,N,E,h,T,T_c,de_deg");
     for p in traj.points() {
         println!(

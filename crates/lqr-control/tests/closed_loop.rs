@@ -277,16 +277,28 @@ fn thesis_table_3_4_weights_fly_the_mission() {
     for ordering in [Ordering::GaussSeidel, Ordering::Jacobi] {
         let mut s = Scenario::mission(MissionParams::default());
         s.ordering = ordering;
-        let params = LqrParams { weight_set: 0, ..Default::default() };
+        let params = LqrParams {
+            weight_set: 0,
+            ..Default::default()
+        };
         let (trace, check, c) = run(Airframe::default(), params, &s);
-        assert_mission(&format!("thesis Table 3.4 weights, {ordering:?}"), &trace, &check, &c, 2.0);
+        assert_mission(
+            &format!("thesis Table 3.4 weights, {ordering:?}"),
+            &trace,
+            &check,
+            &c,
+            2.0,
+        );
     }
 }
 
 #[test]
 fn thesis_mode_trajectory_flies_the_mission() {
     let s = Scenario::mission(MissionParams::default());
-    let params = LqrParams { trajectory_mode: 0, ..Default::default() };
+    let params = LqrParams {
+        trajectory_mode: 0,
+        ..Default::default()
+    };
     let (trace, check, c) = run(Airframe::default(), params, &s);
     report("thesis closed-form trajectory (3.3.3-3.3.17)", &trace, &check, &c);
     assert!(trace.completed(), "{:?}", trace.failure);
@@ -297,11 +309,17 @@ fn thesis_mode_trajectory_flies_the_mission() {
 fn slow_vertical_speed_is_handled() {
     // v_vertical = 0 (hover) is outside the (V, α, β) model's domain: rejected at
     // construction with a clear message; 1 m/s flies.
-    let m = MissionParams { v_vertical: 0.0, ..Default::default() };
+    let m = MissionParams {
+        v_vertical: 0.0,
+        ..Default::default()
+    };
     let e = LqrController::new(Airframe::default(), m, LqrParams::default()).unwrap_err();
     println!("v_vertical = 0: {e}");
     assert!(e.0.contains("v_vertical"));
-    let s = Scenario::mission(MissionParams { v_vertical: 1.0, ..Default::default() });
+    let s = Scenario::mission(MissionParams {
+        v_vertical: 1.0,
+        ..Default::default()
+    });
     let (trace, check, c) = run(Airframe::default(), LqrParams::default(), &s);
     report("v_vertical = 1 m/s", &trace, &check, &c);
     assert!(trace.completed() && check.passed(), "{:?} {check}", trace.failure);

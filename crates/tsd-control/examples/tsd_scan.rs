@@ -13,16 +13,41 @@ fn set(p: &mut TsdParams, name: &str, value: f64) {
         ($($f:ident),*) => { $( if name == stringify!($f) { p.$f = value; found = true; } )* };
     }
     fields!(
-        axial_pole_1_vertical, axial_pole_2_vertical, axial_pole_1_level, axial_pole_2_level,
-        roll_pole_re_vertical, roll_pole_im_vertical, roll_pole_re_level, roll_pole_im_level,
-        normal_pole_real_vertical, normal_pole_re_vertical, normal_pole_im_vertical,
-        normal_pole_real_level, normal_pole_re_level, normal_pole_im_level,
-        directional_pole_real_vertical, directional_pole_re_vertical, directional_pole_im_vertical,
-        directional_pole_real_level, directional_pole_re_level, directional_pole_im_level,
-        nvd_pole_vertical, nvd_pole_level, guidance_pole_re_vertical, guidance_pole_im_vertical,
-        guidance_pole_re_level, guidance_pole_im_level, antiwindup_gain, flap_mixing_factor,
-        vertical_flap_mixing_factor, min_airspeed, normal_vector_blend_time, min_normal_accel,
-        wind_frame_speed_low, wind_frame_speed_high, feedforward_lead
+        axial_pole_1_vertical,
+        axial_pole_2_vertical,
+        axial_pole_1_level,
+        axial_pole_2_level,
+        roll_pole_re_vertical,
+        roll_pole_im_vertical,
+        roll_pole_re_level,
+        roll_pole_im_level,
+        normal_pole_real_vertical,
+        normal_pole_re_vertical,
+        normal_pole_im_vertical,
+        normal_pole_real_level,
+        normal_pole_re_level,
+        normal_pole_im_level,
+        directional_pole_real_vertical,
+        directional_pole_re_vertical,
+        directional_pole_im_vertical,
+        directional_pole_real_level,
+        directional_pole_re_level,
+        directional_pole_im_level,
+        nvd_pole_vertical,
+        nvd_pole_level,
+        guidance_pole_re_vertical,
+        guidance_pole_im_vertical,
+        guidance_pole_re_level,
+        guidance_pole_im_level,
+        antiwindup_gain,
+        flap_mixing_factor,
+        vertical_flap_mixing_factor,
+        min_airspeed,
+        normal_vector_blend_time,
+        min_normal_accel,
+        wind_frame_speed_low,
+        wind_frame_speed_high,
+        feedforward_lead
     );
     assert!(found, "unknown parameter {name}");
 }
@@ -42,7 +67,11 @@ fn main() {
             ("jacobi", 5.0, 10.0, Ordering::Jacobi),
             ("fast", 3.0, 4.0, Ordering::GaussSeidel),
         ] {
-            let mission = MissionParams { t_transition_1: t1, t_transition_2: t2, ..Default::default() };
+            let mission = MissionParams {
+                t_transition_1: t1,
+                t_transition_2: t2,
+                ..Default::default()
+            };
             let x0 = plant.trim_vertical_climb(3.0).unwrap().state;
             let mut ctl = TsdController::new(p, mission, Airframe::default()).unwrap();
             let mut sc = Scenario::mission(mission);

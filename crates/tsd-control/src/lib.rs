@@ -45,7 +45,7 @@ use flight_mission::{
     Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, FlightController, MissionParams, Notice,
     ParamError, Phase,
 };
-use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, Quaternion, RowVector3, UnitQuaternion, Vector3};
 use tailsitter_physics::Airframe;
 
 /// Number of f64 values written by [`TsdController::save`].
@@ -68,10 +68,68 @@ pub struct Internals {
     pub normal_weight: f64,
     /// Schedule variable: 0 at v_vertical, 1 at v_level.
     pub schedule: f64,
+    /// Weight κ of the wind axes (vs the reference-path frame), 0..1.
+    pub frame_weight: f64,
     /// Mixing ratios (δfc/δe, δv/δr) (4.2.12, Table 4.2).
     pub mixing: (f64, f64),
     /// Unsaturated virtual commands (T_c, δm, δA, δR).
     pub virtual_cmd: [f64; 4],
+}
+
+/// The flight condition the loops are scheduled on (measured).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FlightCondition {
+    /// Airspeed V̄ [m/s].
+    pub airspeed: f64,
+    /// Angle of attack α [rad] (derivatives interpolated in it).
+    pub alpha: f64,
+    /// Thrust T [N].
+    pub thrust: f64,
+    /// Induced velocity w [m/s]: the slip-stream surfaces see V̄ + 2w.
+    pub induced_velocity: f64,
+}
+
+/// Every loop's linear model and gains at one flight condition (§4.2, §4.3, Table 4.3).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LoopDesign {
+    /// Schedule variable: 0 at v_vertical, 1 at v_level (pole blending).
+    pub schedule: f64,
+    /// Weight κ of the wind axes vs the reference-path frame (low-speed frame).
+    pub kappa: f64,
+    /// Airspeed used in the models, V̄ floored at `min_airspeed` [m/s].
+    pub v: f64,
+    /// Mixing ratios (δfc/δe, δv/δr).
+    pub mixing: (f64, f64),
+    /// Guidance (K_P, K_V) (4.3.24).
+    pub guidance: (f64, f64),
+    /// Axial (K_A, K_E) (4.2.8).
+    pub axial: (f64, f64),
+    /// Normal loop model (A, B) in (C_W, Q′, E_C) ([`gains::normal_model`]).
+    pub normal_model: (Matrix3<f64>, Vector3<f64>),
+    /// Desired characteristic polynomial of the normal loop.
+    pub normal_poly: [f64; 3],
+    /// Normal loop gains (K_C, K_Q, K_E).
+    pub normal_gains: RowVector3<f64>,
+    /// Pitch damping a22 and mixed control effectiveness b2 of the normal loop [1/s, 1/s²].
+    pub a22_n: f64,
+    pub b2: f64,
+    /// Roll model (a21, a22, a23, b21) (4.2.26).
+    pub roll_model: (f64, f64, f64, f64),
+    /// Desired characteristic polynomial of the roll/NVD loop.
+    pub roll_poly: [f64; 3],
+    /// Roll/NVD gains (K_P, K_E, K_φ) (4.3.11, corrected).
+    pub roll_gains: (f64, f64, f64),
+    /// Directional loop model (A, B) in (B_W, R′, E_B) ([`gains::directional_model`]).
+    pub directional_model: (Matrix3<f64>, Vector3<f64>),
+    /// Desired characteristic polynomial of the directional loop.
+    pub directional_poly: [f64; 3],
+    /// Directional gains (K_B, K_R, K_E).
+    pub directional_gains: RowVector3<f64>,
+    /// Yaw model coefficients a32, a33, b31, b32 (4.2.31).
+    pub a32: f64,
+    pub a33: f64,
+    pub b31: f64,
+    pub b32: f64,
 }
 
 /// Integrator state of the four inner loops: the thrust contribution [N] and, for the
@@ -213,6 +271,125 @@ impl TsdController {
         (rn, rv)
     }
 
+    /// Weight κ of the wind axes against the reference-path frame at `airspeed`: 0 below
+    /// `wind_frame_speed_low`, 1 above `wind_frame_speed_high`, linear between.
+    pub fn frame_weight(&self, airspeed: f64) -> f64 {
+        let p = &self.params;
+        ((airspeed - p.wind_frame_speed_low) / (p.wind_frame_speed_high - p.wind_frame_speed_low)).clamp(0.0, 1.0)
+    }
+
+    /// Design every loop at flight condition `fc` (gain scheduling, §4.2): the models of
+    /// (4.2.1–4.2.31) with q̄ = ½ρV̄² and q̄_s = ½ρ(V̄ + 2w)², poles of Table 4.3 blended in
+    /// airspeed, gains by pole placement. `Err` names a loop whose gains are not finite.
+    pub fn design(&self, fc: &FlightCondition) -> Result<LoopDesign, &'static str> {
+        let p = &self.params;
+        let af = &self.airframe;
+        let m = af.mass;
+        let (vv, vl) = (self.mission.v_vertical, self.mission.v_level);
+        let v = fc.airspeed.max(p.min_airspeed);
+        let sched = ((fc.airspeed - vv) / (vl - vv)).clamp(0.0, 1.0);
+        let kappa = self.frame_weight(fc.airspeed);
+        let rho = af.air_density;
+        let (s_ref, b_ref, c_ref) = (af.wing_area, af.wing_span, af.mean_chord);
+        let qbar = 0.5 * rho * v * v;
+        let vs = v + 2.0 * fc.induced_velocity.max(0.0);
+        let qbar_s = 0.5 * rho * vs * vs;
+        // q̄S/(2V̄) · (rate derivative): (2.3.5) without dividing by V̄.
+        let kr = 0.25 * rho * v * s_ref;
+        let thrust = fc.thrust.max(0.0);
+        let cos_alpha = fc.alpha.cos();
+        let c = af.coefficients(fc.alpha);
+        let (rn, rv) = self.mixing_ratios(fc.alpha);
+        let (ixx, iyy, izz) = (af.i_xx, af.i_yy, af.i_zz);
+        let blend = |a: f64, b: f64| lerp(a, b, sched);
+
+        let guidance = gains::guidance_gains(
+            blend(p.guidance_pole_re_vertical, p.guidance_pole_re_level),
+            blend(p.guidance_pole_im_vertical, p.guidance_pole_im_level),
+        );
+        let axial = gains::axial_gains(
+            m,
+            af.tau_thrust,
+            gains::char_poly_2_real(
+                blend(p.axial_pole_1_vertical, p.axial_pole_1_level),
+                blend(p.axial_pole_2_vertical, p.axial_pole_2_level),
+            ),
+        );
+
+        // Normal (4.2.9–4.2.17). Z_α = V̄ a11 includes the thrust's normal component
+        // −T sin α of (2.5.28): in vertical flight it is the main normal force.
+        let z_alpha = -(qbar * s_ref * c.c_L_alpha + thrust * cos_alpha) / m;
+        let a11_n = z_alpha / v;
+        let a21_n = qbar * s_ref * c_ref * c.c_m_alpha / iyy;
+        let a22_n = kr * c_ref * c_ref * c.c_m_q / iyy;
+        let b2 = qbar_s * s_ref * c_ref * (c.c_m_de + rn * c.c_m_dfc) / iyy;
+        let normal_model = gains::normal_model(kappa * a11_n, a21_n, a22_n, b2, z_alpha);
+        let normal_poly = gains::char_poly_3(
+            blend(p.normal_pole_real_vertical, p.normal_pole_real_level),
+            blend(p.normal_pole_re_vertical, p.normal_pole_re_level),
+            blend(p.normal_pole_im_vertical, p.normal_pole_im_level),
+        );
+        let normal_gains = gains::place_3(&normal_model.0, &normal_model.1, normal_poly).ok_or("normal-acceleration")?;
+
+        // Roll (4.2.21–4.2.26) with NVD (4.3.7–4.3.11): ailerons (free stream) and
+        // differential flaps (slip-stream) deflected together.
+        let a21_r = qbar * s_ref * b_ref * c.c_l_beta / ixx;
+        let a22_r = kr * b_ref * b_ref * c.c_l_p / ixx;
+        let a23_r = kr * b_ref * b_ref * c.c_l_r / ixx;
+        let b21 = s_ref * b_ref * (qbar * c.c_l_da + qbar_s * c.c_l_dfd) / ixx;
+        let roll_poly = gains::char_poly_3(
+            blend(p.nvd_pole_vertical, p.nvd_pole_level),
+            blend(p.roll_pole_re_vertical, p.roll_pole_re_level),
+            blend(p.roll_pole_im_vertical, p.roll_pole_im_level),
+        );
+        let roll_gains = gains::roll_nvd_gains(a22_r, b21, roll_poly).ok_or("roll")?;
+
+        // Directional (4.2.27–4.2.31): Y_β = V̄ a11 with the thrust term −T cos α sin β.
+        let y_beta = (qbar * s_ref * c.c_Y_beta - thrust * cos_alpha) / m;
+        let a11_l = y_beta / v;
+        let a31 = qbar * s_ref * b_ref * c.c_n_beta / izz;
+        let a32 = kr * b_ref * b_ref * c.c_n_p / izz;
+        let a33 = kr * b_ref * b_ref * c.c_n_r / izz;
+        let b31 = s_ref * b_ref * (qbar * c.c_n_da + qbar_s * c.c_n_dfd) / izz;
+        let b32 = qbar_s * s_ref * b_ref * (c.c_n_dr + rv * c.c_n_dv) / izz;
+        let directional_model = gains::directional_model(kappa * a11_l, a31, a33, b32, y_beta);
+        let directional_poly = gains::char_poly_3(
+            blend(p.directional_pole_real_vertical, p.directional_pole_real_level),
+            blend(p.directional_pole_re_vertical, p.directional_pole_re_level),
+            blend(p.directional_pole_im_vertical, p.directional_pole_im_level),
+        );
+        let directional_gains =
+            gains::place_3(&directional_model.0, &directional_model.1, directional_poly).ok_or("directional")?;
+
+        let finite = [guidance.0, guidance.1, axial.0, axial.1, b2, b21, b32].iter().all(|x| x.is_finite());
+        if !finite {
+            return Err("scheduled");
+        }
+        Ok(LoopDesign {
+            schedule: sched,
+            kappa,
+            v,
+            mixing: (rn, rv),
+            guidance,
+            axial,
+            normal_model,
+            normal_poly,
+            normal_gains,
+            a22_n,
+            b2,
+            roll_model: (a21_r, a22_r, a23_r, b21),
+            roll_poly,
+            roll_gains,
+            directional_model,
+            directional_poly,
+            directional_gains,
+            a32,
+            a33,
+            b31,
+            b32,
+        })
+    }
+
     fn err(msg: impl Into<String>) -> ControlError {
         ControlError(msg.into())
     }
@@ -235,10 +412,8 @@ impl FlightController for TsdController {
         }
         let p = self.params;
         let af = self.airframe;
-        let m = af.mass;
         let g = af.gravity;
         let ts = self.mission.sample_time;
-        let (vv, vl) = (self.mission.v_vertical, self.mission.v_level);
 
         // ---- Reference (§4.3.3) ------------------------------------------------------
         let reference = self.trajectory.at(input.t);
@@ -248,14 +423,14 @@ impl FlightController for TsdController {
         // ---- Measured wind axes and specific accelerations ----------------------------
         let q = &meas.quat;
         let att = UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]));
-        let r_eb = att.to_rotation_matrix(); // body → earth
-                                             // Frame of the specific accelerations: the wind axes (thesis) above
-                                             // `wind_frame_speed_high`, the reference-path axes below `wind_frame_speed_low`
-                                             // (κ = 0), blended between. κ also scales the path-rotation terms of the loop models
-                                             // (a11 C_W, the gravity terms g₁/V̄, g₂/V̄ and their feedback linearisation): at low
-                                             // speed the wind axes turn as fast as the body and the time-scale separation fails.
-        let kappa = ((meas.airspeed - p.wind_frame_speed_low) / (p.wind_frame_speed_high - p.wind_frame_speed_low))
-            .clamp(0.0, 1.0);
+        // Body → earth.
+        let r_eb = att.to_rotation_matrix();
+        // Frame of the specific accelerations: the wind axes (thesis) above
+        // `wind_frame_speed_high`, the reference-path axes below `wind_frame_speed_low`
+        // (κ = 0), blended between. κ also scales the path-rotation terms of the loop models
+        // (a11 C_W, the gravity terms g₁/V̄, g₂/V̄ and their feedback linearisation): at low
+        // speed the wind axes turn as fast as the body and the time-scale separation fails.
+        let kappa = self.frame_weight(meas.airspeed);
         let (fa, fb) = {
             let (sa, ca) = meas.alpha.sin_cos();
             let (sb, cb) = meas.beta.sin_cos();
@@ -284,27 +459,21 @@ impl FlightController for TsdController {
         let p_s = pr * ca + rr * sa;
         let r_s = rr * ca - pr * sa;
 
-        // ---- Gain schedule -----------------------------------------------------------
-        let v = meas.airspeed.max(p.min_airspeed);
-        let sched = ((meas.airspeed - vv) / (vl - vv)).clamp(0.0, 1.0);
-        let rho = af.air_density;
-        let (s_ref, b_ref, c_ref) = (af.wing_area, af.wing_span, af.mean_chord);
-        let qbar = 0.5 * rho * v * v;
-        let vs = v + 2.0 * meas.induced_velocity.max(0.0);
-        let qbar_s = 0.5 * rho * vs * vs;
-        let kr = 0.25 * rho * v * s_ref; // q̄S/(2V̄): rate derivatives (2.3.5)
-        let thrust = meas.thrust.max(0.0);
-        let cos_alpha = meas.alpha.cos();
-        let c = af.coefficients(meas.alpha);
-        let (rn, rv) = self.mixing_ratios(meas.alpha);
-        let (ixx, iyy, izz) = (af.i_xx, af.i_yy, af.i_zz);
+        // ---- Gain schedule: every loop designed at this flight condition ----------------
+        let d = self
+            .design(&FlightCondition {
+                airspeed: meas.airspeed,
+                alpha: meas.alpha,
+                thrust: meas.thrust,
+                induced_velocity: meas.induced_velocity,
+            })
+            .map_err(|what| Self::err(format!("{what} gains not computable at t = {} s", input.t)))?;
+        let (v, sched) = (d.v, d.schedule);
+        let (rn, rv) = d.mixing;
         let lim = af.deflection_limit;
 
         // ---- Guidance (4.3.24) ---------------------------------------------------------
-        let (kp_g, kv_g) = gains::guidance_gains(
-            lerp(p.guidance_pole_re_vertical, p.guidance_pole_re_level, sched),
-            lerp(p.guidance_pole_im_vertical, p.guidance_pole_im_level, sched),
-        );
+        let (kp_g, kv_g) = d.guidance;
         let vel_error = meas.vel_ned - reference.vel;
         let sigma_ff = if p.feedforward_lead > 0.0 {
             self.trajectory.at(input.t + p.feedforward_lead).specific_accel
@@ -363,36 +532,11 @@ impl FlightController for TsdController {
         let roll_error = if sj.hypot(ck) > 0.1 { sj.atan2(ck) } else { 0.0 };
 
         // ---- Axial loop (4.2.1–4.2.8) --------------------------------------------------
-        let (ka, ke_a) = gains::axial_gains(
-            m,
-            af.tau_thrust,
-            gains::char_poly_2_real(
-                lerp(p.axial_pole_1_vertical, p.axial_pole_1_level, sched),
-                lerp(p.axial_pole_2_vertical, p.axial_pole_2_level, sched),
-            ),
-        );
+        let (ka, ke_a) = d.axial;
         let thrust_p = -ka * a_w;
 
         // ---- Normal loop (4.2.9–4.2.17) ------------------------------------------------
-        // a11 includes the thrust's normal component −T sin α of (2.5.28): in vertical flight
-        // it is the main normal force.
-        let z_alpha = -(qbar * s_ref * c.c_L_alpha + thrust * cos_alpha) / m; // = V̄ a11
-        let a11_n = z_alpha / v;
-        let a21_n = qbar * s_ref * c_ref * c.c_m_alpha / iyy;
-        let a22_n = kr * c_ref * c_ref * c.c_m_q / iyy;
-        let b2 = qbar_s * s_ref * c_ref * (c.c_m_de + rn * c.c_m_dfc) / iyy;
-        let (an, bn) = gains::normal_model(kappa * a11_n, a21_n, a22_n, b2, z_alpha);
-        let poly_n = gains::char_poly_3(
-            lerp(p.normal_pole_real_vertical, p.normal_pole_real_level, sched),
-            lerp(p.normal_pole_re_vertical, p.normal_pole_re_level, sched),
-            lerp(p.normal_pole_im_vertical, p.normal_pole_im_level, sched),
-        );
-        let k_n = gains::place_3(&an, &bn, poly_n).ok_or_else(|| {
-            Self::err(format!(
-                "normal-acceleration gains not computable at t = {} s (V = {v} m/s)",
-                input.t
-            ))
-        })?;
+        let (k_n, a22_n, b2) = (d.normal_gains, d.a22_n, d.b2);
         // Gravity along the wind z axis g₁ = g e33 and its rate (4.2.17), from
         // dk^W/dt = Q_W i^W − P_W j^W with Q_W = −(C_W + g₁)/V̄ (2.5.12).
         let g1 = kappa * g * e33;
@@ -404,39 +548,16 @@ impl FlightController for TsdController {
         let dm_p = -k_n[0] * c_w - k_n[1] * q_prime + dm_g;
 
         // ---- Roll / NVD (4.2.21–4.2.26, 4.3.7–4.3.11) -----------------------------------
-        // Ailerons (free stream) and differential flaps (slip-stream) deflected together.
-        let a21_r = qbar * s_ref * b_ref * c.c_l_beta / ixx;
-        let a22_r = kr * b_ref * b_ref * c.c_l_p / ixx;
-        let a23_r = kr * b_ref * b_ref * c.c_l_r / ixx;
-        let b21 = s_ref * b_ref * (qbar * c.c_l_da + qbar_s * c.c_l_dfd) / ixx;
-        let poly_r = gains::char_poly_3(
-            lerp(p.nvd_pole_vertical, p.nvd_pole_level, sched),
-            lerp(p.roll_pole_re_vertical, p.roll_pole_re_level, sched),
-            lerp(p.roll_pole_im_vertical, p.roll_pole_im_level, sched),
-        );
-        let (kp_r, ke_r, kphi) = gains::roll_nvd_gains(a22_r, b21, poly_r)
-            .ok_or_else(|| Self::err(format!("roll gains not computable at t = {} s", input.t)))?;
-        let p_ref = kphi * roll_error; // P_R = P_Wc + K_φ φ, P_Wc = 0 (no turns in the mission)
-                                       // (4.2.25): cancel the sideslip and yaw-rate roll moments.
+        let (a21_r, _, a23_r, b21) = d.roll_model;
+        let (kp_r, ke_r, kphi) = d.roll_gains;
+        // P_R = P_Wc + K_φ φ, P_Wc = 0 (no turns in the mission).
+        let p_ref = kphi * roll_error;
+        // (4.2.25): cancel the sideslip and yaw-rate roll moments.
         let da_f = -(a21_r * meas.beta + a23_r * r_s) / b21;
         let da_p = -kp_r * p_s + da_f;
 
         // ---- Directional (4.2.27–4.2.31) -----------------------------------------------
-        let y_beta = (qbar * s_ref * c.c_Y_beta - thrust * cos_alpha) / m; // = V̄ a11
-        let a11_l = y_beta / v;
-        let a31 = qbar * s_ref * b_ref * c.c_n_beta / izz;
-        let a32 = kr * b_ref * b_ref * c.c_n_p / izz;
-        let a33 = kr * b_ref * b_ref * c.c_n_r / izz;
-        let b31 = s_ref * b_ref * (qbar * c.c_n_da + qbar_s * c.c_n_dfd) / izz;
-        let b32 = qbar_s * s_ref * b_ref * (c.c_n_dr + rv * c.c_n_dv) / izz;
-        let (ad, bd) = gains::directional_model(kappa * a11_l, a31, a33, b32, y_beta);
-        let poly_d = gains::char_poly_3(
-            lerp(p.directional_pole_real_vertical, p.directional_pole_real_level, sched),
-            lerp(p.directional_pole_re_vertical, p.directional_pole_re_level, sched),
-            lerp(p.directional_pole_im_vertical, p.directional_pole_im_level, sched),
-        );
-        let k_d = gains::place_3(&ad, &bd, poly_d)
-            .ok_or_else(|| Self::err(format!("directional gains not computable at t = {} s", input.t)))?;
+        let (k_d, a32, a33, b31, b32) = (d.directional_gains, d.a32, d.a33, d.b31, d.b32);
         // Gravity along the wind y axis g₂ = g e23 and its rate, from dj^W/dt = −R_W i^W +
         // P_W k^W with R_W = (B_W + g₂)/V̄ (2.5.12).
         let g2 = kappa * g * e23;
@@ -524,6 +645,7 @@ impl FlightController for TsdController {
             roll_error,
             normal_weight,
             schedule: sched,
+            frame_weight: d.kappa,
             mixing: (rn, rv),
             virtual_cmd: [thrust_c, dm, da, dr],
         };

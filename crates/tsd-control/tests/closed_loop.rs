@@ -206,15 +206,27 @@ fn default_mission_with_perturbed_plant() {
     let cases = [
         (
             "plant C_m_alpha x 1.2",
-            Airframe { c_m_alpha_a0: nominal.c_m_alpha_a0 * 1.2, c_m_alpha_a1: nominal.c_m_alpha_a1 * 1.2, ..nominal },
+            Airframe {
+                c_m_alpha_a0: nominal.c_m_alpha_a0 * 1.2,
+                c_m_alpha_a1: nominal.c_m_alpha_a1 * 1.2,
+                ..nominal
+            },
         ),
         (
             "plant C_L_alpha x 0.8",
-            Airframe { c_L_alpha_a0: nominal.c_L_alpha_a0 * 0.8, c_L_alpha_a1: nominal.c_L_alpha_a1 * 0.8, ..nominal },
+            Airframe {
+                c_L_alpha_a0: nominal.c_L_alpha_a0 * 0.8,
+                c_L_alpha_a1: nominal.c_L_alpha_a1 * 0.8,
+                ..nominal
+            },
         ),
         (
             "plant C_m_de x 0.8",
-            Airframe { c_m_de_a0: nominal.c_m_de_a0 * 0.8, c_m_de_a1: nominal.c_m_de_a1 * 0.8, ..nominal },
+            Airframe {
+                c_m_de_a0: nominal.c_m_de_a0 * 0.8,
+                c_m_de_a1: nominal.c_m_de_a1 * 0.8,
+                ..nominal
+            },
         ),
     ];
     let mut failures = Vec::new();
