@@ -47,6 +47,8 @@ pub struct LqrModel {
     last: Option<ControllerOutput>,
     /// Controller state read from an FMU state before the controller existed.
     pending: Option<Vec<f64>>,
+    /// The previous sample reported a saturation: warn only when one starts.
+    saturated: bool,
 }
 
 impl LqrModel {
@@ -148,9 +150,12 @@ impl LqrModel {
             Some(Notice::GainFallback(why)) => log.warning(format_args!(
                 "t = {t} s: gain computation failed ({why}); using the last good gains"
             )),
-            Some(Notice::Saturated(name)) => log.warning(format_args!("t = {t} s: {name} saturated")),
-            None => {}
+            Some(Notice::Saturated(name)) if !self.saturated => {
+                log.warning(format_args!("t = {t} s: {name} saturated (further saturations until it ends are not logged)"))
+            }
+            _ => {}
         }
+        self.saturated = matches!(out.notice, Some(Notice::Saturated(_)));
         self.last = Some(out);
         Ok(())
     }
@@ -184,6 +189,7 @@ impl FmuModel for LqrModel {
             clock: SampleClock::new(vars.sample_time.max(1e-9), 0.0),
             last: None,
             pending: None,
+            saturated: false,
         }
     }
 
@@ -193,6 +199,7 @@ impl FmuModel for LqrModel {
         self.pending = None;
         self.clock = SampleClock::new(vars.sample_time, start_time);
         self.last = None;
+        self.saturated = false;
         let due = self.clock.take(start_time);
         debug_assert!(due);
         self.sample(vars, start_time, log)?;

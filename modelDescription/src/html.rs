@@ -1,59 +1,116 @@
-//! HTML tables of every port and parameter, for `documentation/index.html`.
+//! Variable reference tables of every port and parameter: HTML for
+//! `documentation/index.html` and Markdown for the reviewed reference in
+//! `modelDescription/generated/<modelIdentifier>.md`. Both come from [`sections`].
 
 use crate::{fmt_f64, Causality, Model, Start, VarType};
 use quick_xml::escape::escape;
 use std::fmt::Write;
 
-/// One `<h2>` + `<table>` per causality, every variable with type, unit,
-/// start, range, variability and description.
-pub fn variable_tables(model: &Model) -> String {
-    let mut out = String::new();
-    let sections = [
+/// Column headers of the tables.
+pub const COLUMNS: [&str; 9] = ["name", "vr", "type", "unit", "start", "min", "max", "variability", "description"];
+
+/// One titled section per causality present, each row the nine [`COLUMNS`] as plain text.
+pub fn sections(model: &Model) -> Vec<(&'static str, Vec<[String; 9]>)> {
+    let order = [
         (Causality::Input, "Inputs"),
         (Causality::Output, "Outputs"),
         (Causality::Parameter, "Parameters"),
         (Causality::CalculatedParameter, "Calculated parameters"),
         (Causality::Local, "Locals"),
     ];
-    for (causality, title) in sections {
-        let vars: Vec<_> = model.variables.iter().filter(|v| v.decl.causality == causality).collect();
-        if vars.is_empty() {
-            continue;
+    let mut out = Vec::new();
+    for (causality, title) in order {
+        let rows: Vec<[String; 9]> = model
+            .variables
+            .iter()
+            .filter(|v| v.decl.causality == causality)
+            .map(|v| {
+                let d = &v.decl;
+                let unit = match (&d.unit, &v.display_unit) {
+                    (Some(u), Some(du)) => format!("{u} (shown in {du})"),
+                    (Some(u), None) => u.clone(),
+                    _ => String::new(),
+                };
+                let num = |x: f64| if d.var_type == VarType::Integer { format!("{}", x as i64) } else { fmt_f64(x) };
+                let start = match &d.start {
+                    Some(Start::Number(x)) => num(*x),
+                    Some(Start::Bool(b)) => b.to_string(),
+                    Some(Start::Text(s)) => s.clone(),
+                    None => "calculated".to_string(),
+                };
+                [
+                    d.name.clone(),
+                    v.value_reference.to_string(),
+                    format!("{:?}", d.var_type),
+                    unit,
+                    start,
+                    d.min.map(num).unwrap_or_default(),
+                    d.max.map(num).unwrap_or_default(),
+                    v.variability.as_str().to_string(),
+                    d.description.clone(),
+                ]
+            })
+            .collect();
+        if !rows.is_empty() {
+            out.push((title, rows));
         }
-        let _ = writeln!(out, "<h2>{title} ({})</h2>", vars.len());
-        let _ = writeln!(
-            out,
-            "<table>\n<tr><th>name</th><th>vr</th><th>type</th><th>unit</th><th>start</th><th>min</th><th>max</th><th>variability</th><th>description</th></tr>"
-        );
-        for v in vars {
-            let d = &v.decl;
-            let unit = match (&d.unit, &v.display_unit) {
-                (Some(u), Some(du)) => format!("{u} (shown in {du})"),
-                (Some(u), None) => u.clone(),
-                _ => String::new(),
-            };
-            let num = |x: f64| if d.var_type == VarType::Integer { format!("{}", x as i64) } else { fmt_f64(x) };
-            let start = match &d.start {
-                Some(Start::Number(x)) => num(*x),
-                Some(Start::Bool(b)) => b.to_string(),
-                Some(Start::Text(s)) => s.clone(),
-                None => "calculated".to_string(),
-            };
-            let _ = writeln!(
-                out,
-                "<tr><td><code>{}</code></td><td>{}</td><td>{:?}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
-                escape(d.name.as_str()),
-                v.value_reference,
-                d.var_type,
-                escape(unit.as_str()),
-                escape(start.as_str()),
-                d.min.map(num).unwrap_or_default(),
-                d.max.map(num).unwrap_or_default(),
-                v.variability.as_str(),
-                escape(d.description.as_str())
-            );
+    }
+    out
+}
+
+/// One `<h2>` + `<table>` per causality, every variable with type, unit,
+/// start, range, variability and description.
+pub fn variable_tables(model: &Model) -> String {
+    let mut out = String::new();
+    for (title, rows) in sections(model) {
+        let _ = writeln!(out, "<h2>{title} ({})</h2>", rows.len());
+        let header: String = COLUMNS.iter().map(|c| format!("<th>{c}</th>")).collect();
+        let _ = writeln!(out, "<table>\n<tr>{header}</tr>");
+        for row in rows {
+            let cells: String = row
+                .iter()
+                .enumerate()
+                .map(|(i, c)| {
+                    if i == 0 {
+                        format!("<td><code>{}</code></td>", escape(c.as_str()))
+                    } else {
+                        format!("<td>{}</td>", escape(c.as_str()))
+                    }
+                })
+                .collect();
+            let _ = writeln!(out, "<tr>{cells}</tr>");
         }
         out.push_str("</table>\n");
+    }
+    out
+}
+
+/// The same tables in Markdown, headed by the model's name and GUID-free
+/// metadata (so the file only changes when the interface does).
+pub fn variable_reference_markdown(model: &Model) -> String {
+    let mut out = format!(
+        "# `{}` — variable reference\n\n{}\n\n@generated by `cargo xtask regen` from `modelDescription/{}.json`: do not edit.\n",
+        model.model_identifier, model.description, model.model_identifier
+    );
+    for (title, rows) in sections(model) {
+        let _ = writeln!(out, "\n## {title} ({})\n", rows.len());
+        let _ = writeln!(out, "| {} |", COLUMNS.join(" | "));
+        let _ = writeln!(out, "|{}", "---|".repeat(COLUMNS.len()));
+        for row in rows {
+            let cells: Vec<String> = row
+                .iter()
+                .enumerate()
+                .map(|(i, c)| {
+                    let c = c.replace('|', "\\|");
+                    if i == 0 {
+                        format!("`{c}`")
+                    } else {
+                        c
+                    }
+                })
+                .collect();
+            let _ = writeln!(out, "| {} |", cells.join(" | "));
+        }
     }
     out
 }

@@ -33,6 +33,11 @@ fn reviewed_xml_matches_generated() {
         let reviewed = std::fs::read_to_string(&path)
             .unwrap_or_else(|e| panic!("{}: {e} (run `cargo xtask regen`)", path.display()));
         assert!(generated == reviewed, "{} drifted from its declaration: run `cargo xtask regen` and review the diff", path.display());
+        let md = model_description::html::variable_reference_markdown(&model);
+        let path = dir().join("generated").join(format!("{id}.md"));
+        let reviewed = std::fs::read_to_string(&path)
+            .unwrap_or_else(|e| panic!("{}: {e} (run `cargo xtask regen`)", path.display()));
+        assert!(md == reviewed, "{} drifted from its declaration: run `cargo xtask regen`", path.display());
     }
 }
 

@@ -1,7 +1,8 @@
 //! Project tasks, run as `cargo xtask <task>`:
 //! - `dist`: build the FMU libraries in release mode and write `dist/<modelIdentifier>.fmu`
 //!   (modelDescription.xml, binaries/linux64/<id>.so, documentation/index.html);
-//! - `regen`: rewrite the reviewed copies `modelDescription/generated/<id>.xml`.
+//! - `regen`: rewrite the reviewed copies `modelDescription/generated/<id>.xml` and the
+//!   variable references `modelDescription/generated/<id>.md`.
 
 use clap::{Parser, Subcommand};
 use std::io::Write;
@@ -63,10 +64,16 @@ fn regen() -> Result<(), String> {
     let dir = workspace_root().join("modelDescription/generated");
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
     for (_, id, _) in FMUS {
-        let xml = model_description::xml::model_description(&load(id)?);
-        let path = dir.join(format!("{id}.xml"));
-        std::fs::write(&path, xml).map_err(|e| format!("{}: {e}", path.display()))?;
-        println!("wrote {}", path.display());
+        let model = load(id)?;
+        let files = [
+            (format!("{id}.xml"), model_description::xml::model_description(&model)),
+            (format!("{id}.md"), model_description::html::variable_reference_markdown(&model)),
+        ];
+        for (name, text) in files {
+            let path = dir.join(name);
+            std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+            println!("wrote {}", path.display());
+        }
     }
     Ok(())
 }

@@ -329,7 +329,8 @@ impl TsdController {
             blend(p.normal_pole_re_vertical, p.normal_pole_re_level),
             blend(p.normal_pole_im_vertical, p.normal_pole_im_level),
         );
-        let normal_gains = gains::place_3(&normal_model.0, &normal_model.1, normal_poly).ok_or("normal-acceleration")?;
+        let normal_gains =
+            gains::place_3(&normal_model.0, &normal_model.1, normal_poly).ok_or("normal-acceleration")?;
 
         // Roll (4.2.21–4.2.26) with NVD (4.3.7–4.3.11): ailerons (free stream) and
         // differential flaps (slip-stream) deflected together.
@@ -361,7 +362,9 @@ impl TsdController {
         let directional_gains =
             gains::place_3(&directional_model.0, &directional_model.1, directional_poly).ok_or("directional")?;
 
-        let finite = [guidance.0, guidance.1, axial.0, axial.1, b2, b21, b32].iter().all(|x| x.is_finite());
+        let finite = [guidance.0, guidance.1, axial.0, axial.1, b2, b21, b32]
+            .iter()
+            .all(|x| x.is_finite());
         if !finite {
             return Err("scheduled");
         }
@@ -727,6 +730,89 @@ mod tests {
         );
         assert!(mixed.iter().all(|z| z.re < 0.0), "mixed: {mixed:?}");
         println!("zeros of C_W/δe: {elevator:?}; of C_W/δm: {mixed:?}");
+    }
+
+    fn sorted(mut v: Vec<nalgebra::Complex<f64>>) -> Vec<nalgebra::Complex<f64>> {
+        v.sort_by(|a, b| a.re.partial_cmp(&b.re).unwrap().then(a.im.partial_cmp(&b.im).unwrap()));
+        v
+    }
+
+    fn assert_poles(m: &Matrix3<f64>, want: &[(f64, f64)], what: &str) {
+        let got = sorted(m.complex_eigenvalues().iter().copied().collect());
+        let mut want: Vec<_> = want.iter().map(|&(re, im)| nalgebra::Complex::new(re, im)).collect();
+        want = sorted(want);
+        for (w, g) in want.iter().zip(got.iter()) {
+            assert!(
+                (w - g).norm() < 1e-6 * (1.0 + w.norm()),
+                "{what}: want {want:?}, got {got:?}"
+            );
+        }
+    }
+
+    /// At the vertical climb (3 m/s, T = mg, w ≈ 10.4 m/s) and in level flight (25 m/s), every
+    /// scheduled loop closed on its own model has exactly the poles of Table 4.3.
+    #[test]
+    fn scheduled_loops_have_the_poles_of_table_4_3() {
+        let ctl = TsdController::with_mission(MissionParams::default()).unwrap();
+        let p = TsdParams::default();
+        let vertical = FlightCondition {
+            airspeed: 3.0,
+            alpha: 0.0,
+            thrust: 88.3,
+            induced_velocity: 10.4,
+        };
+        let level = FlightCondition {
+            airspeed: 25.0,
+            alpha: 0.092,
+            thrust: 9.3,
+            induced_velocity: 0.6,
+        };
+        for (fc, lvl) in [(vertical, false), (level, true)] {
+            let d = ctl.design(&fc).unwrap();
+            assert_eq!(d.schedule, if lvl { 1.0 } else { 0.0 });
+            let pick = |v: f64, l: f64| if lvl { l } else { v };
+            let (a, b) = d.normal_model;
+            let (re, im) = (
+                pick(p.normal_pole_re_vertical, p.normal_pole_re_level),
+                pick(p.normal_pole_im_vertical, p.normal_pole_im_level),
+            );
+            let real = pick(p.normal_pole_real_vertical, p.normal_pole_real_level);
+            assert_poles(&(a - b * d.normal_gains), &[(real, 0.0), (re, im), (re, -im)], "normal");
+            let (a, b) = d.directional_model;
+            let (re, im) = (
+                pick(p.directional_pole_re_vertical, p.directional_pole_re_level),
+                pick(p.directional_pole_im_vertical, p.directional_pole_im_level),
+            );
+            let real = pick(p.directional_pole_real_vertical, p.directional_pole_real_level);
+            assert_poles(
+                &(a - b * d.directional_gains),
+                &[(real, 0.0), (re, im), (re, -im)],
+                "directional",
+            );
+            let (_, a22, _, b21) = d.roll_model;
+            let (kp, ke, kphi) = d.roll_gains;
+            let (re, im) = (
+                pick(p.roll_pole_re_vertical, p.roll_pole_re_level),
+                pick(p.roll_pole_im_vertical, p.roll_pole_im_level),
+            );
+            let nvd = pick(p.nvd_pole_vertical, p.nvd_pole_level);
+            assert_poles(
+                &gains::roll_nvd_closed_loop(a22, b21, kp, ke, kphi),
+                &[(nvd, 0.0), (re, im), (re, -im)],
+                "roll/NVD",
+            );
+            // Axial (4.2.6) in (T, E_A).
+            let (ka, ke) = d.axial;
+            let (m, tau) = (Airframe::default().mass, Airframe::default().tau_thrust);
+            let acl = nalgebra::Matrix2::new(-(1.0 + ka / m) / tau, -ke / tau, 1.0 / m, 0.0);
+            let mut e: Vec<f64> = acl.complex_eigenvalues().iter().map(|c| c.re).collect();
+            e.sort_by(|a, b| a.partial_cmp(b).unwrap());
+            assert!((e[0] + 15.0).abs() < 1e-9 && (e[1] + 10.0).abs() < 1e-9, "axial {e:?}");
+            // Slip-stream: the vertical climb keeps full pitch authority (b2 from q̄_s).
+            assert!(d.b2 < -100.0, "b2 = {}", d.b2);
+            // Low-speed frame in vertical flight, wind axes in level flight.
+            assert_eq!(d.kappa, if lvl { 1.0 } else { 0.0 });
+        }
     }
 
     #[test]
