@@ -150,9 +150,9 @@ impl LqrModel {
             Some(Notice::GainFallback(why)) => log.warning(format_args!(
                 "t = {t} s: gain computation failed ({why}); using the last good gains"
             )),
-            Some(Notice::Saturated(name)) if !self.saturated => {
-                log.warning(format_args!("t = {t} s: {name} saturated (further saturations until it ends are not logged)"))
-            }
+            Some(Notice::Saturated(name)) if !self.saturated => log.warning(format_args!(
+                "t = {t} s: {name} saturated (further saturations until it ends are not logged)"
+            )),
             _ => {}
         }
         self.saturated = matches!(out.notice, Some(Notice::Saturated(_)));

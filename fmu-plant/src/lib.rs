@@ -6,9 +6,7 @@
 
 use fmi2_export::{FmuModel, Logger, ModelError, StateError, StateReader, StateWriter};
 use nalgebra::Vector3;
-use tailsitter_physics::{
-    dcm_earth_to_body, quat_from_euler_321, Plant, StateVector, Trim, N_STATES,
-};
+use tailsitter_physics::{dcm_earth_to_body, quat_from_euler_321, Plant, StateVector, Trim, N_STATES};
 
 /// Generated from the declaration: `Variables`, `vr`, `GUID`, `MODEL_IDENTIFIER`, `MODEL_DESCRIPTION_XML`.
 #[allow(clippy::all)]
@@ -34,7 +32,9 @@ impl PlantModel {
     /// The physics as parameterised by `vars`.
     fn plant_from(vars: &Variables) -> Result<Plant, ModelError> {
         let airframe = vars.airframe();
-        airframe.validate().map_err(|e| ModelError::new(format!("invalid airframe parameter: {e}")))?;
+        airframe
+            .validate()
+            .map_err(|e| ModelError::new(format!("invalid airframe parameter: {e}")))?;
         let mut plant = Plant::new(airframe);
         plant.integration_step = vars.integration_step;
         Ok(plant)
@@ -59,7 +59,12 @@ impl PlantModel {
                 )))
             }
         };
-        trim.map_err(|e| ModelError::new(format!("initial trim at initial_speed = {} m/s failed: {e}", vars.initial_speed)))
+        trim.map_err(|e| {
+            ModelError::new(format!(
+                "initial trim at initial_speed = {} m/s failed: {e}",
+                vars.initial_speed
+            ))
+        })
     }
 
     /// The commanded inputs `u` of the physics, in `tailsitter_physics::idx` order.
@@ -126,7 +131,11 @@ impl FmuModel for PlantModel {
     const GUID: &'static str = GUID;
 
     fn new(vars: &Variables) -> Self {
-        Self { plant: Plant::new(vars.airframe()), x: StateVector::zeros(), stale: true }
+        Self {
+            plant: Plant::new(vars.airframe()),
+            x: StateVector::zeros(),
+            stale: true,
+        }
     }
 
     fn initialize(&mut self, vars: &mut Variables, _start_time: f64, _log: &mut Logger<'_>) -> Result<(), ModelError> {
@@ -165,7 +174,10 @@ impl FmuModel for PlantModel {
         let u = Self::inputs(vars);
         let wind = Self::wind(vars);
         self.plant.advance(&mut self.x, &u, &wind, h).map_err(|e| {
-            ModelError::new(format!("plant left its envelope in the step from t = {t} s to {} s: {e}", t + h))
+            ModelError::new(format!(
+                "plant left its envelope in the step from t = {t} s to {} s: {e}",
+                t + h
+            ))
         })?;
         self.write_outputs(vars);
         Ok(())

@@ -7,7 +7,17 @@ use quick_xml::escape::escape;
 use std::fmt::Write;
 
 /// Column headers of the tables.
-pub const COLUMNS: [&str; 9] = ["name", "vr", "type", "unit", "start", "min", "max", "variability", "description"];
+pub const COLUMNS: [&str; 9] = [
+    "name",
+    "vr",
+    "type",
+    "unit",
+    "start",
+    "min",
+    "max",
+    "variability",
+    "description",
+];
 
 /// One titled section per causality present, each row the nine [`COLUMNS`] as plain text.
 pub fn sections(model: &Model) -> Vec<(&'static str, Vec<[String; 9]>)> {
@@ -31,7 +41,13 @@ pub fn sections(model: &Model) -> Vec<(&'static str, Vec<[String; 9]>)> {
                     (Some(u), None) => u.clone(),
                     _ => String::new(),
                 };
-                let num = |x: f64| if d.var_type == VarType::Integer { format!("{}", x as i64) } else { fmt_f64(x) };
+                let num = |x: f64| {
+                    if d.var_type == VarType::Integer {
+                        format!("{}", x as i64)
+                    } else {
+                        fmt_f64(x)
+                    }
+                };
                 let start = match &d.start {
                     Some(Start::Number(x)) => num(*x),
                     Some(Start::Bool(b)) => b.to_string(),

@@ -243,7 +243,10 @@ pub const AUTHOR: &str = "Tail-sitter FMU developers";
 /// Log categories the export layer understands (kept equal to
 /// `fmi2_export::LOG_CATEGORIES` by a test in each FMU crate).
 pub const LOG_CATEGORIES: &[(&str, &str)] = &[
-    ("logStatusWarning", "Warnings: saturation, fallbacks, recoverable problems"),
+    (
+        "logStatusWarning",
+        "Warnings: saturation, fallbacks, recoverable problems",
+    ),
     ("logStatusError", "Errors: illegal calls, bad arguments, failed steps"),
     ("logAll", "Everything, including debug messages"),
 ];
@@ -262,7 +265,10 @@ pub fn load(dir: &Path, model_identifier: &str, version: &str) -> Result<Model, 
         .clone()
         .ok_or_else(|| DeclError(format!("{}: missing modelIdentifier", path.display())))?;
     if id != model_identifier {
-        return err(format!("{}: modelIdentifier '{id}' does not match the file name", path.display()));
+        return err(format!(
+            "{}: modelIdentifier '{id}' does not match the file name",
+            path.display()
+        ));
     }
     let variables = decls
         .into_iter()
@@ -331,22 +337,34 @@ fn resolve(decl: VariableDecl, value_reference: u32) -> Result<Variable, DeclErr
         Some("rad/s") => Some("deg/s".to_string()),
         _ => None,
     });
-    Ok(Variable { decl, value_reference, variability, display_unit })
+    Ok(Variable {
+        decl,
+        value_reference,
+        variability,
+        display_unit,
+    })
 }
 
 fn is_rust_identifier(s: &str) -> bool {
     let mut chars = s.chars();
     matches!(chars.next(), Some(c) if c.is_ascii_alphabetic() || c == '_')
         && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
-        && !matches!(s, "type" | "fn" | "struct" | "impl" | "self" | "Self" | "move" | "ref" | "mod" | "use" | "let")
+        && !matches!(
+            s,
+            "type" | "fn" | "struct" | "impl" | "self" | "Self" | "move" | "ref" | "mod" | "use" | "let"
+        )
 }
 
 /// Check the rules of FMI 2.0 (start/initial per causality, min ≤ start ≤ max, units known)
 /// and our own (names are Rust identifiers, unique; dependencies name inputs; groups declared).
 fn check(model: &Model) -> Result<(), DeclError> {
     let mut names = BTreeSet::new();
-    let inputs: BTreeSet<&str> =
-        model.variables.iter().filter(|v| v.decl.causality == Causality::Input).map(|v| v.name()).collect();
+    let inputs: BTreeSet<&str> = model
+        .variables
+        .iter()
+        .filter(|v| v.decl.causality == Causality::Input)
+        .map(|v| v.name())
+        .collect();
     for v in &model.variables {
         let d = &v.decl;
         let n = &d.name;
@@ -365,7 +383,10 @@ fn check(model: &Model) -> Result<(), DeclError> {
             return err(format!("variable '{n}': {} needs a start value", d.causality.as_str()));
         }
         if forbids_start && d.start.is_some() {
-            return err(format!("variable '{n}': {} is calculated and takes no start value", d.causality.as_str()));
+            return err(format!(
+                "variable '{n}': {} is calculated and takes no start value",
+                d.causality.as_str()
+            ));
         }
         match (d.causality, v.variability) {
             (Causality::Parameter | Causality::CalculatedParameter, Variability::Fixed | Variability::Tunable) => {}

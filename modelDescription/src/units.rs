@@ -19,11 +19,24 @@ pub struct Unit {
     pub display_units: &'static [DisplayUnit],
 }
 
-const DEG: DisplayUnit = DisplayUnit { name: "deg", factor: 57.295_779_513_082_32 };
-const DEG_PER_S: DisplayUnit = DisplayUnit { name: "deg/s", factor: 57.295_779_513_082_32 };
+const DEG: DisplayUnit = DisplayUnit {
+    name: "deg",
+    factor: 57.295_779_513_082_32,
+};
+const DEG_PER_S: DisplayUnit = DisplayUnit {
+    name: "deg/s",
+    factor: 57.295_779_513_082_32,
+};
 
 const fn unit(name: &'static str, kg: i32, m: i32, s: i32, rad: i32) -> Unit {
-    Unit { name, kg, m, s, rad, display_units: &[] }
+    Unit {
+        name,
+        kg,
+        m,
+        s,
+        rad,
+        display_units: &[],
+    }
 }
 
 /// Every unit a declaration may use.
@@ -38,8 +51,22 @@ pub const UNITS: &[Unit] = &[
     unit("kg.m2", 1, 2, 0, 0),
     unit("kg/m3", 1, -3, 0, 0),
     unit("N", 1, 1, -2, 0),
-    Unit { name: "rad", kg: 0, m: 0, s: 0, rad: 1, display_units: &[DEG] },
-    Unit { name: "rad/s", kg: 0, m: 0, s: -1, rad: 1, display_units: &[DEG_PER_S] },
+    Unit {
+        name: "rad",
+        kg: 0,
+        m: 0,
+        s: 0,
+        rad: 1,
+        display_units: &[DEG],
+    },
+    Unit {
+        name: "rad/s",
+        kg: 0,
+        m: 0,
+        s: -1,
+        rad: 1,
+        display_units: &[DEG_PER_S],
+    },
 ];
 
 /// Look a unit up by name.

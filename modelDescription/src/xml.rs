@@ -92,21 +92,23 @@ fn unit_definitions(w: &mut W, model: &Model) -> Result<()> {
     }
     w.create_element("UnitDefinitions").write_inner_content(|w| {
         for u in used {
-            w.create_element("Unit").with_attribute(("name", u.name)).write_inner_content(|w| {
-                let mut base = w.create_element("BaseUnit");
-                for (name, exp) in [("kg", u.kg), ("m", u.m), ("s", u.s), ("rad", u.rad)] {
-                    if exp != 0 {
-                        base = base.with_attribute((name, exp.to_string().as_str()));
+            w.create_element("Unit")
+                .with_attribute(("name", u.name))
+                .write_inner_content(|w| {
+                    let mut base = w.create_element("BaseUnit");
+                    for (name, exp) in [("kg", u.kg), ("m", u.m), ("s", u.s), ("rad", u.rad)] {
+                        if exp != 0 {
+                            base = base.with_attribute((name, exp.to_string().as_str()));
+                        }
                     }
-                }
-                base.write_empty()?;
-                for d in u.display_units {
-                    w.create_element("DisplayUnit")
-                        .with_attributes([("name", d.name), ("factor", fmt_f64(d.factor).as_str())])
-                        .write_empty()?;
-                }
-                Ok(())
-            })?;
+                    base.write_empty()?;
+                    for d in u.display_units {
+                        w.create_element("DisplayUnit")
+                            .with_attributes([("name", d.name), ("factor", fmt_f64(d.factor).as_str())])
+                            .write_empty()?;
+                    }
+                    Ok(())
+                })?;
         }
         Ok(())
     })?;
@@ -166,7 +168,9 @@ fn scalar_variable(w: &mut W, v: &Variable) -> Result<()> {
                 Some(Start::Text(s)) => attrs.push(("start", s.clone())),
                 None => {}
             }
-            w.create_element(tag).with_attributes(attrs.iter().map(|(k, v)| (*k, v.as_str()))).write_empty()?;
+            w.create_element(tag)
+                .with_attributes(attrs.iter().map(|(k, v)| (*k, v.as_str())))
+                .write_empty()?;
             Ok(())
         })?;
     Ok(())
@@ -174,12 +178,20 @@ fn scalar_variable(w: &mut W, v: &Variable) -> Result<()> {
 
 /// 1-based index of a variable in ModelVariables.
 fn index_of(model: &Model, name: &str) -> usize {
-    model.variables.iter().position(|v| v.name() == name).map(|i| i + 1).expect("checked at load")
+    model
+        .variables
+        .iter()
+        .position(|v| v.name() == name)
+        .map(|i| i + 1)
+        .expect("checked at load")
 }
 
 fn model_structure(w: &mut W, model: &Model) -> Result<()> {
-    let outputs: Vec<&Variable> =
-        model.variables.iter().filter(|v| v.decl.causality == Causality::Output).collect();
+    let outputs: Vec<&Variable> = model
+        .variables
+        .iter()
+        .filter(|v| v.decl.causality == Causality::Output)
+        .collect();
     let initial: Vec<&Variable> = model
         .variables
         .iter()
@@ -189,8 +201,12 @@ fn model_structure(w: &mut W, model: &Model) -> Result<()> {
         if !outputs.is_empty() {
             w.create_element("Outputs").write_inner_content(|w| {
                 for v in &outputs {
-                    let deps: Vec<String> =
-                        v.decl.depends_on.iter().map(|n| index_of(model, n).to_string()).collect();
+                    let deps: Vec<String> = v
+                        .decl
+                        .depends_on
+                        .iter()
+                        .map(|n| index_of(model, n).to_string())
+                        .collect();
                     let index = index_of(model, v.name()).to_string();
                     let deps = deps.join(" ");
                     w.create_element("Unknown")
@@ -205,7 +221,9 @@ fn model_structure(w: &mut W, model: &Model) -> Result<()> {
             w.create_element("InitialUnknowns").write_inner_content(|w| {
                 for v in &initial {
                     let index = index_of(model, v.name()).to_string();
-                    w.create_element("Unknown").with_attribute(("index", index.as_str())).write_empty()?;
+                    w.create_element("Unknown")
+                        .with_attribute(("index", index.as_str()))
+                        .write_empty()?;
                 }
                 Ok(())
             })?;

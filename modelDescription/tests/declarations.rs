@@ -2,7 +2,9 @@
 //! every attribute intact, the reviewed copies in `generated/` have not drifted,
 //! and malformed declarations are rejected with a message naming the variable.
 
-use fmi_schema::fmi2::{Causality as XCausality, Fmi2ModelDescription, ScalarVariableElement, Variability as XVariability};
+use fmi_schema::fmi2::{
+    Causality as XCausality, Fmi2ModelDescription, ScalarVariableElement, Variability as XVariability,
+};
 use model_description::{load, xml::model_description, Causality, Start, VarType};
 use std::path::{Path, PathBuf};
 
@@ -20,7 +22,10 @@ fn model_ids() -> Vec<String> {
         })
         .collect();
     ids.sort();
-    assert!(ids.contains(&"tailsitter_plant".to_string()), "plant declaration missing: {ids:?}");
+    assert!(
+        ids.contains(&"tailsitter_plant".to_string()),
+        "plant declaration missing: {ids:?}"
+    );
     ids
 }
 
@@ -32,12 +37,20 @@ fn reviewed_xml_matches_generated() {
         let path = dir().join("generated").join(format!("{id}.xml"));
         let reviewed = std::fs::read_to_string(&path)
             .unwrap_or_else(|e| panic!("{}: {e} (run `cargo xtask regen`)", path.display()));
-        assert!(generated == reviewed, "{} drifted from its declaration: run `cargo xtask regen` and review the diff", path.display());
+        assert!(
+            generated == reviewed,
+            "{} drifted from its declaration: run `cargo xtask regen` and review the diff",
+            path.display()
+        );
         let md = model_description::html::variable_reference_markdown(&model);
         let path = dir().join("generated").join(format!("{id}.md"));
         let reviewed = std::fs::read_to_string(&path)
             .unwrap_or_else(|e| panic!("{}: {e} (run `cargo xtask regen`)", path.display()));
-        assert!(md == reviewed, "{} drifted from its declaration: run `cargo xtask regen`", path.display());
+        assert!(
+            md == reviewed,
+            "{} drifted from its declaration: run `cargo xtask regen`",
+            path.display()
+        );
     }
 }
 
@@ -68,7 +81,12 @@ fn xml_round_trips_through_fmi_schema() {
             };
             assert_eq!(x.causality, causality, "{}", d.name);
             let variability = x.variability.expect("variability written");
-            assert_eq!(format!("{variability:?}").to_lowercase(), v.variability.as_str().to_lowercase(), "{}", d.name);
+            assert_eq!(
+                format!("{variability:?}").to_lowercase(),
+                v.variability.as_str().to_lowercase(),
+                "{}",
+                d.name
+            );
             let _ = XVariability::Continuous;
             match (&x.elem, d.var_type, &d.start) {
                 (ScalarVariableElement::Real(real), VarType::Real, start) => {
@@ -85,12 +103,17 @@ fn xml_round_trips_through_fmi_schema() {
                     };
                     assert_eq!(i.start, want, "{}", d.name);
                 }
-                (ScalarVariableElement::Boolean(_), VarType::Boolean, _) | (ScalarVariableElement::String, VarType::String, _) => {}
+                (ScalarVariableElement::Boolean(_), VarType::Boolean, _)
+                | (ScalarVariableElement::String, VarType::String, _) => {}
                 (elem, t, _) => panic!("{}: element {elem:?} for type {t:?}", d.name),
             }
         }
         let outputs = &md.model_structure.outputs.unknowns;
-        let n_out = model.variables.iter().filter(|v| v.decl.causality == Causality::Output).count();
+        let n_out = model
+            .variables
+            .iter()
+            .filter(|v| v.decl.causality == Causality::Output)
+            .count();
         assert_eq!(outputs.len(), n_out);
     }
 }
@@ -112,7 +135,11 @@ fn guid_changes_with_the_interface() {
     let a = load(&dir(), "tailsitter_plant", "1.0.0").unwrap();
     let b = load(&dir(), "tailsitter_plant", "1.0.1").unwrap();
     assert_ne!(a.guid, b.guid);
-    assert_eq!(a.guid, load(&dir(), "tailsitter_plant", "1.0.0").unwrap().guid, "GUID must be deterministic");
+    assert_eq!(
+        a.guid,
+        load(&dir(), "tailsitter_plant", "1.0.0").unwrap().guid,
+        "GUID must be deterministic"
+    );
 }
 
 fn load_text(json: &str) -> Result<model_description::Model, String> {
@@ -136,19 +163,52 @@ fn malformed_declarations_are_rejected() {
     assert!(load_text(&decl(ok)).is_ok());
     let cases = [
         (format!("{ok},{ok}"), "declared twice"),
-        (r#"{"name":"a","causality":"parameter","description":"d"}"#.to_string(), "needs a start"),
-        (r#"{"name":"a","causality":"output","start":1,"description":"d"}"#.to_string(), "takes no start"),
-        (r#"{"name":"a","causality":"parameter","start":5,"max":1,"description":"d"}"#.to_string(), "outside"),
-        (r#"{"name":"a","causality":"parameter","start":1,"unit":"furlong","description":"d"}"#.to_string(), "unknown unit"),
-        (r#"{"name":"a b","causality":"parameter","start":1,"description":"d"}"#.to_string(), "Rust identifier"),
-        (r#"{"name":"a","causality":"parameter","start":1,"description":" "}"#.to_string(), "empty description"),
-        (r#"{"name":"a","causality":"input","start":1,"variability":"fixed","description":"d"}"#.to_string(), "only parameters"),
-        (r#"{"name":"a","causality":"output","dependsOn":["x"],"description":"d"}"#.to_string(), "not an input"),
-        (r#"{"name":"a","causality":"parameter","type":"Integer","start":1.5,"description":"d"}"#.to_string(), "does not fit"),
-        (r#"{"name":"a","causality":"parameter","start":1,"group":"g","description":"d"}"#.to_string(), "group 'g'"),
+        (
+            r#"{"name":"a","causality":"parameter","description":"d"}"#.to_string(),
+            "needs a start",
+        ),
+        (
+            r#"{"name":"a","causality":"output","start":1,"description":"d"}"#.to_string(),
+            "takes no start",
+        ),
+        (
+            r#"{"name":"a","causality":"parameter","start":5,"max":1,"description":"d"}"#.to_string(),
+            "outside",
+        ),
+        (
+            r#"{"name":"a","causality":"parameter","start":1,"unit":"furlong","description":"d"}"#.to_string(),
+            "unknown unit",
+        ),
+        (
+            r#"{"name":"a b","causality":"parameter","start":1,"description":"d"}"#.to_string(),
+            "Rust identifier",
+        ),
+        (
+            r#"{"name":"a","causality":"parameter","start":1,"description":" "}"#.to_string(),
+            "empty description",
+        ),
+        (
+            r#"{"name":"a","causality":"input","start":1,"variability":"fixed","description":"d"}"#.to_string(),
+            "only parameters",
+        ),
+        (
+            r#"{"name":"a","causality":"output","dependsOn":["x"],"description":"d"}"#.to_string(),
+            "not an input",
+        ),
+        (
+            r#"{"name":"a","causality":"parameter","type":"Integer","start":1.5,"description":"d"}"#.to_string(),
+            "does not fit",
+        ),
+        (
+            r#"{"name":"a","causality":"parameter","start":1,"group":"g","description":"d"}"#.to_string(),
+            "group 'g'",
+        ),
     ];
     for (vars, expected) in cases {
         let e = load_text(&decl(&vars)).expect_err(&vars);
-        assert!(e.contains(expected) && e.contains('a'), "{vars}: got '{e}', expected '{expected}'");
+        assert!(
+            e.contains(expected) && e.contains('a'),
+            "{vars}: got '{e}', expected '{expected}'"
+        );
     }
 }

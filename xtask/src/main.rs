@@ -12,9 +12,21 @@ use std::process::Command;
 /// FMUs this workspace can package: (crate, modelIdentifier, Markdown files
 /// rendered into documentation/index.html: the FMU's readme, then its library's equations).
 const FMUS: &[(&str, &str, &[&str])] = &[
-    ("fmu-plant", "tailsitter_plant", &["fmu-plant/README.md", "crates/tailsitter-physics/README.md"]),
-    ("fmu-lqr", "tailsitter_lqr", &["fmu-lqr/README.md", "crates/lqr-control/README.md"]),
-    ("fmu-tsd", "tailsitter_tsd", &["fmu-tsd/README.md", "crates/tsd-control/README.md"]),
+    (
+        "fmu-plant",
+        "tailsitter_plant",
+        &["fmu-plant/README.md", "crates/tailsitter-physics/README.md"],
+    ),
+    (
+        "fmu-lqr",
+        "tailsitter_lqr",
+        &["fmu-lqr/README.md", "crates/lqr-control/README.md"],
+    ),
+    (
+        "fmu-tsd",
+        "tailsitter_tsd",
+        &["fmu-tsd/README.md", "crates/tsd-control/README.md"],
+    ),
 ];
 
 #[derive(Parser)]
@@ -40,12 +52,19 @@ enum Task {
 }
 
 fn workspace_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("xtask lives in the workspace").to_path_buf()
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("xtask lives in the workspace")
+        .to_path_buf()
 }
 
 fn load(id: &str) -> Result<model_description::Model, String> {
-    model_description::load(&workspace_root().join("modelDescription"), id, env!("CARGO_PKG_VERSION"))
-        .map_err(|e| e.to_string())
+    model_description::load(
+        &workspace_root().join("modelDescription"),
+        id,
+        env!("CARGO_PKG_VERSION"),
+    )
+    .map_err(|e| e.to_string())
 }
 
 fn main() {
@@ -67,7 +86,10 @@ fn regen() -> Result<(), String> {
         let model = load(id)?;
         let files = [
             (format!("{id}.xml"), model_description::xml::model_description(&model)),
-            (format!("{id}.md"), model_description::html::variable_reference_markdown(&model)),
+            (
+                format!("{id}.md"),
+                model_description::html::variable_reference_markdown(&model),
+            ),
         ];
         for (name, text) in files {
             let path = dir.join(name);
@@ -80,9 +102,15 @@ fn regen() -> Result<(), String> {
 
 fn dist(only: &[String], out: &Path) -> Result<(), String> {
     let root = workspace_root();
-    let selected: Vec<_> = FMUS.iter().filter(|(_, id, _)| only.is_empty() || only.iter().any(|o| o == id)).collect();
+    let selected: Vec<_> = FMUS
+        .iter()
+        .filter(|(_, id, _)| only.is_empty() || only.iter().any(|o| o == id))
+        .collect();
     if selected.is_empty() {
-        return Err(format!("no FMU matches {only:?}; known: {:?}", FMUS.iter().map(|f| f.1).collect::<Vec<_>>()));
+        return Err(format!(
+            "no FMU matches {only:?}; known: {:?}",
+            FMUS.iter().map(|f| f.1).collect::<Vec<_>>()
+        ));
     }
     let mut cargo = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
     cargo.current_dir(&root).args(["build", "--release", "--locked"]);
@@ -93,7 +121,11 @@ fn dist(only: &[String], out: &Path) -> Result<(), String> {
     if !status.success() {
         return Err("cargo build --release failed".into());
     }
-    let out = if out.is_absolute() { out.to_path_buf() } else { root.join(out) };
+    let out = if out.is_absolute() {
+        out.to_path_buf()
+    } else {
+        root.join(out)
+    };
     std::fs::create_dir_all(&out).map_err(|e| e.to_string())?;
     for (_, id, docs) in selected {
         let model = load(id)?;
@@ -108,7 +140,12 @@ fn dist(only: &[String], out: &Path) -> Result<(), String> {
         }
         let path = out.join(format!("{id}.fmu"));
         write_fmu(&path, &model, &binary, &readme)?;
-        println!("wrote {} ({} variables, guid {})", path.display(), model.variables.len(), model.guid);
+        println!(
+            "wrote {} ({} variables, guid {})",
+            path.display(),
+            model.variables.len(),
+            model.guid
+        );
     }
     Ok(())
 }
@@ -119,12 +156,19 @@ fn write_fmu(path: &Path, model: &model_description::Model, binary: &[u8], readm
     let options = zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
     let id = &model.model_identifier;
     let entries: [(String, Vec<u8>); 3] = [
-        ("modelDescription.xml".into(), model_description::xml::model_description(model).into_bytes()),
+        (
+            "modelDescription.xml".into(),
+            model_description::xml::model_description(model).into_bytes(),
+        ),
         (format!("binaries/linux64/{id}.so"), binary.to_vec()),
-        ("documentation/index.html".into(), documentation(model, readme).into_bytes()),
+        (
+            "documentation/index.html".into(),
+            documentation(model, readme).into_bytes(),
+        ),
     ];
     for (name, bytes) in entries {
-        zip.start_file(name.as_str(), options).map_err(|e| format!("{name}: {e}"))?;
+        zip.start_file(name.as_str(), options)
+            .map_err(|e| format!("{name}: {e}"))?;
         zip.write_all(&bytes).map_err(|e| format!("{name}: {e}"))?;
     }
     zip.finish().map_err(|e| e.to_string())?;
@@ -135,7 +179,10 @@ fn write_fmu(path: &Path, model: &model_description::Model, binary: &[u8], readm
 /// Markdown, then a table of every port and parameter from the declaration.
 fn documentation(model: &model_description::Model, readme: &str) -> String {
     let mut body = String::new();
-    pulldown_cmark::html::push_html(&mut body, pulldown_cmark::Parser::new_ext(readme, pulldown_cmark::Options::all()));
+    pulldown_cmark::html::push_html(
+        &mut body,
+        pulldown_cmark::Parser::new_ext(readme, pulldown_cmark::Options::all()),
+    );
     format!(
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{name}</title>\n<style>\
 body{{font-family:sans-serif;max-width:70em;margin:2em auto;line-height:1.4}}\

@@ -5,9 +5,7 @@
 //!
 //! Frames: NED earth axes for positions, velocities and wind; SI units.
 
-use flight_mission::{
-    Command, ControllerInput, Diagnostics, FlightController, Measurement, MissionParams, Notice, Phase,
-};
+use flight_mission::{Command, ControllerInput, Diagnostics, FlightController, Measurement, MissionParams, Notice};
 use nalgebra::Vector3;
 use tailsitter_physics::{idx, InputVector, Plant, StateVector};
 
@@ -33,7 +31,11 @@ pub enum Wind {
     /// Zero before `t_start`, `wind` from then on.
     Step { t_start: f64, wind: Vector3<f64> },
     /// 1 − cos gust: `amplitude · (1 − cos(2π (t − t_start)/duration)) / 2` inside the gust.
-    OneMinusCosine { t_start: f64, duration: f64, amplitude: Vector3<f64> },
+    OneMinusCosine {
+        t_start: f64,
+        duration: f64,
+        amplitude: Vector3<f64>,
+    },
 }
 
 impl Wind {
@@ -49,7 +51,11 @@ impl Wind {
                     Vector3::zeros()
                 }
             }
-            Wind::OneMinusCosine { t_start, duration, amplitude } => {
+            Wind::OneMinusCosine {
+                t_start,
+                duration,
+                amplitude,
+            } => {
                 let s = (t - t_start) / duration;
                 if (0.0..=1.0).contains(&s) {
                     amplitude * (0.5 * (1.0 - (2.0 * std::f64::consts::PI * s).cos()))
@@ -223,7 +229,9 @@ impl Trace {
 
     /// Maximum angle of attack [rad] with `t0 ≤ t < t1`.
     pub fn max_alpha(&self, t0: f64, t1: f64) -> f64 {
-        self.window(t0, t1).map(|s| s.measurement.alpha).fold(f64::NEG_INFINITY, f64::max)
+        self.window(t0, t1)
+            .map(|s| s.measurement.alpha)
+            .fold(f64::NEG_INFINITY, f64::max)
     }
 }
 
@@ -254,9 +262,14 @@ impl MissionCheck {
             level_airspeed_error = level_airspeed_error.max((sample.measurement.airspeed - mission.v_level).abs());
             level_pitch_error = level_pitch_error.max((sample.theta - theta_level_trim).abs());
         }
-        let final_pitch_error =
-            trace.samples.last().map_or(f64::INFINITY, |s| (s.theta - std::f64::consts::FRAC_PI_2).abs());
-        let all_finite = trace.samples.iter().all(|s| s.x.iter().all(|v| v.is_finite()) && s.command.is_finite());
+        let final_pitch_error = trace
+            .samples
+            .last()
+            .map_or(f64::INFINITY, |s| (s.theta - std::f64::consts::FRAC_PI_2).abs());
+        let all_finite = trace
+            .samples
+            .iter()
+            .all(|s| s.x.iter().all(|v| v.is_finite()) && s.command.is_finite());
         Self {
             level_airspeed_error,
             level_pitch_error,
@@ -288,7 +301,11 @@ impl std::fmt::Display for MissionCheck {
         )?;
         const NAMES: [&str; 5] = ["vertical 1", "transition 1", "level", "transition 2", "vertical 2"];
         for (name, e) in NAMES.iter().zip(self.phase_errors.iter()) {
-            writeln!(f, "  {name:>12}: max {:.3} m, rms {:.3} m ({} samples)", e.max, e.rms, e.samples)?;
+            writeln!(
+                f,
+                "  {name:>12}: max {:.3} m, rms {:.3} m ({} samples)",
+                e.max, e.rms, e.samples
+            )?;
         }
         Ok(())
     }
@@ -298,7 +315,9 @@ impl std::fmt::Display for MissionCheck {
 /// well defined at θ = 90°.
 pub fn pitch(x: &StateVector) -> f64 {
     let q = x.fixed_rows::<4>(idx::Q1).into_owned();
-    (-tailsitter_physics::dcm_earth_to_body(&q)[(0, 2)]).clamp(-1.0, 1.0).asin()
+    (-tailsitter_physics::dcm_earth_to_body(&q)[(0, 2)])
+        .clamp(-1.0, 1.0)
+        .asin()
 }
 
 /// Fly `controller` with `plant` from state `x0` through `scenario`.
@@ -313,7 +332,11 @@ pub fn pitch(x: &StateVector) -> f64 {
 pub fn fly<C: FlightController>(plant: &Plant, x0: StateVector, controller: &mut C, scenario: &Scenario) -> Trace {
     let h = scenario.comm_step;
     let n = (scenario.stop_time / h).round() as usize;
-    let mut trace = Trace { samples: Vec::with_capacity(n + 1), failure: None, notices: Vec::new() };
+    let mut trace = Trace {
+        samples: Vec::with_capacity(n + 1),
+        failure: None,
+        notices: Vec::new(),
+    };
     let mut clock = flight_mission::SampleClock::new(scenario.mission.sample_time, 0.0);
     let mut x = x0;
     let mut held: Option<flight_mission::ControllerOutput> = None;
@@ -321,10 +344,16 @@ pub fn fly<C: FlightController>(plant: &Plant, x0: StateVector, controller: &mut
     for k in 0..=n {
         let t = k as f64 * h;
         let wind = scenario.wind.at(t);
-        let u_now = previous_command.map(|c| plant_inputs(&c)).unwrap_or_else(InputVector::zeros);
+        let u_now = previous_command
+            .map(|c| plant_inputs(&c))
+            .unwrap_or_else(InputVector::zeros);
         let measurement = measure(plant, &x, &u_now, &wind);
         if clock.take(t) || held.is_none() {
-            let input = ControllerInput { t, measurement, ref_offset_ned: scenario.ref_offset(t) };
+            let input = ControllerInput {
+                t,
+                measurement,
+                ref_offset_ned: scenario.ref_offset(t),
+            };
             match controller.update(&input) {
                 Ok(out) => {
                     if let Some(notice) = out.notice {
@@ -374,7 +403,11 @@ mod tests {
 
     #[test]
     fn gust_shape() {
-        let g = Wind::OneMinusCosine { t_start: 1.0, duration: 2.0, amplitude: Vector3::new(4.0, 0.0, 0.0) };
+        let g = Wind::OneMinusCosine {
+            t_start: 1.0,
+            duration: 2.0,
+            amplitude: Vector3::new(4.0, 0.0, 0.0),
+        };
         assert_eq!(g.at(0.5), Vector3::zeros());
         assert!((g.at(2.0).x - 4.0).abs() < 1e-12);
         assert!((g.at(1.5).x - 2.0).abs() < 1e-12);

@@ -42,7 +42,14 @@ fn climb() -> (Plant, tailsitter_physics::Trim, Hold) {
         elevator: u[idx::ELEVATOR_CMD],
         ..Command::default()
     };
-    (plant, trim, Hold { command, samples: Vec::new() })
+    (
+        plant,
+        trim,
+        Hold {
+            command,
+            samples: Vec::new(),
+        },
+    )
 }
 
 #[test]
@@ -54,11 +61,19 @@ fn trimmed_climb_held_open_loop() {
     assert!(trace.completed(), "{:?}", trace.failure);
     assert_eq!(trace.samples.len(), 101);
     let last = trace.samples.last().unwrap();
-    assert!((last.measurement.pos_ned.z + 6.0).abs() < 1e-3, "{}", last.measurement.pos_ned.z);
+    assert!(
+        (last.measurement.pos_ned.z + 6.0).abs() < 1e-3,
+        "{}",
+        last.measurement.pos_ned.z
+    );
     assert!((last.theta - std::f64::consts::FRAC_PI_2).abs() < 1e-3);
     // Samples at every multiple of the sample time, the first at 0.
     assert_eq!(hold.samples.len(), 101);
-    assert!(hold.samples.iter().enumerate().all(|(k, t)| (t - 0.02 * k as f64).abs() < 1e-12));
+    assert!(hold
+        .samples
+        .iter()
+        .enumerate()
+        .all(|(k, t)| (t - 0.02 * k as f64).abs() < 1e-12));
 }
 
 #[test]
@@ -70,7 +85,11 @@ fn jacobi_flies_the_previous_command() {
     scenario.ordering = Ordering::Jacobi;
     let jacobi = fly(&plant, trim.state, &mut hold.clone(), &scenario);
     for k in 1..gs.samples.len() {
-        assert_eq!(jacobi.samples[k].command.aileron, gs.samples[k - 1].command.aileron, "step {k}");
+        assert_eq!(
+            jacobi.samples[k].command.aileron,
+            gs.samples[k - 1].command.aileron,
+            "step {k}"
+        );
     }
     assert_eq!(jacobi.samples[0].command, gs.samples[0].command);
 }
@@ -99,7 +118,10 @@ fn wind_and_offsets_reach_plant_and_controller() {
     let first = &trace.samples[0];
     // A 3 m/s headwind from the north on a climbing aircraft: airspeed √(3² + 3²).
     assert!((first.measurement.airspeed - 18f64.sqrt()).abs() < 1e-9);
-    assert!(trace.samples.iter().all(|s| (s.pos_error() - if s.t >= 0.5 - 1e-9 { 5.0 } else { 0.0 }).abs() < 1e-9));
+    assert!(trace
+        .samples
+        .iter()
+        .all(|s| (s.pos_error() - if s.t >= 0.5 - 1e-9 { 5.0 } else { 0.0 }).abs() < 1e-9));
 }
 
 #[test]
@@ -109,5 +131,9 @@ fn plant_failure_stops_the_run_with_a_message() {
     let scenario = Scenario::mission(MissionParams::default());
     let trace = fly(&plant, trim.state, &mut hold, &scenario);
     assert!(!trace.completed());
-    assert!(trace.failure.as_deref().unwrap().contains("non-finite"), "{:?}", trace.failure);
+    assert!(
+        trace.failure.as_deref().unwrap().contains("non-finite"),
+        "{:?}",
+        trace.failure
+    );
 }

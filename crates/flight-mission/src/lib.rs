@@ -79,9 +79,14 @@ impl MissionParams {
                 return Err(ParamError(format!("{name} = {value}: must be finite and ≥ 0")));
             }
         }
-        for (name, value) in [("t_transition_1", self.t_transition_1), ("t_transition_2", self.t_transition_2)] {
+        for (name, value) in [
+            ("t_transition_1", self.t_transition_1),
+            ("t_transition_2", self.t_transition_2),
+        ] {
             if value <= 0.0 {
-                return Err(ParamError(format!("{name} = {value}: a transition needs a positive duration")));
+                return Err(ParamError(format!(
+                    "{name} = {value}: a transition needs a positive duration"
+                )));
             }
         }
         if self.sample_time <= 0.0 {
@@ -196,7 +201,13 @@ impl Measurement {
             ["p", "q", "r"],
             ["accel_x", "accel_y", "accel_z"],
         ];
-        let vectors = [&self.pos_ned, &self.vel_ned, &self.vel_body, &self.rates, &self.specific_force_body];
+        let vectors = [
+            &self.pos_ned,
+            &self.vel_ned,
+            &self.vel_body,
+            &self.rates,
+            &self.specific_force_body,
+        ];
         for (vector, names) in vectors.iter().zip(V3.iter()) {
             for (value, name) in vector.iter().zip(names.iter()) {
                 if !value.is_finite() {
@@ -210,8 +221,14 @@ impl Measurement {
                 return Some(name);
             }
         }
-        const SURFACES: [&str; 6] =
-            ["elevator", "aileron", "rudder", "flap_collective", "flap_differential", "vertical_flap"];
+        const SURFACES: [&str; 6] = [
+            "elevator",
+            "aileron",
+            "rudder",
+            "flap_collective",
+            "flap_differential",
+            "vertical_flap",
+        ];
         for (value, name) in self.surfaces.iter().zip(SURFACES.iter()) {
             if !value.is_finite() {
                 return Some(name);
@@ -348,7 +365,10 @@ pub struct SampleClock {
 impl SampleClock {
     /// A clock whose first sample is due at `start_time` (rounded up to a multiple).
     pub fn new(sample_time: f64, start_time: f64) -> Self {
-        let mut clock = Self { sample_time, next_index: 0 };
+        let mut clock = Self {
+            sample_time,
+            next_index: 0,
+        };
         clock.next_index = clock.index_at_or_after(start_time);
         clock
     }
@@ -375,7 +395,9 @@ impl SampleClock {
     /// multiple of `sample_time` after `t`.
     pub fn take(&mut self, t: f64) -> bool {
         if t + self.tolerance() >= self.next_sample_time() {
-            self.next_index = self.index_at_or_after(t + 0.5 * self.sample_time).max(self.next_index + 1);
+            self.next_index = self
+                .index_at_or_after(t + 0.5 * self.sample_time)
+                .max(self.next_index + 1);
             true
         } else {
             false
@@ -415,11 +437,20 @@ mod tests {
 
     #[test]
     fn invalid_missions_are_named() {
-        let m = MissionParams { sample_time: 0.0, ..Default::default() };
+        let m = MissionParams {
+            sample_time: 0.0,
+            ..Default::default()
+        };
         assert!(m.validate().unwrap_err().0.contains("sample_time"));
-        let m = MissionParams { t_level: f64::NAN, ..Default::default() };
+        let m = MissionParams {
+            t_level: f64::NAN,
+            ..Default::default()
+        };
         assert!(m.validate().unwrap_err().0.contains("t_level"));
-        let m = MissionParams { v_level: 2.0, ..Default::default() };
+        let m = MissionParams {
+            v_level: 2.0,
+            ..Default::default()
+        };
         assert!(m.validate().unwrap_err().0.contains("v_level"));
     }
 

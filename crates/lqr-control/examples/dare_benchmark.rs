@@ -25,7 +25,11 @@ fn main() {
     let m = MissionParams::default();
     let c = LqrController::new(Airframe::default(), m, LqrParams::default()).expect("controller");
     let p = c.trajectory().at(t);
-    let rep = if p.euler_321.y > LqrParams::default().euler_switch_pitch { EulerRep::E231 } else { EulerRep::E321 };
+    let rep = if p.euler_321.y > LqrParams::default().euler_switch_pitch {
+        EulerRep::E231
+    } else {
+        EulerRep::E321
+    };
     let x = p.state(rep);
     let sol = c.solve_gain(rep, &x, &p.u, t).expect("gain");
     let w = c.schedule().at(&m, t);
@@ -46,7 +50,9 @@ fn main() {
     let pp = dare_sda(&sol.phi, &sol.gamma, &q, &w.r).expect("dare");
     let k = lqr_gain(&sol.phi, &sol.gamma, &pp, &w.r).expect("gain");
     let r = DMatrix::<f64>::from_diagonal(&nalgebra::DVector::from_column_slice(w.r.as_slice()));
-    let r_rows: Vec<Vec<f64>> = (0..r.nrows()).map(|i| (0..r.ncols()).map(|j| r[(i, j)]).collect()).collect();
+    let r_rows: Vec<Vec<f64>> = (0..r.nrows())
+        .map(|i| (0..r.ncols()).map(|j| r[(i, j)]).collect())
+        .collect();
     let json = serde_json::json!({
         "t": t,
         "euler": format!("{rep:?}"),

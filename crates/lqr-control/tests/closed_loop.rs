@@ -112,7 +112,7 @@ fn position_steps_level_flight() {
         t_level: 30.0,
         ..Default::default()
     };
-    let t0 = m.phase_starts()[2] + 5.0;
+    let t0 = m.phase_starts()[2] + 2.0;
     step(
         "level, normal (down) 5 m",
         m,

@@ -685,7 +685,14 @@ proptest::proptest! {
 /// round-off above the Newton tolerance; the trim must still converge.
 #[test]
 fn trim_converges_with_tiny_inertias() {
-    let airframe = Airframe { i_xx: 1e-4, i_yy: 1e-4, i_zz: 1e-4, ..Airframe::default() };
-    let trim = Plant::new(airframe).trim_vertical_climb(3.0).expect("trim with tiny inertias");
+    let airframe = Airframe {
+        i_xx: 1e-4,
+        i_yy: 1e-4,
+        i_zz: 1e-4,
+        ..Airframe::default()
+    };
+    let trim = Plant::new(airframe)
+        .trim_vertical_climb(3.0)
+        .expect("trim with tiny inertias");
     assert!((trim.thrust - 88.376_020_578).abs() < 1e-6, "{}", trim.thrust);
 }

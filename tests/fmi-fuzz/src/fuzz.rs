@@ -31,6 +31,10 @@ pub struct Config {
     pub deadline: Option<Instant>,
     /// Calls per sequence (uniform in 1..=max_calls).
     pub max_calls: usize,
+    /// Optional cap on the sequences of individual FMUs (id → count): expensive
+    /// models (the LQR FMU builds its trajectory and gains in every instantiate
+    /// and reset) get fewer sequences in the short run.
+    pub per_fmu_cap: BTreeMap<String, u64>,
 }
 
 impl Default for Config {
@@ -40,6 +44,7 @@ impl Default for Config {
             sequences: 1000,
             deadline: None,
             max_calls: 40,
+            per_fmu_cap: BTreeMap::new(),
         }
     }
 }
@@ -59,6 +64,8 @@ pub struct Report {
     pub restore_checks: u64,
     /// Calls slower than 1 s.
     pub slow_calls: Vec<String>,
+    /// Per FMU: (sequences, seconds).
+    pub per_fmu: BTreeMap<String, (u64, f64)>,
 }
 
 impl Report {
@@ -79,6 +86,9 @@ impl Report {
              coverage: {pairs} (function, state) pairs, {outcomes} (function, state, status) outcomes",
             self.sequences, self.calls, self.reset_checks, self.restore_checks, self.violations
         );
+        for (id, (n, secs)) in &self.per_fmu {
+            println!("  {id}: {n} sequences in {secs:.1} s");
+        }
         for v in &self.first_violations {
             println!("  VIOLATION {v}");
         }
@@ -289,7 +299,23 @@ impl<'a> Fuzzer<'a> {
 
     pub fn run(mut self, cfg: &Config) -> Report {
         while self.report.sequences < cfg.sequences && cfg.deadline.is_none_or(|d| Instant::now() < d) {
-            self.sequence(cfg.max_calls);
+            let t0 = Instant::now();
+            let open: Vec<usize> = (0..self.fmus.len())
+                .filter(|&i| {
+                    let id = &self.fmus[i].id;
+                    cfg.per_fmu_cap
+                        .get(id)
+                        .is_none_or(|cap| self.report.per_fmu.get(id).map_or(0, |e| e.0) < *cap)
+                })
+                .collect();
+            if open.is_empty() {
+                break;
+            }
+            let f = *self.rng.pick(&open);
+            let id = self.sequence(f, cfg.max_calls);
+            let entry = self.report.per_fmu.entry(id).or_default();
+            entry.0 += 1;
+            entry.1 += t0.elapsed().as_secs_f64();
             self.report.sequences += 1;
         }
         for d in &mut self.donors {
@@ -373,9 +399,9 @@ impl<'a> Fuzzer<'a> {
         (!others.is_empty()).then(|| *self.rng.pick(&others))
     }
 
-    fn sequence(&mut self, max_calls: usize) {
+    /// One random sequence on a random FMU; returns its id.
+    fn sequence(&mut self, f: usize, max_calls: usize) -> String {
         self.seq += 1;
-        let f = self.rng.below(self.fmus.len());
         let fmu: &'a Fmu = &self.fmus[f];
         let logging_on = self.rng.chance(0.5);
         let mut live = Live::new(fmu, &format!("fuzz{}", self.seq), logging_on);
@@ -437,6 +463,7 @@ impl<'a> Fuzzer<'a> {
                 "cleanup",
             );
         }
+        fmu.id.clone()
     }
 
     #[allow(clippy::too_many_lines)]

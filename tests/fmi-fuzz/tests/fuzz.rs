@@ -1,6 +1,7 @@
 //! The short deterministic fuzz run of the test suite: a fixed seed and a fixed
 //! number of random FMI call sequences over every FMU library (target/release,
-//! built by `cargo xtask dist`). `FMI_FUZZ_SEQUENCES` / `FMI_FUZZ_SEED` override;
+//! built by `cargo xtask dist`). `FMI_FUZZ_SEQUENCES` / `FMI_FUZZ_LQR_SEQUENCES` /
+//! `FMI_FUZZ_SEED` override;
 //! the long run is `cargo run --release -p fmi-fuzz -- fuzz --seconds N`.
 
 use fmi_fuzz::fuzz::{Config, Fuzzer};
@@ -17,9 +18,11 @@ fn random_call_sequences_keep_every_invariant() {
     let seed = env("FMI_FUZZ_SEED", 20_240_607u64);
     let cfg = Config {
         seed,
-        sequences: env("FMI_FUZZ_SEQUENCES", 2500),
+        sequences: env("FMI_FUZZ_SEQUENCES", 2700),
         deadline: None,
         max_calls: 40,
+        // ~0.1 s per LQR sequence (its instantiate/reset builds the trajectory and gains).
+        per_fmu_cap: [("tailsitter_lqr".to_string(), env("FMI_FUZZ_LQR_SEQUENCES", 200))].into(),
     };
     let t0 = Instant::now();
     let report = Fuzzer::new(&fmus, seed).run(&cfg);

@@ -34,6 +34,7 @@ fn main() {
                 sequences,
                 deadline: Some(Instant::now() + Duration::from_secs(seconds)),
                 max_calls: arg(&args, "--max-calls", 60),
+                per_fmu_cap: Default::default(),
             };
             let t0 = Instant::now();
             let report = Fuzzer::new(&fmus, seed).run(&cfg);
