@@ -219,10 +219,11 @@ class ClosedLoop:
                 c.setReal(self._c_vr_in, y_p)
                 c.setReal(offset_vr, list(off))
                 p.setReal(wind_vr, list(w))
-                if k < n:
-                    t0 = wall.perf_counter()
-                    c.doStep(currentCommunicationPoint=t, communicationStepSize=h)
-                    t_ctrl += wall.perf_counter() - t0
+                # The controller also samples at the last point, so the recorded
+                # reference and command belong to the same time as the plant outputs.
+                t0 = wall.perf_counter()
+                c.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+                t_ctrl += wall.perf_counter() - t0
                 if self.ordering == "gauss-seidel":
                     u_c = c.getReal(self._c_vr_out)
                 p.setReal(self._p_vr_in, u_c)
@@ -261,7 +262,7 @@ class ClosedLoop:
             ordering=self.ordering,
             wall_time_controller=t_ctrl,
             wall_time_plant=t_plant,
-            steps=n,
+            steps=n + 1,
         )
 
 

@@ -276,3 +276,60 @@ fn controllers_keep_every_output_finite_on_garbage_inputs() {
         assert!(bad.is_empty(), "{}: non-finite outputs {bad:?}", fmu.id);
     }
 }
+
+#[test]
+fn a_step_whose_end_time_overflows_is_refused() {
+    // fmi2SetupExperiment accepts any finite start time; t + h must stay finite too,
+    // or the FMU time becomes +inf, every later currentCommunicationPoint "matches"
+    // it, and the FMU's own serialized state no longer deserializes.
+    let mut accepted = Vec::new();
+    for fmu in &load_required() {
+        let mut inst = fmu.instance("overflow", false);
+        assert_eq!(inst.setup(1e300, None), OK);
+        assert_eq!(inst.enter_init(), OK);
+        if inst.exit_init() != OK {
+            continue; // a model refusing this start time is fine (see the next test)
+        }
+        if inst.step(1e300, f64::MAX) == OK {
+            let mut t = 0.0;
+            // SAFETY: live instance, valid out pointer.
+            unsafe {
+                fmi_fuzz::ffi!(
+                    fmu.api,
+                    get_real_status(inst.c, fmi_fuzz::fmi2::fmi2StatusKind_fmi2LastSuccessfulTime, &mut t)
+                )
+            };
+            accepted.push(format!("{}: FMU time {t}", fmu.id));
+        }
+    }
+    assert!(
+        accepted.is_empty(),
+        "fmi2DoStep(t = 1e300, h = f64::MAX) accepted: {accepted:?}"
+    );
+}
+
+#[test]
+fn any_finite_start_time_is_handled_without_panic() {
+    // A panic is caught by the export layer (fmi2Error "internal error (panic)"),
+    // but it is a model bug: a huge start/mission time must be refused or handled.
+    let mut panics = Vec::new();
+    for fmu in &load_required() {
+        for start in [1e300, 1e20, -1e20] {
+            let mut inst = fmu.instance("start", false);
+            assert_eq!(inst.setup(start, None), OK);
+            assert_eq!(inst.enter_init(), OK);
+            if inst.exit_init() == OK {
+                inst.step(start, fmu.default_step);
+                inst.get_reals(&inst.all_real_vrs());
+            }
+            panics.extend(
+                inst.host
+                    .records()
+                    .into_iter()
+                    .filter(|r| r.message.contains("panic"))
+                    .map(|r| format!("{} start {start}: {}", fmu.id, r.message)),
+            );
+        }
+    }
+    assert!(panics.is_empty(), "{panics:#?}");
+}

@@ -22,7 +22,7 @@ fn random_call_sequences_keep_every_invariant() {
         deadline: None,
         max_calls: 40,
         // ~0.1 s per LQR sequence (its instantiate/reset builds the trajectory and gains).
-        per_fmu_cap: [("tailsitter_lqr".to_string(), env("FMI_FUZZ_LQR_SEQUENCES", 200))].into(),
+        per_fmu_cap: [("tailsitter_lqr".to_string(), env("FMI_FUZZ_LQR_SEQUENCES", 120))].into(),
     };
     let t0 = Instant::now();
     let report = Fuzzer::new(&fmus, seed).run(&cfg);
