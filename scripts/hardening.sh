@@ -7,7 +7,8 @@
 #
 # Environment: TAILSITTER_FMUS=a,b narrows the FMUs (default: all three);
 # HARDENING_SKIP_DIST=1 skips `cargo xtask dist`; FUZZ_SEED sets the fuzz seed;
-# VALGRIND_CYCLES (default 5) cycles per FMU under valgrind; RSS_CYCLES (default 100000).
+# VALGRIND_CYCLES (default 5) cycles per FMU under valgrind; RSS_CYCLES (default 100000)
+# light and RSS_FULL_CYCLES (default 5000; ~40 ms each for the LQR FMU) full cycles.
 #
 # Steps and what each reports:
 #  1. long call-sequence fuzz through the C ABI: sequences, FMI calls, reset and restore
@@ -15,7 +16,8 @@
 #  2. valgrind memcheck of instantiate → 50 steps → get/serialize/deserialize/set state →
 #     free cycles of each FMU: the ERROR SUMMARY and LEAK SUMMARY → target/hardening/valgrind.txt
 #     (2b: the same for a few hundred fuzz sequences: error paths, corrupt FMU states)
-#  3. RSS before/after RSS_CYCLES instantiate/initialise/step/state/free cycles per FMU
+#  3. RSS before/after RSS_CYCLES instantiate/state/free cycles and RSS_FULL_CYCLES
+#     instantiate/initialise/step/state/free cycles per FMU
 #  4. 64 instances stepped concurrently vs. sequentially (the cargo test, with output)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -42,8 +44,9 @@ valgrind --tool=memcheck --leak-check=full --errors-for-leak-kinds=definite,indi
     "$BIN" fuzz --sequences "${VALGRIND_FUZZ_SEQUENCES:-300}" --seconds 3600 2>&1 | tee "$OUT/valgrind-fuzz.txt" \
     | grep -E "fmi-fuzz:|VIOLATION|ERROR SUMMARY|definitely lost|indirectly lost"
 
-echo "== 3. RSS over ${RSS_CYCLES:-100000} cycles per FMU"
+echo "== 3. RSS over ${RSS_CYCLES:-100000} instantiate/state/free and ${RSS_FULL_CYCLES:-5000} full cycles per FMU"
 "$BIN" rss --n "${RSS_CYCLES:-100000}" | tee "$OUT/rss.txt"
+"$BIN" rss --full --n "${RSS_FULL_CYCLES:-5000}" | tee -a "$OUT/rss.txt"
 
 echo "== 4. 64 concurrent instances vs. sequential runs"
 cargo test --release -p fmi-fuzz --test threads_memory -- --nocapture --test-threads 1 | tee "$OUT/threads.txt"

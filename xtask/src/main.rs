@@ -1,8 +1,12 @@
 //! Project tasks, run as `cargo xtask <task>`:
 //! - `dist`: build the FMU libraries in release mode and write `dist/<modelIdentifier>.fmu`
 //!   (modelDescription.xml, binaries/linux64/<id>.so, documentation/index.html);
+//! - `ssp`: write the SSP 1.0 closed-loop systems `dist/<controller>.ssp` from the packaged FMUs
+//!   (`dist` writes them too);
 //! - `regen`: rewrite the reviewed copies `modelDescription/generated/<id>.xml` and the
 //!   variable references `modelDescription/generated/<id>.md`.
+
+mod ssp;
 
 use clap::{Parser, Subcommand};
 use std::io::Write;
@@ -47,6 +51,12 @@ enum Task {
         #[arg(long, default_value = "dist")]
         out: PathBuf,
     },
+    /// Write dist/<controller>.ssp (plant + controller closed loop, SSP 1.0) from the packaged FMUs.
+    Ssp {
+        /// Folder holding the FMUs; the SSPs are written there.
+        #[arg(long, default_value = "dist")]
+        out: PathBuf,
+    },
     /// Regenerate modelDescription/generated/<id>.xml from the declarations.
     Regen,
 }
@@ -56,6 +66,15 @@ fn workspace_root() -> PathBuf {
         .parent()
         .expect("xtask lives in the workspace")
         .to_path_buf()
+}
+
+/// `path` relative to the workspace root unless absolute.
+fn absolute(path: &Path) -> PathBuf {
+    if path.is_absolute() {
+        path.to_path_buf()
+    } else {
+        workspace_root().join(path)
+    }
 }
 
 fn load(id: &str) -> Result<model_description::Model, String> {
@@ -71,6 +90,7 @@ fn main() {
     let cli = Cli::parse();
     let result = match cli.task {
         Task::Dist { only, out } => dist(&only, &out),
+        Task::Ssp { out } => ssp::write_all(&absolute(&out)).map(|_| ()),
         Task::Regen => regen(),
     };
     if let Err(e) = result {
@@ -121,11 +141,7 @@ fn dist(only: &[String], out: &Path) -> Result<(), String> {
     if !status.success() {
         return Err("cargo build --release failed".into());
     }
-    let out = if out.is_absolute() {
-        out.to_path_buf()
-    } else {
-        root.join(out)
-    };
+    let out = absolute(out);
     std::fs::create_dir_all(&out).map_err(|e| e.to_string())?;
     for (_, id, docs) in selected {
         let model = load(id)?;
@@ -146,6 +162,11 @@ fn dist(only: &[String], out: &Path) -> Result<(), String> {
             model.variables.len(),
             model.guid
         );
+    }
+    // The closed-loop systems of whatever FMUs the folder now holds.
+    let has = |id: &str| out.join(format!("{id}.fmu")).exists();
+    if has(ssp::PLANT) && ssp::CONTROLLERS.iter().any(|c| has(c)) {
+        ssp::write_all(&out)?;
     }
     Ok(())
 }

@@ -44,7 +44,8 @@ impl Analysable for lqr_control::LqrController {
     }
     fn load_state(&mut self, s: &[f64]) {
         let mut it = s.iter().copied();
-        self.restore(&mut || it.next()).expect("LQR state restores what save wrote");
+        self.restore(&mut || it.next())
+            .expect("LQR state restores what save wrote");
     }
     /// Layout of `LqrController::save`: [has_origin, origin(3), integrator, …]: the
     /// airspeed integrator (3.2.12–3.2.14) is the only continuous state.
@@ -61,7 +62,8 @@ impl Analysable for tsd_control::TsdController {
     }
     fn load_state(&mut self, s: &[f64]) {
         let mut it = s.iter().copied();
-        self.restore(&mut || it.next()).expect("TSD state restores what save wrote");
+        self.restore(&mut || it.next())
+            .expect("TSD state restores what save wrote");
     }
     /// Layout of `TsdController::save`: [initialized, thrust, normal, roll, directional
     /// integrators, saturation mask]: the four inner-loop integrators (§4.2).
@@ -131,7 +133,11 @@ pub fn chart_of_plant(base: &StateVector, x: &StateVector) -> [f64; 19] {
     }
     let v = Vector3::new(e[0], e[1], e[2]);
     let s = v.norm();
-    let th = if s > 0.0 { v * (2.0 * s.atan2(e[3]) / s) } else { Vector3::zeros() };
+    let th = if s > 0.0 {
+        v * (2.0 * s.atan2(e[3]) / s)
+    } else {
+        Vector3::zeros()
+    };
     d[6] = th.x;
     d[7] = th.y;
     d[8] = th.z;
@@ -239,6 +245,21 @@ pub struct ClosedLoopPoles {
     pub coords: Vec<String>,
 }
 
+/// The method on any sampled map: `f` maps deviations at step k to deviations at step k+1
+/// (sample time `ts`); returns its central-difference Jacobian at `z0` (steps `h`), the
+/// eigen-pairs (discrete poles z) and the s-plane poles ln(z)/T in the same order.
+pub fn poles_of_map(
+    f: impl Fn(&DVector<f64>) -> DVector<f64>,
+    z0: &DVector<f64>,
+    h: &[f64],
+    ts: f64,
+) -> (DMatrix<f64>, Vec<Eigen>, Vec<C64>) {
+    let jac = crate::linalg::jacobian(f, z0, h);
+    let discrete = eigen(&jac);
+    let poles = discrete.iter().map(|e| z_to_s(e.value, ts)).collect();
+    (jac, discrete, poles)
+}
+
 /// Jacobian of the closed-loop sampled map at `op` and its poles.
 pub fn closed_loop_poles<C: Analysable>(plant: &Plant, op: &OperatingPoint<C>, ts: f64) -> ClosedLoopPoles {
     let dyn_states = op.controller.dynamic_states();
@@ -251,9 +272,7 @@ pub fn closed_loop_poles<C: Analysable>(plant: &Plant, op: &OperatingPoint<C>, t
     for i in &dyn_idx {
         h.push(1e-6 * sn[*i].abs().max(1.0));
     }
-    let jac = crate::linalg::jacobian(|z| step(plant, op, &dyn_idx, z, ts, Some(&base)).0, &z0, &h);
-    let discrete = eigen(&jac);
-    let poles = discrete.iter().map(|e| z_to_s(e.value, ts)).collect();
+    let (jac, discrete, poles) = poles_of_map(|z| step(plant, op, &dyn_idx, z, ts, Some(&base)).0, &z0, &h, ts);
     let mut coords: Vec<String> = PLANT_COORDS.iter().map(|s| s.to_string()).collect();
     coords.extend(dyn_states.iter().map(|d| d.1.to_string()));
     ClosedLoopPoles {

@@ -7,6 +7,10 @@
 //! See README.md for the command that regenerates everything.
 
 pub mod cache;
+pub mod campaign;
 pub mod closed;
+pub mod controllers;
 pub mod linalg;
 pub mod modes;
+pub mod robust;
+pub mod sensitivity;

@@ -17,9 +17,16 @@ pub struct Eigen {
 }
 
 /// Eigenvalues of a real square matrix (real Schur form), sorted by real part then
-/// imaginary part (deterministic order).
+/// imaginary part (deterministic order). Empty if the matrix has non-finite entries or the
+/// QR iteration does not converge in 10 000 steps (nalgebra's default would loop forever).
 pub fn eigenvalues(a: &DMatrix<f64>) -> Vec<C64> {
-    let mut ev: Vec<C64> = a.clone().complex_eigenvalues().iter().copied().collect();
+    if !a.iter().all(|v| v.is_finite()) {
+        return Vec::new();
+    }
+    let Some(schur) = nalgebra::linalg::Schur::try_new(a.clone(), 1e-14, 10_000) else {
+        return Vec::new();
+    };
+    let mut ev: Vec<C64> = schur.complex_eigenvalues().iter().copied().collect();
     ev.sort_by(|x, y| x.re.total_cmp(&y.re).then(x.im.total_cmp(&y.im)));
     ev
 }
@@ -44,7 +51,10 @@ pub fn eigen(a: &DMatrix<f64>) -> Vec<Eigen> {
                     }
                 }
             }
-            Eigen { value: lambda, vector: v }
+            Eigen {
+                value: lambda,
+                vector: v,
+            }
         })
         .collect()
 }

@@ -1,38 +1,97 @@
-use analysis::closed::{poles_at, Condition};
-use analysis::linalg::fmt_pole;
-use flight_mission::MissionParams;
-use tailsitter_physics::{Airframe, Plant};
+//! `analysis` CLI: regenerates the analysis report (open-loop modes, closed-loop poles,
+//! Table 5.1, nonlinear robustness and gust sweeps) into an output folder.
+//!
+//! ```text
+//! cargo run --release -p analysis -- all --out out/analysis
+//! .venv/bin/python crates/analysis/plot.py out/analysis
+//! ```
+
+use std::path::PathBuf;
+
+use analysis::campaign::{run, Config};
+use analysis::closed::Condition;
+use analysis::controllers::Kind;
+use clap::{Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(
+    name = "analysis",
+    about = "Tail-sitter controller analysis (thesis §3.4.2, §4.4.1, ch. 5 and beyond)"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Cmd,
+}
+
+#[derive(clap::Args, Clone)]
+struct Common {
+    /// Output folder (Markdown, CSV, JSON, cache/).
+    #[arg(long, default_value = "out/analysis")]
+    out: PathBuf,
+    /// N of the geometric sweep (5.1.1); the thesis uses 50.
+    #[arg(long, default_value_t = 50)]
+    n: usize,
+    /// Only these parameter ids (CLa, CLq, CLde, CYb, …, m, Ix, Iy, Iz); default all 25.
+    #[arg(long, value_delimiter = ',')]
+    params: Vec<String>,
+    /// Largest gust amplitude (m/s); the sweep is 1, 2, … this.
+    #[arg(long, default_value_t = 20)]
+    max_gust: u32,
+    /// Threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// No progress bars.
+    #[arg(long)]
+    quiet: bool,
+    /// Sensitivity study in level flight only (the thesis's condition).
+    #[arg(long)]
+    level_only: bool,
+}
+
+#[derive(Subcommand)]
+enum Cmd {
+    /// Everything: modes, poles, Table 5.1, nonlinear robustness, gusts.
+    All(Common),
+    /// Modes, closed-loop poles and Table 5.1 only (no nonlinear mission sweeps).
+    Linear(Common),
+    /// Modes, poles, and the nonlinear robustness and gust sweeps (Table 5.1 included).
+    Nonlinear(Common),
+}
 
 fn main() {
-    let plant = Plant::new(Airframe::default());
-    let m = analysis::modes::level_modes(&plant, 25.0).unwrap();
-    for md in &m.modes {
-        println!("{:20} {:.3} ± {:.3}i  {:?}", md.name, md.re, md.im, md.shape);
+    let cli = Cli::parse();
+    let (c, robustness, gusts) = match cli.command {
+        Cmd::All(c) => (c, true, true),
+        Cmd::Linear(c) => (c, false, false),
+        Cmd::Nonlinear(c) => (c, true, true),
+    };
+    if let Some(t) = c.threads {
+        let _ = rayon::ThreadPoolBuilder::new().num_threads(t).build_global();
     }
-    let m = analysis::modes::vertical_modes(&plant, 3.0).unwrap();
-    for md in &m.modes {
-        println!("{:20} {:.3} ± {:.3}i", md.name, md.re, md.im);
+    let mut cfg = Config::full(c.out);
+    cfg.n = c.n.max(2);
+    cfg.params = c.params;
+    cfg.gust_amplitudes = (1..=c.max_gust.max(1)).map(f64::from).collect();
+    cfg.robustness = robustness;
+    cfg.gusts = gusts;
+    cfg.progress = !c.quiet;
+    cfg.controllers = Kind::ALL.to_vec();
+    if c.level_only {
+        cfg.conditions = vec![Condition::Level];
     }
-    let mission = MissionParams::default();
-    for cond in Condition::ALL {
-        let t0 = std::time::Instant::now();
-        let c = lqr_control::LqrController::new(Airframe::default(), mission, Default::default()).unwrap();
-        let p = poles_at(&plant, c, &mission, cond);
-        println!("LQR {cond:?} {:?}", t0.elapsed());
-        if let Ok(p) = p { println!("{}", p.poles.iter().map(|s| fmt_pole(*s)).collect::<Vec<_>>().join(", ")); } else { println!("{p:?}"); }
-        let t0 = std::time::Instant::now();
-        let c = tsd_control::TsdController::new(Default::default(), mission, Airframe::default()).unwrap();
-        let p = poles_at(&plant, c, &mission, cond);
-        println!("TSD {cond:?} {:?}", t0.elapsed());
-        if let Ok(p) = p { println!("{}", p.poles.iter().map(|s| fmt_pole(*s)).collect::<Vec<_>>().join(", ")); } else { println!("{p:?}"); }
+    match run(&cfg) {
+        Ok(s) => {
+            eprintln!(
+                "wrote {}/report.md: {} jobs ({} from the cache) in {:.1} s",
+                cfg.out.display(),
+                s.jobs,
+                s.cache_hits,
+                s.wall_time_s
+            );
+        }
+        Err(e) => {
+            eprintln!("analysis failed: {e}");
+            std::process::exit(1);
+        }
     }
-    let t0 = std::time::Instant::now();
-    let mut c = lqr_control::LqrController::new(Airframe::default(), mission, Default::default()).unwrap();
-    let x0 = plant.trim_vertical_climb(3.0).unwrap().state;
-    let tr = closed_loop::fly(&plant, x0, &mut c, &closed_loop::Scenario::mission(mission));
-    println!("LQR mission {:?} {:?}", t0.elapsed(), tr.failure);
-    let t0 = std::time::Instant::now();
-    let mut c = tsd_control::TsdController::new(Default::default(), mission, Airframe::default()).unwrap();
-    let tr = closed_loop::fly(&plant, x0, &mut c, &closed_loop::Scenario::mission(mission));
-    println!("TSD mission {:?} {:?}", t0.elapsed(), tr.failure);
 }

@@ -9,9 +9,9 @@
 //! held) are left out, which also removes the quaternion's redundant norm direction.
 
 use nalgebra::{DMatrix, SMatrix, Vector3};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use tailsitter_physics::{
-    euler_231_from_quat, euler_321_from_quat, idx, quat_from_euler_231, quat_from_euler_321, Plant, PhysicsError,
+    euler_231_from_quat, euler_321_from_quat, idx, quat_from_euler_231, quat_from_euler_321, PhysicsError, Plant,
     StateVector, Trim,
 };
 
@@ -37,7 +37,17 @@ fn z_of(x: &StateVector, set: EulerSet) -> [f64; 9] {
         EulerSet::E321 => euler_321_from_quat(&q),
         EulerSet::E231 => euler_231_from_quat(&q),
     };
-    [vbar, w.atan2(u), (v / vbar).asin(), x[idx::P], x[idx::Q], x[idx::R], e[0], e[1], e[2]]
+    [
+        vbar,
+        w.atan2(u),
+        (v / vbar).asin(),
+        x[idx::P],
+        x[idx::Q],
+        x[idx::R],
+        e[0],
+        e[1],
+        e[2],
+    ]
 }
 
 fn x_of(z: &[f64], base: &StateVector, set: EulerSet) -> StateVector {
@@ -91,7 +101,7 @@ pub fn rigid_body_matrix(plant: &Plant, trim: &Trim, set: EulerSet) -> DMatrix<f
 }
 
 /// One open-loop mode.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Mode {
     /// Conventional name (level flight) or a description by dominant coordinates.
     pub name: String,
@@ -109,7 +119,7 @@ pub struct Mode {
 }
 
 /// Open-loop modes at a trim.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct ModeSet {
     /// "level 25 m/s" etc.
     pub condition: String,
@@ -174,7 +184,10 @@ pub fn modes_of(a: &DMatrix<f64>, v_trim: f64, conventional: bool) -> Vec<Mode> 
             out[*long_c.last().unwrap()].0.name = "short period".into();
         }
         let lat_c: Vec<usize> = (0..out.len()).filter(|&i| !out[i].1 && complex(&out[i].0)).collect();
-        if let Some(&i) = lat_c.iter().max_by(|&&a, &&b| out[a].0.omega_n.total_cmp(&out[b].0.omega_n)) {
+        if let Some(&i) = lat_c
+            .iter()
+            .max_by(|&&a, &&b| out[a].0.omega_n.total_cmp(&out[b].0.omega_n))
+        {
             out[i].0.name = "Dutch roll".into();
         }
         let mut lat_r: Vec<usize> = (0..out.len()).filter(|&i| !out[i].1 && !complex(&out[i].0)).collect();
@@ -182,7 +195,7 @@ pub fn modes_of(a: &DMatrix<f64>, v_trim: f64, conventional: bool) -> Vec<Mode> 
         let mut real_named = 0;
         for &i in &lat_r {
             if out[i].0.omega_n < 1e-5 {
-                out[i].0.name = "heading (ψ, neutral)".into();
+                out[i].0.name = "heading (ψ neutral)".into();
             } else if real_named == 0 {
                 out[i].0.name = "roll".into();
                 real_named += 1;
@@ -227,34 +240,65 @@ pub fn vertical_modes(plant: &Plant, v: f64) -> Result<ModeSet, PhysicsError> {
     })
 }
 
+/// A thesis mode: (name, eigenvalue, shape rows (coordinate, magnitude, phase deg)).
+pub type ThesisMode = (&'static str, C64, Vec<(&'static str, f64, f64)>);
+
 /// Thesis Tables 3.2/3.3, uncontrolled column: (mode, eigenvalue, shape rows as
 /// (coordinate, magnitude, phase deg)).
-pub fn thesis_open_loop() -> Vec<(&'static str, C64, Vec<(&'static str, f64, f64)>)> {
+pub fn thesis_open_loop() -> Vec<ThesisMode> {
     vec![
         (
             "phugoid",
             C64::new(-0.006, 0.462),
-            vec![("V", 1.0, 0.0), ("α", 0.001, 175.0), ("q", 0.022, -7.0), ("θ", 0.0477, -97.0)],
+            vec![
+                ("V", 1.0, 0.0),
+                ("α", 0.001, 175.0),
+                ("q", 0.022, -7.0),
+                ("θ", 0.0477, -97.0),
+            ],
         ),
         (
             "short period",
             C64::new(-10.44, 24.204),
-            vec![("V", 0.136, -54.0), ("α", 0.045, -105.0), ("q", 1.0, 0.0), ("θ", 0.042, -116.0)],
+            vec![
+                ("V", 0.136, -54.0),
+                ("α", 0.045, -105.0),
+                ("q", 1.0, 0.0),
+                ("θ", 0.042, -116.0),
+            ],
         ),
         (
             "Dutch roll",
             C64::new(-3.334, 14.06),
-            vec![("β", 0.071, 84.0), ("p", 0.124, -111.0), ("r", 1.0, 0.0), ("φ", 0.090, 146.0), ("ψ", 0.692, -103.0)],
+            vec![
+                ("β", 0.071, 84.0),
+                ("p", 0.124, -111.0),
+                ("r", 1.0, 0.0),
+                ("φ", 0.090, 146.0),
+                ("ψ", 0.692, -103.0),
+            ],
         ),
         (
             "roll",
             C64::new(-10.340, 0.0),
-            vec![("β", 0.030, 0.0), ("p", 1.0, 0.0), ("r", 0.088, 0.0), ("φ", 0.097, 180.0), ("ψ", 0.009, 180.0)],
+            vec![
+                ("β", 0.030, 0.0),
+                ("p", 1.0, 0.0),
+                ("r", 0.088, 0.0),
+                ("φ", 0.097, 180.0),
+                ("ψ", 0.009, 180.0),
+            ],
         ),
         (
             "spiral",
             C64::new(0.225, 0.0),
-            vec![("β", 0.007, 0.0), ("p", 0.024, 0.0), ("r", 0.280, 0.0), ("φ", 0.556, 0.0), ("ψ", 1.0, 0.0)],
+            vec![
+                ("β", 0.007, 0.0),
+                ("p", 0.024, 0.0),
+                ("r", 0.280, 0.0),
+                ("φ", 0.556, 0.0),
+                ("ψ", 1.0, 0.0),
+            ],
         ),
     ]
 }

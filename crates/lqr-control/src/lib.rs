@@ -32,7 +32,7 @@ use model::{ix, linearise, state_of, wrap_pi, EulerRep, NA, NU, NX, U, X};
 use trajectory::{TrajPoint, Trajectory, TrajectoryMode, TrajectoryOptions};
 use weights::{load_set, WeightSchedule, Weights, DEFAULT_WEIGHTS_JSON};
 
-/// Smallest reference airspeed the (V, α, β) model for control supports [m/s].
+/// Smallest reference airspeed the (V, α, β) model for control supports \[m/s\].
 pub const MIN_AIRSPEED: f64 = 0.5;
 
 /// Size of the augmented ZOH exponential: states + integrator + inputs.
@@ -45,7 +45,7 @@ pub type Gain = SMatrix<f64, NU, NA>;
 /// parameter names).
 #[derive(Debug, Clone, PartialEq)]
 pub struct LqrParams {
-    /// T_l: period of relinearisation and gain computation [s] (§3.1.3, §3.2.4: 0.2 s).
+    /// T_l: period of relinearisation and gain computation \[s\] (§3.1.3, §3.2.4: 0.2 s).
     pub relinearisation_period: f64,
     /// 0 = exact steady-state DARE (structured doubling), 1 = the thesis's backward
     /// iteration over `riccati_horizon` steps (3.1.3–3.1.5).
@@ -56,22 +56,22 @@ pub struct LqrParams {
     pub r_scale: f64,
     /// Index of the weight set in the weights JSON (0 = thesis Table 3.4).
     pub weight_set: i32,
-    /// Time over which the weights blend from one phase's table to the next [s].
+    /// Time over which the weights blend from one phase's table to the next \[s\].
     pub weight_blend_time: f64,
-    /// Reference 3-2-1 pitch above which the 2-3-1 Euler set is used [rad].
+    /// Reference 3-2-1 pitch above which the 2-3-1 Euler set is used \[rad\].
     pub euler_switch_pitch: f64,
-    /// Limit of the airspeed-error integrator |∫ΔV dt| [m].
+    /// Limit of the airspeed-error integrator |∫ΔV dt| \[m\].
     pub integrator_limit: f64,
-    /// Leak λ of the airspeed integrator, ẋ_I = V − V_t − λ x_I [1/s]. Must be > 0: with
+    /// Leak λ of the airspeed integrator, ẋ_I = V − V_t − λ x_I \[1/s\]. Must be > 0: with
     /// λ = 0 the integrator minus the along-track position is an uncontrollable mode at
     /// z = 1 (ẋ_I = ΔV = along-track Δṗ in straight flight) and no stabilising DARE
     /// solution exists.
     pub integrator_leak: f64,
     /// Trajectory: 0 = thesis closed forms (3.3.3–3.3.4, 3.3.13–3.3.17), 1 = force balance.
     pub trajectory_mode: i32,
-    /// α_max of (3.3.4) [rad] (trajectory_mode 0 only).
+    /// α_max of (3.3.4) \[rad\] (trajectory_mode 0 only).
     pub alpha_max: f64,
-    /// Banked-turn radius ρ in the level segment [m] (3.3.18–3.3.21); 0 = straight, < 0 left.
+    /// Banked-turn radius ρ in the level segment \[m\] (3.3.18–3.3.21); 0 = straight, < 0 left.
     pub turn_radius: f64,
 }
 

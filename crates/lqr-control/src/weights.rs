@@ -115,7 +115,7 @@ impl MaxDeviations {
 pub struct WeightSchedule {
     /// Vertical, Tran1, Level, Tran2.
     pub phases: [Weights; 4],
-    /// Blend time after a phase boundary [s].
+    /// Blend time after a phase boundary \[s\].
     pub blend_time: f64,
 }
 

@@ -324,3 +324,34 @@ fn slow_vertical_speed_is_handled() {
     report("v_vertical = 1 m/s", &trace, &check, &c);
     assert!(trace.completed() && check.passed(), "{:?} {check}", trace.failure);
 }
+
+#[test]
+fn robustness_gust_faster_transitions_and_finer_sampling() {
+    // A 1−cos lateral-and-vertical gust of 5 m/s in level flight.
+    let mut s = Scenario::mission(MissionParams::default());
+    s.wind = closed_loop::Wind::OneMinusCosine {
+        t_start: 13.0,
+        duration: 2.0,
+        amplitude: Vector3::new(0.0, 5.0, 2.0),
+    };
+    let (trace, check, c) = run(Airframe::default(), LqrParams::default(), &s);
+    report("1-cos gust (0, 5, 2) m/s over 2 s in level flight", &trace, &check, &c);
+    assert!(trace.completed() && check.all_finite, "{:?}", trace.failure);
+    // Faster transitions than the thesis flew with the LQR (T1 = 3 s, T2 = 5 s).
+    let m = MissionParams {
+        t_transition_1: 3.0,
+        t_transition_2: 5.0,
+        ..Default::default()
+    };
+    let (trace, check, c) = run(Airframe::default(), LqrParams::default(), &Scenario::mission(m));
+    report("fast mission T1 = 3 s, T2 = 5 s", &trace, &check, &c);
+    assert!(trace.completed() && check.passed(), "{:?} {check}", trace.failure);
+    // 10 ms sampling.
+    let m = MissionParams {
+        sample_time: 0.01,
+        ..Default::default()
+    };
+    let (trace, check, c) = run(Airframe::default(), LqrParams::default(), &Scenario::mission(m));
+    report("sample_time 10 ms", &trace, &check, &c);
+    assert!(trace.completed() && check.passed(), "{:?} {check}", trace.failure);
+}

@@ -713,6 +713,24 @@ pub fn cycle(fmu: &Fmu, steps: usize) -> bool {
     ok
 }
 
+/// The light cycle: instantiate → setup → get/serialize/deserialize/set/free the
+/// FMU state → free, without initialisation (the LQR FMU's initialisation builds
+/// its trajectory and gains: ~40 ms). Returns false on any status other than OK.
+pub fn light_cycle(fmu: &Fmu) -> bool {
+    let Some(mut inst) = fmu.instantiate("light", false) else {
+        return false;
+    };
+    let mut ok = inst.setup(0.0, None) == OK;
+    let (s, mut state) = inst.get_state();
+    ok &= s == OK;
+    let (s, bytes) = inst.serialize(state);
+    ok &= s == OK;
+    let (s, mut restored) = inst.deserialize(&bytes);
+    ok &= s == OK && inst.set_state(restored) == OK;
+    ok &= inst.free_state(&mut restored) == OK && inst.free_state(&mut state) == OK;
+    ok
+}
+
 /// Resident set size of this process (KiB), from /proc/self/status.
 pub fn rss_kib() -> u64 {
     let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();

@@ -1,10 +1,10 @@
 //! Threads and memory through the real C ABI (target/release libraries):
 //! 64 instances stepped concurrently give bit-identical results to sequential
-//! runs, and 10 000 instantiate/initialise/step/state/free cycles do not grow
-//! the resident set (numbers printed; run with --nocapture).
+//! runs, and 10 000 instantiate/state/free cycles (plus full life cycles with
+//! initialisation and a step) do not grow the resident set (numbers printed; run with --nocapture).
 
 use fmi_fuzz::model_description_types::VarType;
-use fmi_fuzz::{cycle, load_required, rss_kib, Fmu, Var, OK};
+use fmi_fuzz::{cycle, light_cycle, load_required, rss_kib, Fmu, Var, OK};
 use std::sync::Barrier;
 
 /// Instance `i`: Real inputs nudged by an amount depending on `i`, then `steps`
@@ -73,29 +73,53 @@ fn sixty_four_concurrent_instances_match_sequential_runs() {
     }
 }
 
+/// RSS before and after `n` cycles (after a warm-up); panics if a cycle fails.
+fn rss_over(fmu: &Fmu, n: usize, cycle: impl Fn(&Fmu) -> bool) -> (u64, u64, u64) {
+    for _ in 0..n.min(200) {
+        assert!(cycle(fmu));
+    }
+    let before = rss_kib();
+    let mut mid = 0;
+    for i in 0..n {
+        assert!(cycle(fmu), "{}: cycle {i} failed", fmu.id);
+        if i == n / 2 {
+            mid = rss_kib();
+        }
+    }
+    (before, mid, rss_kib())
+}
+
 #[test]
-fn ten_thousand_cycles_do_not_grow_the_resident_set() {
+fn ten_thousand_instantiate_free_cycles_do_not_grow_the_resident_set() {
     const CYCLES: usize = 10_000;
     for fmu in &load_required() {
-        for _ in 0..500 {
-            assert!(cycle(fmu, 1));
-        }
-        let before = rss_kib();
-        let mut mid = 0;
-        for i in 0..CYCLES {
-            assert!(cycle(fmu, 1), "{}: cycle {i} failed", fmu.id);
-            if i == CYCLES / 2 {
-                mid = rss_kib();
-            }
-        }
-        let after = rss_kib();
+        let (before, mid, after) = rss_over(fmu, CYCLES, light_cycle);
         println!(
-            "{}: RSS {before} KiB → {mid} KiB (after {}) → {after} KiB after {CYCLES} cycles ({:+} KiB)",
+            "{}: instantiate/setup/state/serialize/free: RSS {before} KiB → {mid} KiB → {after} KiB \
+             over {CYCLES} cycles ({:+} KiB)",
             fmu.id,
-            CYCLES / 2,
             after as i64 - before as i64
         );
         // 10 000 cycles leaking even 400 bytes each would add ~4 MiB.
+        assert!(
+            after < before + 4096,
+            "{}: RSS grew from {before} KiB to {after} KiB",
+            fmu.id
+        );
+    }
+}
+
+#[test]
+fn full_life_cycles_do_not_grow_the_resident_set() {
+    // With initialisation and a step; fewer for the LQR FMU (~40 ms per initialisation).
+    for fmu in &load_required() {
+        let n = if fmu.id == "tailsitter_lqr" { 300 } else { 5_000 };
+        let (before, mid, after) = rss_over(fmu, n, |f| cycle(f, 1));
+        println!(
+            "{}: full life cycle: RSS {before} KiB → {mid} KiB → {after} KiB over {n} cycles ({:+} KiB)",
+            fmu.id,
+            after as i64 - before as i64
+        );
         assert!(
             after < before + 4096,
             "{}: RSS grew from {before} KiB to {after} KiB",

@@ -4,12 +4,13 @@
 //!   fuzzer over every required FMU until the time or sequence budget is spent;
 //! - `fmi-fuzz cycles [--n N]`: instantiate → simulate → get/serialize/deserialize/set state →
 //!   free, N times per FMU (the valgrind memcheck driver);
-//! - `fmi-fuzz rss [--n N]`: RSS before/after N instantiate/initialise/step/free cycles per FMU.
+//! - `fmi-fuzz rss [--n N] [--full]`: RSS before/after N instantiate/state/free cycles per FMU
+//!   (`--full`: with initialisation and a step).
 //!
 //! `TAILSITTER_FMUS=a,b` narrows the FMUs; exit code 1 on any violation.
 
 use fmi_fuzz::fuzz::{Config, Fuzzer};
-use fmi_fuzz::{cycle, load_required, rss_kib};
+use fmi_fuzz::{cycle, light_cycle, load_required, rss_kib};
 use std::time::{Duration, Instant};
 
 fn arg<T: std::str::FromStr>(args: &[String], name: &str, default: T) -> T {
@@ -62,19 +63,26 @@ fn main() {
         }
         Some("rss") => {
             let n: usize = arg(&args, "--n", 10_000);
+            let full = args.iter().any(|a| a == "--full");
             for fmu in &fmus {
+                let run = |f: &fmi_fuzz::Fmu| if full { cycle(f, 1) } else { light_cycle(f) };
                 for _ in 0..200 {
-                    cycle(fmu, 1);
+                    run(fmu);
                 }
                 let before = rss_kib();
                 let t0 = Instant::now();
                 for i in 0..n {
-                    assert!(cycle(fmu, 1), "{}: cycle {i} failed", fmu.id);
+                    assert!(run(fmu), "{}: cycle {i} failed", fmu.id);
                 }
                 let after = rss_kib();
                 println!(
-                    "{}: RSS {before} KiB → {after} KiB after {n} cycles ({:+} KiB, {:.1} s)",
+                    "{}: RSS {before} KiB → {after} KiB after {n} {} cycles ({:+} KiB, {:.1} s)",
                     fmu.id,
+                    if full {
+                        "full (init + step)"
+                    } else {
+                        "instantiate/state/free"
+                    },
                     after as i64 - before as i64,
                     t0.elapsed().as_secs_f64()
                 );
@@ -83,7 +91,7 @@ fn main() {
         _ => {
             eprintln!("usage: fmi-fuzz fuzz [--seconds N] [--seed S] [--sequences N] [--max-calls N] [--coverage]");
             eprintln!("       fmi-fuzz cycles [--n N]");
-            eprintln!("       fmi-fuzz rss [--n N]");
+            eprintln!("       fmi-fuzz rss [--n N] [--full]");
             std::process::exit(2);
         }
     }

@@ -1,0 +1,191 @@
+#!/usr/bin/env python3
+"""Plots of the analysis report (run after `cargo run --release -p analysis -- all --out DIR`).
+
+Usage: .venv/bin/python crates/analysis/plot.py DIR
+
+Reads the CSV files the Rust campaign wrote into DIR and writes PNGs beside them:
+  open_loop_modes.png                 open-loop poles (level, vertical), thesis Tables 3.2/3.3
+  closed_loop_poles_<cond>.png        closed-loop poles of both controllers (Figs. 3.16/3.17)
+  loci_<ctl>_<cond>_pitch.png         pole loci for C_mα, C_mq, C_mδe (Figs. 5.1/5.2)
+  loci_<ctl>_<cond>_all.png           pole loci for every parameter of Table 5.1 (Figs. E.4–E.15)
+  table_5_1.png                       regenerated Table 5.1 next to the thesis's
+  robustness.png, gusts.png           nonlinear robustness ranges and largest survived gusts
+"""
+import csv
+import sys
+from collections import defaultdict
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def rows(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def splane(ax, title):
+    ax.axvline(0, color="k", lw=0.5)
+    ax.axhline(0, color="k", lw=0.5)
+    ax.set_xlabel("Re s (1/s)")
+    ax.set_ylabel("Im s (rad/s)")
+    ax.set_title(title, fontsize=9)
+    ax.grid(alpha=0.3)
+
+
+def main(out):
+    out = Path(out)
+    if (out / "open_loop_modes.csv").exists():
+        fig, ax = plt.subplots(figsize=(6, 4.5))
+        by = defaultdict(list)
+        for r in rows(out / "open_loop_modes.csv"):
+            by[r["condition"]].append((float(r["re"]), float(r["im"])))
+        for cond, pts in by.items():
+            xs = [p[0] for p in pts] + [p[0] for p in pts if p[1] > 0]
+            ys = [p[1] for p in pts] + [-p[1] for p in pts if p[1] > 0]
+            ax.plot(xs, ys, "x", label=cond)
+        thesis = [(-0.006, 0.462), (-10.44, 24.204), (-3.334, 14.06), (-10.34, 0), (0.225, 0)]
+        ax.plot([t[0] for t in thesis], [t[1] for t in thesis], "o", mfc="none", label="thesis (level)")
+        splane(ax, "Open-loop modes")
+        ax.legend(fontsize=7)
+        fig.tight_layout()
+        fig.savefig(out / "open_loop_modes.png", dpi=120)
+        plt.close(fig)
+
+    if (out / "closed_loop_poles.csv").exists():
+        cl = rows(out / "closed_loop_poles.csv")
+        for cond in sorted({r["condition"] for r in cl}):
+            fig, ax = plt.subplots(figsize=(6, 4.5))
+            for ctl, mk in (("LQR", "x"), ("TSD", "+")):
+                pts = [(float(r["re"]), float(r["im"])) for r in cl if r["condition"] == cond and r["controller"] == ctl]
+                ax.plot([p[0] for p in pts], [p[1] for p in pts], mk, label=ctl)
+            splane(ax, f"Closed-loop poles, {cond} flight")
+            ax.legend(fontsize=7)
+            fig.tight_layout()
+            fig.savefig(out / f"closed_loop_poles_{cond}.png", dpi=120)
+            plt.close(fig)
+
+    if (out / "loci.csv").exists():
+        loci = defaultdict(lambda: defaultdict(list))
+        for r in rows(out / "loci.csv"):
+            loci[(r["controller"], r["condition"], r["param"])][int(r["pole"])].append(
+                (int(r["k"]), float(r["re"]), float(r["im"]))
+            )
+        combos = sorted({(c, d) for (c, d, _) in loci})
+        params = []
+        for (_, _, p) in loci:
+            if p not in params:
+                params.append(p)
+
+        def draw(ax, key, title):
+            for pts in loci[key].values():
+                pts.sort()
+                ax.plot([p[1] for p in pts], [p[2] for p in pts], "-", lw=0.8)
+                ax.plot([pts[0][1]], [pts[0][2]], "k.", ms=2)
+            splane(ax, title)
+
+        for ctl, cond in combos:
+            pitch = [p for p in ("Cma", "Cmq", "Cmde") if (ctl, cond, p) in loci]
+            if pitch:
+                fig, axs = plt.subplots(1, len(pitch), figsize=(5 * len(pitch), 4.2))
+                axs = axs if len(pitch) > 1 else [axs]
+                for ax, p in zip(axs, pitch):
+                    draw(ax, (ctl, cond, p), f"{ctl} {cond}: {p} (dot = smallest factor)")
+                fig.tight_layout()
+                fig.savefig(out / f"loci_{ctl}_{cond}_pitch.png", dpi=110)
+                plt.close(fig)
+            ps = [p for p in params if (ctl, cond, p) in loci]
+            ncol = 5
+            nrow = (len(ps) + ncol - 1) // ncol
+            if ps:
+                fig, axs = plt.subplots(nrow, ncol, figsize=(4 * ncol, 3.4 * nrow), squeeze=False)
+                for i, p in enumerate(ps):
+                    draw(axs[i // ncol][i % ncol], (ctl, cond, p), f"{ctl} {cond}: {p}")
+                for j in range(len(ps), nrow * ncol):
+                    axs[j // ncol][j % ncol].axis("off")
+                fig.tight_layout()
+                fig.savefig(out / f"loci_{ctl}_{cond}_all.png", dpi=80)
+                plt.close(fig)
+
+    if (out / "table_5_1.csv").exists():
+        t = rows(out / "table_5_1.csv")
+        level = [r for r in t if r["condition"] == "level"]
+        params = []
+        for r in level:
+            if r["param"] not in params:
+                params.append(r["param"])
+        fig, ax = plt.subplots(figsize=(12, 4.5))
+        w = 0.2
+        for i, (ctl, col) in enumerate((("LQR", "C0"), ("TSD", "C1"))):
+            ours = {r["param"]: float(r["rms_percent"]) for r in level if r["controller"] == ctl}
+            th = {r["param"]: float(r["thesis_percent"]) for r in level if r["controller"] == ctl}
+            xs = range(len(params))
+            ax.bar([x + (2 * i - 1.5) * w for x in xs], [th.get(p, 0) for p in params], w, color=col, alpha=0.4,
+                   label=f"{ctl} thesis")
+            ax.bar([x + (2 * i - 0.5) * w for x in xs], [ours.get(p, 0) for p in params], w, color=col,
+                   label=f"{ctl} ours")
+        ax.set_xticks(range(len(params)))
+        ax.set_xticklabels(params, rotation=60, fontsize=8)
+        ax.set_ylabel("RMS pole movement (% of ω_n)")
+        ax.set_title("Table 5.1, level flight: thesis against regenerated")
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        fig.savefig(out / "table_5_1.png", dpi=110)
+        plt.close(fig)
+
+    if (out / "robustness.csv").exists():
+        r = rows(out / "robustness.csv")
+        params = []
+        for x in r:
+            if x["param"] not in params:
+                params.append(x["param"])
+        fig, axs = plt.subplots(1, 2, figsize=(12, 5), sharey=True)
+        for ax, ctl in zip(axs, ("LQR", "TSD")):
+            for i, p in enumerate(params):
+                pts = [(float(x["factor"]), x["passed"] == "true") for x in r if x["param"] == p and x["controller"] == ctl]
+                ax.scatter([q[0] for q in pts], [i] * len(pts), c=["g" if q[1] else "r" for q in pts], s=6)
+            ax.set_xscale("log")
+            ax.set_yticks(range(len(params)))
+            ax.set_yticklabels(params, fontsize=8)
+            ax.set_xlabel("scale factor (plant only)")
+            ax.set_title(f"{ctl}: mission passed (green) / failed (red)")
+            ax.axvline(1, color="k", lw=0.5)
+        fig.tight_layout()
+        fig.savefig(out / "robustness.png", dpi=110)
+        plt.close(fig)
+
+    if (out / "gusts.csv").exists():
+        g = rows(out / "gusts.csv")
+        cases = []
+        for x in g:
+            c = (x["phase"], x["axis"])
+            if c not in cases:
+                cases.append(c)
+        fig, ax = plt.subplots(figsize=(9, 4))
+        for i, ctl in enumerate(("LQR", "TSD")):
+            best = []
+            for ph, axis in cases:
+                pts = sorted((float(x["amplitude"]), x["passed"] == "true") for x in g
+                             if x["controller"] == ctl and x["phase"] == ph and x["axis"] == axis)
+                b = 0.0
+                for a, ok in pts:
+                    if not ok:
+                        break
+                    b = a
+                best.append(b)
+            ax.bar([j + (i - 0.5) * 0.4 for j in range(len(cases))], best, 0.4, label=ctl)
+        ax.set_xticks(range(len(cases)))
+        ax.set_xticklabels([f"{p}\n{a}" for p, a in cases], fontsize=8)
+        ax.set_ylabel("largest survived 1−cos gust (m/s)")
+        ax.legend()
+        fig.tight_layout()
+        fig.savefig(out / "gusts.png", dpi=110)
+        plt.close(fig)
+    print(f"plots written to {out}")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1] if len(sys.argv) > 1 else "out/analysis")

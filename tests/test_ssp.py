@@ -1,0 +1,265 @@
+"""The SSP 1.0 system files dist/<controller>.ssp (written by `cargo xtask ssp`, and by
+`cargo xtask dist`): structure, schema, and flights under two SSP importers.
+
+- fmpy 0.3.32 (`fmpy.ssp.simulation.simulate_ssp`) validates the SSD against the SSP 1.0
+  schema and flies it. Its limits, worked around or tested as far as they go:
+  * it does not apply the SSD's ParameterBindings (it reads them, `read_ssd`, but
+    `simulate_ssp` only applies a `parameter_set` argument): the test builds that argument
+    from the SSD's own bindings;
+  * it ignores the default experiment: stop time and step size are passed explicitly,
+    and it advances time by repeated addition (it may take one step past 35 s);
+  * it is a Jacobi master whose connectors all start at 0.0, so over the first step the
+    controller sees zeros (a zero quaternion, zero airspeed) and the plant a zero command;
+    the loop recovers within a few samples and flies the mission;
+  * it records connectors only, one row per step labelled with the step's start time but
+    holding the values at its end: the SSD declares every plant output and controller
+    output as a connector so the whole state is recorded.
+- libcosim (libcosimpy 0.0.6, `CosimExecution.from_ssp_file`) reads the bindings, the
+  default experiment and the OSP step-size annotation, and flies it.
+"""
+
+from __future__ import annotations
+
+import math
+import pathlib
+import zipfile
+
+import numpy as np
+import pytest
+from lxml import etree
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+DIST = ROOT / "dist"
+CONTROLLERS = ["tailsitter_lqr", "tailsitter_tsd"]
+MISSION = {
+    "t_vertical_1": 5.0,
+    "t_transition_1": 5.0,
+    "t_level": 10.0,
+    "t_transition_2": 10.0,
+    "t_vertical_2": 5.0,
+    "v_level": 25.0,
+    "v_vertical": 3.0,
+    "sample_time": 0.02,
+}
+NS = {
+    "ssd": "http://ssp-standard.org/SSP1/SystemStructureDescription",
+    "ssc": "http://ssp-standard.org/SSP1/SystemStructureCommon",
+    "ssv": "http://ssp-standard.org/SSP1/SystemStructureParameterValues",
+    "osp": "http://opensimulationplatform.com/SSP/OSPAnnotations",
+}
+LEVEL_END = 20.0  # t_vertical_1 + t_transition_1 + t_level
+
+
+def ssp_path(controller: str) -> pathlib.Path:
+    path = DIST / f"{controller}.ssp"
+    assert path.exists(), f"{path} missing: run `cargo xtask dist` (or `cargo xtask ssp`) first"
+    return path
+
+
+def ssd_root(controller: str):
+    with zipfile.ZipFile(ssp_path(controller)) as z:
+        return etree.fromstring(z.read("SystemStructure.ssd"))
+
+
+def model_description(fmu_bytes: bytes):
+    import io
+
+    with zipfile.ZipFile(io.BytesIO(fmu_bytes)) as z:
+        return etree.fromstring(z.read("modelDescription.xml"))
+
+
+def variables(md) -> dict[str, tuple[str, str]]:
+    """name -> (causality, type element)."""
+    out = {}
+    for sv in md.iterfind("ModelVariables/ScalarVariable"):
+        out[sv.get("name")] = (sv.get("causality", "local"), sv[0].tag)
+    return out
+
+
+@pytest.mark.parametrize("controller", CONTROLLERS)
+def test_archive_holds_the_packaged_fmus(controller):
+    """resources/*.fmu are byte-identical to dist/*.fmu (else the SSP is stale: `cargo xtask ssp`)."""
+    with zipfile.ZipFile(ssp_path(controller)) as z:
+        names = set(z.namelist())
+        assert names == {
+            "SystemStructure.ssd",
+            "resources/tailsitter_plant.fmu",
+            f"resources/{controller}.fmu",
+        }
+        for fmu in ("tailsitter_plant", controller):
+            assert z.read(f"resources/{fmu}.fmu") == (DIST / f"{fmu}.fmu").read_bytes(), (
+                f"{controller}.ssp holds a stale {fmu}.fmu: run `cargo xtask ssp`"
+            )
+
+
+@pytest.mark.parametrize("controller", CONTROLLERS)
+def test_ssd_passes_fmpy_schema_and_wires_by_name(controller):
+    from fmpy.ssp.ssd import read_ssd, validate_tree
+
+    ssd = read_ssd(str(ssp_path(controller)), validate=True)  # raises on schema errors
+    comps = {c.name: c for c in ssd.system.elements}
+    assert set(comps) == {"plant", "controller"}
+    assert comps["plant"].source == "resources/tailsitter_plant.fmu"
+    assert comps["controller"].source == f"resources/{controller}.fmu"
+
+    with zipfile.ZipFile(ssp_path(controller)) as z:
+        plant_vars = variables(model_description(z.read("resources/tailsitter_plant.fmu")))
+        ctrl_vars = variables(model_description(z.read(f"resources/{controller}.fmu")))
+    # Every connection joins equal names: plant output -> controller input, controller output -> plant input.
+    wired = set()
+    for c in ssd.system.connections:
+        assert c.startConnector == c.endConnector
+        assert (c.startElement, c.endElement) in {("plant", "controller"), ("controller", "plant")}
+        src = plant_vars if c.startElement == "plant" else ctrl_vars
+        dst = ctrl_vars if c.startElement == "plant" else plant_vars
+        assert src[c.startConnector][0] == "output" and dst[c.endConnector][0] == "input"
+        assert src[c.startConnector][1] == dst[c.endConnector][1]
+        wired.add((c.endElement, c.endConnector))
+    expected = {("controller", n) for n, (caus, _) in ctrl_vars.items() if caus == "input" and n in plant_vars}
+    expected |= {("plant", n) for n, (caus, _) in ctrl_vars.items() if caus == "output" and n in plant_vars}
+    assert wired == expected
+    assert {n for n, (caus, _) in plant_vars.items() if caus == "input" and n.endswith("_cmd")} <= {
+        n for e, n in wired if e == "plant"
+    }
+    # Connector kinds and types match the FMUs (SSP 1.0: the kind must match the causality).
+    for comp, fmu_vars in (("plant", plant_vars), ("controller", ctrl_vars)):
+        for conn in ssd_root(controller).iterfind(f".//ssd:Component[@name='{comp}']/ssd:Connectors/ssd:Connector", NS):
+            caus, kind = fmu_vars[conn.get("name")]
+            assert conn.get("kind") == caus
+            assert etree.QName(conn[0]).localname == kind
+    # Inline parameter sets are valid SSV too.
+    for ps in ssd_root(controller).iterfind(".//ssd:ParameterValues/ssv:ParameterSet", NS):
+        validate_tree(etree.fromstring(etree.tostring(ps)), "SystemStructureParameterValues.xsd")
+
+
+@pytest.mark.parametrize("controller", CONTROLLERS)
+def test_ssd_binds_the_mission_and_default_experiment(controller):
+    from fmpy.ssp.ssd import read_ssd
+
+    ssd = read_ssd(str(ssp_path(controller)))
+    comps = {c.name: c for c in ssd.system.elements}
+    bound = {
+        p.name: float(p.value)
+        for b in comps["controller"].parameterBindings
+        for ps in b.parameterValues
+        for p in ps.parameters
+    }
+    assert bound == MISSION
+    plant = {
+        p.name: p.value for b in comps["plant"].parameterBindings for ps in b.parameterValues for p in ps.parameters
+    }
+    assert plant == {"initial_condition": "0", "initial_speed": "3.0"}
+    root = ssd_root(controller)
+    exp = root.find("ssd:DefaultExperiment", NS)
+    assert float(exp.get("startTime")) == 0.0 and float(exp.get("stopTime")) == 35.0
+    osp = "ssd:Annotations/ssc:Annotation[@type='com.opensimulationplatform']"
+    algo = exp.find(f"{osp}/osp:Algorithm/osp:FixedStepAlgorithm", NS)
+    assert float(algo.get("baseStepSize")) == 0.02
+
+
+def test_swapping_the_controller_swaps_one_component():
+    """The two SSDs differ only in the controller component and the connections it needs."""
+    roots = {c: ssd_root(c) for c in CONTROLLERS}
+
+    def plant_xml(root):
+        return etree.tostring(root.find(".//ssd:Component[@name='plant']", NS), method="c14n")
+
+    def rest(root):
+        root = etree.fromstring(etree.tostring(root))
+        system = root.find("ssd:System", NS)
+        for tag in ("ssd:Elements", "ssd:Connections"):
+            system.remove(system.find(tag, NS))
+        for a in ("name",):
+            root.attrib.pop(a)
+            system.attrib.pop(a)
+        system.attrib.pop("description")
+        return etree.tostring(root, method="c14n")
+
+    lqr, tsd = roots["tailsitter_lqr"], roots["tailsitter_tsd"]
+    assert plant_xml(lqr) == plant_xml(tsd)
+    assert rest(lqr) == rest(tsd)
+    for root in (lqr, tsd):
+        assert [c.get("name") for c in root.iterfind("ssd:System/ssd:Elements/ssd:Component", NS)] == [
+            "controller",
+            "plant",
+        ]
+
+
+def fmpy_parameter_set(path: pathlib.Path):
+    """The SSD's own bindings as the `parameter_set` fmpy's simulate_ssp applies (names system-relative)."""
+    from fmpy.ssp.ssd import ParameterSet, read_ssd
+
+    ssd = read_ssd(str(path))
+    params = []
+    for comp in ssd.system.elements:
+        for b in comp.parameterBindings:
+            for ps in b.parameterValues:
+                for p in ps.parameters:
+                    p.name = f"{comp.name}.{p.name}"
+                    params.append(p)
+    return ParameterSet(name="bindings", parameters=params)
+
+
+@pytest.mark.parametrize("controller", CONTROLLERS)
+def test_fmpy_simulate_ssp_flies_the_default_mission(controller):
+    from fmpy.ssp.simulation import simulate_ssp
+
+    path = ssp_path(controller)
+    r = simulate_ssp(str(path), stop_time=35.0, step_size=0.02, parameter_set=fmpy_parameter_set(path))
+    # fmpy advances time by repeated addition of the step and loops while time < stop:
+    # 50 * 35 additions of 0.02 fall short of 35.0, so it may take one extra step.
+    assert len(r) in (1750, 1751)
+    for name in r.dtype.names:
+        assert np.all(np.isfinite(r[name])), f"{name} not finite"
+    # Row k holds the values at the end of the step that starts at r["time"][k].
+    t_end = r["time"] + 0.02
+    theta, airspeed = r["plant.theta"], r["plant.airspeed"]
+    window = (t_end >= LEVEL_END - 5.0) & (t_end < LEVEL_END)
+    level_error = np.max(np.abs(airspeed[window] - 25.0))
+    final_pitch = abs(math.degrees(theta[-1]) - 90.0)
+    print(f"\n{controller} under fmpy simulate_ssp: level airspeed error {level_error:.3f} m/s, "
+          f"final pitch {final_pitch:.2f} deg from vertical, max pos_error {r['controller.pos_error'].max():.3f} m")
+    assert level_error < 1.0
+    assert final_pitch < 10.0
+    assert r["controller.phase"][-1] == 4
+    assert set(np.unique(r["controller.phase"])) == {0, 1, 2, 3, 4}
+    # Controller inputs are recorded too: they are the plant outputs one step later (Jacobi).
+    if "controller.theta" in r.dtype.names:
+        assert np.array_equal(r["controller.theta"], r["plant.theta"])
+
+
+@pytest.mark.parametrize("controller", CONTROLLERS)
+def test_libcosim_from_ssp_file_flies_the_default_mission(controller):
+    """Straight libcosimpy: from_ssp_file takes step size and mission from the SSP."""
+    from libcosimpy.CosimEnums import CosimVariableType
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+    from libcosimpy.CosimObserver import CosimObserver
+
+    log_output_level(CosimLogLevel.ERROR)
+    execution = CosimExecution.from_ssp_file(str(ssp_path(controller)))
+    assert execution.num_slaves() == 2
+    plant = execution.slave_index_from_instance_name("plant")
+    ctrl = execution.slave_index_from_instance_name("controller")
+    assert plant is not None and ctrl is not None
+    pv = {v.name.decode(): v.reference for v in execution.slave_variables(plant)}
+    cv = {v.name.decode(): v.reference for v in execution.slave_variables(ctrl)}
+    last = CosimObserver.create_last_value()
+    series = CosimObserver.create_time_series()
+    assert execution.add_observer(last) and execution.add_observer(series)
+    assert series.start_time_series(plant, pv["airspeed"], CosimVariableType.REAL)
+    assert execution.simulate_until(35 * 10**9)
+    status = execution.status()
+    assert status.current_time == 35 * 10**9  # 1750 steps of the annotated 0.02 s
+    # The parameter bindings reached the controller.
+    assert last.last_real_values(ctrl, [cv[n] for n in MISSION]) == pytest.approx(list(MISSION.values()))
+    theta, airspeed = last.last_real_values(plant, [pv["theta"], pv["airspeed"]])
+    assert abs(math.degrees(theta) - 90.0) < 10.0
+    assert last.last_integer_values(ctrl, [cv["phase"]]) == [4]
+    times, _, speeds = series.time_series_real_samples(plant, pv["airspeed"], from_step=1, sample_count=1750)
+    t = np.array(times) / 1e9
+    v = np.array(speeds)
+    window = (t >= LEVEL_END - 5.0) & (t < LEVEL_END)
+    assert window.sum() == 250
+    assert np.max(np.abs(v[window] - 25.0)) < 1.0
+    assert np.all(np.isfinite(v))

@@ -1,0 +1,592 @@
+//! SSP 1.0 system packages `dist/<controller>.ssp`: the closed loop of plant + controller as one
+//! archive a system-level tool loads (fmpy's `simulate_ssp`, libcosim's `from_ssp_file`, ...).
+//!
+//! Layout of the archive:
+//! - `SystemStructure.ssd`: one system with the components `plant` and `controller`
+//!   (`resources/<modelIdentifier>.fmu`), connected by port name (DESIGN.md §2): every controller
+//!   input named like a plant output reads it, every controller output named like a plant input
+//!   drives it. The mission parameters (§3) are an inline parameter set on the controller, the
+//!   plant's initial trim speed is bound to `v_vertical`. Default experiment 0–35 s, with the OSP
+//!   annotation giving libcosim its fixed base step (0.02 s = `sample_time`); tools that do not know
+//!   the annotation ignore it.
+//! - `resources/tailsitter_plant.fmu`, `resources/<controller>.fmu`: the packaged FMUs, verbatim.
+//!
+//! The SSD is the same for every controller except the controller component's source and the
+//! connections it needs (a controller reads the subset of plant outputs it declares as inputs):
+//! swapping the controller swaps one component.
+//!
+//! Reader constraints the writer respects (checked by tests/test_ssp.py):
+//! - fmpy 0.3.32 validates the SSD against the SSP 1.0 schema and needs a connection for every
+//!   declared input connector, so plant inputs that nothing drives (`wind_*`) and controller inputs
+//!   without a plant output (`ref_offset_*`) are not declared as connectors;
+//! - libcosim reads the SSD with fixed prefixes (`ssd:`, `ssc:`, `ssv:`, `osp:`) and needs a type
+//!   element on every connector; namespace declarations sit on the root element only (libcosim would
+//!   read an `xmlns` attribute on an element it iterates as a child).
+
+use quick_xml::events::{BytesDecl, BytesStart, Event};
+use quick_xml::Writer;
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+
+/// The plant every system holds.
+pub const PLANT: &str = "tailsitter_plant";
+/// Controllers a system is written for (each when its FMU exists).
+pub const CONTROLLERS: &[&str] = &["tailsitter_lqr", "tailsitter_tsd"];
+/// Default experiment: the default mission (DESIGN.md §3) is 35 s long.
+pub const STOP_TIME: f64 = 35.0;
+/// Communication step = the controllers' default `sample_time`.
+pub const STEP_SIZE: f64 = 0.02;
+/// Mission parameters (DESIGN.md §3), bound on the controller.
+pub const MISSION: &[(&str, f64)] = &[
+    ("t_vertical_1", 5.0),
+    ("t_transition_1", 5.0),
+    ("t_level", 10.0),
+    ("t_transition_2", 10.0),
+    ("t_vertical_2", 5.0),
+    ("v_level", 25.0),
+    ("v_vertical", 3.0),
+    ("sample_time", STEP_SIZE),
+];
+
+const NS_SSD: &str = "http://ssp-standard.org/SSP1/SystemStructureDescription";
+const NS_SSC: &str = "http://ssp-standard.org/SSP1/SystemStructureCommon";
+const NS_SSV: &str = "http://ssp-standard.org/SSP1/SystemStructureParameterValues";
+const NS_OSP: &str = "http://opensimulationplatform.com/SSP/OSPAnnotations";
+
+/// One scalar variable of an FMU, as far as the SSD needs it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Port {
+    pub name: String,
+    pub causality: String,
+    /// Real, Integer, Boolean, String or Enumeration.
+    pub kind: String,
+    pub unit: Option<String>,
+}
+
+/// A unit definition: name and the attributes of its BaseUnit (same names in FMI 2.0 and SSC).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Unit {
+    pub name: String,
+    pub base: Vec<(String, String)>,
+}
+
+/// What the SSD needs of one FMU.
+#[derive(Debug, Clone)]
+pub struct FmuInfo {
+    pub model_identifier: String,
+    pub ports: Vec<Port>,
+    pub units: Vec<Unit>,
+}
+
+impl FmuInfo {
+    fn with<'a>(&'a self, causality: &'a str) -> impl Iterator<Item = &'a Port> + 'a {
+        self.ports.iter().filter(move |p| p.causality == causality)
+    }
+
+    fn port(&self, name: &str) -> Option<&Port> {
+        self.ports.iter().find(|p| p.name == name)
+    }
+}
+
+/// Write `<dir>/<controller>.ssp` for every controller whose FMU is in `dir`; the plant FMU must be.
+pub fn write_all(dir: &Path) -> Result<Vec<PathBuf>, String> {
+    let plant_fmu = dir.join(format!("{PLANT}.fmu"));
+    if !plant_fmu.exists() {
+        return Err(format!("{} missing: run `cargo xtask dist` first", plant_fmu.display()));
+    }
+    let mut written = Vec::new();
+    for id in CONTROLLERS {
+        let controller_fmu = dir.join(format!("{id}.fmu"));
+        if !controller_fmu.exists() {
+            println!("skipping {id}.ssp: {} missing", controller_fmu.display());
+            continue;
+        }
+        let path = dir.join(format!("{id}.ssp"));
+        write_ssp(&path, &plant_fmu, &controller_fmu)?;
+        println!("wrote {}", path.display());
+        written.push(path);
+    }
+    if written.is_empty() {
+        return Err(format!("no controller FMU in {}", dir.display()));
+    }
+    Ok(written)
+}
+
+/// Write one SSP archive: the SSD and both FMUs under `resources/`.
+pub fn write_ssp(path: &Path, plant_fmu: &Path, controller_fmu: &Path) -> Result<(), String> {
+    let read = |p: &Path| std::fs::read(p).map_err(|e| format!("{}: {e}", p.display()));
+    let (plant_bytes, controller_bytes) = (read(plant_fmu)?, read(controller_fmu)?);
+    let plant = fmu_info(&plant_bytes).map_err(|e| format!("{}: {e}", plant_fmu.display()))?;
+    let controller = fmu_info(&controller_bytes).map_err(|e| format!("{}: {e}", controller_fmu.display()))?;
+    let ssd = system_description(&plant, &controller)?;
+    let file = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut zip = zip::ZipWriter::new(file);
+    let deflated = zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
+    // The FMUs are zip archives already: store them.
+    let stored = zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Stored);
+    let entries = [
+        ("SystemStructure.ssd".to_string(), ssd.into_bytes(), deflated),
+        (resource(&plant.model_identifier), plant_bytes, stored),
+        (resource(&controller.model_identifier), controller_bytes, stored),
+    ];
+    for (name, bytes, options) in entries {
+        zip.start_file(name.as_str(), options)
+            .map_err(|e| format!("{name}: {e}"))?;
+        zip.write_all(&bytes).map_err(|e| format!("{name}: {e}"))?;
+    }
+    zip.finish().map_err(|e| e.to_string())?;
+    Ok(())
+}
+
+fn resource(model_identifier: &str) -> String {
+    format!("resources/{model_identifier}.fmu")
+}
+
+/// Read modelDescription.xml out of an FMU archive.
+pub fn fmu_info(fmu: &[u8]) -> Result<FmuInfo, String> {
+    let mut archive = zip::ZipArchive::new(std::io::Cursor::new(fmu)).map_err(|e| e.to_string())?;
+    let mut xml = String::new();
+    archive
+        .by_name("modelDescription.xml")
+        .map_err(|e| format!("modelDescription.xml: {e}"))?
+        .read_to_string(&mut xml)
+        .map_err(|e| format!("modelDescription.xml: {e}"))?;
+    parse_model_description(&xml)
+}
+
+fn attribute(e: &BytesStart, name: &str) -> Result<Option<String>, String> {
+    match e.try_get_attribute(name).map_err(|err| err.to_string())? {
+        Some(a) => Ok(Some(a.unescape_value().map_err(|err| err.to_string())?.into_owned())),
+        None => Ok(None),
+    }
+}
+
+/// The model identifier, scalar variables and unit definitions of an FMI 2.0 model description.
+pub fn parse_model_description(xml: &str) -> Result<FmuInfo, String> {
+    let mut reader = quick_xml::Reader::from_str(xml);
+    let mut info = FmuInfo {
+        model_identifier: String::new(),
+        ports: Vec::new(),
+        units: Vec::new(),
+    };
+    // The ScalarVariable whose type element comes next.
+    let mut pending: Option<(String, String)> = None;
+    loop {
+        let event = reader.read_event().map_err(|e| format!("modelDescription.xml: {e}"))?;
+        let e = match &event {
+            Event::Start(e) | Event::Empty(e) => e,
+            Event::End(e) if e.name().as_ref() == b"ScalarVariable" => {
+                if let Some((name, _)) = pending.take() {
+                    return Err(format!("variable {name} has no type element"));
+                }
+                continue;
+            }
+            Event::Eof => break,
+            _ => continue,
+        };
+        match e.name().as_ref() {
+            b"CoSimulation" => info.model_identifier = attribute(e, "modelIdentifier")?.unwrap_or_default(),
+            b"Unit" => info.units.push(Unit {
+                name: attribute(e, "name")?.ok_or("Unit without name")?,
+                base: Vec::new(),
+            }),
+            b"BaseUnit" => {
+                let unit = info.units.last_mut().ok_or("BaseUnit outside Unit")?;
+                for a in e.attributes() {
+                    let a = a.map_err(|err| err.to_string())?;
+                    let value = a.unescape_value().map_err(|err| err.to_string())?.into_owned();
+                    unit.base
+                        .push((String::from_utf8_lossy(a.key.as_ref()).into_owned(), value));
+                }
+            }
+            b"ScalarVariable" => {
+                let name = attribute(e, "name")?.ok_or("ScalarVariable without name")?;
+                // FMI 2.0 default causality is local.
+                let causality = attribute(e, "causality")?.unwrap_or_else(|| "local".into());
+                pending = Some((name, causality));
+            }
+            kind @ (b"Real" | b"Integer" | b"Boolean" | b"String" | b"Enumeration") => {
+                if let Some((name, causality)) = pending.take() {
+                    info.ports.push(Port {
+                        name,
+                        causality,
+                        kind: String::from_utf8_lossy(kind).into_owned(),
+                        unit: attribute(e, "unit")?,
+                    });
+                }
+            }
+            _ => {}
+        }
+    }
+    if info.model_identifier.is_empty() {
+        return Err("no CoSimulation modelIdentifier".into());
+    }
+    Ok(info)
+}
+
+/// A connection `start.connector → end.connector` (same connector name at both ends).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Connection {
+    pub start: &'static str,
+    pub end: &'static str,
+    pub name: String,
+}
+
+/// Connections by name (DESIGN.md §2): plant outputs → controller inputs, controller outputs →
+/// plant inputs. Errors if types differ or a plant command input (`*_cmd`) is left undriven.
+pub fn connections(plant: &FmuInfo, controller: &FmuInfo) -> Result<Vec<Connection>, String> {
+    let mut out = Vec::new();
+    for (from, from_id, to, to_id) in [
+        (plant, "plant", controller, "controller"),
+        (controller, "controller", plant, "plant"),
+    ] {
+        for output in from.with("output") {
+            if let Some(input) = to.port(&output.name).filter(|p| p.causality == "input") {
+                if input.kind != output.kind {
+                    return Err(format!(
+                        "{}: {} output is {}, {} input is {}",
+                        output.name, from.model_identifier, output.kind, to.model_identifier, input.kind
+                    ));
+                }
+                out.push(Connection {
+                    start: from_id,
+                    end: to_id,
+                    name: output.name.clone(),
+                });
+            }
+        }
+    }
+    let undriven: Vec<_> = plant
+        .with("input")
+        .filter(|p| p.name.ends_with("_cmd") && !out.iter().any(|c| c.end == "plant" && c.name == p.name))
+        .map(|p| p.name.as_str())
+        .collect();
+    if !undriven.is_empty() {
+        return Err(format!(
+            "{} does not drive plant inputs {undriven:?}",
+            controller.model_identifier
+        ));
+    }
+    Ok(out)
+}
+
+type Xml = Writer<Vec<u8>>;
+type XmlResult = std::io::Result<()>;
+
+fn real(value: f64) -> String {
+    // Rust's shortest round-trip representation; always a valid xs:double.
+    format!("{value:?}")
+}
+
+/// The connectors of one component: every output (recorded by tools that record connectors), and
+/// the inputs a connection drives.
+fn component(
+    w: &mut Xml,
+    name: &str,
+    fmu: &FmuInfo,
+    inputs: &[&str],
+    parameters: &[(&str, String, String)],
+) -> XmlResult {
+    w.create_element("ssd:Component")
+        .with_attributes([
+            ("name", name),
+            ("type", "application/x-fmu-sharedlibrary"),
+            ("source", resource(&fmu.model_identifier).as_str()),
+        ])
+        .write_inner_content(|w| {
+            w.create_element("ssd:Connectors").write_inner_content(|w| {
+                let ports = fmu.ports.iter().filter(|p| {
+                    p.causality == "output" || (p.causality == "input" && inputs.contains(&p.name.as_str()))
+                });
+                for p in ports {
+                    w.create_element("ssd:Connector")
+                        .with_attributes([("name", p.name.as_str()), ("kind", p.causality.as_str())])
+                        .write_inner_content(|w| {
+                            let mut ty = w.create_element(format!("ssc:{}", p.kind));
+                            if let Some(unit) = p.unit.as_deref().filter(|_| p.kind == "Real") {
+                                ty = ty.with_attribute(("unit", unit));
+                            }
+                            ty.write_empty()?;
+                            Ok(())
+                        })?;
+                }
+                Ok(())
+            })?;
+            if !parameters.is_empty() {
+                w.create_element("ssd:ParameterBindings").write_inner_content(|w| {
+                    w.create_element("ssd:ParameterBinding").write_inner_content(|w| {
+                        w.create_element("ssd:ParameterValues")
+                            .write_inner_content(|w| parameter_set(w, parameters))?;
+                        Ok(())
+                    })?;
+                    Ok(())
+                })?;
+            }
+            Ok(())
+        })?;
+    Ok(())
+}
+
+/// An inline SSV parameter set named `mission`: (name, type element, value).
+fn parameter_set(w: &mut Xml, parameters: &[(&str, String, String)]) -> XmlResult {
+    w.create_element("ssv:ParameterSet")
+        .with_attributes([("version", "1.0"), ("name", "mission")])
+        .write_inner_content(|w| {
+            w.create_element("ssv:Parameters").write_inner_content(|w| {
+                for (name, kind, value) in parameters {
+                    w.create_element("ssv:Parameter")
+                        .with_attribute(("name", *name))
+                        .write_inner_content(|w| {
+                            w.create_element(format!("ssv:{kind}"))
+                                .with_attribute(("value", value.as_str()))
+                                .write_empty()?;
+                            Ok(())
+                        })?;
+                }
+                Ok(())
+            })?;
+            Ok(())
+        })?;
+    Ok(())
+}
+
+/// Parameter values for `fmu`, checking each is a parameter of the declared type.
+fn bindings(
+    fmu: &FmuInfo,
+    values: &[(&'static str, &str, String)],
+) -> Result<Vec<(&'static str, String, String)>, String> {
+    values
+        .iter()
+        .map(|(name, kind, value)| match fmu.port(name) {
+            Some(p) if p.causality == "parameter" && p.kind == *kind => Ok((*name, kind.to_string(), value.clone())),
+            Some(p) => Err(format!(
+                "{}.{name} is a {} {}, not a {kind} parameter",
+                fmu.model_identifier, p.causality, p.kind
+            )),
+            None => Err(format!("{} has no parameter {name}", fmu.model_identifier)),
+        })
+        .collect()
+}
+
+/// SystemStructure.ssd of the closed loop.
+pub fn system_description(plant: &FmuInfo, controller: &FmuInfo) -> Result<String, String> {
+    let links = connections(plant, controller)?;
+    let inputs_of =
+        |end: &str| -> Vec<&str> { links.iter().filter(|c| c.end == end).map(|c| c.name.as_str()).collect() };
+    let (plant_inputs, controller_inputs) = (inputs_of("plant"), inputs_of("controller"));
+    let mission: Vec<_> = MISSION.iter().map(|(n, v)| (*n, "Real", real(*v))).collect();
+    let controller_parameters = bindings(controller, &mission)?;
+    let v_vertical = MISSION
+        .iter()
+        .find(|(n, _)| *n == "v_vertical")
+        .map(|m| m.1)
+        .unwrap_or(3.0);
+    // The plant starts in the trimmed vertical climb at the mission's climb speed (DESIGN.md §3).
+    let plant_parameters = bindings(
+        plant,
+        &[
+            ("initial_condition", "Integer", "0".to_string()),
+            ("initial_speed", "Real", real(v_vertical)),
+        ],
+    )?;
+    let mut units: Vec<&Unit> = Vec::new();
+    for u in plant.units.iter().chain(&controller.units) {
+        if !units.iter().any(|known| known.name == u.name) {
+            units.push(u);
+        }
+    }
+    let name = format!("{}_closed_loop", controller.model_identifier);
+    let description = format!(
+        "Tail-sitter closed loop: {} flying {} (DESIGN.md section 2 port wiring by name, section 3 mission).",
+        controller.model_identifier, plant.model_identifier
+    );
+    let mut w = Writer::new_with_indent(Vec::new(), b' ', 2);
+    let io = |e: std::io::Error| e.to_string();
+    w.write_event(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None)))
+        .map_err(io)?;
+    w.create_element("ssd:SystemStructureDescription")
+        .with_attributes([
+            ("xmlns:ssd", NS_SSD),
+            ("xmlns:ssc", NS_SSC),
+            ("xmlns:ssv", NS_SSV),
+            ("xmlns:osp", NS_OSP),
+            ("version", "1.0"),
+            ("name", name.as_str()),
+            (
+                "generationTool",
+                concat!("tailsitter xtask ", env!("CARGO_PKG_VERSION")),
+            ),
+        ])
+        .write_inner_content(|w| {
+            w.create_element("ssd:System")
+                .with_attributes([("name", name.as_str()), ("description", description.as_str())])
+                .write_inner_content(|w| {
+                    w.create_element("ssd:Elements").write_inner_content(|w| {
+                        component(w, "controller", controller, &controller_inputs, &controller_parameters)?;
+                        component(w, "plant", plant, &plant_inputs, &plant_parameters)
+                    })?;
+                    w.create_element("ssd:Connections").write_inner_content(|w| {
+                        for c in &links {
+                            w.create_element("ssd:Connection")
+                                .with_attributes([
+                                    ("startElement", c.start),
+                                    ("startConnector", c.name.as_str()),
+                                    ("endElement", c.end),
+                                    ("endConnector", c.name.as_str()),
+                                ])
+                                .write_empty()?;
+                        }
+                        Ok(())
+                    })?;
+                    Ok(())
+                })?;
+            if !units.is_empty() {
+                w.create_element("ssd:Units").write_inner_content(|w| {
+                    for u in &units {
+                        w.create_element("ssc:Unit")
+                            .with_attribute(("name", u.name.as_str()))
+                            .write_inner_content(|w| {
+                                w.create_element("ssc:BaseUnit")
+                                    .with_attributes(u.base.iter().map(|(k, v)| (k.as_str(), v.as_str())))
+                                    .write_empty()?;
+                                Ok(())
+                            })?;
+                    }
+                    Ok(())
+                })?;
+            }
+            w.create_element("ssd:DefaultExperiment")
+                .with_attributes([("startTime", "0.0"), ("stopTime", real(STOP_TIME).as_str())])
+                .write_inner_content(|w| {
+                    w.create_element("ssd:Annotations").write_inner_content(|w| {
+                        w.create_element("ssc:Annotation")
+                            .with_attribute(("type", "com.opensimulationplatform"))
+                            .write_inner_content(|w| {
+                                w.create_element("osp:Algorithm").write_inner_content(|w| {
+                                    w.create_element("osp:FixedStepAlgorithm")
+                                        .with_attribute(("baseStepSize", real(STEP_SIZE).as_str()))
+                                        .write_empty()?;
+                                    Ok(())
+                                })?;
+                                Ok(())
+                            })?;
+                        Ok(())
+                    })?;
+                    Ok(())
+                })?;
+            Ok(())
+        })
+        .map_err(io)?;
+    let mut text = String::from_utf8(w.into_inner()).map_err(|e| e.to_string())?;
+    text.push('\n');
+    Ok(text)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn port(name: &str, causality: &str, kind: &str) -> Port {
+        Port {
+            name: name.into(),
+            causality: causality.into(),
+            kind: kind.into(),
+            unit: None,
+        }
+    }
+
+    fn plant() -> FmuInfo {
+        FmuInfo {
+            model_identifier: PLANT.into(),
+            ports: vec![
+                port("thrust_cmd", "input", "Real"),
+                port("wind_n", "input", "Real"),
+                port("theta", "output", "Real"),
+                port("pos_d", "output", "Real"),
+                port("initial_condition", "parameter", "Integer"),
+                port("initial_speed", "parameter", "Real"),
+            ],
+            units: vec![Unit {
+                name: "m".into(),
+                base: vec![("m".into(), "1".into())],
+            }],
+        }
+    }
+
+    fn controller() -> FmuInfo {
+        let mut ports = vec![
+            port("thrust_cmd", "output", "Real"),
+            port("phase", "output", "Integer"),
+            port("pos_d", "input", "Real"),
+            port("ref_offset_n", "input", "Real"),
+        ];
+        ports.extend(MISSION.iter().map(|(n, _)| port(n, "parameter", "Real")));
+        FmuInfo {
+            model_identifier: "tailsitter_tsd".into(),
+            ports,
+            units: vec![],
+        }
+    }
+
+    #[test]
+    fn connects_by_name_both_ways() {
+        let c = connections(&plant(), &controller()).unwrap();
+        let names: Vec<_> = c.iter().map(|c| (c.start, c.end, c.name.as_str())).collect();
+        assert_eq!(
+            names,
+            [("plant", "controller", "pos_d"), ("controller", "plant", "thrust_cmd")]
+        );
+    }
+
+    #[test]
+    fn undriven_command_is_an_error() {
+        let mut c = controller();
+        c.ports.retain(|p| p.name != "thrust_cmd");
+        assert!(connections(&plant(), &c).unwrap_err().contains("thrust_cmd"));
+    }
+
+    #[test]
+    fn ssd_declares_only_connected_inputs_and_binds_the_mission() {
+        let ssd = system_description(&plant(), &controller()).unwrap();
+        assert!(ssd.contains(r#"<ssd:Connector name="pos_d" kind="input">"#));
+        assert!(!ssd.contains("wind_n"), "undriven plant input declared");
+        assert!(!ssd.contains("ref_offset_n"), "unconnected controller input declared");
+        assert!(ssd.contains(r#"<ssd:Connector name="phase" kind="output">"#));
+        assert!(ssd.contains(r#"<ssv:Parameter name="t_level">"#));
+        assert!(ssd.contains(r#"<ssv:Integer value="0"/>"#));
+        assert!(ssd.contains(r#"<osp:FixedStepAlgorithm baseStepSize="0.02"/>"#));
+        assert!(ssd.contains(r#"stopTime="35.0""#));
+    }
+
+    #[test]
+    fn missing_mission_parameter_is_an_error() {
+        let mut c = controller();
+        c.ports.retain(|p| p.name != "t_level");
+        assert!(system_description(&plant(), &c).unwrap_err().contains("t_level"));
+    }
+
+    #[test]
+    fn parses_a_model_description() {
+        let xml = r#"<?xml version="1.0"?><fmiModelDescription fmiVersion="2.0">
+  <CoSimulation modelIdentifier="m"/>
+  <UnitDefinitions><Unit name="m/s"><BaseUnit m="1" s="-1"/></Unit></UnitDefinitions>
+  <ModelVariables>
+    <ScalarVariable name="a&amp;b" valueReference="0" causality="output"><Real unit="m/s"/></ScalarVariable>
+    <ScalarVariable name="k" valueReference="1" causality="parameter" variability="fixed"><Integer start="1"/></ScalarVariable>
+    <ScalarVariable name="x" valueReference="2"><Real/></ScalarVariable>
+  </ModelVariables></fmiModelDescription>"#;
+        let info = parse_model_description(xml).unwrap();
+        assert_eq!(info.model_identifier, "m");
+        assert_eq!(
+            info.units,
+            [Unit {
+                name: "m/s".into(),
+                base: vec![("m".into(), "1".into()), ("s".into(), "-1".into())]
+            }]
+        );
+        assert_eq!(info.ports[0].name, "a&b");
+        assert_eq!(info.ports[0].unit.as_deref(), Some("m/s"));
+        assert_eq!(info.ports[1].kind, "Integer");
+        assert_eq!(info.ports[2].causality, "local");
+    }
+}
