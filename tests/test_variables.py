@@ -25,7 +25,7 @@ def start_of(v):
         return int(v.start)
     if v.type == "Boolean":
         return v.start in ("true", "1", True)
-    return v.start
+    return v.start or ""
 
 
 @pytest.mark.parametrize("name", FMUS)
@@ -38,6 +38,8 @@ def test_every_variable_as_declared(fmus, name):
     settable_in_init = {"parameter", "input"}
     for v in fmu.md.modelVariables:
         (value,) = getter(s, v)([v.valueReference])
+        if isinstance(value, bytes):
+            value = value.decode()
         if v.start is not None and v.causality in settable_in_init:
             assert value == pytest.approx(start_of(v)), v.name
         if v.causality in settable_in_init:
