@@ -87,8 +87,8 @@ def test_default_mission_jacobi(fmus, controller, level_trim_theta):
 )
 def test_position_step_settles(fmus, controller, flight, offset):
     if flight == "level":
-        t_step, params = 12.0, {"t_level": 30.0}
-        stop = 32.0
+        t_step, params = 16.0, {"t_level": 30.0}  # 6 s into level flight: the transition has settled
+        stop = 34.0
     else:
         t_step, params = 2.0, {"t_vertical_1": 30.0}
         stop = 15.0

@@ -24,8 +24,8 @@ NAMES = {"lqr": "tailsitter_lqr", "tsd": "tailsitter_tsd"}
 COLORS = {"lqr": "tab:blue", "tsd": "tab:red"}
 STEP_CASES = [
     # (flight, axis, offset NED, step time, controller params, stop time)
-    ("level", "normal", (0.0, 0.0, 5.0), 12.0, {"t_level": 30.0}, 30.0),
-    ("level", "lateral", (0.0, 5.0, 0.0), 12.0, {"t_level": 30.0}, 30.0),
+    ("level", "normal", (0.0, 0.0, 5.0), 16.0, {"t_level": 30.0}, 34.0),
+    ("level", "lateral", (0.0, 5.0, 0.0), 16.0, {"t_level": 30.0}, 34.0),
     ("vertical", "normal", (5.0, 0.0, 0.0), 2.0, {"t_vertical_1": 30.0}, 15.0),
     ("vertical", "lateral", (0.0, 5.0, 0.0), 2.0, {"t_vertical_1": 30.0}, 15.0),
 ]
@@ -97,7 +97,8 @@ def plot_steps(step_runs: dict[str, dict[str, tuple[RunResult, float]]], path: p
                 m = r.time >= t_step - 1.0
                 a.plot(r.time[m] - t_step, pos_error(r)[m], color=COLORS[key], label=key.upper())
         a.axhline(0.5, color="k", lw=0.8, ls=":")
-        a.set(title=f"5 m step, {case} flight", xlabel="time after step [s]", ylabel="position error [m]")
+        flight, axis = case.split()
+        a.set(title=f"5 m {axis} step in {flight} flight", xlabel="time after step [s]", ylabel="position error [m]")
         a.grid(True, alpha=0.3)
         a.legend()
     fig.tight_layout()
@@ -149,7 +150,7 @@ def main(argv: list[str] | None = None) -> int:
                 t1, t2 = missions[name]
                 params = mission_params(t1, t2)
                 loop = ClosedLoop(plant, ctrls[key], controller_params=params, ordering=ordering)
-                r = loop.run(stop_time=25.0 + t1 + t2, progress=True, description=f"{key} {name}")
+                r = loop.run(stop_time=20.0 + t1 + t2, progress=True, description=f"{key} {name}")
                 mission_runs[name][key] = r
                 r.write_csv(out / "csv" / f"{key}_{name}_mission.csv")
             else:

@@ -119,7 +119,7 @@ class RunResult:
         names = list(self.signals)
         header = ",".join(f"{n} [{self.units.get(n, '')}]" if self.units.get(n) else n for n in names)
         data = np.column_stack([self.signals[n] for n in names])
-        np.savetxt(path, data, delimiter=",", header=header, comments="", fmt="%.10g")
+        np.savetxt(path, data, delimiter=",", header=header, comments="", fmt="%.17g")
 
 
 class ClosedLoop:
