@@ -232,7 +232,7 @@ def main(argv: list[str] | None = None) -> int:
     for label, vals in rows:
         md.append(f"| {label} | " + " | ".join(vals) + " |")
     md += ["", "Fastest transition flown (completed with α < 20°): " + ", ".join(
-        f"{k.upper()} T1 = {fastest[k][0]:g} s, T2 = {fastest[k][1]:g} s" if fastest[k] else f"{k.upper()}: none completed"
+        f"{k.upper()} T1 = {fastest[k][0]:g} s, T2 = {fastest[k][1]:g} s" if fastest[k] else f"{k.upper()}: none of the missions flown kept α < 20°"
         for k in keys)]
     if step_rows:
         md += ["", "## Position steps", "", "| step | " + " | ".join(k.upper() for k in keys) + " |", "|" + "---|" * (len(keys) + 1)]

@@ -21,7 +21,7 @@ fn random_call_sequences_keep_every_invariant() {
         sequences: env("FMI_FUZZ_SEQUENCES", 2700),
         deadline: None,
         max_calls: 40,
-        // ~0.1 s per LQR sequence (its instantiate/reset builds the trajectory and gains).
+        // ~0.1 s per LQR sequence (its initialisation builds the trajectory and gains, ~40 ms).
         per_fmu_cap: [("tailsitter_lqr".to_string(), env("FMI_FUZZ_LQR_SEQUENCES", 120))].into(),
     };
     let t0 = Instant::now();
