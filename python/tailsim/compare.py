@@ -106,6 +106,27 @@ def plot_steps(step_runs: dict[str, dict[str, tuple[RunResult, float]]], path: p
     plt.close(fig)
 
 
+def analysis_section(out: pathlib.Path) -> list[str]:
+    """The analysis campaign's report (`analysis/report.md`, written by
+    `cargo run --release -p analysis -- all --out <out>/analysis`), headings
+    demoted under one section, with its plots."""
+    report = out / "analysis" / "report.md"
+    if not report.exists():
+        return []
+    lines = ["", "## Analysis: modes, closed-loop poles, sensitivity (Table 5.1) and robustness", ""]
+    for line in report.read_text().splitlines():
+        if line.startswith("#"):
+            line = "#" + line if line.startswith("##") else "### " + line.lstrip("# ")
+            line = line if not line.startswith("####") else "### " + line.lstrip("# ")
+        lines.append(line)
+    pngs = sorted((out / "analysis").glob("*.png"))
+    if pngs:
+        lines += ["", "### Analysis plots", ""]
+        for p in pngs:
+            lines += [f"![{p.stem}](analysis/{p.name})", ""]
+    return lines
+
+
 def fmt(x: float, digits: int = 2) -> str:
     if x is None or (isinstance(x, float) and math.isnan(x)):
         return "–"
@@ -212,7 +233,7 @@ def main(argv: list[str] | None = None) -> int:
         ]
         fastest[k] = min(done, key=lambda tt: tt[0] + tt[1]) if done else None
     step_rows = []
-    for c in STEP_CASES:
+    for c in [] if args.no_steps else STEP_CASES:
         name = f"{c[0]} {c[1]}"
         vals = []
         for k in keys:
@@ -244,6 +265,7 @@ def main(argv: list[str] | None = None) -> int:
     for title, p in plots:
         md += [f"### {title}", "", f"![{title}]({p.name})", ""]
     md += ["CSV of every run (time + all signals, units in the header): `csv/`."]
+    md += analysis_section(out)
     (out / "report.md").write_text("\n".join(md) + "\n")
 
     body = []

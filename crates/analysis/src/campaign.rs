@@ -38,6 +38,9 @@ pub struct Config {
     pub gust_amplitudes: Vec<f64>,
     /// Run the nonlinear robustness sweep.
     pub robustness: bool,
+    /// Also sweep the nonlinear robustness over τ^this (≤ 1: no wide sweep), to find
+    /// where the missions start failing.
+    pub wide_tau_power: f64,
     /// Run the gust sweep.
     pub gusts: bool,
     /// Show progress bars.
@@ -57,6 +60,7 @@ impl Config {
             params: Vec::new(),
             gust_amplitudes: (1..=20).map(f64::from).collect(),
             robustness: true,
+            wide_tau_power: 3.0,
             gusts: true,
             progress: true,
             mission: MissionParams::default(),
@@ -202,6 +206,9 @@ pub struct RobustnessResult {
     pub worst_pos_error: f64,
 }
 
+/// Position-error bound (m) of the stricter gust survival column.
+pub const POS_BOUND: f64 = 10.0;
+
 /// Results of the gust sweep.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct GustResult {
@@ -217,6 +224,8 @@ pub struct GustResult {
     pub outcomes: Vec<FlightOutcome>,
     /// Largest amplitude with every smaller one passing.
     pub largest_survived: f64,
+    /// The same with the position error also below [`POS_BOUND`].
+    pub largest_bounded: f64,
 }
 
 /// Everything the campaign produced.
@@ -228,8 +237,10 @@ pub struct Summary {
     pub closed_loop: Vec<(Kind, Condition, PoleJob)>,
     /// Sensitivity.
     pub sensitivity: Vec<SensitivityResult>,
-    /// Nonlinear parameter robustness.
+    /// Nonlinear parameter robustness over the thesis's sweep.
     pub robustness: Vec<RobustnessResult>,
+    /// The same over the wider sweep τ^`wide_tau_power`.
+    pub robustness_wide: Vec<RobustnessResult>,
     /// Gusts.
     pub gusts: Vec<GustResult>,
     /// Wall time of the run (s).
@@ -335,59 +346,68 @@ pub fn run(cfg: &Config) -> std::io::Result<Summary> {
         })
         .collect();
 
-    // 4a. nonlinear robustness over the same sweeps.
+    // 4a. nonlinear robustness over the same sweeps (and a wider one).
     let flights_cache = Cache::open(Some(&cache_dir), "flights")?;
-    let mut robustness = Vec::new();
+    let (mut robustness, mut robustness_wide) = (Vec::new(), Vec::new());
     if cfg.robustness {
-        let mut jobs: Vec<(usize, Kind, f64)> = Vec::new();
-        for (pi, p) in params.iter().enumerate() {
-            for &kind in &cfg.controllers {
-                for fk in sensitivity::factors(p.tau(), cfg.n) {
-                    jobs.push((pi, kind, fk));
+        let sweep = |tau_power: f64, msg: &str| -> Vec<RobustnessResult> {
+            let taus: Vec<f64> = params.iter().map(|p| p.tau().powf(tau_power)).collect();
+            let mut jobs: Vec<(usize, Kind, f64)> = Vec::new();
+            for (pi, tau) in taus.iter().enumerate() {
+                for &kind in &cfg.controllers {
+                    for fk in sensitivity::factors(*tau, cfg.n) {
+                        jobs.push((pi, kind, fk));
+                    }
                 }
             }
-        }
-        let pb = bar(cfg, jobs.len(), "nonlinear robustness");
-        let out: Vec<FlightOutcome> = jobs
-            .par_iter()
-            .map(|(pi, kind, fk)| {
-                let af = params[*pi].scaled(&nominal, *fk);
-                let sc = closed_loop::Scenario::mission(mission);
-                let key = cache::key(&format!("mission|{}|{:?}|{:?}", id_of(*kind), sc, af));
-                let r = flights_cache.get_or(&key, || robust::fly_mission(&af, kind.make(&mission), &sc));
-                pb.inc(1);
-                r
-            })
-            .collect();
-        pb.finish();
-        let mut at = 0;
-        for p in &params {
-            let f = sensitivity::factors(p.tau(), cfg.n);
-            for &kind in &cfg.controllers {
-                let outcomes: Vec<FlightOutcome> = out[at..at + f.len()].to_vec();
-                at += f.len();
-                let passed: Vec<bool> = outcomes.iter().map(|o| o.passed).collect();
-                let nom = sensitivity::nominal_index(&f);
-                let range = robust::passing_range(&f, &passed, nom);
-                let worst = match range {
-                    Some((lo, hi)) => f
-                        .iter()
-                        .zip(&outcomes)
-                        .filter(|(x, _)| **x >= lo && **x <= hi)
-                        .map(|(_, o)| o.max_pos_error)
-                        .fold(0.0, f64::max),
-                    None => f64::NAN,
-                };
-                robustness.push(RobustnessResult {
-                    param: p.id.into(),
-                    name: p.name.into(),
-                    controller: kind,
-                    factors: f.clone(),
-                    outcomes,
-                    range,
-                    worst_pos_error: worst,
-                });
+            let pb = bar(cfg, jobs.len(), msg);
+            let out: Vec<FlightOutcome> = jobs
+                .par_iter()
+                .map(|(pi, kind, fk)| {
+                    let af = params[*pi].scaled(&nominal, *fk);
+                    let sc = closed_loop::Scenario::mission(mission);
+                    let key = cache::key(&format!("mission|{}|{:?}|{:?}", id_of(*kind), sc, af));
+                    let r = flights_cache.get_or(&key, || robust::fly_mission(&af, kind.make(&mission), &sc));
+                    pb.inc(1);
+                    r
+                })
+                .collect();
+            pb.finish();
+            let mut res = Vec::new();
+            let mut at = 0;
+            for (p, tau) in params.iter().zip(&taus) {
+                let f = sensitivity::factors(*tau, cfg.n);
+                for &kind in &cfg.controllers {
+                    let outcomes: Vec<FlightOutcome> = out[at..at + f.len()].to_vec();
+                    at += f.len();
+                    let passed: Vec<bool> = outcomes.iter().map(|o| o.passed).collect();
+                    let nom = sensitivity::nominal_index(&f);
+                    let range = robust::passing_range(&f, &passed, nom);
+                    let worst = match range {
+                        Some((lo, hi)) => f
+                            .iter()
+                            .zip(&outcomes)
+                            .filter(|(x, _)| **x >= lo && **x <= hi)
+                            .map(|(_, o)| o.max_pos_error)
+                            .fold(0.0, f64::max),
+                        None => f64::NAN,
+                    };
+                    res.push(RobustnessResult {
+                        param: p.id.into(),
+                        name: p.name.into(),
+                        controller: kind,
+                        factors: f.clone(),
+                        outcomes,
+                        range,
+                        worst_pos_error: worst,
+                    });
+                }
             }
+            res
+        };
+        robustness = sweep(1.0, "nonlinear robustness");
+        if cfg.wide_tau_power > 1.0 {
+            robustness_wide = sweep(cfg.wide_tau_power, "wide robustness");
         }
     }
 
@@ -427,16 +447,25 @@ pub fn run(cfg: &Config) -> std::io::Result<Summary> {
                 amplitudes: cfg.gust_amplitudes.clone(),
                 outcomes: chunk.to_vec(),
                 largest_survived: robust::largest_survived(&cfg.gust_amplitudes, &passed),
+                largest_bounded: robust::largest_survived(
+                    &cfg.gust_amplitudes,
+                    &chunk
+                        .iter()
+                        .map(|o| o.passed && o.max_pos_error <= POS_BOUND)
+                        .collect::<Vec<_>>(),
+                ),
             });
         }
     }
 
-    let total_jobs = presults.len() + robustness.len() * cfg.n + gusts.len() * cfg.gust_amplitudes.len();
+    let total_jobs =
+        presults.len() + (robustness.len() + robustness_wide.len()) * cfg.n + gusts.len() * cfg.gust_amplitudes.len();
     let summary = Summary {
         open_loop,
         closed_loop,
         sensitivity: sens,
         robustness,
+        robustness_wide,
         gusts,
         wall_time_s: start.elapsed().as_secs_f64(),
         cache_hits: poles_cache.hits() + flights_cache.hits(),
@@ -674,7 +703,8 @@ pub fn write_report(out: &Path, s: &Summary, cfg: &Config) -> std::io::Result<()
          (m, I); controllers keep their nominal design model. Entry: RMS over the closed-loop poles of each pole's \
          largest excursion from nominal, in % of its nominal natural frequency (poles with ω_n < {} rad/s left out). \
          `!` marks sweeps with an unstable closed-loop pole somewhere, `✗n` sweeps where n points failed to reach the \
-         operating point. The thesis's column is level flight.\n",
+         operating point, `sn` sweeps where at n points an actuator saturated at the operating point (a pole at z = 0, \
+         left out of that pole's excursion). The thesis's column is level flight.\n",
         cfg.n,
         sensitivity::MIN_OMEGA
     );
@@ -708,6 +738,9 @@ pub fn write_report(out: &Path, s: &Summary, cfg: &Config) -> std::io::Result<()
                         let mut t = format!("{:.1}%", row.rms_percent);
                         if row.unstable_points > 0 {
                             t.push_str(" !");
+                        }
+                        if row.degenerate_points > 0 {
+                            let _ = write!(t, " s{}", row.degenerate_points);
                         }
                         if row.failed_points > 0 {
                             let _ = write!(t, " ✗{}", row.failed_points);
@@ -763,64 +796,31 @@ pub fn write_report(out: &Path, s: &Summary, cfg: &Config) -> std::io::Result<()
 
     // ---- robustness
     if !s.robustness.is_empty() {
-        let mut rb = String::new();
-        let _ = writeln!(
-            rb,
-            "\n## Nonlinear robustness (beyond the thesis)\n\n\
+        let intro = "\n## Nonlinear robustness (beyond the thesis)\n\n\
              The whole default mission flown in the nonlinear closed loop with the parameter scaled over the same \
-             sweep; range = contiguous range of factors around 1 over which the mission passes the controller issues' \
-             criteria (`MissionCheck::passed`); worst = largest position error over that range; passes = passing \
-             points of N.\n"
-        );
-        let mut header = String::from("| parameter |");
-        let mut rule = String::from("|---|");
-        for &k in &cfg.controllers {
-            let _ = write!(header, " {0} range | {0} passes | {0} worst pos. err (m) |", k.name());
-            rule.push_str("---|---|---|");
+             sweep as Table 5.1 (τ = 1.5 / 1.1); range = contiguous range of factors around 1 over which the mission \
+             passes the controller issues' criteria (`MissionCheck::passed`); worst = largest position error over \
+             that range; passes = passing points of N. The mission is symmetric and flown in calm air, so the lateral \
+             derivatives are hardly excited (identical position errors): their robustness shows in the gust sweep.\n";
+        let rb = robustness_section(intro, &s.robustness, cfg);
+        write(out, "robustness.csv", &rb.1)?;
+        let mut text = rb.0;
+        if !s.robustness_wide.is_empty() {
+            let intro = format!(
+                "\n### Wider sweep: τ^{} ({:.2} … {:.2} aerodynamic, {:.3} … {:.3} m and I)\n\n\
+                 The same flights over a wider range, to find where the missions start failing.\n",
+                cfg.wide_tau_power,
+                1.5f64.powf(-cfg.wide_tau_power),
+                1.5f64.powf(cfg.wide_tau_power * (1.0 - 2.0 / cfg.n as f64)),
+                1.1f64.powf(-cfg.wide_tau_power),
+                1.1f64.powf(cfg.wide_tau_power * (1.0 - 2.0 / cfg.n as f64)),
+            );
+            let w = robustness_section(&intro, &s.robustness_wide, cfg);
+            write(out, "robustness_wide.csv", &w.1)?;
+            text.push_str(&w.0);
         }
-        let _ = writeln!(rb, "{header}\n{rule}");
-        let mut csv = String::from("param,controller,factor,passed,completed,max_pos_error,level_airspeed_error,level_pitch_error_deg,failure\n");
-        for p in cfg.selected_params() {
-            let mut line = format!("| {} |", p.name);
-            for &k in &cfg.controllers {
-                let Some(r) = s.robustness.iter().find(|r| r.param == p.id && r.controller == k) else {
-                    line.push_str(" — | — | — |");
-                    continue;
-                };
-                let n_pass = r.outcomes.iter().filter(|o| o.passed).count();
-                let range = match r.range {
-                    Some((lo, hi)) => format!("{lo:.3} … {hi:.3}"),
-                    None => "nominal fails".into(),
-                };
-                let _ = write!(
-                    line,
-                    " {} | {}/{} | {} |",
-                    range,
-                    n_pass,
-                    r.outcomes.len(),
-                    nan_str(r.worst_pos_error, 2)
-                );
-                for (f, o) in r.factors.iter().zip(&r.outcomes) {
-                    let _ = writeln!(
-                        csv,
-                        "{},{},{},{},{},{},{},{},\"{}\"",
-                        p.id,
-                        k.name(),
-                        f,
-                        o.passed,
-                        o.completed,
-                        o.max_pos_error,
-                        o.level_airspeed_error,
-                        o.level_pitch_error_deg,
-                        o.failure.clone().unwrap_or_default().replace('"', "'")
-                    );
-                }
-            }
-            let _ = writeln!(rb, "{line}");
-        }
-        write(out, "robustness.csv", &csv)?;
-        write(out, "robustness.md", &rb)?;
-        md.push_str(&rb);
+        write(out, "robustness.md", &text)?;
+        md.push_str(&text);
     }
 
     // ---- gusts
@@ -832,7 +832,8 @@ pub fn write_report(out: &Path, s: &Summary, cfg: &Config) -> std::io::Result<()
              1−cos gusts of {} s along one earth axis (NED; + = towards north/east/down), amplitudes {}…{} m/s: in the \
              first vertical phase (3 m/s climb, from t = 1.5 s), centred on the middle of the first transition, and in \
              level flight (from 2 s after its start). Largest amplitude A such that every amplitude ≤ A still passes the \
-             mission criteria (0 = the smallest fails).\n",
+             mission criteria (0 = the smallest fails); the criteria do not bound the position error, so the last \
+             column also requires a position error ≤ 10 m.\n",
             robust::GUST_DURATION,
             cfg.gust_amplitudes.first().copied().unwrap_or(0.0),
             cfg.gust_amplitudes.last().copied().unwrap_or(0.0)
@@ -842,10 +843,11 @@ pub fn write_report(out: &Path, s: &Summary, cfg: &Config) -> std::io::Result<()
         for &k in &cfg.controllers {
             let _ = write!(
                 header,
-                " {0} largest survived (m/s) | {0} max pos. err at it (m) |",
-                k.name()
+                " {0} largest survived (m/s) | {0} max pos. err at it (m) | {0} largest with pos. err ≤ {1} m |",
+                k.name(),
+                POS_BOUND
             );
-            rule.push_str("---|---|");
+            rule.push_str("---|---|---|");
         }
         let _ = writeln!(gu, "{header}\n{rule}");
         let mut csv = String::from("controller,phase,axis,amplitude,passed,completed,max_pos_error\n");
@@ -866,7 +868,13 @@ pub fn write_report(out: &Path, s: &Summary, cfg: &Config) -> std::io::Result<()
                         .position(|a| *a == g.largest_survived)
                         .map(|i| g.outcomes[i].max_pos_error)
                         .unwrap_or(f64::NAN);
-                    let _ = write!(line, " {:.0} | {} |", g.largest_survived, nan_str(err, 2));
+                    let _ = write!(
+                        line,
+                        " {:.0} | {} | {:.0} |",
+                        g.largest_survived,
+                        nan_str(err, 2),
+                        g.largest_bounded
+                    );
                     for (a, o) in g.amplitudes.iter().zip(&g.outcomes) {
                         let _ = writeln!(
                             csv,
@@ -892,6 +900,61 @@ pub fn write_report(out: &Path, s: &Summary, cfg: &Config) -> std::io::Result<()
     let json = serde_json::to_string(s).map_err(std::io::Error::other)?;
     write(out, "summary.json", &json)?;
     Ok(())
+}
+
+/// Markdown table and CSV of a robustness sweep.
+fn robustness_section(intro: &str, results: &[RobustnessResult], cfg: &Config) -> (String, String) {
+    let mut rb = String::from(intro);
+    let _ = writeln!(rb);
+    let mut header = String::from("| parameter |");
+    let mut rule = String::from("|---|");
+    for &k in &cfg.controllers {
+        let _ = write!(header, " {0} range | {0} passes | {0} worst pos. err (m) |", k.name());
+        rule.push_str("---|---|---|");
+    }
+    let _ = writeln!(rb, "{header}\n{rule}");
+    let mut csv = String::from(
+        "param,controller,factor,passed,completed,max_pos_error,level_airspeed_error,level_pitch_error_deg,failure\n",
+    );
+    for p in cfg.selected_params() {
+        let mut line = format!("| {} |", p.name);
+        for &k in &cfg.controllers {
+            let Some(r) = results.iter().find(|r| r.param == p.id && r.controller == k) else {
+                line.push_str(" — | — | — |");
+                continue;
+            };
+            let n_pass = r.outcomes.iter().filter(|o| o.passed).count();
+            let range = match r.range {
+                Some((lo, hi)) => format!("{lo:.3} … {hi:.3}"),
+                None => "nominal fails".into(),
+            };
+            let _ = write!(
+                line,
+                " {} | {}/{} | {} |",
+                range,
+                n_pass,
+                r.outcomes.len(),
+                nan_str(r.worst_pos_error, 2)
+            );
+            for (f, o) in r.factors.iter().zip(&r.outcomes) {
+                let _ = writeln!(
+                    csv,
+                    "{},{},{},{},{},{},{},{},\"{}\"",
+                    p.id,
+                    k.name(),
+                    f,
+                    o.passed,
+                    o.completed,
+                    o.max_pos_error,
+                    o.level_airspeed_error,
+                    o.level_pitch_error_deg,
+                    o.failure.clone().unwrap_or_default().replace('"', "'")
+                );
+            }
+        }
+        let _ = writeln!(rb, "{line}");
+    }
+    (rb, csv)
 }
 
 /// Why our open-loop modes differ from Tables 3.2/3.3 (DESIGN.md §4, §6).

@@ -37,6 +37,9 @@ struct Common {
     /// Largest gust amplitude (m/s); the sweep is 1, 2, … this.
     #[arg(long, default_value_t = 20)]
     max_gust: u32,
+    /// The wider nonlinear sweep covers τ^this (0 = no wider sweep).
+    #[arg(long, default_value_t = 3.0)]
+    wide_tau_power: f64,
     /// Threads (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
@@ -73,6 +76,7 @@ fn main() {
     cfg.params = c.params;
     cfg.gust_amplitudes = (1..=c.max_gust.max(1)).map(f64::from).collect();
     cfg.robustness = robustness;
+    cfg.wide_tau_power = c.wide_tau_power;
     cfg.gusts = gusts;
     cfg.progress = !c.quiet;
     cfg.controllers = Kind::ALL.to_vec();

@@ -17,6 +17,9 @@ use tailsitter_physics::Airframe;
 
 use crate::linalg::{match_poles, C64};
 
+/// s-plane poles with Re s below this (z ≈ 0: a saturated actuator) are degenerate.
+pub const DEGENERATE_S: f64 = -1e6;
+
 /// Poles slower than this (rad/s) are not counted in the RMS.
 pub const MIN_OMEGA: f64 = 0.05;
 
@@ -153,6 +156,11 @@ pub struct SensitivityRow {
     pub failed_points: usize,
     /// Number of sweep points with an unstable closed-loop pole (Re s > 0).
     pub unstable_points: usize,
+    /// Number of sweep points with a degenerate pole z ≈ 0 (s ≤ [`DEGENERATE_S`]): a
+    /// saturated actuator annihilates its direction in one step; such points are left out
+    /// of that pole's excursion.
+    #[serde(default)]
+    pub degenerate_points: usize,
     /// Tracked loci: `loci[i][k]` = pole i at factor k (None where the point failed).
     pub loci: Vec<Vec<Option<(f64, f64)>>>,
 }
@@ -193,11 +201,12 @@ pub fn track(points: &[Option<Vec<C64>>], nominal: usize) -> Option<SensitivityR
         let d = loci[i]
             .iter()
             .flatten()
+            .filter(|(re, _)| *re > DEGENERATE_S)
             .map(|(re, im)| (C64::new(*re, *im) - p).norm())
             .fold(0.0, f64::max)
             / w;
-        let first = loci[i].iter().flatten().next();
-        let last = loci[i].iter().flatten().last();
+        let first = loci[i].iter().flatten().find(|(re, _)| *re > DEGENERATE_S);
+        let last = loci[i].iter().flatten().rfind(|(re, _)| *re > DEGENERATE_S);
         let span = match (first, last) {
             (Some(a), Some(b)) => (C64::new(a.0, a.1) - C64::new(b.0, b.1)).norm() / w,
             _ => 0.0,
@@ -211,6 +220,11 @@ pub fn track(points: &[Option<Vec<C64>>], nominal: usize) -> Option<SensitivityR
         rms_percent: 100.0 * (sum / c).sqrt(),
         rms_span_percent: 100.0 * (sum_span / c).sqrt(),
         failed_points: points.iter().filter(|p| p.is_none()).count(),
+        degenerate_points: points
+            .iter()
+            .flatten()
+            .filter(|p| p.iter().any(|s| s.re <= DEGENERATE_S))
+            .count(),
         unstable_points: points
             .iter()
             .flatten()

@@ -443,8 +443,8 @@ impl Trajectory {
     pub fn at(&self, t: f64) -> TrajPoint {
         let n = self.points.len();
         let s = (t.max(0.0)) / TABLE_STEP;
-        let i = s.floor() as usize;
-        if i + 1 >= n {
+        // Compare in floating point: a huge t must not overflow the index (fuzzing found it).
+        if !(s + 1.0 < n as f64) {
             let mut p = self.points[n - 1];
             let dt = t - p.t;
             let (sg, cg) = p.gamma.sin_cos();
@@ -453,6 +453,7 @@ impl Trajectory {
             p.t = t;
             return p;
         }
+        let i = s.floor() as usize;
         self.points[i].lerp(&self.points[i + 1], s - i as f64)
     }
 
@@ -502,6 +503,21 @@ mod tests {
             .windows(2)
             .map(|w| (f(&w[1]) - f(&w[0])).abs())
             .fold(0.0, f64::max)
+    }
+
+    /// Regression (fuzzing): a huge mission time overflowed the table index.
+    #[test]
+    fn huge_times_continue_the_last_climb() {
+        let traj = Trajectory::new(&Airframe::default(), &MissionParams::default(), &TrajectoryOptions::default())
+            .unwrap();
+        for t in [1e20, 1e300, f64::MAX] {
+            let p = traj.at(t);
+            assert_eq!(p.t, t);
+            assert!(p.v.is_finite());
+        }
+        let last = traj.points().last().unwrap();
+        let p = traj.at(last.t + 1.0);
+        assert!((p.pos_neh.z - last.pos_neh.z - last.v).abs() < 1e-9, "climbs at v_vertical");
     }
 
     #[test]

@@ -58,6 +58,8 @@ pub struct Report {
     /// "fmi2Function @ state" → calls per returned status (OK, Warning, Discard, Error).
     pub coverage: BTreeMap<String, [u64; 4]>,
     pub violations: u64,
+    /// Violations by kind (FMU + function + a digit-free prefix of the description).
+    pub violation_kinds: BTreeMap<String, u64>,
     /// The first violations, described.
     pub first_violations: Vec<String>,
     pub reset_checks: u64,
@@ -88,6 +90,9 @@ impl Report {
         );
         for (id, (n, secs)) in &self.per_fmu {
             println!("  {id}: {n} sequences in {secs:.1} s");
+        }
+        for (k, n) in &self.violation_kinds {
+            println!("  {n:>6} × {k}");
         }
         for v in &self.first_violations {
             println!("  VIOLATION {v}");
@@ -327,6 +332,18 @@ impl<'a> Fuzzer<'a> {
 
     fn violation(&mut self, fmu: &Fmu, what: String) {
         self.report.violations += 1;
+        let kind = if let Some(i) = what.find("internal error (panic)") {
+            let func = what.split(':').next().unwrap_or("");
+            let msg: String = what[i..].chars().take(60).filter(|c| !c.is_ascii_digit()).collect();
+            format!("{func}: {msg}")
+        } else {
+            what.chars().filter(|c| !c.is_ascii_digit()).take(70).collect()
+        };
+        *self
+            .report
+            .violation_kinds
+            .entry(format!("{}: {kind}", fmu.id))
+            .or_default() += 1;
         if self.report.first_violations.len() < 40 {
             self.report.first_violations.push(format!(
                 "[{} seq {} seed-state {:#x}] {what}",

@@ -5,7 +5,15 @@
 
 use fmi_fuzz::model_description_types::VarType;
 use fmi_fuzz::{cycle, light_cycle, load_required, rss_kib, Fmu, Var, OK};
-use std::sync::Barrier;
+use std::sync::{Barrier, Mutex};
+
+/// The tests of this file run one at a time: RSS is per process, and the
+/// 64-thread test's stacks and malloc arenas would blur the RSS measurements.
+static SERIAL: Mutex<()> = Mutex::new(());
+
+fn serial() -> std::sync::MutexGuard<'static, ()> {
+    SERIAL.lock().unwrap_or_else(|e| e.into_inner())
+}
 
 /// Instance `i`: Real inputs nudged by an amount depending on `i`, then `steps`
 /// steps; returns the bit patterns of every value after each step.
@@ -40,6 +48,7 @@ fn run(fmu: &Fmu, i: usize, steps: usize, barrier: Option<&Barrier>) -> Vec<u64>
 
 #[test]
 fn sixty_four_concurrent_instances_match_sequential_runs() {
+    let _serial = serial();
     const N: usize = 64;
     const STEPS: usize = 100;
     for fmu in &load_required() {
@@ -91,6 +100,7 @@ fn rss_over(fmu: &Fmu, n: usize, cycle: impl Fn(&Fmu) -> bool) -> (u64, u64, u64
 
 #[test]
 fn ten_thousand_instantiate_free_cycles_do_not_grow_the_resident_set() {
+    let _serial = serial();
     const CYCLES: usize = 10_000;
     for fmu in &load_required() {
         let (before, mid, after) = rss_over(fmu, CYCLES, light_cycle);
@@ -111,6 +121,7 @@ fn ten_thousand_instantiate_free_cycles_do_not_grow_the_resident_set() {
 
 #[test]
 fn full_life_cycles_do_not_grow_the_resident_set() {
+    let _serial = serial();
     // With initialisation and a step; fewer for the LQR FMU (~40 ms per initialisation).
     for fmu in &load_required() {
         let n = if fmu.id == "tailsitter_lqr" { 300 } else { 5_000 };
