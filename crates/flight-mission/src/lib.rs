@@ -319,6 +319,22 @@ pub enum Notice {
     Saturated(&'static str),
 }
 
+/// |a − b| without overflow: a scaled Euclidean norm, finite for any finite
+/// inputs (|d| up to f64::MAX · √3), so a diagnostic never turns infinite.
+pub fn distance(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+    let d = a - b;
+    let m = d.amax();
+    if m == 0.0 || !m.is_finite() {
+        return if m.is_nan() { f64::NAN } else { m };
+    }
+    let n = m * (d / m).norm();
+    if n.is_finite() {
+        n
+    } else {
+        f64::MAX
+    }
+}
+
 /// What a controller returns at a sample.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ControllerOutput {
@@ -433,6 +449,20 @@ mod tests {
         assert_eq!(m.phase_at(25.0).0, Phase::TransitionToVertical);
         assert_eq!(m.phase_at(31.0).0, Phase::Vertical2);
         assert_eq!(m.phase_at(100.0).0, Phase::Vertical2);
+    }
+
+    /// Regression (fuzzing): huge but finite positions made `pos_error` infinite.
+    #[test]
+    fn distance_never_overflows() {
+        let a = Vector3::new(1e300, -1e300, 1e300);
+        let d = distance(&a, &Vector3::zeros());
+        assert!(d.is_finite() && (d / 1e300 - 3f64.sqrt()).abs() < 1e-12);
+        assert_eq!(distance(&Vector3::new(3.0, 4.0, 0.0), &Vector3::zeros()), 5.0);
+        assert_eq!(distance(&a, &a), 0.0);
+        assert_eq!(
+            distance(&Vector3::new(f64::MAX, -f64::MAX, 0.0), &Vector3::zeros()),
+            f64::MAX
+        );
     }
 
     #[test]

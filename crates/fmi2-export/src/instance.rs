@@ -520,6 +520,11 @@ impl<M: FmuModel> Instance<M> {
                 "communicationStepSize = {h} s must be finite and > 0"
             )));
         }
+        if !(t + h).is_finite() {
+            return Err(Fmi2Error::error(format!(
+                "step from {t} s by {h} s ends at a non-finite time"
+            )));
+        }
         if let Some(stop) = self.machine.stop_time {
             if t + h > stop + 1e-9 * stop.abs().max(1.0) {
                 return Err(Fmi2Error::error(format!(

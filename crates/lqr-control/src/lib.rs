@@ -487,7 +487,7 @@ impl FlightController for LqrController {
             ref_pos_ned: Vector3::new(ref_neh.x, ref_neh.y, -ref_neh.z),
             ref_airspeed: reference.v,
             phase: self.mission.phase_at(t).0,
-            pos_error: (pos - ref_neh).norm(),
+            pos_error: flight_mission::distance(&pos, &ref_neh),
         };
         let command = Command {
             thrust: u[0],

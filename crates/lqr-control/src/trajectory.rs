@@ -508,8 +508,12 @@ mod tests {
     /// Regression (fuzzing): a huge mission time overflowed the table index.
     #[test]
     fn huge_times_continue_the_last_climb() {
-        let traj = Trajectory::new(&Airframe::default(), &MissionParams::default(), &TrajectoryOptions::default())
-            .unwrap();
+        let traj = Trajectory::new(
+            &Airframe::default(),
+            &MissionParams::default(),
+            &TrajectoryOptions::default(),
+        )
+        .unwrap();
         for t in [1e20, 1e300, f64::MAX] {
             let p = traj.at(t);
             assert_eq!(p.t, t);
@@ -517,7 +521,10 @@ mod tests {
         }
         let last = traj.points().last().unwrap();
         let p = traj.at(last.t + 1.0);
-        assert!((p.pos_neh.z - last.pos_neh.z - last.v).abs() < 1e-9, "climbs at v_vertical");
+        assert!(
+            (p.pos_neh.z - last.pos_neh.z - last.v).abs() < 1e-9,
+            "climbs at v_vertical"
+        );
     }
 
     #[test]

@@ -87,6 +87,10 @@ pub struct FlightCondition {
     pub thrust: f64,
     /// Induced velocity w [m/s]: the slip-stream surfaces see V̄ + 2w.
     pub induced_velocity: f64,
+    /// Air-velocity component along the body x axis, V̄ cos α cos β [m/s]: the variable of
+    /// the low-speed frame blend κ ([`TsdController::frame_weight`]). Equal to V̄ when the
+    /// air flows from the nose; in hover in a crosswind it stays at the climb rate.
+    pub axial_airspeed: f64,
 }
 
 /// Every loop's linear model and gains at one flight condition (§4.2, §4.3, Table 4.3).
@@ -271,11 +275,20 @@ impl TsdController {
         (rn, rv)
     }
 
-    /// Weight κ of the wind axes against the reference-path frame at `airspeed`: 0 below
+    /// Weight κ of the wind axes against the reference-path frame at the axial airspeed
+    /// `axial_airspeed` = V̄ cos α cos β (air-velocity component along the nose): 0 below
     /// `wind_frame_speed_low`, 1 above `wind_frame_speed_high`, linear between.
-    pub fn frame_weight(&self, airspeed: f64) -> f64 {
+    ///
+    /// The blend variable is the *axial* component, not V̄: in hover in a crosswind the air
+    /// velocity points far off the nose (β = 59° in a 5 m/s crosswind at a 3 m/s climb), the
+    /// wind axes turn with every change of the aircraft's horizontal velocity (1 m/s turns
+    /// them by ~11° at V̄ = 5 m/s) and the small-α/β loop models do not hold, so the wind axes
+    /// are no frame for the loops there; with V̄ as the variable a 4 m/s crosswind blended
+    /// them in and the lateral position diverged after 8 s (README, "Low-speed frame").
+    pub fn frame_weight(&self, axial_airspeed: f64) -> f64 {
         let p = &self.params;
-        ((airspeed - p.wind_frame_speed_low) / (p.wind_frame_speed_high - p.wind_frame_speed_low)).clamp(0.0, 1.0)
+        ((axial_airspeed - p.wind_frame_speed_low) / (p.wind_frame_speed_high - p.wind_frame_speed_low))
+            .clamp(0.0, 1.0)
     }
 
     /// Design every loop at flight condition `fc` (gain scheduling, §4.2): the models of
@@ -288,7 +301,7 @@ impl TsdController {
         let (vv, vl) = (self.mission.v_vertical, self.mission.v_level);
         let v = fc.airspeed.max(p.min_airspeed);
         let sched = ((fc.airspeed - vv) / (vl - vv)).clamp(0.0, 1.0);
-        let kappa = self.frame_weight(fc.airspeed);
+        let kappa = self.frame_weight(fc.axial_airspeed);
         let rho = af.air_density;
         let (s_ref, b_ref, c_ref) = (af.wing_area, af.wing_span, af.mean_chord);
         let qbar = 0.5 * rho * v * v;
@@ -433,7 +446,8 @@ impl FlightController for TsdController {
         // (κ = 0), blended between. κ also scales the path-rotation terms of the loop models
         // (a11 C_W, the gravity terms g₁/V̄, g₂/V̄ and their feedback linearisation): at low
         // speed the wind axes turn as fast as the body and the time-scale separation fails.
-        let kappa = self.frame_weight(meas.airspeed);
+        let axial_airspeed = meas.airspeed * meas.alpha.cos() * meas.beta.cos();
+        let kappa = self.frame_weight(axial_airspeed);
         let (fa, fb) = {
             let (sa, ca) = meas.alpha.sin_cos();
             let (sb, cb) = meas.beta.sin_cos();
@@ -469,6 +483,7 @@ impl FlightController for TsdController {
                 alpha: meas.alpha,
                 thrust: meas.thrust,
                 induced_velocity: meas.induced_velocity,
+                axial_airspeed,
             })
             .map_err(|what| Self::err(format!("{what} gains not computable at t = {} s", input.t)))?;
         let (v, sched) = (d.v, d.schedule);
@@ -659,7 +674,7 @@ impl FlightController for TsdController {
                 ref_pos_ned: ref_pos,
                 ref_airspeed: reference.airspeed,
                 phase: reference.phase,
-                pos_error: pos_error_vec.norm(),
+                pos_error: flight_mission::distance(&meas.pos_ned, &ref_pos),
             },
             notice,
         })
@@ -760,12 +775,14 @@ mod tests {
             alpha: 0.0,
             thrust: 88.3,
             induced_velocity: 10.4,
+            axial_airspeed: 3.0,
         };
         let level = FlightCondition {
             airspeed: 25.0,
             alpha: 0.092,
             thrust: 9.3,
             induced_velocity: 0.6,
+            axial_airspeed: 25.0 * 0.092f64.cos(),
         };
         for (fc, lvl) in [(vertical, false), (level, true)] {
             let d = ctl.design(&fc).unwrap();
