@@ -696,3 +696,16 @@ fn trim_converges_with_tiny_inertias() {
         .expect("trim with tiny inertias");
     assert!((trim.thrust - 88.376_020_578).abs() < 1e-6, "{}", trim.thrust);
 }
+
+/// Regression (fuzzing): a huge communication step ran for minutes; it is refused at once.
+#[test]
+fn enormous_steps_are_refused_promptly() {
+    let p = plant();
+    let trim = p.trim_vertical_climb(3.0).unwrap();
+    let mut x = trim.state;
+    let err = p.advance(&mut x, &trim.inputs, &zero_wind(), 1e6).unwrap_err();
+    assert!(err.to_string().contains("step size h"), "{err}");
+    assert_eq!(x, trim.state, "state untouched");
+    // The largest accepted step still integrates.
+    p.advance(&mut x, &trim.inputs, &zero_wind(), MAX_SUBSTEPS * p.integration_step * 0.001).unwrap();
+}

@@ -1147,7 +1147,8 @@ impl<'a> Fuzzer<'a> {
         let t_ok = t.is_finite() && (t - m.time).abs() <= 1e-9 * m.time.abs().max(1.0);
         let h_ok = h.is_finite() && h > 0.0;
         let stop_ok = m.stop.is_none_or(|stop| t + h <= stop + 1e-9 * stop.abs().max(1.0));
-        let expect = if st == StepComplete && t_ok && h_ok && stop_ok {
+        let end_ok = (t + h).is_finite();
+        let expect = if st == StepComplete && t_ok && h_ok && stop_ok && end_ok {
             Expect::OkOrError
         } else {
             Expect::Error
