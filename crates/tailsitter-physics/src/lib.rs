@@ -27,7 +27,7 @@ pub use attitude::{
     quat_from_dcm, quat_from_euler_231, quat_from_euler_321,
 };
 pub use error::PhysicsError;
-pub use plant::{Envelope, Outputs, Plant, Trim};
+pub use plant::{Envelope, Outputs, Plant, Trim, MAX_SUBSTEPS};
 
 use nalgebra::SVector;
 
