@@ -1,9 +1,14 @@
 //! Scan one tuning parameter over values and print the mission metrics (tuning aid).
 //!
 //! `cargo run --release -p tsd-control --example tsd_scan -- <param> <v1> <v2> ...`
+//!
+//! With `TSD_SCAN_WIND=1` it also hovers 35 s (vertical flight) in a constant 5 m/s wind
+//! from N, E, S, W, NE and flies the default mission in a 3 m/s crosswind (from the east),
+//! printing max / final position error [m].
 
-use closed_loop::{fly, MissionCheck, Ordering, Scenario};
+use closed_loop::{fly, MissionCheck, Ordering, Scenario, Wind};
 use flight_mission::MissionParams;
+use nalgebra::Vector3;
 use tailsitter_physics::{Airframe, Plant};
 use tsd_control::{TsdController, TsdParams};
 
@@ -87,5 +92,54 @@ fn main() {
             );
         }
         println!("{line}");
+        if std::env::var("TSD_SCAN_WIND").is_ok() {
+            println!("    {}", wind_line(&plant, p, theta_trim));
+        }
     }
+}
+
+/// Hover in a steady 5 m/s wind from five directions, then the default mission in a 3 m/s crosswind.
+fn wind_line(plant: &Plant, p: TsdParams, theta_trim: f64) -> String {
+    let mut line = String::from("wind 5 m/s, max/final:");
+    let s = std::f64::consts::FRAC_1_SQRT_2;
+    // Wind vectors (NED, air velocity): a wind *from* the north blows south.
+    for (label, w) in [
+        ("N", [-1.0, 0.0]),
+        ("E", [0.0, -1.0]),
+        ("S", [1.0, 0.0]),
+        ("W", [0.0, 1.0]),
+        ("NE", [-s, -s]),
+    ] {
+        let mission = MissionParams {
+            t_vertical_1: 40.0,
+            ..Default::default()
+        };
+        let x0 = plant.trim_vertical_climb(3.0).unwrap().state;
+        let mut ctl = TsdController::new(p, mission, Airframe::default()).unwrap();
+        let mut sc = Scenario::mission(mission);
+        sc.stop_time = 35.0;
+        sc.wind = Wind::Constant(Vector3::new(5.0 * w[0], 5.0 * w[1], 0.0));
+        let tr = fly(plant, x0, &mut ctl, &sc);
+        let fin = tr.window(15.0, 36.0).map(|s| s.pos_error()).fold(0.0, f64::max);
+        line += &format!(
+            "  {label}: {:.2}/{:.2}{}",
+            tr.max_pos_error(),
+            fin,
+            if tr.completed() { "" } else { " FAIL" }
+        );
+    }
+    let mission = MissionParams::default();
+    let x0 = plant.trim_vertical_climb(3.0).unwrap().state;
+    let mut ctl = TsdController::new(p, mission, Airframe::default()).unwrap();
+    let mut sc = Scenario::mission(mission);
+    sc.wind = Wind::Constant(Vector3::new(0.0, -3.0, 0.0));
+    let tr = fly(plant, x0, &mut ctl, &sc);
+    let check = MissionCheck::of(&tr, &mission, theta_trim);
+    line += &format!(
+        "  | mission 3 m/s crosswind: {} max {:.2} m, α {:.1}°",
+        if check.passed() && tr.completed() { "ok" } else { "FAIL" },
+        tr.max_pos_error(),
+        tr.max_alpha(0.0, 100.0).to_degrees()
+    );
+    line
 }

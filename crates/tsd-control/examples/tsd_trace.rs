@@ -1,7 +1,8 @@
 //! Print a closed-loop time series of the TSD controller (debugging and tuning aid).
 //!
 //! `cargo run --release -p tsd-control --example tsd_trace -- <case> [every_s]`
-//! with case one of `default`, `fast`, `jacobi`, `vstep-n`, `vstep-e`, `lstep-d`, `lstep-e`.
+//! with case one of `default`, `fast`, `jacobi`, `vstep-n`, `vstep-e`, `lstep-d`, `lstep-e`, `hover`
+//! (40 s of vertical flight); a constant wind with `TSD_WIND=n,e,d` [m/s, NED].
 
 use closed_loop::{measure, pitch, plant_inputs, Ordering, Scenario};
 use flight_mission::{ControllerInput, FlightController, MissionParams};
@@ -45,8 +46,23 @@ fn main() {
             steps.push((15.0, off));
             stop = Some(45.0);
         }
+        "hover" => {
+            mission.t_vertical_1 = 40.0;
+            stop = Some(35.0);
+        }
         _ => {}
     }
+    // Constant wind (NED, m/s) from the environment: `TSD_WIND=n,e,d`.
+    let wind = std::env::var("TSD_WIND")
+        .ok()
+        .map(|s| {
+            let v: Vec<f64> = s
+                .split(',')
+                .map(|x| x.trim().parse().expect("TSD_WIND=n,e,d"))
+                .collect();
+            Vector3::new(v[0], v[1], v[2])
+        })
+        .unwrap_or_else(Vector3::zeros);
     let plant = Plant::new(Airframe::default());
     let mut x = plant.trim_vertical_climb(mission.v_vertical).unwrap().state;
     let mut ctl = TsdController::with_mission(mission).unwrap();
@@ -61,7 +77,7 @@ fn main() {
     println!("     t ph   err_n   err_e   err_d  theta  alpha   beta    V     T     de     da     dr   Ac     Bc     Cc    Aw    Bw    Cw   phiE   w     p     q     r   vcmd");
     for k in 0..=n {
         let t = k as f64 * h;
-        let meas = measure(&plant, &x, &u, &Vector3::zeros());
+        let meas = measure(&plant, &x, &u, &wind);
         let out = ctl
             .update(&ControllerInput {
                 t,
@@ -91,7 +107,7 @@ fn main() {
         if k == n {
             break;
         }
-        if let Err(e) = plant.advance(&mut x, &u, &Vector3::zeros(), h) {
+        if let Err(e) = plant.advance(&mut x, &u, &wind, h) {
             println!("plant failed at {t}: {e}");
             break;
         }

@@ -287,8 +287,7 @@ impl TsdController {
     /// them in and the lateral position diverged after 8 s (README, "Low-speed frame").
     pub fn frame_weight(&self, axial_airspeed: f64) -> f64 {
         let p = &self.params;
-        ((axial_airspeed - p.wind_frame_speed_low) / (p.wind_frame_speed_high - p.wind_frame_speed_low))
-            .clamp(0.0, 1.0)
+        ((axial_airspeed - p.wind_frame_speed_low) / (p.wind_frame_speed_high - p.wind_frame_speed_low)).clamp(0.0, 1.0)
     }
 
     /// Design every loop at flight condition `fc` (gain scheduling, §4.2): the models of
@@ -443,9 +442,11 @@ impl FlightController for TsdController {
         let r_eb = att.to_rotation_matrix();
         // Frame of the specific accelerations: the wind axes (thesis) above
         // `wind_frame_speed_high`, the reference-path axes below `wind_frame_speed_low`
-        // (κ = 0), blended between. κ also scales the path-rotation terms of the loop models
-        // (a11 C_W, the gravity terms g₁/V̄, g₂/V̄ and their feedback linearisation): at low
-        // speed the wind axes turn as fast as the body and the time-scale separation fails.
+        // (κ = 0), blended between, in the axial airspeed V̄ cos α cos β (not V̄: a crosswind
+        // in hover must not blend in wind axes that point along the span). κ also scales the
+        // path-rotation terms of the loop models (a11 C_W, the gravity terms g₁/V̄, g₂/V̄ and
+        // their feedback linearisation): at low speed the wind axes turn as fast as the body
+        // and the time-scale separation fails.
         let axial_airspeed = meas.airspeed * meas.alpha.cos() * meas.beta.cos();
         let kappa = self.frame_weight(axial_airspeed);
         let (fa, fb) = {

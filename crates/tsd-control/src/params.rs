@@ -77,11 +77,13 @@ pub struct TsdParams {
     /// Below this normal part of the commanded acceleration the prescribed normal vector is
     /// used even in level flight (§4.3.2.1) [m/s²].
     pub min_normal_accel: f64,
-    /// Below this airspeed the specific accelerations are resolved in the reference-path
-    /// frame instead of the wind axes (the wind axes turn as fast as the body at low
-    /// speed, (C_W + g₁)/V̄, and the time-scale separation fails) [m/s].
+    /// Below this axial airspeed V̄ cos α cos β the specific accelerations are resolved in
+    /// the reference-path frame instead of the wind axes (the wind axes turn as fast as the
+    /// body at low speed, (C_W + g₁)/V̄, and the time-scale separation fails; the axial
+    /// component keeps a hover crosswind out of the blend) [m/s].
     pub wind_frame_speed_low: f64,
-    /// Above this airspeed the wind axes are used, as in the thesis; linear blend between [m/s].
+    /// Above this axial airspeed V̄ cos α cos β the wind axes are used, as in the thesis;
+    /// linear blend between [m/s].
     pub wind_frame_speed_high: f64,
     /// Preview of the feed-forward specific acceleration: Σ^RE of (4.3.24) is taken from the
     /// trajectory this much ahead of the sample, compensating the lag of the inner loops
