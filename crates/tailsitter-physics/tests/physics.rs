@@ -707,5 +707,11 @@ fn enormous_steps_are_refused_promptly() {
     assert!(err.to_string().contains("step size h"), "{err}");
     assert_eq!(x, trim.state, "state untouched");
     // The largest accepted step still integrates.
-    p.advance(&mut x, &trim.inputs, &zero_wind(), MAX_SUBSTEPS * p.integration_step * 0.001).unwrap();
+    p.advance(
+        &mut x,
+        &trim.inputs,
+        &zero_wind(),
+        MAX_SUBSTEPS * p.integration_step * 0.001,
+    )
+    .unwrap();
 }
