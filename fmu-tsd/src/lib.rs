@@ -10,11 +10,8 @@
 //! command otherwise; after `fmi2ExitInitializationMode` the outputs already
 //! hold the command for the start time.
 
-use flight_mission::{
-    Command, ControllerInput, ControllerOutput, Diagnostics, FlightController, Measurement, Notice, Phase, SampleClock,
-};
+use flight_mission::{ControllerOutput, ControllerPorts, FlightController, Notice, SampleClock};
 use fmi2_export::{FmuModel, Logger, ModelError, StateError, StateReader, StateWriter};
-use nalgebra::{Vector3, Vector4};
 use tailsitter_physics::Airframe;
 use tsd_control::TsdController;
 
@@ -24,6 +21,9 @@ mod generated {
     include!(concat!(env!("OUT_DIR"), "/variables.rs"));
 }
 pub use generated::{vr, Variables, GUID, MODEL_DESCRIPTION_XML, MODEL_IDENTIFIER};
+
+// The ports of DESIGN.md §2 ↔ the controller's input and output types.
+flight_mission::impl_controller_ports!(Variables);
 
 /// One controller instance: the controller, its sample clock and the held output.
 #[derive(Debug, Clone)]
@@ -40,51 +40,11 @@ impl TsdModel {
             .map_err(|e| ModelError::new(format!("invalid parameter: {e}")))
     }
 
-    /// The measurement from the input variables; a non-finite input is an error naming it.
-    fn measurement(vars: &Variables) -> Result<Measurement, ModelError> {
-        let m = Measurement {
-            pos_ned: Vector3::new(vars.pos_n, vars.pos_e, vars.pos_d),
-            vel_ned: Vector3::new(vars.vel_n, vars.vel_e, vars.vel_d),
-            vel_body: Vector3::new(vars.u, vars.v, vars.w),
-            rates: Vector3::new(vars.p, vars.q, vars.r),
-            quat: Vector4::new(vars.quat_1, vars.quat_2, vars.quat_3, vars.quat_4),
-            airspeed: vars.airspeed,
-            alpha: vars.alpha,
-            beta: vars.beta,
-            thrust: vars.thrust,
-            surfaces: [
-                vars.elevator,
-                vars.aileron,
-                vars.rudder,
-                vars.flap_collective,
-                vars.flap_differential,
-                vars.vertical_flap,
-            ],
-            specific_force_body: Vector3::new(vars.accel_x, vars.accel_y, vars.accel_z),
-            induced_velocity: vars.induced_velocity,
-        };
-        if let Some(name) = m.first_non_finite() {
-            return Err(ModelError::new(format!("input '{name}' is not finite")));
-        }
-        for (name, value) in [
-            ("ref_offset_n", vars.ref_offset_n),
-            ("ref_offset_e", vars.ref_offset_e),
-            ("ref_offset_d", vars.ref_offset_d),
-        ] {
-            if !value.is_finite() {
-                return Err(ModelError::new(format!("input '{name}' is not finite")));
-            }
-        }
-        Ok(m)
-    }
-
     /// Sample the controller at `t` and hold the result.
     fn sample(&mut self, vars: &Variables, t: f64, log: &mut Logger<'_>) -> Result<(), ModelError> {
-        let input = ControllerInput {
-            t,
-            measurement: Self::measurement(vars)?,
-            ref_offset_ned: Vector3::new(vars.ref_offset_n, vars.ref_offset_e, vars.ref_offset_d),
-        };
+        let input = vars
+            .controller_input(t)
+            .map_err(|name| ModelError::new(format!("input '{name}' is not finite at t = {t} s")))?;
         let out = self
             .controller
             .update(&input)
@@ -100,35 +60,9 @@ impl TsdModel {
 
     /// Write the held command and diagnostics to the outputs.
     fn write_outputs(&self, vars: &mut Variables) {
-        let Some(out) = self.held else { return };
-        let Command {
-            thrust,
-            elevator,
-            aileron,
-            rudder,
-            flap_collective,
-            flap_differential,
-            vertical_flap,
-        } = out.command;
-        vars.thrust_cmd = thrust;
-        vars.elevator_cmd = elevator;
-        vars.aileron_cmd = aileron;
-        vars.rudder_cmd = rudder;
-        vars.flap_collective_cmd = flap_collective;
-        vars.flap_differential_cmd = flap_differential;
-        vars.vertical_flap_cmd = vertical_flap;
-        let Diagnostics {
-            ref_pos_ned,
-            ref_airspeed,
-            phase,
-            pos_error,
-        } = out.diagnostics;
-        vars.ref_pos_n = ref_pos_ned.x;
-        vars.ref_pos_e = ref_pos_ned.y;
-        vars.ref_pos_d = ref_pos_ned.z;
-        vars.ref_airspeed = ref_airspeed;
-        vars.phase = phase.code();
-        vars.pos_error = pos_error;
+        if let Some(out) = &self.held {
+            vars.write_output(out);
+        }
     }
 }
 
@@ -176,34 +110,9 @@ impl FmuModel for TsdModel {
     fn write_state(&self, w: &mut StateWriter) {
         self.controller.save(&mut |x| w.f64(x));
         w.u64(self.clock.next_index());
-        match self.held {
-            Some(out) => {
-                w.bool(true);
-                let c = out.command;
-                for x in [
-                    c.thrust,
-                    c.elevator,
-                    c.aileron,
-                    c.rudder,
-                    c.flap_collective,
-                    c.flap_differential,
-                    c.vertical_flap,
-                ] {
-                    w.f64(x);
-                }
-                let d = out.diagnostics;
-                for x in [
-                    d.ref_pos_ned.x,
-                    d.ref_pos_ned.y,
-                    d.ref_pos_ned.z,
-                    d.ref_airspeed,
-                    d.pos_error,
-                ] {
-                    w.f64(x);
-                }
-                w.i32(d.phase.code());
-            }
-            None => w.bool(false),
+        w.bool(self.held.is_some());
+        if let Some(out) = &self.held {
+            out.save(&mut |x| w.f64(x));
         }
     }
 
@@ -214,40 +123,15 @@ impl FmuModel for TsdModel {
         }
         let next_index = r.u64()?;
         let held = if r.bool()? {
-            let mut c = [0.0; 7];
-            for v in c.iter_mut() {
+            let mut saved = [0.0; ControllerOutput::SAVED_LEN];
+            for v in saved.iter_mut() {
                 *v = r.f64()?;
             }
-            let mut d = [0.0; 5];
-            for v in d.iter_mut() {
-                *v = r.f64()?;
-            }
-            let phase = match r.i32()? {
-                0 => Phase::Vertical1,
-                1 => Phase::TransitionToLevel,
-                2 => Phase::Level,
-                3 => Phase::TransitionToVertical,
-                4 => Phase::Vertical2,
-                other => return Err(StateError::invalid(format!("phase {other} out of range"))),
-            };
-            Some(ControllerOutput {
-                command: Command {
-                    thrust: c[0],
-                    elevator: c[1],
-                    aileron: c[2],
-                    rudder: c[3],
-                    flap_collective: c[4],
-                    flap_differential: c[5],
-                    vertical_flap: c[6],
-                },
-                diagnostics: Diagnostics {
-                    ref_pos_ned: Vector3::new(d[0], d[1], d[2]),
-                    ref_airspeed: d[3],
-                    phase,
-                    pos_error: d[4],
-                },
-                notice: None,
-            })
+            let mut it = saved.into_iter();
+            Some(
+                ControllerOutput::restore(&mut || it.next())
+                    .ok_or_else(|| StateError::invalid("held output: phase out of range"))?,
+            )
         } else {
             None
         };
