@@ -706,7 +706,7 @@ mod tests {
         saved[12] = 7.0;
         let mut it = saved.clone().into_iter();
         assert_eq!(ControllerOutput::restore(&mut || it.next()), None, "invalid phase");
-        let mut it = saved[..5].to_vec().into_iter();
+        let mut it = saved[..5].iter().copied();
         assert_eq!(ControllerOutput::restore(&mut || it.next()), None, "truncated");
         ports.write_output(&output);
         assert_eq!(
