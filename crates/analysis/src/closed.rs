@@ -47,10 +47,11 @@ impl Analysable for lqr_control::LqrController {
         self.restore(&mut || it.next())
             .expect("LQR state restores what save wrote");
     }
-    /// Layout of `LqrController::save`: [has_origin, origin(3), integrator, …]: the
-    /// airspeed integrator (3.2.12–3.2.14) is the only continuous state.
+    /// Layout of `LqrController::save`: [has_origin, origin(3), integrator, …, ∫ΔN, ∫ΔE, ∫Δh]:
+    /// the airspeed integrator (3.2.12–3.2.14) and, with `position_integral = 1`, the three
+    /// position integrators are the continuous states.
     fn dynamic_states(&self) -> Vec<(usize, &'static str)> {
-        vec![(4, "∫ΔV")]
+        self.dynamic_state_layout()
     }
 }
 

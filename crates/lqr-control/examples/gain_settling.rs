@@ -16,7 +16,7 @@ use std::fmt::Write as _;
 use tailsitter_physics::Airframe;
 
 const STATES: [&str; NA] = [
-    "Vint", "V", "alpha", "beta", "p", "q", "r", "phi", "theta", "psi", "N", "E", "h", "T",
+    "Vint", "V", "alpha", "beta", "p", "q", "r", "phi", "theta", "psi", "N", "E", "h", "T", "Nint", "Eint", "hint",
 ];
 const INPUTS: [&str; 4] = ["Tc", "de", "da", "dr"];
 

@@ -28,12 +28,15 @@ use tailsitter_physics::Airframe;
 use linalg::{
     dare_residual, dare_sda, discretise_zoh, lqr_gain, riccati_backward, spectral_radius_bound, RiccatiError,
 };
-use model::{ix, linearise, state_of, wrap_pi, EulerRep, NA, NU, NX, U, X};
+use model::{ix, linearise, state_of, wrap_pi, EulerRep, I_POS, NA, NU, NX, U, X};
 use trajectory::{TrajPoint, Trajectory, TrajectoryMode, TrajectoryOptions};
 use weights::{load_set, WeightSchedule, Weights, DEFAULT_WEIGHTS_JSON};
 
 /// Smallest reference airspeed the (V, α, β) model for control supports \[m/s\].
 pub const MIN_AIRSPEED: f64 = 0.5;
+
+/// Bound on the magnitude of the wind estimate \[m/s\].
+pub const MAX_WIND_ESTIMATE: f64 = 20.0;
 
 /// Size of the augmented ZOH exponential: states + integrator + inputs.
 const NM: usize = NA + NU;
@@ -67,6 +70,23 @@ pub struct LqrParams {
     /// z = 1 (ẋ_I = ΔV = along-track Δṗ in straight flight) and no stabilising DARE
     /// solution exists.
     pub integrator_leak: f64,
+    /// 1 (default) = integral action on the earth-frame position error ∫ΔN, ∫ΔE, ∫Δh (zero
+    /// steady-state position error in a steady wind or with a model mismatch); 0 = the
+    /// thesis's structure, integral action on airspeed only (3.2.12–3.2.14).
+    pub position_integral: i32,
+    /// Limit of each position-error integrator |∫Δp dt| \[m·s\].
+    pub position_integrator_limit: f64,
+    /// Leak of the position integrators \[1/s\], ẋ_Ip = p − p_t − λ_p x_Ip. Not needed for
+    /// stabilisability (see `solve_gain`); > 0 trades the zero steady-state error for less
+    /// integrator memory.
+    pub position_integrator_leak: f64,
+    /// 1 (default) = wind-consistent air-data reference: the reference airspeed, α and β are
+    /// those of the reference ground velocity minus the estimated wind, seen from the
+    /// reference attitude, weighted by sin²θ_ref (full in vertical flight, none in level
+    /// flight); 0 = the thesis's no-wind reference (V_t, α_t, β_t = 0).
+    pub wind_compensation: i32,
+    /// Time constant of the wind estimate ŵ = low-pass(v_inertial − DCMᵀ v_air) \[s\].
+    pub wind_filter_time: f64,
     /// Trajectory: 0 = thesis closed forms (3.3.3–3.3.4, 3.3.13–3.3.17), 1 = force balance.
     pub trajectory_mode: i32,
     /// α_max of (3.3.4) \[rad\] (trajectory_mode 0 only).
@@ -87,6 +107,11 @@ impl Default for LqrParams {
             euler_switch_pitch: 50f64.to_radians(),
             integrator_limit: 10.0,
             integrator_leak: 0.1,
+            position_integral: 0,
+            position_integrator_limit: 50.0,
+            position_integrator_leak: 0.0,
+            wind_compensation: 1,
+            wind_filter_time: 1.0,
             trajectory_mode: 1,
             alpha_max: 15f64.to_radians(),
             turn_radius: 0.0,
@@ -114,6 +139,10 @@ pub struct LqrController {
     // ---- state ----
     origin: Option<Vector3<f64>>,
     integrator: f64,
+    /// ∫ΔN, ∫ΔE, ∫Δh \[m·s\].
+    pos_integrator: Vector3<f64>,
+    /// Low-pass wind estimate, NED \[m/s\]; NaN before the first sample.
+    wind: Vector3<f64>,
     gain: Gain,
     have_gain: bool,
     rep: EulerRep,
@@ -173,11 +202,31 @@ impl LqrController {
             ("r_scale", params.r_scale),
             ("integrator_limit", params.integrator_limit),
             ("integrator_leak", params.integrator_leak),
+            ("position_integrator_limit", params.position_integrator_limit),
+            ("wind_filter_time", params.wind_filter_time),
         ];
         for (name, v) in positive {
             if !(v.is_finite() && v > 0.0) {
                 return Err(ControlError(format!("{name} = {v}: must be finite and > 0")));
             }
+        }
+        if !(params.position_integrator_leak.is_finite() && params.position_integrator_leak >= 0.0) {
+            return Err(ControlError(format!(
+                "position_integrator_leak = {}: must be finite and >= 0",
+                params.position_integrator_leak
+            )));
+        }
+        if !(0..=1).contains(&params.wind_compensation) {
+            return Err(ControlError(format!(
+                "wind_compensation = {}: expected 0 (no-wind reference) or 1",
+                params.wind_compensation
+            )));
+        }
+        if !(0..=1).contains(&params.position_integral) {
+            return Err(ControlError(format!(
+                "position_integral = {}: expected 0 (thesis: airspeed integrator only) or 1 (position integrators)",
+                params.position_integral
+            )));
         }
         if !(params.euler_switch_pitch > 0.1 && params.euler_switch_pitch < 1.47) {
             return Err(ControlError(format!(
@@ -228,6 +277,8 @@ impl LqrController {
             schedule,
             origin: None,
             integrator: 0.0,
+            pos_integrator: Vector3::zeros(),
+            wind: Vector3::new(f64::NAN, f64::NAN, f64::NAN),
             gain: Gain::zeros(),
             have_gain: false,
             rep: EulerRep::E231,
@@ -262,6 +313,21 @@ impl LqrController {
     /// Gain computation counters.
     pub fn stats(&self) -> GainStats {
         self.stats
+    }
+
+    /// The tuning parameters.
+    pub fn params(&self) -> &LqrParams {
+        &self.params
+    }
+
+    /// Whether the position-error integrators are active (`position_integral = 1`).
+    pub fn has_position_integral(&self) -> bool {
+        self.params.position_integral != 0
+    }
+
+    /// The position integrators ∫ΔN, ∫ΔE, ∫Δh \[m·s\] and the wind estimate (NED, m/s).
+    pub fn integrator_states(&self) -> (f64, Vector3<f64>, Vector3<f64>) {
+        (self.integrator, self.pos_integrator, self.wind)
     }
 
     /// The weight schedule.
@@ -300,6 +366,19 @@ impl LqrController {
         a[(0, 0)] = -self.params.integrator_leak;
         a[(0, 1 + ix::V)] = 1.0;
         a.fixed_view_mut::<NX, NX>(1, 1).copy_from(&f);
+        for j in 0..3 {
+            if self.has_position_integral() {
+                // ẋ_Ip = p − p_t − λ_p x_Ip, p ∈ {N, E, h}.
+                a[(I_POS + j, 1 + ix::N + j)] = 1.0;
+                a[(I_POS + j, I_POS + j)] = -self.params.position_integrator_leak;
+            } else {
+                // Thesis structure: the position integrators are inert, decoupled, stable
+                // states (not driven by the model, not driving it). The DARE solution is then
+                // block-diagonal and their gain columns are zero: K on the other states is
+                // exactly the thesis's 14-state gain.
+                a[(I_POS + j, I_POS + j)] = -1.0;
+            }
+        }
         let mut b = SMatrix::<f64, NA, NU>::zeros();
         b.fixed_view_mut::<NX, NU>(1, 0).copy_from(&g);
         if !a.iter().chain(b.iter()).all(|v| v.is_finite()) {
@@ -332,6 +411,78 @@ impl LqrController {
         })
     }
 
+    /// Update the wind estimate: ŵ ← ŵ + (1 − e^{−T_s/τ_w}) (v_inertial − DCMᵀ v_air − ŵ),
+    /// v_air = V (cα cβ, sβ, sα cβ); initialised with the first measurement, bounded by
+    /// [`MAX_WIND_ESTIMATE`], only finite values committed.
+    fn estimate_wind(&mut self, m: &flight_mission::Measurement) {
+        if self.params.wind_compensation == 0 {
+            self.wind = Vector3::zeros();
+            return;
+        }
+        let (sa, ca) = m.alpha.sin_cos();
+        let (sb, cb) = m.beta.sin_cos();
+        let v_air = m.airspeed * Vector3::new(ca * cb, sb, sa * cb);
+        let raw = m.vel_ned - model::dcm_of_quat(&m.quat).transpose() * v_air;
+        let mut w = if self.wind.iter().all(|v| v.is_finite()) {
+            let k = 1.0 - (-self.mission.sample_time / self.params.wind_filter_time).exp();
+            self.wind + k * (raw - self.wind)
+        } else {
+            raw
+        };
+        let n = w.norm();
+        if n > MAX_WIND_ESTIMATE {
+            w *= MAX_WIND_ESTIMATE / n;
+        }
+        if w.iter().all(|v| v.is_finite()) {
+            self.wind = w;
+        }
+    }
+
+    /// Reference (V, α, β): with wind compensation, those of the air velocity
+    /// `v_g,t − s ŵ` in the reference body axes, where `v_g,t = DCM_tᵀ V_t (cα_t, 0, sα_t)`
+    /// is the reference (no-wind) ground velocity and `s = sin²θ_ref` (1 in vertical flight,
+    /// where holding a position in wind needs large α or β — with the no-wind reference
+    /// α_t = β_t = 0 the LQR fights the air angles, yaws about the thrust axis and loses the
+    /// aircraft beyond ≈ 3 m/s — and 0 in level flight, where the airspeed is the mission's).
+    fn air_reference(&self, p: &TrajPoint) -> Vector3<f64> {
+        let plain = Vector3::new(p.v, p.alpha, 0.0);
+        if self.params.wind_compensation == 0 || !self.wind.iter().all(|v| v.is_finite()) {
+            return plain;
+        }
+        let s = p.euler_321.y.sin().powi(2);
+        let c = model::dcm_of_quat(&p.quat());
+        let (sa, ca) = p.alpha.sin_cos();
+        let v_g = c.transpose() * (p.v * Vector3::new(ca, 0.0, sa));
+        let v_b = c * (v_g - s * self.wind);
+        let v = v_b.norm();
+        if !(v.is_finite() && v >= MIN_AIRSPEED) {
+            return plain;
+        }
+        Vector3::new(v, v_b.z.atan2(v_b.x), (v_b.y / v).clamp(-1.0, 1.0).asin())
+    }
+
+    /// Position integrators ∫ΔN, ∫ΔE, ∫Δh: x_Ip(k+1) = e^{−λ_p T_s} x_Ip(k) + T_s (p − p_t),
+    /// with anti-windup per integrator: the update is skipped when its increment would push a
+    /// saturated command further into its limit (conditional integration, through the
+    /// integrator's gain column), the result is clamped to `position_integrator_limit`, and
+    /// only finite values are committed.
+    fn integrate_position(&mut self, x: &X, xt: &X, saturated: &[f64; NU]) {
+        let ts = self.mission.sample_time;
+        let lim = self.params.position_integrator_limit;
+        let decay = (-self.params.position_integrator_leak * ts).exp();
+        for j in 0..3 {
+            let old = self.pos_integrator[j];
+            let next = (decay * old + ts * (x[ix::N + j] - xt[ix::N + j])).clamp(-lim, lim);
+            let delta = next - old;
+            // Command change caused by this increment: −K[:, I_POS + j] · delta.
+            let winds_up =
+                (0..NU).any(|i| saturated[i] != 0.0 && -self.gain[(i, I_POS + j)] * delta * saturated[i] > 0.0);
+            if next.is_finite() && !winds_up {
+                self.pos_integrator[j] = next;
+            }
+        }
+    }
+
     /// Append the controller's state (everything `update` depends on besides its
     /// construction parameters) as f64s.
     pub fn save(&self, out: &mut impl FnMut(f64)) {
@@ -352,6 +503,27 @@ impl LqrController {
         for v in self.gain.iter() {
             out(*v);
         }
+        for v in self.pos_integrator.iter() {
+            out(*v);
+        }
+        for v in self.wind.iter() {
+            out(*v);
+        }
+    }
+
+    /// Positions in the [`Self::save`] layout of the controller's continuous states, with
+    /// names: index 4 = the airspeed integrator; after the gains ∫ΔN, ∫ΔE, ∫Δh (with
+    /// `position_integral = 1`) and the wind estimate (with `wind_compensation = 1`).
+    pub fn dynamic_state_layout(&self) -> Vec<(usize, &'static str)> {
+        let mut v = vec![(4, "∫ΔV")];
+        let n = 11 + NU * NA;
+        if self.has_position_integral() {
+            v.extend([(n, "∫ΔN"), (n + 1, "∫ΔE"), (n + 2, "∫Δh")]);
+        }
+        if self.params.wind_compensation != 0 {
+            v.extend([(n + 3, "ŵ_N"), (n + 4, "ŵ_E"), (n + 5, "ŵ_D")]);
+        }
+        v
     }
 
     /// Restore what [`Self::save`] wrote; `None` from `next` = truncated state.
@@ -368,6 +540,12 @@ impl LqrController {
         self.stats.fallbacks = take()? as u64;
         self.stats.last_spectral_radius = take()?;
         for v in self.gain.iter_mut() {
+            *v = take()?;
+        }
+        for v in self.pos_integrator.iter_mut() {
+            *v = take()?;
+        }
+        for v in self.wind.iter_mut() {
             *v = take()?;
         }
         Ok(())
@@ -400,6 +578,11 @@ impl FlightController for LqrController {
         xt[ix::N] = ref_neh.x;
         xt[ix::E] = ref_neh.y;
         xt[ix::H] = ref_neh.z;
+        self.estimate_wind(m);
+        let air_ref = self.air_reference(&reference);
+        xt[ix::V] = air_ref.x;
+        xt[ix::ALPHA] = air_ref.y;
+        xt[ix::BETA] = air_ref.z;
 
         let mut notice = None;
         let due = t + 1e-9 >= self.next_relinearisation;
@@ -425,6 +608,9 @@ impl FlightController for LqrController {
                         xt[ix::N] = ref_neh.x;
                         xt[ix::E] = ref_neh.y;
                         xt[ix::H] = ref_neh.z;
+                        xt[ix::V] = air_ref.x;
+                        xt[ix::ALPHA] = air_ref.y;
+                        xt[ix::BETA] = air_ref.z;
                     }
                 }
             }
@@ -439,6 +625,9 @@ impl FlightController for LqrController {
 
         let mut dx = SVector::<f64, NA>::zeros();
         dx[0] = self.integrator;
+        for j in 0..3 {
+            dx[I_POS + j] = self.pos_integrator[j];
+        }
         for i in 0..NX {
             let d = x[i] - xt[i];
             dx[1 + i] = if (ix::PHI..=ix::PSI).contains(&i) {
@@ -451,6 +640,8 @@ impl FlightController for LqrController {
         // Limits of the plant: thrust range, deflection limit.
         let af = &self.airframe;
         let mut thrust_saturated = 0.0;
+        // Direction (+1 above the upper limit, −1 below the lower, 0 inside) per command.
+        let mut saturated = [0.0f64; NU];
         for i in 0..NU {
             let (lo, hi) = if i == 0 {
                 (af.thrust_min, af.thrust_max)
@@ -458,8 +649,9 @@ impl FlightController for LqrController {
                 (-af.deflection_limit, af.deflection_limit)
             };
             if u[i] < lo || u[i] > hi {
+                saturated[i] = if u[i] > hi { 1.0 } else { -1.0 };
                 if i == 0 {
-                    thrust_saturated = if u[i] > hi { 1.0 } else { -1.0 };
+                    thrust_saturated = saturated[i];
                 }
                 u[i] = u[i].clamp(lo, hi);
                 if notice.is_none() {
@@ -479,7 +671,13 @@ impl FlightController for LqrController {
             let lim = self.params.integrator_limit;
             let ts = self.mission.sample_time;
             let decay = (-self.params.integrator_leak * ts).exp();
-            self.integrator = (decay * self.integrator + ts * dv).clamp(-lim, lim);
+            let next = (decay * self.integrator + ts * dv).clamp(-lim, lim);
+            if next.is_finite() {
+                self.integrator = next;
+            }
+        }
+        if self.has_position_integral() {
+            self.integrate_position(&x, &xt, &saturated);
         }
 
         let pos = Vector3::new(m.pos_ned.x, m.pos_ned.y, -m.pos_ned.z);

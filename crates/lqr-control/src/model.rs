@@ -32,8 +32,11 @@ use tailsitter_physics::{
 pub const NX: usize = 13;
 /// Number of inputs.
 pub const NU: usize = 7;
-/// Model states plus the airspeed integrator (3.2.12–3.2.14).
-pub const NA: usize = NX + 1;
+/// Model states plus the airspeed integrator (3.2.12–3.2.14) and the three earth-frame
+/// position integrators ∫ΔN, ∫ΔE, ∫Δh (extension of the thesis): `[x_IV, x (13), x_IN, x_IE, x_Ih]`.
+pub const NA: usize = NX + 4;
+/// Index of ∫ΔN in the augmented state (∫ΔE, ∫Δh follow).
+pub const I_POS: usize = NX + 1;
 
 /// Model state vector.
 pub type X = SVector<f64, NX>;

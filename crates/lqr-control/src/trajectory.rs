@@ -444,7 +444,7 @@ impl Trajectory {
         let n = self.points.len();
         let s = (t.max(0.0)) / TABLE_STEP;
         // Compare in floating point: a huge t must not overflow the index (fuzzing found it).
-        if !(s + 1.0 < n as f64) {
+        if s + 1.0 >= n as f64 {
             let mut p = self.points[n - 1];
             let dt = t - p.t;
             let (sg, cg) = p.gamma.sin_cos();

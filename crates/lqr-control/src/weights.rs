@@ -30,6 +30,13 @@ pub struct MaxDeviations {
     pub e: f64,
     pub h: f64,
     pub thrust: f64,
+    /// Position integrators ∫ΔN, ∫ΔE, ∫Δh \[m·s\] (extension; absent = the default below).
+    #[serde(default = "default_pos_int")]
+    pub n_int: f64,
+    #[serde(default = "default_pos_int")]
+    pub e_int: f64,
+    #[serde(default = "default_pos_int")]
+    pub h_int: f64,
     pub thrust_cmd: f64,
     pub elevator: f64,
     pub aileron: f64,
@@ -39,6 +46,13 @@ pub struct MaxDeviations {
     pub vertical_flap: f64,
     /// R of (3.4.2).
     pub r_scale: f64,
+}
+
+/// Maximum deviation of a position integrator when a table does not give one \[m·s\].
+pub const DEFAULT_POSITION_INTEGRAL_DEVIATION: f64 = 0.3;
+
+fn default_pos_int() -> f64 {
+    DEFAULT_POSITION_INTEGRAL_DEVIATION
 }
 
 /// One named set of four phase tables.
@@ -61,7 +75,7 @@ struct WeightFile {
 /// Diagonal weights in SI units: state (integrator first, then the model states) and input.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Weights {
-    /// diag Q₁ over [∫ΔV, V, α, β, p, q, r, φ, θ, ψ, N, E, h, T].
+    /// diag Q₁ over [∫ΔV, V, α, β, p, q, r, φ, θ, ψ, N, E, h, T, ∫ΔN, ∫ΔE, ∫Δh].
     pub q: SVector<f64, NA>,
     /// diag Q₂ over [T_c, δe, δa, δr, δfc, δfd, δv], R included.
     pub r: SVector<f64, NU>,
@@ -86,6 +100,9 @@ impl MaxDeviations {
             self.e,
             self.h,
             self.thrust,
+            self.n_int,
+            self.e_int,
+            self.h_int,
         ];
         let inputs = [
             self.thrust_cmd,

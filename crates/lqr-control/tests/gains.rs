@@ -14,7 +14,7 @@ fn setup(
 ) -> (
     LqrController,
     lqr_control::GainSolution,
-    SMatrix<f64, 14, 14>,
+    SMatrix<f64, { lqr_control::model::NA }, { lqr_control::model::NA }>,
     nalgebra::SVector<f64, 7>,
 ) {
     let m = MissionParams::default();
