@@ -8,10 +8,9 @@
 //! samples the inputs set for `t` when `t` is a due multiple of `sample_time`
 //! ([`SampleClock`]) and holds the command otherwise.
 
-use flight_mission::{ControllerInput, ControllerOutput, FlightController, Measurement, Notice, SampleClock};
+use flight_mission::{ControllerOutput, ControllerPorts, FlightController, Notice, SampleClock};
 use fmi2_export::{FmuModel, Logger, ModelError, StateError, StateReader, StateWriter};
 use lqr_control::{LqrController, LqrParams};
-use nalgebra::{Vector3, Vector4};
 use tailsitter_physics::Airframe;
 
 /// Generated from the declaration: `Variables`, `vr`, `GUID`, `MODEL_IDENTIFIER`, `MODEL_DESCRIPTION_XML`.
@@ -20,6 +19,12 @@ mod generated {
     include!(concat!(env!("OUT_DIR"), "/variables.rs"));
 }
 pub use generated::{vr, Variables, GUID, MODEL_DESCRIPTION_XML, MODEL_IDENTIFIER};
+
+// The ports of DESIGN.md §2 ↔ the controller's input and output types.
+flight_mission::impl_controller_ports!(Variables);
+
+/// Upper bound on the controller values an FMU state may claim (the real count is a few hundred).
+const MAX_SAVED_VALUES: usize = 4096;
 
 /// Number of f64s of [`LqrController::save`] (checked when restoring).
 fn saved_len(c: &LqrController) -> usize {
@@ -80,65 +85,17 @@ impl LqrModel {
         Ok(ctl)
     }
 
-    /// The controller input at time `t` from the input variables.
-    fn input(vars: &Variables, t: f64) -> Result<ControllerInput, ModelError> {
-        let measurement = Measurement {
-            pos_ned: Vector3::new(vars.pos_n, vars.pos_e, vars.pos_d),
-            vel_ned: Vector3::new(vars.vel_n, vars.vel_e, vars.vel_d),
-            vel_body: Vector3::new(vars.u, vars.v, vars.w),
-            rates: Vector3::new(vars.p, vars.q, vars.r),
-            quat: Vector4::new(vars.quat_1, vars.quat_2, vars.quat_3, vars.quat_4),
-            airspeed: vars.airspeed,
-            alpha: vars.alpha,
-            beta: vars.beta,
-            thrust: vars.thrust,
-            surfaces: [
-                vars.elevator,
-                vars.aileron,
-                vars.rudder,
-                vars.flap_collective,
-                vars.flap_differential,
-                vars.vertical_flap,
-            ],
-            specific_force_body: Vector3::new(vars.accel_x, vars.accel_y, vars.accel_z),
-            induced_velocity: vars.induced_velocity,
-        };
-        if let Some(name) = measurement.first_non_finite() {
-            return Err(ModelError::new(format!("input {name} is not finite at t = {t} s")));
-        }
-        let ref_offset_ned = Vector3::new(vars.ref_offset_n, vars.ref_offset_e, vars.ref_offset_d);
-        if !ref_offset_ned.iter().all(|x| x.is_finite()) {
-            return Err(ModelError::new(format!("ref_offset_n/e/d not finite at t = {t} s")));
-        }
-        Ok(ControllerInput {
-            t,
-            measurement,
-            ref_offset_ned,
-        })
-    }
-
     fn write_outputs(&self, vars: &mut Variables) {
-        let Some(out) = &self.last else { return };
-        let c = &out.command;
-        vars.thrust_cmd = c.thrust;
-        vars.elevator_cmd = c.elevator;
-        vars.aileron_cmd = c.aileron;
-        vars.rudder_cmd = c.rudder;
-        vars.flap_collective_cmd = c.flap_collective;
-        vars.flap_differential_cmd = c.flap_differential;
-        vars.vertical_flap_cmd = c.vertical_flap;
-        let d = &out.diagnostics;
-        vars.ref_pos_n = d.ref_pos_ned.x;
-        vars.ref_pos_e = d.ref_pos_ned.y;
-        vars.ref_pos_d = d.ref_pos_ned.z;
-        vars.ref_airspeed = d.ref_airspeed;
-        vars.phase = d.phase.code();
-        vars.pos_error = d.pos_error;
+        if let Some(out) = &self.last {
+            vars.write_output(out);
+        }
     }
 
     /// One sample at `t`.
     fn sample(&mut self, vars: &Variables, t: f64, log: &mut Logger<'_>) -> Result<(), ModelError> {
-        let input = Self::input(vars, t)?;
+        let input = vars
+            .controller_input(t)
+            .map_err(|name| ModelError::new(format!("input {name} is not finite at t = {t} s")))?;
         let controller = self
             .controller
             .as_mut()
@@ -224,34 +181,9 @@ impl FmuModel for LqrModel {
 
     fn write_state(&self, w: &mut StateWriter) {
         w.u64(self.clock.next_index());
-        match &self.last {
-            Some(out) => {
-                w.bool(true);
-                let c = &out.command;
-                for v in [
-                    c.thrust,
-                    c.elevator,
-                    c.aileron,
-                    c.rudder,
-                    c.flap_collective,
-                    c.flap_differential,
-                    c.vertical_flap,
-                ] {
-                    w.f64(v);
-                }
-                let d = &out.diagnostics;
-                for v in [
-                    d.ref_pos_ned.x,
-                    d.ref_pos_ned.y,
-                    d.ref_pos_ned.z,
-                    d.ref_airspeed,
-                    d.pos_error,
-                ] {
-                    w.f64(v);
-                }
-                w.i32(d.phase.code());
-            }
-            None => w.bool(false),
+        w.bool(self.last.is_some());
+        if let Some(out) = &self.last {
+            out.save(&mut |v| w.f64(v));
         }
         match (&self.controller, &self.pending) {
             (Some(c), _) => {
@@ -271,40 +203,25 @@ impl FmuModel for LqrModel {
     fn read_state(&mut self, r: &mut StateReader<'_>) -> Result<(), StateError> {
         let next_index = r.u64()?;
         let last = if r.bool()? {
-            let mut v = [0.0; 12];
-            for x in v.iter_mut() {
+            let mut saved = [0.0; ControllerOutput::SAVED_LEN];
+            for x in saved.iter_mut() {
                 *x = r.f64()?;
             }
-            let phase = match r.i32()? {
-                0 => flight_mission::Phase::Vertical1,
-                1 => flight_mission::Phase::TransitionToLevel,
-                2 => flight_mission::Phase::Level,
-                3 => flight_mission::Phase::TransitionToVertical,
-                4 => flight_mission::Phase::Vertical2,
-                p => return Err(StateError::invalid(format!("phase {p} out of range"))),
-            };
-            Some(ControllerOutput {
-                command: flight_mission::Command {
-                    thrust: v[0],
-                    elevator: v[1],
-                    aileron: v[2],
-                    rudder: v[3],
-                    flap_collective: v[4],
-                    flap_differential: v[5],
-                    vertical_flap: v[6],
-                },
-                diagnostics: flight_mission::Diagnostics {
-                    ref_pos_ned: Vector3::new(v[7], v[8], v[9]),
-                    ref_airspeed: v[10],
-                    phase,
-                    pos_error: v[11],
-                },
-                notice: None,
-            })
+            let mut it = saved.into_iter();
+            Some(
+                ControllerOutput::restore(&mut || it.next())
+                    .ok_or_else(|| StateError::invalid("held output: phase out of range"))?,
+            )
         } else {
             None
         };
         let n = r.u32()? as usize;
+        // The count comes from the buffer: bound it before allocating.
+        if n > MAX_SAVED_VALUES {
+            return Err(StateError::invalid(format!(
+                "LQR state claims {n} values (at most {MAX_SAVED_VALUES})"
+            )));
+        }
         let mut saved = Vec::with_capacity(n);
         for _ in 0..n {
             saved.push(r.f64()?);
