@@ -12,8 +12,10 @@ use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
-/// Bumped when a change of this crate changes results: invalidates every cached result.
-pub const CODE_VERSION: &str = "analysis-1";
+/// Version of the code behind the results: a hash (by `build.rs`) of the sources of the
+/// physics, mission, closed-loop, controller and analysis crates. Any edit there
+/// invalidates every cached result.
+pub const CODE_VERSION: &str = env!("RESULTS_SOURCE_HASH");
 
 /// FNV-1a 64-bit hash of `text`.
 pub fn fnv1a64(text: &str) -> u64 {
