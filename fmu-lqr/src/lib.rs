@@ -8,7 +8,7 @@
 //! samples the inputs set for `t` when `t` is a due multiple of `sample_time`
 //! ([`SampleClock`]) and holds the command otherwise.
 
-use flight_mission::{ControllerOutput, ControllerPorts, FlightController, Notice, SampleClock};
+use flight_mission::{ControllerOutput, ControllerPorts, FlightController, SampleClock};
 use fmi2_export::{FmuModel, Logger, ModelError, StateError, StateReader, StateWriter};
 use lqr_control::{LqrController, LqrParams};
 use tailsitter_physics::Airframe;
@@ -103,16 +103,7 @@ impl LqrModel {
         let out = controller
             .update(&input)
             .map_err(|e| ModelError::new(format!("LQR at t = {t} s: {e}")))?;
-        match out.notice {
-            Some(Notice::GainFallback(why)) => log.warning(format_args!(
-                "t = {t} s: gain computation failed ({why}); using the last good gains"
-            )),
-            Some(Notice::Saturated(name)) if !self.saturated => log.warning(format_args!(
-                "t = {t} s: {name} saturated (further saturations until it ends are not logged)"
-            )),
-            _ => {}
-        }
-        self.saturated = matches!(out.notice, Some(Notice::Saturated(_)));
+        self.saturated = controller_fmu::log_notice(log, t, out.notice, self.saturated);
         self.last = Some(out);
         Ok(())
     }
@@ -181,10 +172,7 @@ impl FmuModel for LqrModel {
 
     fn write_state(&self, w: &mut StateWriter) {
         w.u64(self.clock.next_index());
-        w.bool(self.last.is_some());
-        if let Some(out) = &self.last {
-            out.save(&mut |v| w.f64(v));
-        }
+        controller_fmu::write_held(w, &self.last);
         match (&self.controller, &self.pending) {
             (Some(c), _) => {
                 w.u32(saved_len(c) as u32);
@@ -202,19 +190,7 @@ impl FmuModel for LqrModel {
 
     fn read_state(&mut self, r: &mut StateReader<'_>) -> Result<(), StateError> {
         let next_index = r.u64()?;
-        let last = if r.bool()? {
-            let mut saved = [0.0; ControllerOutput::SAVED_LEN];
-            for x in saved.iter_mut() {
-                *x = r.f64()?;
-            }
-            let mut it = saved.into_iter();
-            Some(
-                ControllerOutput::restore(&mut || it.next())
-                    .ok_or_else(|| StateError::invalid("held output: phase out of range"))?,
-            )
-        } else {
-            None
-        };
+        let last = controller_fmu::read_held(r)?;
         let n = r.u32()? as usize;
         // The count comes from the buffer: bound it before allocating.
         if n > MAX_SAVED_VALUES {

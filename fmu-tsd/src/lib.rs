@@ -10,7 +10,7 @@
 //! command otherwise; after `fmi2ExitInitializationMode` the outputs already
 //! hold the command for the start time.
 
-use flight_mission::{ControllerOutput, ControllerPorts, FlightController, Notice, SampleClock};
+use flight_mission::{ControllerOutput, ControllerPorts, FlightController, SampleClock};
 use fmi2_export::{FmuModel, Logger, ModelError, StateError, StateReader, StateWriter};
 use tailsitter_physics::Airframe;
 use tsd_control::TsdController;
@@ -31,6 +31,8 @@ pub struct TsdModel {
     controller: TsdController,
     clock: SampleClock,
     held: Option<ControllerOutput>,
+    /// The previous sample reported a saturation: warn only when one starts.
+    saturated: bool,
 }
 
 impl TsdModel {
@@ -49,11 +51,7 @@ impl TsdModel {
             .controller
             .update(&input)
             .map_err(|e| ModelError::new(format!("TSD controller failed at t = {t} s: {e}")))?;
-        match out.notice {
-            Some(Notice::Saturated(name)) => log.warning(format_args!("t = {t} s: {name} saturated")),
-            Some(Notice::GainFallback(what)) => log.warning(format_args!("t = {t} s: gain fallback: {what}")),
-            None => {}
-        }
+        self.saturated = controller_fmu::log_notice(log, t, out.notice, self.saturated);
         self.held = Some(out);
         Ok(())
     }
@@ -81,6 +79,7 @@ impl FmuModel for TsdModel {
             controller,
             clock,
             held: None,
+            saturated: false,
         }
     }
 
@@ -110,10 +109,7 @@ impl FmuModel for TsdModel {
     fn write_state(&self, w: &mut StateWriter) {
         self.controller.save(&mut |x| w.f64(x));
         w.u64(self.clock.next_index());
-        w.bool(self.held.is_some());
-        if let Some(out) = &self.held {
-            out.save(&mut |x| w.f64(x));
-        }
+        controller_fmu::write_held(w, &self.held);
     }
 
     fn read_state(&mut self, r: &mut StateReader<'_>) -> Result<(), StateError> {
@@ -122,19 +118,7 @@ impl FmuModel for TsdModel {
             *v = r.f64()?;
         }
         let next_index = r.u64()?;
-        let held = if r.bool()? {
-            let mut saved = [0.0; ControllerOutput::SAVED_LEN];
-            for v in saved.iter_mut() {
-                *v = r.f64()?;
-            }
-            let mut it = saved.into_iter();
-            Some(
-                ControllerOutput::restore(&mut || it.next())
-                    .ok_or_else(|| StateError::invalid("held output: phase out of range"))?,
-            )
-        } else {
-            None
-        };
+        let held = controller_fmu::read_held(r)?;
         let mut it = values.into_iter();
         self.controller
             .restore(&mut || it.next())
