@@ -5,34 +5,13 @@ mod common;
 
 use common::{cstring, vr, Host, Toy, TOY_GUID};
 use fmi2_export::fmi_sys::fmi2::*;
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
+use fmi2_export::testing::{allocations, CountingAllocator};
 use std::ptr::null;
 
 fmi2_export::export_fmu!(Toy);
 
-struct Counting;
-
-thread_local! {
-    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
-}
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        let _ = ALLOCATIONS.try_with(|n| n.set(n.get() + 1));
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-}
-
 #[global_allocator]
-static GLOBAL: Counting = Counting;
-
-fn allocations() -> usize {
-    ALLOCATIONS.with(Cell::get)
-}
+static GLOBAL: CountingAllocator = CountingAllocator;
 
 #[test]
 fn do_step_does_not_allocate() {
