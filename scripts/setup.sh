@@ -5,11 +5,15 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-if ! ldconfig -p 2>/dev/null | grep -q 'libclang.*\.so'; then
+# fmi-sys runs bindgen, which loads libclang's C API at build time. Test for the library
+# bindgen really loads (scripts/find-libclang.sh), not for any file named libclang*: the
+# base image ships libclang-cpp14, which matches such a name but has no C API.
+if ! scripts/find-libclang.sh >/dev/null; then
     echo "== installing libclang-dev (needed by fmi-sys' bindgen)"
     SUDO=""; [ "$(id -u)" = 0 ] || SUDO="sudo"
     $SUDO apt-get update -qq
-    $SUDO DEBIAN_FRONTEND=noninteractive apt-get install -y -qq libclang-dev >/dev/null
+    $SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq libclang-dev >/dev/null
+    scripts/find-libclang.sh >/dev/null || { echo "setup: libclang-dev installed but no loadable libclang found" >&2; exit 1; }
 fi
 
 if [ ! -x .venv/bin/python ] || ! cmp -s tests/requirements.txt .venv/requirements.installed; then
