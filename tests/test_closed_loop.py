@@ -116,7 +116,7 @@ def test_mission_with_plant_c_m_alpha_scaled(fmus, controller, level_trim_theta)
 
 @pytest.mark.parametrize("controller", CONTROLLERS)
 def test_controllers_are_interchangeable(fmus, controller):
-    """Same ports and mission parameters in both controllers (DESIGN.md §2-3)."""
+    """Same ports and mission parameters in both controllers (docs/DESIGN.md, "Ports and timing")."""
     a, b = fmus["tailsitter_lqr"], fmus["tailsitter_tsd"]
     shared = {"input", "output"}
     ports = lambda f: {(v.name, v.causality, v.type, v.unit) for v in f.md.modelVariables if v.causality in shared}

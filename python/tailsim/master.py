@@ -1,9 +1,10 @@
 """A co-simulation master for the tail-sitter FMUs (fmpy's FMU2Slave underneath).
 
-Timing follows DESIGN.md §2. Gauss-Seidel (the reference): at each
-communication point t the controller inputs are set from the plant outputs at
-t, the controller steps, the plant inputs are set from the controller outputs,
-the plant steps. Jacobi: both units are set from values at t before either
+Timing follows docs/DESIGN.md, "Ports and timing" and "A co-simulation
+step". Gauss-Seidel (the reference): at each communication point t the
+controller inputs are set from the plant outputs at t, the controller steps,
+the plant inputs are set from the controller outputs, the plant steps.
+Jacobi: both units are set from values at t before either
 steps, so the plant flies the command of the previous sample.
 """
 

@@ -84,12 +84,25 @@ def window(t: np.ndarray, t0: float, t1: float) -> np.ndarray:
     return (t >= t0 - EDGE_TOLERANCE) & (t < t1 - EDGE_TOLERANCE)
 
 
+def level_window(t: np.ndarray, mission: Mapping[str, float]) -> np.ndarray:
+    """Samples of the criteria's level window: the last `level_window` seconds of
+    level flight (from the later of its start and its end minus that)."""
+    s = phase_starts(mission)
+    return window(t, max(s[3] - CRITERIA["level_window"], s[2]), s[3])
+
+
+def declared_mission() -> dict[str, float]:
+    """The mission parameters' defaults as the controllers declare them
+    (modelDescription/fragments/controller_interface.json, group "mission"); from
+    a packaged FMU read the same start values with `Fmu.starts`."""
+    fragment = json.loads((CRITERIA_FILE.parent / "controller_interface.json").read_text())
+    return {v["name"]: float(v["start"]) for v in fragment["variables"] if v.get("group") == "mission"}
+
+
 def mission_check(r: RunResult, mission: Mapping[str, float], theta_level_trim: float) -> MissionCheck:
     """`closed_loop::MissionCheck::of` on a recorded run; `mission` holds the
     controller's mission parameters (t_*, v_level)."""
-    s = phase_starts(mission)
-    t0, t1 = max(s[3] - CRITERIA["level_window"], s[2]), s[3]
-    w = window(r.time, t0, t1)
+    w = level_window(r.time, mission)
     level_v = float(np.max(np.abs(r["airspeed"][w] - float(mission["v_level"])), initial=0.0))
     level_theta = float(np.max(np.abs(r["theta"][w] - theta_level_trim), initial=0.0))
     final_theta = abs(float(r["theta"][-1]) - math.pi / 2) if len(r.time) else math.inf

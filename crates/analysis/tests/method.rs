@@ -234,6 +234,29 @@ fn tail_sitter_map_matches_zoh_of_linearisation() {
     assert!((left[0] - C64::new(1.0, 0.0)).norm() < 2e-3, "{}", left[0]);
 }
 
+/// The same object keys at every level (arrays: their first elements; `null` matches anything).
+fn same_structure(a: &serde_json::Value, b: &serde_json::Value, at: &str) -> Result<(), String> {
+    use serde_json::Value;
+    match (a, b) {
+        (Value::Object(x), Value::Object(y)) => {
+            let (kx, ky): (Vec<_>, Vec<_>) = (x.keys().collect(), y.keys().collect());
+            if kx != ky {
+                return Err(format!("{at}: keys {kx:?} against {ky:?}"));
+            }
+            x.iter().try_for_each(|(k, v)| same_structure(v, &y[k], &format!("{at}.{k}")))
+        }
+        (Value::Array(x), Value::Array(y)) => match (x.first(), y.first()) {
+            (Some(p), Some(q)) => same_structure(p, q, &format!("{at}[0]")),
+            _ => Ok(()),
+        },
+        (Value::Null, _) | (_, Value::Null) => Ok(()),
+        (Value::Number(_), Value::Number(_)) | (Value::String(_), Value::String(_)) | (Value::Bool(_), Value::Bool(_)) => {
+            Ok(())
+        }
+        _ => Err(format!("{at}: {a} against {b}")),
+    }
+}
+
 /// A tiny campaign (N = 2, one parameter, one gust amplitude): Table 5.1, the robustness
 /// and gust tables come from actual runs, are cached, and a re-run computes nothing.
 #[test]
@@ -272,6 +295,12 @@ fn tiny_campaign_tables_come_from_runs_and_are_cached() {
             .expect("row of C_mδe");
         let rms = row["row"]["rms_percent"].as_f64().unwrap();
         assert!((rms - r.row.as_ref().unwrap().rms_percent).abs() < 1e-12, "{row}");
+    }
+    // Same structure as the stored campaign output the Python renderer is tested on.
+    let fixture = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/analysis/report.json");
+    let fixture: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(fixture).unwrap()).unwrap();
+    if let Err(e) = same_structure(&report, &fixture, "report.json") {
+        panic!("{e}: refresh tests/data/analysis/ (see tests/test_analysis_report.py) and the renderer");
     }
     let table = std::fs::read_to_string(dir.join("table_5_1.csv")).unwrap();
     assert_eq!(table.lines().filter(|l| l.starts_with("Cmde,")).count(), 2, "{table}");
