@@ -243,16 +243,17 @@ fn same_structure(a: &serde_json::Value, b: &serde_json::Value, at: &str) -> Res
             if kx != ky {
                 return Err(format!("{at}: keys {kx:?} against {ky:?}"));
             }
-            x.iter().try_for_each(|(k, v)| same_structure(v, &y[k], &format!("{at}.{k}")))
+            x.iter()
+                .try_for_each(|(k, v)| same_structure(v, &y[k], &format!("{at}.{k}")))
         }
         (Value::Array(x), Value::Array(y)) => match (x.first(), y.first()) {
             (Some(p), Some(q)) => same_structure(p, q, &format!("{at}[0]")),
             _ => Ok(()),
         },
         (Value::Null, _) | (_, Value::Null) => Ok(()),
-        (Value::Number(_), Value::Number(_)) | (Value::String(_), Value::String(_)) | (Value::Bool(_), Value::Bool(_)) => {
-            Ok(())
-        }
+        (Value::Number(_), Value::Number(_))
+        | (Value::String(_), Value::String(_))
+        | (Value::Bool(_), Value::Bool(_)) => Ok(()),
         _ => Err(format!("{at}: {a} against {b}")),
     }
 }
