@@ -258,7 +258,7 @@ def main(argv: list[str] | None = None) -> int:
 
     md = ["# Tail-sitter controller comparison", ""]
     md.append(f"Master: fmpy, {ordering}; plant `tailsitter_plant`; controllers: {', '.join(NAMES[k] for k in keys)}. "
-              f"Level-trim pitch of the plant at 25 m/s: {math.degrees(theta_trim):.2f}°. Wall time {time.time() - t_start:.0f} s.")
+              f"Level-trim pitch of the plant at {defaults['v_level']:g} m/s: {math.degrees(theta_trim):.2f}°. Wall time {time.time() - t_start:.0f} s.")
     md += ["", "## Missions (thesis ch. 6 comparison)", ""]
     md.append("| " + " | ".join(header) + " |")
     md.append("|" + "---|" * len(header))
