@@ -20,7 +20,7 @@ cargo xtask dist
 if [ "$analysis" = 1 ]; then
     echo "== analysis campaign (out/analysis)"
     cargo run --release --locked -p analysis -- all --out out/analysis
-    .venv/bin/python crates/analysis/plot.py out/analysis
+    PYTHONPATH=python .venv/bin/python -m tailsim.analysis_report out/analysis
 fi
 echo "== flying the missions"
 PYTHONPATH=python .venv/bin/python -m tailsim.compare --out out "${runner_args[@]+"${runner_args[@]}"}"

@@ -28,11 +28,13 @@ import pytest
 from tailsim import ClosedLoop
 from tailsim.cosim import run_fmus, run_ssp
 from tailsim.master import pos_error
+from tailsim.metrics import CRITERIA, declared_mission, level_window, phase_starts
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 DIST = ROOT / "dist"
 CONTROLLERS = ["tailsitter_lqr", "tailsitter_tsd"]
-LEVEL_END = 20.0
+MISSION = declared_mission()
+LEVEL_END = phase_starts(MISSION)[3]
 # Euler angles are ill-conditioned in vertical flight (gimbal lock at theta = 90 deg: phi and psi
 # swing by pi for tiny attitude changes); the attitude is compared through the quaternion.
 GIMBAL = {"phi", "psi"}
@@ -80,10 +82,10 @@ def test_libcosim_flies_the_default_mission(runs, controller):
     assert r.steps == 1751 and r.time[-1] == pytest.approx(35.0)
     for name, values in r.signals.items():
         assert np.all(np.isfinite(values)), f"{name} not finite"
-    t = r.time
-    window = (t >= LEVEL_END - 5.0) & (t < LEVEL_END)
-    assert np.max(np.abs(r["airspeed"][window] - 25.0)) < 1.0
-    assert abs(math.degrees(r["theta"][-1]) - 90.0) < 10.0
+    window = level_window(r.time, MISSION)
+    assert window.sum() > 0
+    assert np.max(np.abs(r["airspeed"][window] - MISSION["v_level"])) <= CRITERIA["level_airspeed_error_max"]
+    assert abs(math.degrees(r["theta"][-1]) - 90.0) <= CRITERIA["final_pitch_error_max"]
     assert r["phase"][-1] == 4
 
 
@@ -158,8 +160,9 @@ def test_libcosim_parameters_reach_the_fmus(tmp_path):
         controller_params={"v_level": 22.0},
         stop_time=LEVEL_END,
     )
-    window = (r.time >= LEVEL_END - 5.0) & (r.time < LEVEL_END)
-    assert np.max(np.abs(r["airspeed"][window] - 22.0)) < 1.0
+    window = level_window(r.time, {**MISSION, "v_level": 22.0})
+    assert window.sum() > 0
+    assert np.max(np.abs(r["airspeed"][window] - 22.0)) <= CRITERIA["level_airspeed_error_max"]
     assert np.max(np.abs(r["ref_airspeed"][window] - 22.0)) < 1e-9
 
 

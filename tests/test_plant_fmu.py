@@ -37,7 +37,7 @@ def test_default_experiment_climbs_steadily(plant):
     assert result["time"][-1] == pytest.approx(float(de.stopTime))
     for name in OUTPUTS:
         assert np.all(np.isfinite(result[name])), name
-    # Trimmed 3 m/s vertical climb with the default inputs (DESIGN.md §3).
+    # Trimmed 3 m/s vertical climb with the default inputs (the plant's declared start values).
     assert np.max(np.abs(result["vel_d"] + 3.0)) < 1e-6
     assert np.max(np.abs(result["theta"] - math.pi / 2)) < 1e-6
     assert np.max(np.abs(result["pos_n"])) < 1e-6

@@ -27,27 +27,20 @@ import zipfile
 import numpy as np
 import pytest
 from lxml import etree
+from tailsim.metrics import CRITERIA, declared_mission, level_window, phase_starts
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 DIST = ROOT / "dist"
 CONTROLLERS = ["tailsitter_lqr", "tailsitter_tsd"]
-MISSION = {
-    "t_vertical_1": 5.0,
-    "t_transition_1": 5.0,
-    "t_level": 10.0,
-    "t_transition_2": 10.0,
-    "t_vertical_2": 5.0,
-    "v_level": 25.0,
-    "v_vertical": 3.0,
-    "sample_time": 0.02,
-}
+# The SSP binds the controllers' declared mission defaults.
+MISSION = declared_mission()
 NS = {
     "ssd": "http://ssp-standard.org/SSP1/SystemStructureDescription",
     "ssc": "http://ssp-standard.org/SSP1/SystemStructureCommon",
     "ssv": "http://ssp-standard.org/SSP1/SystemStructureParameterValues",
     "osp": "http://opensimulationplatform.com/SSP/OSPAnnotations",
 }
-LEVEL_END = 20.0  # t_vertical_1 + t_transition_1 + t_level
+LEVEL_END = phase_starts(MISSION)[3]  # t_vertical_1 + t_transition_1 + t_level
 
 
 def ssp_path(controller: str) -> pathlib.Path:
@@ -214,13 +207,13 @@ def test_fmpy_simulate_ssp_flies_the_default_mission(controller):
     # Row k holds the values at the end of the step that starts at r["time"][k].
     t_end = r["time"] + 0.02
     theta, airspeed = r["plant.theta"], r["plant.airspeed"]
-    window = (t_end >= LEVEL_END - 5.0) & (t_end < LEVEL_END)
-    level_error = np.max(np.abs(airspeed[window] - 25.0))
+    window = level_window(t_end, MISSION)
+    level_error = np.max(np.abs(airspeed[window] - MISSION["v_level"]))
     final_pitch = abs(math.degrees(theta[-1]) - 90.0)
     print(f"\n{controller} under fmpy simulate_ssp: level airspeed error {level_error:.3f} m/s, "
           f"final pitch {final_pitch:.2f} deg from vertical, max pos_error {r['controller.pos_error'].max():.3f} m")
-    assert level_error < 1.0
-    assert final_pitch < 10.0
+    assert level_error <= CRITERIA["level_airspeed_error_max"]
+    assert final_pitch <= CRITERIA["final_pitch_error_max"]
     assert r["controller.phase"][-1] == 4
     assert set(np.unique(r["controller.phase"])) == {0, 1, 2, 3, 4}
     # Controller inputs are recorded too: they are the plant outputs one step later (Jacobi).
@@ -254,12 +247,12 @@ def test_libcosim_from_ssp_file_flies_the_default_mission(controller):
     # The parameter bindings reached the controller.
     assert last.last_real_values(ctrl, [cv[n] for n in MISSION]) == pytest.approx(list(MISSION.values()))
     theta, airspeed = last.last_real_values(plant, [pv["theta"], pv["airspeed"]])
-    assert abs(math.degrees(theta) - 90.0) < 10.0
+    assert abs(math.degrees(theta) - 90.0) <= CRITERIA["final_pitch_error_max"]
     assert last.last_integer_values(ctrl, [cv["phase"]]) == [4]
     times, _, speeds = series.time_series_real_samples(plant, pv["airspeed"], from_step=1, sample_count=1750)
     t = np.array(times) / 1e9
     v = np.array(speeds)
-    window = (t >= LEVEL_END - 5.0) & (t < LEVEL_END)
-    assert window.sum() == 250
-    assert np.max(np.abs(v[window] - 25.0)) < 1.0
+    window = level_window(t, MISSION)
+    assert window.sum() == 250  # 5 s of 0.02 s steps
+    assert np.max(np.abs(v[window] - MISSION["v_level"])) <= CRITERIA["level_airspeed_error_max"]
     assert np.all(np.isfinite(v))

@@ -1,5 +1,5 @@
 //! Hashes the source of every crate whose code decides the campaign results
-//! (physics, mission, closed loop, both controllers, this crate) into
+//! (physics, mission, closed loop and its mission criteria, both controllers, this crate) into
 //! `RESULTS_SOURCE_HASH`, part of every cache key: editing any of them
 //! invalidates the cached results instead of serving stale ones.
 
@@ -12,10 +12,15 @@ const SOURCES: &[&str] = &[
     "../lqr-control/src",
     "../lqr-control/resources",
     "../tsd-control/src",
+    "../../modelDescription/fragments/mission_criteria.json",
     "src",
 ];
 
 fn files(dir: &Path, out: &mut Vec<PathBuf>) {
+    if dir.is_file() {
+        out.push(dir.to_path_buf());
+        return;
+    }
     let Ok(entries) = std::fs::read_dir(dir) else { return };
     for entry in entries.flatten() {
         let path = entry.path();

@@ -7,8 +7,6 @@ controller, write CSVs, plots and a report (Markdown + self-contained HTML).
 from __future__ import annotations
 
 import argparse
-import base64
-import html
 import json
 import math
 import pathlib
@@ -17,11 +15,16 @@ import time
 
 import numpy as np
 
+from . import analysis_report
 from .master import ClosedLoop, Fmu, RunResult, pos_error, step
-from .metrics import PHASES, SURFACES, mission_metrics, step_settling
+from .metrics import CRITERIA, PHASES, mission_metrics, phase_starts, step_settling
+from .report import fmt, markdown_to_html
 
 NAMES = {"lqr": "tailsitter_lqr", "tsd": "tailsitter_tsd"}
 COLORS = {"lqr": "tab:blue", "tsd": "tab:red"}
+# The mission parameters every controller declares (modelDescription/fragments/controller_interface.json).
+DURATIONS = ["t_vertical_1", "t_transition_1", "t_level", "t_transition_2", "t_vertical_2"]
+MISSION = DURATIONS + ["v_level"]
 STEP_CASES = [
     # (flight, axis, offset NED, step time, controller params, stop time)
     ("level", "normal", (0.0, 0.0, 5.0), 16.0, {"t_level": 30.0}, 34.0),
@@ -43,8 +46,19 @@ def level_trim_theta(plant: Fmu, v_level: float) -> float:
     return theta
 
 
-def mission_params(t1: float, t2: float) -> dict[str, float]:
-    return {"t_vertical_1": 5.0, "t_transition_1": t1, "t_level": 10.0, "t_transition_2": t2, "t_vertical_2": 5.0}
+def mission_defaults(controllers: list[Fmu]) -> dict[str, float]:
+    """The mission's defaults (durations, v_level) as the controllers declare them
+    (start values in their modelDescription.xml); all controllers must agree."""
+    defaults = controllers[0].starts(MISSION)
+    for c in controllers[1:]:
+        if c.starts(MISSION) != defaults:
+            raise ValueError(f"{c.identifier} declares other mission defaults: {c.starts(MISSION)} != {defaults}")
+    return defaults
+
+
+def mission_params(defaults: dict[str, float], t1: float, t2: float) -> dict[str, float]:
+    """The phase durations of the mission with transitions T1 = `t1`, T2 = `t2`, the rest default."""
+    return {**{k: defaults[k] for k in DURATIONS}, "t_transition_1": t1, "t_transition_2": t2}
 
 
 def plot_mission(runs: dict[str, RunResult], title: str, path: pathlib.Path) -> None:
@@ -96,7 +110,7 @@ def plot_steps(step_runs: dict[str, dict[str, tuple[RunResult, float]]], path: p
                 r, t_step = runs[case]
                 m = r.time >= t_step - 1.0
                 a.plot(r.time[m] - t_step, pos_error(r)[m], color=COLORS[key], label=key.upper())
-        a.axhline(0.5, color="k", lw=0.8, ls=":")
+        a.axhline(CRITERIA["settling_band"], color="k", lw=0.8, ls=":")
         flight, axis = case.split()
         a.set(title=f"5 m {axis} step in {flight} flight", xlabel="time after step [s]", ylabel="position error [m]")
         a.grid(True, alpha=0.3)
@@ -107,32 +121,23 @@ def plot_steps(step_runs: dict[str, dict[str, tuple[RunResult, float]]], path: p
 
 
 def analysis_section(out: pathlib.Path) -> list[str]:
-    """The analysis campaign's report (`analysis/report.md`, written by
-    `cargo run --release -p analysis -- all --out <out>/analysis`), headings
-    demoted under one section, with its plots."""
-    report = out / "analysis" / "report.md"
-    if not report.exists():
+    """The analysis campaign's report, rendered from its data
+    (`analysis/report.json`, written by `cargo run --release -p analysis -- all
+    --out <out>/analysis`), headings demoted under one section, with its plots."""
+    if not (out / "analysis" / "report.json").exists():
         return []
     lines = ["", "## Analysis: modes, closed-loop poles, sensitivity (Table 5.1) and robustness", ""]
-    for line in report.read_text().splitlines():
+    for line in analysis_report.markdown(analysis_report.load(out / "analysis")):
         if line.startswith("#"):
             line = "#" + line if line.startswith("##") else "### " + line.lstrip("# ")
             line = line if not line.startswith("####") else "### " + line.lstrip("# ")
         lines.append(line)
-    pngs = sorted((out / "analysis").glob("*.png"))
+    pngs = analysis_report.plots(out / "analysis")
     if pngs:
         lines += ["", "### Analysis plots", ""]
         for p in pngs:
             lines += [f"![{p.stem}](analysis/{p.name})", ""]
     return lines
-
-
-def fmt(x: float, digits: int = 2) -> str:
-    if x is None or (isinstance(x, float) and math.isnan(x)):
-        return "–"
-    if isinstance(x, float) and math.isinf(x):
-        return "never"
-    return f"{x:.{digits}f}"
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -154,10 +159,14 @@ def main(argv: list[str] | None = None) -> int:
     keys = ["lqr", "tsd"] if args.controller == "both" else [args.controller]
     plant = Fmu(dist / "tailsitter_plant.fmu")
     ctrls = {k: Fmu(dist / f"{NAMES[k]}.fmu") for k in keys}
-    theta_trim = level_trim_theta(plant, 25.0)
+    defaults = mission_defaults(list(ctrls.values()))
+    theta_trim = level_trim_theta(plant, defaults["v_level"])
     ordering = "jacobi" if args.jacobi else "gauss-seidel"
 
-    missions = {"default": (5.0, 10.0), "fast": (args.fast_t1, args.fast_t2)}
+    missions = {
+        "default": (defaults["t_transition_1"], defaults["t_transition_2"]),
+        "fast": (args.fast_t1, args.fast_t2),
+    }
     jobs = [("mission", m, k) for m in missions for k in keys]
     if not args.no_steps:
         jobs += [("step", f"{c[0]} {c[1]}", k) for c in STEP_CASES for k in keys]
@@ -169,9 +178,9 @@ def main(argv: list[str] | None = None) -> int:
         try:
             if kind == "mission":
                 t1, t2 = missions[name]
-                params = mission_params(t1, t2)
+                params = mission_params(defaults, t1, t2)
                 loop = ClosedLoop(plant, ctrls[key], controller_params=params, ordering=ordering)
-                r = loop.run(stop_time=20.0 + t1 + t2, progress=True, description=f"{key} {name}")
+                r = loop.run(stop_time=phase_starts(params)[-1], progress=True, description=f"{key} {name}")
                 mission_runs[name][key] = r
                 r.write_csv(out / "csv" / f"{key}_{name}_mission.csv")
             else:
@@ -199,10 +208,12 @@ def main(argv: list[str] | None = None) -> int:
     # The comparison table.
     rows: list[tuple[str, list[str]]] = []
     metrics = {}
+    limits = {"deflection_limit": plant.start("deflection_limit"), "thrust_max": plant.start("thrust_max")}
     for m, (t1, t2) in missions.items():
         for k in keys:
             if k in mission_runs[m]:
-                metrics[(m, k)] = mission_metrics(mission_runs[m][k], 5.0 + t1 + 10.0, theta_trim)
+                flown = {**mission_params(defaults, t1, t2), "v_level": defaults["v_level"]}
+                metrics[(m, k)] = mission_metrics(mission_runs[m][k], flown, theta_trim, **limits)
     header = ["quantity"] + [f"{k.upper()} {m}" for m in missions for k in keys]
 
     def row(label, f):
@@ -224,12 +235,13 @@ def main(argv: list[str] | None = None) -> int:
     row("level flight: max airspeed error [m/s] / pitch error [deg]", lambda x: f"{fmt(x.level_airspeed_error)} / {fmt(x.level_pitch_error_deg)}")
     row("controller compute per step (fmpy call incl.) [µs]", lambda x: fmt(x.controller_us_per_step, 0))
     fastest = {}
+    alpha_max = CRITERIA["linear_alpha_max"]
     for k in keys:
-        # Flown = completed with α in the linear region of the aerodynamic model (< 20°, thesis §4.4.4).
+        # Flown = completed with α in the linear region of the aerodynamic model (thesis §4.4.4).
         done = [
             missions[m]
             for m in missions
-            if (m, k) in metrics and metrics[(m, k)].completed and metrics[(m, k)].max_alpha_deg < 20.0
+            if (m, k) in metrics and metrics[(m, k)].completed and metrics[(m, k)].max_alpha_deg < alpha_max
         ]
         fastest[k] = min(done, key=lambda tt: tt[0] + tt[1]) if done else None
     step_rows = []
@@ -242,18 +254,18 @@ def main(argv: list[str] | None = None) -> int:
                 vals.append(fmt(step_settling(r, t_step)))
             else:
                 vals.append("failed")
-        step_rows.append((f"settling time to < 0.5 m, 5 m step, {name} [s]", vals))
+        step_rows.append((f"settling time to < {CRITERIA['settling_band']:g} m, 5 m step, {name} [s]", vals))
 
     md = ["# Tail-sitter controller comparison", ""]
     md.append(f"Master: fmpy, {ordering}; plant `tailsitter_plant`; controllers: {', '.join(NAMES[k] for k in keys)}. "
-              f"Level-trim pitch of the plant at 25 m/s: {math.degrees(theta_trim):.2f}°. Wall time {time.time() - t_start:.0f} s.")
+              f"Level-trim pitch of the plant at {defaults['v_level']:g} m/s: {math.degrees(theta_trim):.2f}°. Wall time {time.time() - t_start:.0f} s.")
     md += ["", "## Missions (thesis ch. 6 comparison)", ""]
     md.append("| " + " | ".join(header) + " |")
     md.append("|" + "---|" * len(header))
     for label, vals in rows:
         md.append(f"| {label} | " + " | ".join(vals) + " |")
-    md += ["", "Fastest transition flown (completed with α < 20°): " + ", ".join(
-        f"{k.upper()} T1 = {fastest[k][0]:g} s, T2 = {fastest[k][1]:g} s" if fastest[k] else f"{k.upper()}: none of the missions flown kept α < 20°"
+    md += ["", f"Fastest transition flown (completed with α < {alpha_max:g}°): " + ", ".join(
+        f"{k.upper()} T1 = {fastest[k][0]:g} s, T2 = {fastest[k][1]:g} s" if fastest[k] else f"{k.upper()}: none of the missions flown kept α < {alpha_max:g}°"
         for k in keys)]
     if step_rows:
         md += ["", "## Position steps", "", "| step | " + " | ".join(k.upper() for k in keys) + " |", "|" + "---|" * (len(keys) + 1)]
@@ -268,41 +280,7 @@ def main(argv: list[str] | None = None) -> int:
     md += analysis_section(out)
     (out / "report.md").write_text("\n".join(md) + "\n")
 
-    body = []
-    in_table = False
-    for line in md:
-        if line.startswith("|"):
-            cells = [c.strip() for c in line.strip("|").split("|")]
-            if set("".join(cells)) <= set("-"):
-                continue
-            if not in_table:
-                body.append("<table>")
-                in_table = True
-                body.append("<tr>" + "".join(f"<th>{html.escape(c)}</th>" for c in cells) + "</tr>")
-            else:
-                body.append("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in cells) + "</tr>")
-            continue
-        if in_table:
-            body.append("</table>")
-            in_table = False
-        if line.startswith("### "):
-            body.append(f"<h3>{html.escape(line[4:])}</h3>")
-        elif line.startswith("## "):
-            body.append(f"<h2>{html.escape(line[3:])}</h2>")
-        elif line.startswith("# "):
-            body.append(f"<h1>{html.escape(line[2:])}</h1>")
-        elif line.startswith("!["):
-            name = line[line.rindex("](") + 2 : -1]
-            data = base64.b64encode((out / name).read_bytes()).decode()
-            body.append(f'<img alt="{html.escape(name)}" src="data:image/png;base64,{data}" style="max-width:100%">')
-        elif line.startswith("- "):
-            body.append(f"<p>• {html.escape(line[2:])}</p>")
-        elif line:
-            body.append(f"<p>{html.escape(line)}</p>")
-    if in_table:
-        body.append("</table>")
-    style = "body{font-family:sans-serif;max-width:80em;margin:2em auto}table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:3px 8px}th{background:#eee}"
-    (out / "report.html").write_text(f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>Tail-sitter comparison</title><style>{style}</style></head><body>{''.join(body)}</body></html>\n")
+    (out / "report.html").write_text(markdown_to_html(md, out, "Tail-sitter comparison"))
     summary = {f"{k}_{m}": vars(v) for (m, k), v in metrics.items()}
     (out / "metrics.json").write_text(json.dumps(summary, indent=1, default=str))
     print(f"report: {out / 'report.md'} and {out / 'report.html'}; plots and csv/ in {out}/")

@@ -6,7 +6,7 @@ compare sample by sample with the fmpy master:
 - `run_fmus(plant_fmu, controller_fmu, ...)`: the plain FMUs as two local
   slaves, every controller input connected to the plant output of the same
   name and every controller output to the plant input of the same name
-  (DESIGN.md §2), parameters set as initial values;
+  (docs/DESIGN.md, "Ports and timing"), parameters set as initial values;
 - `run_ssp(path)`: a system file `dist/<controller>.ssp` (written by
   `cargo xtask ssp`), loaded with `CosimExecution.from_ssp_file`; the mission
   parameters come from the SSP's parameter bindings.

@@ -1,9 +1,10 @@
 """A co-simulation master for the tail-sitter FMUs (fmpy's FMU2Slave underneath).
 
-Timing follows DESIGN.md §2. Gauss-Seidel (the reference): at each
-communication point t the controller inputs are set from the plant outputs at
-t, the controller steps, the plant inputs are set from the controller outputs,
-the plant steps. Jacobi: both units are set from values at t before either
+Timing follows docs/DESIGN.md, "Ports and timing" and "A co-simulation
+step". Gauss-Seidel (the reference): at each communication point t the
+controller inputs are set from the plant outputs at t, the controller steps,
+the plant inputs are set from the controller outputs, the plant steps.
+Jacobi: both units are set from values at t before either
 steps, so the plant flies the command of the previous sample.
 """
 
@@ -24,17 +25,28 @@ Vector3 = tuple[float, float, float]
 TimeFunction = Callable[[float], Vector3]
 
 
+# Time edges (s): a communication point t has reached an edge t_edge when
+# t >= t_edge - EDGE_TOLERANCE, so that t = k*h computed in floating point meets
+# an edge at a multiple of h. The same definition as the Rust closed loop
+# (`closed_loop::EDGE_TOLERANCE`: `Wind::Step`, `Scenario::ref_offset`,
+# `Trace::window`); the value is `edge_tolerance` of
+# modelDescription/fragments/mission_criteria.json (tailsim.metrics checks).
+EDGE_TOLERANCE = 1e-9
+
+
 def step(t_step: float, value: Vector3) -> TimeFunction:
-    """A profile that is zero before `t_step` and `value` from then on."""
+    """A profile that is zero before `t_step` and `value` from then on (from the
+    first t with t >= t_step - EDGE_TOLERANCE, as `closed_loop::Wind::Step`)."""
 
     def f(t: float) -> Vector3:
-        return value if t >= t_step - 1e-9 else (0.0, 0.0, 0.0)
+        return value if t >= t_step - EDGE_TOLERANCE else (0.0, 0.0, 0.0)
 
     return f
 
 
 def one_minus_cosine_gust(t_start: float, duration: float, amplitude: Vector3) -> TimeFunction:
-    """The 1 − cos gust: amplitude · (1 − cos(2π(t − t_start)/duration))/2 inside the gust."""
+    """The 1 − cos gust: amplitude · (1 − cos(2π(t − t_start)/duration))/2 for
+    0 ≤ (t − t_start)/duration ≤ 1, zero outside (as `closed_loop::Wind::OneMinusCosine`)."""
 
     def f(t: float) -> Vector3:
         s = (t - t_start) / duration
@@ -57,6 +69,17 @@ class Fmu:
         self.dir = extract(str(self.path), unzipdir=str(target))
         self.variables = {v.name: v for v in self.md.modelVariables}
         self.identifier = self.md.coSimulation.modelIdentifier
+
+    def start(self, name: str) -> float:
+        """The declared start value of variable `name` (its default, from modelDescription.xml)."""
+        v = self.variables[name]
+        if v.start is None:
+            raise KeyError(f"{self.identifier}: variable '{name}' declares no start value")
+        return float(v.start)
+
+    def starts(self, names: list[str]) -> dict[str, float]:
+        """Declared start values of `names`."""
+        return {n: self.start(n) for n in names}
 
     def names(self, causality: str) -> list[str]:
         return [v.name for v in self.md.modelVariables if v.causality == causality]

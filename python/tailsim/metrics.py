@@ -1,16 +1,128 @@
-"""Numbers of the thesis's chapter-6 comparison, computed from a run."""
+"""Numbers of the thesis's chapter-6 comparison, computed from a run.
+
+The mission criteria (1 m/s, 5°, 10°, the 5 s level window, …) are read from
+`modelDescription/fragments/mission_criteria.json`, the file the Rust closed
+loop (`closed_loop::Criteria`) compiles in: one source for both languages.
+`mission_check` mirrors `closed_loop::MissionCheck::of` line by line (same
+window edges, same tolerances); `tests/test_metrics_agree.py` checks both give
+the same numbers on a stored trajectory.
+"""
 
 from __future__ import annotations
 
+import json
 import math
+import pathlib
 from dataclasses import dataclass
+from typing import Mapping
 
 import numpy as np
 
-from .master import RunResult, pos_error, settling_time
+from .master import EDGE_TOLERANCE, RunResult, pos_error, settling_time
 
 PHASES = ["vertical 1", "transition 1", "level", "transition 2", "vertical 2"]
 SURFACES = ["elevator", "aileron", "rudder", "flap_collective", "flap_differential", "vertical_flap"]
+CRITERIA_FILE = pathlib.Path(__file__).resolve().parents[2] / "modelDescription" / "fragments" / "mission_criteria.json"
+
+
+def _load_criteria() -> dict[str, float]:
+    data = json.loads(CRITERIA_FILE.read_text())
+    return {k: float(v["value"]) for k, v in data.items() if isinstance(v, dict)}
+
+
+CRITERIA: dict[str, float] = _load_criteria()
+assert CRITERIA["edge_tolerance"] == EDGE_TOLERANCE, "master.EDGE_TOLERANCE must match mission_criteria.json"
+
+
+@dataclass
+class MissionCheck:
+    """The issues' acceptance criteria on a run (mirror of `closed_loop::MissionCheck`)."""
+
+    level_airspeed_error: float
+    """Max |airspeed − v_level| over the level window (m/s)."""
+    level_pitch_error: float
+    """Max |θ − θ_trim| over the level window (rad)."""
+    final_pitch_error: float
+    """|θ − 90°| at the end (rad)."""
+    all_finite: bool
+    phase_samples: list[int]
+    phase_max: list[float]
+    """Max position error per phase (m), 0 for a phase without samples."""
+    phase_rms: list[float]
+
+    def failures(self) -> list[str]:
+        c = CRITERIA
+        out = []
+        if not self.all_finite:
+            out.append("non-finite values")
+        if not self.level_airspeed_error <= c["level_airspeed_error_max"]:
+            out.append(f"level airspeed error {self.level_airspeed_error:.2f} m/s > {c['level_airspeed_error_max']:g}")
+        if not self.level_pitch_error <= math.radians(c["level_pitch_error_max"]):
+            out.append(
+                f"level pitch error {math.degrees(self.level_pitch_error):.1f} deg > {c['level_pitch_error_max']:g}"
+            )
+        if not self.final_pitch_error <= math.radians(c["final_pitch_error_max"]):
+            out.append(
+                f"final pitch {math.degrees(self.final_pitch_error):.1f} deg from vertical > {c['final_pitch_error_max']:g}"
+            )
+        return out
+
+    def passed(self) -> bool:
+        return not self.failures()
+
+
+def phase_starts(mission: Mapping[str, float]) -> list[float]:
+    """Start times (s) of the five phases and the end of the mission."""
+    out = [0.0]
+    for key in ("t_vertical_1", "t_transition_1", "t_level", "t_transition_2", "t_vertical_2"):
+        out.append(out[-1] + float(mission[key]))
+    return out
+
+
+def window(t: np.ndarray, t0: float, t1: float) -> np.ndarray:
+    """Samples with t0 ≤ t < t1, edges with the shared tolerance (`Trace::window`)."""
+    return (t >= t0 - EDGE_TOLERANCE) & (t < t1 - EDGE_TOLERANCE)
+
+
+def level_window(t: np.ndarray, mission: Mapping[str, float]) -> np.ndarray:
+    """Samples of the criteria's level window: the last `level_window` seconds of
+    level flight (from the later of its start and its end minus that)."""
+    s = phase_starts(mission)
+    return window(t, max(s[3] - CRITERIA["level_window"], s[2]), s[3])
+
+
+def declared_mission() -> dict[str, float]:
+    """The mission parameters' defaults as the controllers declare them
+    (modelDescription/fragments/controller_interface.json, group "mission"); from
+    a packaged FMU read the same start values with `Fmu.starts`."""
+    fragment = json.loads((CRITERIA_FILE.parent / "controller_interface.json").read_text())
+    return {v["name"]: float(v["start"]) for v in fragment["variables"] if v.get("group") == "mission"}
+
+
+def mission_check(r: RunResult, mission: Mapping[str, float], theta_level_trim: float) -> MissionCheck:
+    """`closed_loop::MissionCheck::of` on a recorded run; `mission` holds the
+    controller's mission parameters (t_*, v_level)."""
+    w = level_window(r.time, mission)
+    level_v = float(np.max(np.abs(r["airspeed"][w] - float(mission["v_level"])), initial=0.0))
+    level_theta = float(np.max(np.abs(r["theta"][w] - theta_level_trim), initial=0.0))
+    final_theta = abs(float(r["theta"][-1]) - math.pi / 2) if len(r.time) else math.inf
+    err = pos_error(r)
+    phase = r["phase"]
+    samples, mx, rms = [], [], []
+    for k in range(5):
+        m = phase == k
+        samples.append(int(m.sum()))
+        mx.append(float(np.max(err[m], initial=0.0)))
+        rms.append(float(math.sqrt(np.sum(err[m] ** 2) / m.sum())) if m.any() else 0.0)
+    return MissionCheck(
+        level_airspeed_error=level_v,
+        level_pitch_error=level_theta,
+        final_pitch_error=final_theta,
+        all_finite=all(bool(np.all(np.isfinite(v))) for v in r.signals.values()),
+        phase_samples=samples,
+        phase_max=mx,
+        phase_rms=rms,
+    )
 
 
 @dataclass
@@ -30,20 +142,18 @@ class MissionMetrics:
 
 def mission_metrics(
     r: RunResult,
-    level_end: float,
+    mission: Mapping[str, float],
     theta_trim: float,
-    v_level: float = 25.0,
-    deflection_limit: float = math.radians(25.0),
-    thrust_max: float = 150.0,
+    deflection_limit: float,
+    thrust_max: float,
 ) -> MissionMetrics:
+    """The comparison's numbers of a mission run: the criteria of `mission_check`
+    plus altitude deviation, α, saturation and compute time. `mission`: the
+    controller's mission parameters; `deflection_limit` (rad) and `thrust_max`
+    (N): the plant's (read them from its declaration, `Fmu.start`)."""
+    check = mission_check(r, mission, theta_trim)
     t = r.time
-    err = pos_error(r)
     phase = r["phase"]
-    max_e, rms_e = [], []
-    for k in range(5):
-        m = phase == k
-        max_e.append(float(err[m].max()) if m.any() else float("nan"))
-        rms_e.append(float(math.sqrt(np.mean(err[m] ** 2))) if m.any() else float("nan"))
     alt_dev = []
     for k in (1, 3):
         m = phase == k
@@ -53,34 +163,26 @@ def mission_metrics(
     for s in SURFACES:
         saturated |= np.abs(r[s]) >= deflection_limit * 0.999
     saturated |= (r["thrust_cmd"] >= thrust_max * 0.999) | (r["thrust_cmd"] <= 1e-9)
-    window = (t >= level_end - 5.0) & (t < level_end)
-    finite = all(np.all(np.isfinite(v)) for v in r.signals.values())
-    level_v = float(np.abs(r["airspeed"][window] - v_level).max()) if window.any() else float("nan")
-    level_theta = float(np.degrees(np.abs(r["theta"][window] - theta_trim)).max()) if window.any() else float("nan")
-    final_theta = float(abs(math.degrees(r["theta"][-1]) - 90.0))
-    reasons = []
-    if not finite:
-        reasons.append("non-finite values")
-    if not level_v <= 1.0:
-        reasons.append(f"level airspeed error {level_v:.2f} m/s > 1")
-    if not level_theta <= 5.0:
-        reasons.append(f"level pitch error {level_theta:.1f} deg > 5")
-    if not final_theta <= 10.0:
-        reasons.append(f"final pitch {final_theta:.1f} deg from vertical > 10")
+    nan = float("nan")
+    reasons = check.failures()
     return MissionMetrics(
         completed=not reasons,
         reason="; ".join(reasons) or "ok",
-        max_error=max_e,
-        rms_error=rms_e,
+        max_error=[m if n else nan for m, n in zip(check.phase_max, check.phase_samples)],
+        rms_error=[m if n else nan for m, n in zip(check.phase_rms, check.phase_samples)],
         altitude_deviation_transition=(alt_dev[0], alt_dev[1]),
         max_alpha_deg=float(np.degrees(np.nanmax(r["alpha"]))),
         saturation_time=float(saturated.sum() * h),
-        level_airspeed_error=level_v,
-        level_pitch_error_deg=level_theta,
-        final_pitch_error_deg=final_theta,
+        level_airspeed_error=check.level_airspeed_error,
+        level_pitch_error_deg=math.degrees(check.level_pitch_error),
+        final_pitch_error_deg=math.degrees(check.final_pitch_error),
         controller_us_per_step=1e6 * r.wall_time_controller / max(r.steps, 1),
     )
 
 
-def step_settling(r: RunResult, t_step: float, band: float = 0.5) -> float:
-    return settling_time(r.time, pos_error(r), t_step + 1e-9, band)
+def step_settling(r: RunResult, t_step: float, band: float | None = None) -> float:
+    """Settling time (s) of the position error into `band` (m; default: the
+    criteria's settling band), counted over the samples strictly after the
+    reference step at `t_step` (the step's own sample is left out)."""
+    band = CRITERIA["settling_band"] if band is None else band
+    return settling_time(r.time, pos_error(r), t_step + EDGE_TOLERANCE, band)

@@ -1,9 +1,10 @@
-//! `analysis` CLI: regenerates the analysis report (open-loop modes, closed-loop poles,
-//! Table 5.1, nonlinear robustness and gust sweeps) into an output folder.
+//! `analysis` CLI: computes the data of the analysis report (open-loop modes, closed-loop
+//! poles, Table 5.1, nonlinear robustness and gust sweeps) into an output folder
+//! (`report.json` and CSV files); Python renders the report and its plots.
 //!
 //! ```text
 //! cargo run --release -p analysis -- all --out out/analysis
-//! .venv/bin/python crates/analysis/plot.py out/analysis
+//! PYTHONPATH=python .venv/bin/python -m tailsim.analysis_report out/analysis
 //! ```
 
 use std::path::PathBuf;
@@ -25,7 +26,7 @@ struct Cli {
 
 #[derive(clap::Args, Clone)]
 struct Common {
-    /// Output folder (Markdown, CSV, JSON, cache/).
+    /// Output folder (report.json, CSV, summary.json, cache/).
     #[arg(long, default_value = "out/analysis")]
     out: PathBuf,
     /// N of the geometric sweep (5.1.1); the thesis uses 50.
@@ -86,7 +87,7 @@ fn main() {
     match run(&cfg) {
         Ok(s) => {
             eprintln!(
-                "wrote {}/report.md: {} jobs ({} from the cache) in {:.1} s",
+                "wrote {}/report.json: {} jobs ({} from the cache) in {:.1} s",
                 cfg.out.display(),
                 s.jobs,
                 s.cache_hits,

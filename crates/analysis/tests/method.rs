@@ -234,6 +234,30 @@ fn tail_sitter_map_matches_zoh_of_linearisation() {
     assert!((left[0] - C64::new(1.0, 0.0)).norm() < 2e-3, "{}", left[0]);
 }
 
+/// The same object keys at every level (arrays: their first elements; `null` matches anything).
+fn same_structure(a: &serde_json::Value, b: &serde_json::Value, at: &str) -> Result<(), String> {
+    use serde_json::Value;
+    match (a, b) {
+        (Value::Object(x), Value::Object(y)) => {
+            let (kx, ky): (Vec<_>, Vec<_>) = (x.keys().collect(), y.keys().collect());
+            if kx != ky {
+                return Err(format!("{at}: keys {kx:?} against {ky:?}"));
+            }
+            x.iter()
+                .try_for_each(|(k, v)| same_structure(v, &y[k], &format!("{at}.{k}")))
+        }
+        (Value::Array(x), Value::Array(y)) => match (x.first(), y.first()) {
+            (Some(p), Some(q)) => same_structure(p, q, &format!("{at}[0]")),
+            _ => Ok(()),
+        },
+        (Value::Null, _) | (_, Value::Null) => Ok(()),
+        (Value::Number(_), Value::Number(_))
+        | (Value::String(_), Value::String(_))
+        | (Value::Bool(_), Value::Bool(_)) => Ok(()),
+        _ => Err(format!("{at}: {a} against {b}")),
+    }
+}
+
 /// A tiny campaign (N = 2, one parameter, one gust amplitude): Table 5.1, the robustness
 /// and gust tables come from actual runs, are cached, and a re-run computes nothing.
 #[test]
@@ -256,29 +280,41 @@ fn tiny_campaign_tables_come_from_runs_and_are_cached() {
         assert!(row.rms_percent > 0.0 && row.rms_percent.is_finite());
         assert_eq!(row.failed_points, 0);
     }
-    let table = std::fs::read_to_string(dir.join("table_5_1.md")).unwrap();
-    let line = table
-        .lines()
-        .find(|l| l.starts_with("| C_mδe |"))
-        .expect("row of C_mδe");
+    // The report's data: Table 5.1 in report.json (rendered by tailsim.analysis_report) and CSV.
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap();
+    let param = &report["params"][0];
+    assert_eq!(param["name"], "C_mδe");
+    // Thesis Table 5.1, C_mδe: LQR 59.0 %, TSD 105.0 %.
+    assert_eq!(param["thesis_percent"]["LQR"], 59.0);
+    assert_eq!(param["thesis_percent"]["TSD"], 105.0);
+    let rows = report["sensitivity"]["rows"].as_array().unwrap();
     for r in &sens {
-        assert!(
-            line.contains(&format!("{:.1}%", r.row.as_ref().unwrap().rms_percent)),
-            "{line}"
-        );
+        let row = rows
+            .iter()
+            .find(|x| x["controller"] == r.controller.name() && x["param"] == "Cmde")
+            .expect("row of C_mδe");
+        let rms = row["row"]["rms_percent"].as_f64().unwrap();
+        assert!((rms - r.row.as_ref().unwrap().rms_percent).abs() < 1e-12, "{row}");
     }
-    assert!(
-        line.contains("59.0%") && line.contains("105.0%"),
-        "thesis column: {line}"
-    );
+    // Same structure as the stored campaign output the Python renderer is tested on.
+    let fixture = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/analysis/report.json");
+    let fixture: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(fixture).unwrap()).unwrap();
+    if let Err(e) = same_structure(&report, &fixture, "report.json") {
+        panic!("{e}: refresh tests/data/analysis/ (see tests/test_analysis_report.py) and the renderer");
+    }
+    let table = std::fs::read_to_string(dir.join("table_5_1.csv")).unwrap();
+    assert_eq!(table.lines().filter(|l| l.starts_with("Cmde,")).count(), 2, "{table}");
     assert_eq!(s.robustness.len(), 2);
     for r in &s.robustness {
         assert_eq!(r.outcomes.len(), 2);
         assert!(r.outcomes[1].passed, "nominal mission of {:?} passes", r.controller);
     }
     assert_eq!(s.gusts.len(), 2 * 3 * 3);
-    let rb = std::fs::read_to_string(dir.join("robustness.md")).unwrap();
-    assert!(rb.lines().any(|l| l.starts_with("| C_mδe |")));
+    let rb = report["robustness"]["rows"].as_array().unwrap();
+    assert_eq!(rb.len(), 2);
+    assert!(rb.iter().all(|r| r["param"] == "Cmde" && r["points"] == 2));
+    assert_eq!(report["gusts"]["rows"].as_array().unwrap().len(), 2 * 3 * 3);
     let cache_lines = std::fs::read_to_string(dir.join("cache/poles.jsonl"))
         .unwrap()
         .lines()
@@ -287,7 +323,7 @@ fn tiny_campaign_tables_come_from_runs_and_are_cached() {
     // Re-run: everything from the cache, same tables.
     let s2 = run(&cfg).unwrap();
     assert_eq!(s2.cache_hits, s2.jobs);
-    assert_eq!(std::fs::read_to_string(dir.join("table_5_1.md")).unwrap(), table);
+    assert_eq!(std::fs::read_to_string(dir.join("table_5_1.csv")).unwrap(), table);
     let _ = Kind::ALL;
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -6,8 +6,70 @@
 //! Frames: NED earth axes for positions, velocities and wind; SI units.
 
 use flight_mission::{Command, ControllerInput, Diagnostics, FlightController, Measurement, MissionParams, Notice};
+use std::sync::OnceLock;
+
 use nalgebra::Vector3;
 use tailsitter_physics::{idx, InputVector, Plant, StateVector};
+
+/// The acceptance criteria of a flown mission, read from
+/// `modelDescription/fragments/mission_criteria.json` (compiled in): the one source the
+/// Python metrics and reports (`tailsim.metrics.CRITERIA`) read too.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Criteria {
+    /// The level-flight checks cover the last this-many seconds of level flight (s).
+    pub level_window: f64,
+    /// Largest |airspeed − v_level| over the level window (m/s).
+    pub level_airspeed_error_max: f64,
+    /// Largest |θ − θ_trim| over the level window (rad).
+    pub level_pitch_error_max: f64,
+    /// Largest |θ − 90°| at the end (rad).
+    pub final_pitch_error_max: f64,
+    /// Time-edge tolerance (s): see [`EDGE_TOLERANCE`].
+    pub edge_tolerance: f64,
+}
+
+/// The criteria file's text.
+pub const CRITERIA_JSON: &str = include_str!("../../../modelDescription/fragments/mission_criteria.json");
+
+impl Criteria {
+    /// Parse the criteria file (values in its declared units: s, m/s, deg).
+    pub fn parse(text: &str) -> Result<Self, String> {
+        let v: serde_json::Value = serde_json::from_str(text).map_err(|e| format!("mission criteria: {e}"))?;
+        let get = |key: &str, unit: &str| -> Result<f64, String> {
+            let entry = &v[key];
+            if entry["unit"].as_str() != Some(unit) {
+                return Err(format!("mission criteria: {key} must be given in {unit}"));
+            }
+            entry["value"]
+                .as_f64()
+                .ok_or_else(|| format!("mission criteria: {key} has no numeric value"))
+        };
+        Ok(Self {
+            level_window: get("level_window", "s")?,
+            level_airspeed_error_max: get("level_airspeed_error_max", "m/s")?,
+            level_pitch_error_max: get("level_pitch_error_max", "deg")?.to_radians(),
+            final_pitch_error_max: get("final_pitch_error_max", "deg")?.to_radians(),
+            edge_tolerance: get("edge_tolerance", "s")?,
+        })
+    }
+
+    /// The compiled-in criteria.
+    pub fn get() -> &'static Self {
+        static CRITERIA: OnceLock<Criteria> = OnceLock::new();
+        CRITERIA.get_or_init(|| match Self::parse(CRITERIA_JSON) {
+            Ok(c) => c,
+            // The file is part of the source: a broken one is a build defect, caught by the tests.
+            Err(e) => panic!("{e}"),
+        })
+    }
+}
+
+/// Time edges (s): a communication point `t` has reached an edge `t_edge` when
+/// `t ≥ t_edge − EDGE_TOLERANCE`, so that `t = k·h` computed in floating point meets an
+/// edge at a multiple of `h`. Used by [`Wind::Step`], [`Scenario::ref_offset`] and
+/// [`Trace::window`], and identically by the Python master (`tailsim.master.step`,
+/// `tailsim.metrics.window`); equal to `edge_tolerance` of the criteria file (tested).
+pub const EDGE_TOLERANCE: f64 = 1e-9;
 
 /// How the master orders the two units within a communication step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -28,7 +90,7 @@ pub enum Wind {
     Calm,
     /// The same wind all the time.
     Constant(Vector3<f64>),
-    /// Zero before `t_start`, `wind` from then on.
+    /// Zero before `t_start`, `wind` from then on (from `t ≥ t_start − EDGE_TOLERANCE`).
     Step { t_start: f64, wind: Vector3<f64> },
     /// 1 − cos gust: `amplitude · (1 − cos(2π (t − t_start)/duration)) / 2` inside the gust.
     OneMinusCosine {
@@ -45,7 +107,7 @@ impl Wind {
             Wind::Calm => Vector3::zeros(),
             Wind::Constant(w) => w,
             Wind::Step { t_start, wind } => {
-                if t >= t_start {
+                if t >= t_start - EDGE_TOLERANCE {
                     wind
                 } else {
                     Vector3::zeros()
@@ -99,7 +161,7 @@ impl Scenario {
     pub fn ref_offset(&self, t: f64) -> Vector3<f64> {
         let mut offset = Vector3::zeros();
         for (t_step, value) in &self.ref_offset_steps {
-            if t + 1e-9 >= *t_step {
+            if t >= *t_step - EDGE_TOLERANCE {
                 offset = *value;
             }
         }
@@ -224,7 +286,9 @@ impl Trace {
 
     /// Samples with `t0 ≤ t < t1`.
     pub fn window(&self, t0: f64, t1: f64) -> impl Iterator<Item = &Sample> {
-        self.samples.iter().filter(move |s| s.t >= t0 - 1e-9 && s.t < t1 - 1e-9)
+        self.samples
+            .iter()
+            .filter(move |s| s.t >= t0 - EDGE_TOLERANCE && s.t < t1 - EDGE_TOLERANCE)
     }
 
     /// Maximum angle of attack [rad] with `t0 ≤ t < t1`.
@@ -232,6 +296,36 @@ impl Trace {
         self.window(t0, t1)
             .map(|s| s.measurement.alpha)
             .fold(f64::NEG_INFINITY, f64::max)
+    }
+}
+
+/// What [`MissionCheck`] needs of one communication point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CheckSample {
+    /// Time (s).
+    pub t: f64,
+    /// Mission phase (0…4).
+    pub phase: usize,
+    /// |position − reference position| (m).
+    pub pos_error: f64,
+    /// Airspeed (m/s).
+    pub airspeed: f64,
+    /// Pitch θ (rad).
+    pub theta: f64,
+    /// Every value of the sample finite.
+    pub finite: bool,
+}
+
+impl From<&Sample> for CheckSample {
+    fn from(s: &Sample) -> Self {
+        Self {
+            t: s.t,
+            phase: s.diagnostics.phase as usize,
+            pos_error: s.pos_error(),
+            airspeed: s.measurement.airspeed,
+            theta: s.theta,
+            finite: s.x.iter().all(|v| v.is_finite()) && s.command.is_finite(),
+        }
     }
 }
 
@@ -254,38 +348,57 @@ impl MissionCheck {
     /// Evaluate `trace` of `mission`; `theta_level_trim` is the plant's trimmed
     /// pitch in level flight at `v_level` [rad].
     pub fn of(trace: &Trace, mission: &MissionParams, theta_level_trim: f64) -> Self {
+        let samples: Vec<CheckSample> = trace.samples.iter().map(CheckSample::from).collect();
+        Self::of_samples(&samples, mission, theta_level_trim)
+    }
+
+    /// The same on the recorded values alone (a trajectory from any master; the Python
+    /// `tailsim.metrics.mission_check` mirrors this line by line).
+    pub fn of_samples(samples: &[CheckSample], mission: &MissionParams, theta_level_trim: f64) -> Self {
         let s = mission.phase_starts();
-        let (t0, t1) = ((s[3] - 5.0).max(s[2]), s[3]);
+        let (t0, t1) = ((s[3] - Criteria::get().level_window).max(s[2]), s[3]);
         let mut level_airspeed_error: f64 = 0.0;
         let mut level_pitch_error: f64 = 0.0;
-        for sample in trace.window(t0, t1) {
-            level_airspeed_error = level_airspeed_error.max((sample.measurement.airspeed - mission.v_level).abs());
+        for sample in samples
+            .iter()
+            .filter(|x| x.t >= t0 - EDGE_TOLERANCE && x.t < t1 - EDGE_TOLERANCE)
+        {
+            level_airspeed_error = level_airspeed_error.max((sample.airspeed - mission.v_level).abs());
             level_pitch_error = level_pitch_error.max((sample.theta - theta_level_trim).abs());
         }
-        let final_pitch_error = trace
-            .samples
+        let final_pitch_error = samples
             .last()
             .map_or(f64::INFINITY, |s| (s.theta - std::f64::consts::FRAC_PI_2).abs());
-        let all_finite = trace
-            .samples
-            .iter()
-            .all(|s| s.x.iter().all(|v| v.is_finite()) && s.command.is_finite());
+        let mut phase_errors = [PhaseErrors::default(); 5];
+        let mut sums = [0.0; 5];
+        for x in samples {
+            let k = x.phase.min(4);
+            phase_errors[k].samples += 1;
+            phase_errors[k].max = phase_errors[k].max.max(x.pos_error);
+            sums[k] += x.pos_error * x.pos_error;
+        }
+        for (o, sum) in phase_errors.iter_mut().zip(sums) {
+            if o.samples > 0 {
+                o.rms = (sum / o.samples as f64).sqrt();
+            }
+        }
         Self {
             level_airspeed_error,
             level_pitch_error,
             final_pitch_error,
-            all_finite,
-            phase_errors: trace.phase_errors(),
+            all_finite: samples.iter().all(|x| x.finite),
+            phase_errors,
         }
     }
 
-    /// The issue's criteria: airspeed within 1 m/s and pitch within 5° over the
-    /// last 5 s of level flight, within 10° of vertical at the end, all finite.
+    /// The issue's criteria ([`Criteria`]: airspeed within 1 m/s and pitch within 5° over
+    /// the last 5 s of level flight, within 10° of vertical at the end), all finite.
     pub fn passed(&self) -> bool {
+        let c = Criteria::get();
         self.all_finite
-            && self.level_airspeed_error <= 1.0
-            && self.level_pitch_error <= 5f64.to_radians()
-            && self.final_pitch_error <= 10f64.to_radians()
+            && self.level_airspeed_error <= c.level_airspeed_error_max
+            && self.level_pitch_error <= c.level_pitch_error_max
+            && self.final_pitch_error <= c.final_pitch_error_max
     }
 }
 
@@ -412,6 +525,35 @@ mod tests {
         assert!((g.at(2.0).x - 4.0).abs() < 1e-12);
         assert!((g.at(1.5).x - 2.0).abs() < 1e-12);
         assert_eq!(g.at(3.5), Vector3::zeros());
+    }
+
+    #[test]
+    fn criteria_file_parses_to_the_issue_values() {
+        let c = Criteria::get();
+        assert_eq!(c.level_window, 5.0);
+        assert_eq!(c.level_airspeed_error_max, 1.0);
+        assert!((c.level_pitch_error_max - 5.0 * std::f64::consts::PI / 180.0).abs() < 1e-15);
+        assert!((c.final_pitch_error_max - 10.0 * std::f64::consts::PI / 180.0).abs() < 1e-15);
+        assert_eq!(c.edge_tolerance, EDGE_TOLERANCE);
+        assert!(Criteria::parse(&CRITERIA_JSON.replace("\"deg\"", "\"rad\"")).is_err());
+    }
+
+    #[test]
+    fn step_edges_use_the_shared_tolerance() {
+        let h = 0.02;
+        let w = Wind::Step {
+            t_start: 2.1,
+            wind: Vector3::new(1.0, 0.0, 0.0),
+        };
+        // 105 · 0.02 = 2.1000000000000001 in floating point, 2.1 − 1e-12 just below.
+        assert_eq!(w.at(105.0 * h).x, 1.0);
+        assert_eq!(w.at(2.1 - 1e-12).x, 1.0);
+        assert_eq!(w.at(2.1 - 1e-6).x, 0.0);
+        let mut s = Scenario::mission(MissionParams::default());
+        s.ref_offset_steps = vec![(2.1, Vector3::new(5.0, 0.0, 0.0))];
+        for t in [2.1 - 1e-12, 2.1 - 1e-6, 104.0 * h, 105.0 * h] {
+            assert_eq!(s.ref_offset(t).x, 5.0 * w.at(t).x, "t = {t}");
+        }
     }
 
     #[test]

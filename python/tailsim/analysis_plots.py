@@ -1,9 +1,8 @@
-#!/usr/bin/env python3
-"""Plots of the analysis report (run after `cargo run --release -p analysis -- all --out DIR`).
+"""Plots of the analysis report, from the CSV files the Rust campaign
+(`cargo run --release -p analysis -- all --out DIR`) wrote into DIR; called by
+`python -m tailsim.analysis_report DIR`, which renders the whole report.
 
-Usage: .venv/bin/python crates/analysis/plot.py DIR
-
-Reads the CSV files the Rust campaign wrote into DIR and writes PNGs beside them:
+Writes PNGs beside the CSVs:
   open_loop_modes.png                 open-loop poles (level, vertical), thesis Tables 3.2/3.3
   closed_loop_poles_<cond>.png        closed-loop poles of both controllers (Figs. 3.16/3.17)
   loci_<ctl>_<cond>_pitch.png         pole loci for C_mα, C_mq, C_mδe (Figs. 5.1/5.2)
@@ -11,8 +10,9 @@ Reads the CSV files the Rust campaign wrote into DIR and writes PNGs beside them
   table_5_1.png                       regenerated Table 5.1 next to the thesis's
   robustness.png, gusts.png           nonlinear robustness ranges and largest survived gusts
 """
+
 import csv
-import sys
+import json
 from collections import defaultdict
 from pathlib import Path
 
@@ -47,7 +47,8 @@ def main(out):
             xs = [p[0] for p in pts] + [p[0] for p in pts if p[1] > 0]
             ys = [p[1] for p in pts] + [-p[1] for p in pts if p[1] > 0]
             ax.plot(xs, ys, "x", label=cond)
-        thesis = [(-0.006, 0.462), (-10.44, 24.204), (-3.334, 14.06), (-10.34, 0), (0.225, 0)]
+        # The thesis's level-flight modes (Tables 3.2/3.3), as the campaign states them.
+        thesis = [(m["re"], m["im"]) for m in json.loads((out / "report.json").read_text())["open_loop"]["thesis_level"]]
         ax.plot([t[0] for t in thesis], [t[1] for t in thesis], "o", mfc="none", label="thesis (level)")
         splane(ax, "Open-loop modes")
         ax.legend(fontsize=7)
@@ -184,8 +185,3 @@ def main(out):
         fig.tight_layout()
         fig.savefig(out / "gusts.png", dpi=110)
         plt.close(fig)
-    print(f"plots written to {out}")
-
-
-if __name__ == "__main__":
-    main(sys.argv[1] if len(sys.argv) > 1 else "out/analysis")

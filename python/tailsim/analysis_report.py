@@ -1,0 +1,337 @@
+"""The analysis report, rendered from the data the Rust campaign writes.
+
+    cargo run --release -p analysis -- all --out out/analysis
+    PYTHONPATH=python .venv/bin/python -m tailsim.analysis_report out/analysis
+
+The campaign (`crates/analysis`) writes data only: `report.json` (every table
+as structured data) and the CSV files of every table and figure. This module
+renders them: `report.md` (everything) and one Markdown file per section
+(`open_loop_modes.md`, `closed_loop_poles.md`, `table_5_1.md`,
+`robustness.md`, `gusts.md`), `report.html` and the plots
+(`tailsim.analysis_plots`). `tailsim.compare` includes the same sections in
+the comparison report.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import pathlib
+
+from .report import fmt_or_dash, fmt_pole, markdown_to_html, shortest
+
+OPEN_LOOP_NOTES = (
+    "Differences from the thesis: the thesis's modes were computed from its AVL-based model with numbers it "
+    "does not publish (span, inertia cross-terms, the trim it linearised at: α = 5.9° in AVL against our α ≈ 7.5°, "
+    "δe ≈ −6° once the elevator's own lift counts). Its short period −10.44 ± 24.2i does not follow from its own "
+    "published derivatives: with C_mα = −1.65, C_mq = −7.64, C_Lα = 4.25, I_y = 0.42 kg m², m = 9 kg, S = 0.574 m², "
+    "c̄ = 0.366 m at 25 m/s (q̄Sc̄ ≈ 80 N m), M_α ≈ q̄Sc̄C_mα/I_y ≈ −315 s⁻², M_q ≈ q̄Sc̄²C_mq/(2V I_y) ≈ −10.7 s⁻¹ "
+    "and Z_α/V ≈ q̄SC_Lα/(mV) ≈ 4.2 s⁻¹, so ζω ≈ (10.7 + 4.2)/2 ≈ 7.4 s⁻¹ and ω ≈ √(315 + 10.7·4.2) ≈ 19 rad/s — "
+    "our −7.4 ± 16.5i (ω_n 18.1), not the thesis's ω_n 26.4 rad/s, which would need about twice the pitch "
+    "stiffness C_mα/I_y. Lateral modes depend on the span b = 1.569 m (S/c̄) we assume, which sets the roll damping "
+    "L_p ∝ b² and hence the roll pole (ours ≈ −8 against −10.3) and the Dutch roll. The spiral mode is unstable in "
+    "both (no dihedral, §3.4.2), slower in ours. The phugoid matches in frequency (≈ √2·g/V)."
+)
+
+SENSITIVITY_NOTES = (
+    "Our closed loops differ from the thesis's (controllers retuned for this airframe, our full sampled-data loop "
+    "with servo and thrust lags and integrators against the thesis's linear model), so the percentages are compared "
+    "in ranking, not value. The measure is the largest excursion over the sweep; the end-to-end span "
+    "|p(k=N−1) − p(k=0)| is in `table_5_1.csv` (rms_span_percent)."
+)
+
+
+def load(folder: str | pathlib.Path) -> dict:
+    """`report.json` of an analysis output folder."""
+    return json.loads((pathlib.Path(folder) / "report.json").read_text())
+
+
+def _rows(header: str, rule: str, lines: list[str]) -> list[str]:
+    return [header, rule] + lines
+
+
+def open_loop(d: dict) -> list[str]:
+    ol = d["open_loop"]
+    coords = ol["coords"]
+    lvl, vert = ol["conditions"][0], ol["conditions"][1]
+    tr = lvl["trim"]
+    out = ["## Open-loop modes (thesis §3.4.2, Tables 3.2 and 3.3)", ""]
+    out += [
+        f"{lvl['condition']}: trim α = {tr['alpha_deg']:.2f}°, δe = {tr['elevator_deg']:.2f}°, T = {tr['thrust_n']:.2f} N. "
+        "Coordinates (V̄, α, β, p, q, r, φ, θ, ψ), 3-2-1 Euler angles; mode shapes normalised to the largest displayed "
+        "component (V in m/s, angles in rad, rates in rad/s).",
+        "",
+        "| mode | ours | ζ | ω_n (rad/s) | thesis | shape (ours) | shape (thesis) |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for th in ol["thesis_level"]:
+        m = next((m for m in lvl["modes"] if m["name"] == th["name"]), None)
+        if m is None:
+            continue
+        ours = []
+        for c, _, _ in th["shape"]:
+            i = coords.index(c) if c in coords else 0
+            mag, ph = m["shape"][i]
+            ours.append(f"{c} {mag:.3f}∠{ph:.0f}°")
+        thesis = [f"{c} {a:.3f}∠{p:.0f}°" for c, a, p in th["shape"]]
+        out.append(
+            f"| {m['name']} | {fmt_pole(m['re'], m['im'])} | {m['damping']:.3f} | {m['omega_n']:.3f} | "
+            f"{fmt_pole(th['re'], th['im'])} | {', '.join(ours)} | {', '.join(thesis)} |"
+        )
+    out += [
+        "",
+        f"{vert['condition']}: trim T = {vert['trim']['thrust_n']:.2f} N. The conventional names do not apply; "
+        "modes named by their dominant coordinate.",
+        "",
+        "| mode | eigenvalue | ζ | ω_n (rad/s) |",
+        "|---|---|---|---|",
+    ]
+    for m in vert["modes"]:
+        out.append(f"| {m['name']} | {fmt_pole(m['re'], m['im'])} | {m['damping']:.3f} | {m['omega_n']:.3f} |")
+    out += ["", OPEN_LOOP_NOTES]
+    return out
+
+
+def closed_loop(d: dict) -> list[str]:
+    cl = d["closed_loop"]
+    at = cl["analysis_time_s"]
+    out = [
+        "",
+        "## Closed-loop poles (Jacobian of the closed-loop sampled map, s = ln z / T)",
+        "",
+        "One method for both controllers: plant over one sample time + controller update, perturbed in the plant's "
+        "19 minimal coordinates and the controller's integrators (through its save/restore state), at the operating "
+        f"point the nominal mission reaches (level: t = {at['level']:.1f} s, vertical 3 m/s climb: t = {at['vertical']:.1f} s). "
+        "Upper half plane only; servo (−20) and thrust-lag (−10) poles included.",
+        "",
+    ]
+    for run in cl["runs"]:
+        out += [f"### {run['controller']} — {run['condition']} flight", ""]
+        if run["error"] is not None:
+            out += [f"failed: {run['error']}", ""]
+            continue
+        out += ["| pole | ζ | ω_n (rad/s) | dominant coordinates |", "|---|---|---|---|"]
+        for p in run["poles"]:
+            if p["im"] < -1e-9:
+                continue
+            out.append(f"| {fmt_pole(p['re'], p['im'])} | {p['damping']:.3f} | {p['omega_n']:.3f} | {p['dominant']} |")
+        out.append("")
+        if run["tsd_placed"]:
+            out += [
+                "TSD placed (Table 4.3, our parameters) against achieved (nearest closed-loop pole, one-to-one, closest "
+                "pairs first; where loops couple and poles crowd, the assignment is ambiguous — the dominant coordinates "
+                "in the list above identify the loops):",
+                "",
+                "| loop | placed | achieved (ours) | thesis Table 4.4 |",
+                "|---|---|---|---|",
+            ]
+            for r in run["tsd_placed"]:
+                achieved = fmt_pole(*r["achieved"]) if r["achieved"] is not None else "—"
+                out.append(f"| {r['loop']} | {fmt_pole(*r['placed'])} | {achieved} | {r['thesis'] or '—'} |")
+            out.append("")
+    return out
+
+
+def table_5_1(d: dict) -> list[str]:
+    s = d["sensitivity"]
+    out = [
+        "",
+        "## Sensitivity (thesis §5.1, Table 5.1)",
+        "",
+        "Each parameter scaled in the plant alone by C₀·τ^(−1+2k/N), k = 0…N−1, "
+        f"N = {d['n']}, τ = 1.5 (aerodynamic) / 1.1 (m, I); controllers keep their nominal design model. Entry: RMS over "
+        "the closed-loop poles of each pole's largest excursion from nominal, in % of its nominal natural frequency "
+        f"(poles with ω_n < {shortest(s['min_omega'])} rad/s left out). `!` marks sweeps with an unstable closed-loop "
+        "pole somewhere, `✗n` sweeps where n points failed to reach the operating point, `sn` sweeps where at n points "
+        "an actuator saturated at the operating point (a pole at z = 0, left out of that pole's excursion). The "
+        "thesis's column is level flight.",
+        "",
+    ]
+    header, rule = "| parameter |", "|---|"
+    for k in d["controllers"]:
+        header += f" {k} thesis |"
+        rule += "---|"
+        for c in d["conditions"]:
+            header += f" {k} ours ({c}) |"
+            rule += "---|"
+    out += [header, rule]
+    rows = {(r["param"], r["controller"], r["condition"]): r for r in s["rows"]}
+    for p in d["params"]:
+        line = f"| {p['name']} |"
+        for k in d["controllers"]:
+            line += f" {p['thesis_percent'][k]:.1f}% |"
+            for c in d["conditions"]:
+                row = rows.get((p["id"], k, c), {}).get("row")
+                if row is None:
+                    cell = "failed"
+                else:
+                    cell = f"{row['rms_percent']:.1f}%"
+                    if row["unstable_points"] > 0:
+                        cell += " !"
+                    if row["degenerate_points"] > 0:
+                        cell += f" s{row['degenerate_points']}"
+                    if row["failed_points"] > 0:
+                        cell += f" ✗{row['failed_points']}"
+                line += f" {cell} |"
+        out.append(line)
+    out += ["", SENSITIVITY_NOTES]
+    return out
+
+
+def _robustness_table(d: dict, rows: list[dict]) -> list[str]:
+    header, rule = "| parameter |", "|---|"
+    for k in d["controllers"]:
+        header += f" {k} range | {k} passes | {k} worst pos. err (m) |"
+        rule += "---|---|---|"
+    out = [header, rule]
+    by = {(r["param"], r["controller"]): r for r in rows}
+    for p in d["params"]:
+        line = f"| {p['name']} |"
+        for k in d["controllers"]:
+            r = by.get((p["id"], k))
+            if r is None:
+                line += " — | — | — |"
+                continue
+            rng = f"{r['range'][0]:.3f} … {r['range'][1]:.3f}" if r["range"] is not None else "nominal fails"
+            line += f" {rng} | {r['passes']}/{r['points']} | {fmt_or_dash(r['worst_pos_error'])} |"
+        out.append(line)
+    return out
+
+
+def robustness(d: dict) -> list[str]:
+    rb = d.get("robustness")
+    if not rb:
+        return []
+    out = [
+        "",
+        "## Nonlinear robustness (beyond the thesis)",
+        "",
+        "The whole default mission flown in the nonlinear closed loop with the parameter scaled over the same sweep as "
+        "Table 5.1 (τ = 1.5 / 1.1); range = contiguous range of factors around 1 over which the mission passes the "
+        "controller issues' criteria (`MissionCheck::passed`); worst = largest position error over that range; passes "
+        "= passing points of N. The mission is symmetric and flown in calm air, so the lateral derivatives are hardly "
+        "excited (identical position errors): their robustness shows in the gust sweep.",
+        "",
+    ]
+    out += _robustness_table(d, rb["rows"])
+    w = rb.get("wide")
+    if w:
+        a, m = w["aerodynamic_range"], w["mass_inertia_range"]
+        out += [
+            "",
+            f"### Wider sweep: τ^{shortest(w['tau_power'])} ({a[0]:.2f} … {a[1]:.2f} aerodynamic, "
+            f"{m[0]:.3f} … {m[1]:.3f} m and I)",
+            "",
+            "The same flights over a wider range, to find where the missions start failing.",
+            "",
+        ]
+        out += _robustness_table(d, w["rows"])
+    return out
+
+
+def gusts(d: dict) -> list[str]:
+    g = d.get("gusts")
+    if not g:
+        return []
+    amps = g["amplitudes"]
+    out = [
+        "",
+        "## Gust sweep (beyond the thesis)",
+        "",
+        f"1−cos gusts of {shortest(g['duration_s'])} s along one earth axis (NED; + = towards north/east/down), "
+        f"amplitudes {shortest(amps[0]) if amps else '0'}…{shortest(amps[-1]) if amps else '0'} m/s: in the first "
+        "vertical phase (3 m/s climb, from t = 1.5 s), centred on the middle of the first transition, and in level "
+        "flight (from 2 s after its start). Largest amplitude A such that every amplitude ≤ A still passes the mission "
+        "criteria (0 = the smallest fails); the criteria do not bound the position error, so the last column also "
+        f"requires a position error ≤ {shortest(g['pos_bound_m'])} m.",
+        "",
+    ]
+    header, rule = "| phase | axis |", "|---|---|"
+    bound = shortest(g["pos_bound_m"])
+    for k in d["controllers"]:
+        header += f" {k} largest survived (m/s) | {k} max pos. err at it (m) | {k} largest with pos. err ≤ {bound} m |"
+        rule += "---|---|---|"
+    out += [header, rule]
+    cases: list[tuple[str, str]] = []
+    for r in g["rows"]:
+        if (r["phase"], r["axis"]) not in cases:
+            cases.append((r["phase"], r["axis"]))
+    by = {(r["phase"], r["axis"], r["controller"]): r for r in g["rows"]}
+    for ph, axis in cases:
+        line = f"| {ph} | {axis} |"
+        for k in d["controllers"]:
+            r = by.get((ph, axis, k))
+            if r is None:
+                continue
+            line += (
+                f" {r['largest_survived']:.0f} | {fmt_or_dash(r['max_pos_error_at_largest'])} | "
+                f"{r['largest_bounded']:.0f} |"
+            )
+        out.append(line)
+    return out
+
+
+SECTIONS = {
+    "open_loop_modes.md": open_loop,
+    "closed_loop_poles.md": closed_loop,
+    "table_5_1.md": table_5_1,
+    "robustness.md": robustness,
+    "gusts.md": gusts,
+}
+
+
+def markdown(d: dict) -> list[str]:
+    """The whole analysis report as Markdown lines."""
+    lines = [
+        "# Tail-sitter analysis report",
+        "",
+        f"Generated by `cargo run --release -p analysis -- all --out {d['out']}` (N = {d['n']}, wall time "
+        f"{d['wall_time_s']:.1f} s, {d['jobs']} jobs, {d['cache_hits']} from the cache).",
+        "",
+    ]
+    for section in SECTIONS.values():
+        lines += section(d)
+    return lines
+
+
+def plots(folder: pathlib.Path) -> list[pathlib.Path]:
+    """The analysis plots (PNG) of `folder`, in a stable order."""
+    return sorted(folder.glob("*.png"))
+
+
+def write(folder: str | pathlib.Path, with_plots: bool = True) -> pathlib.Path:
+    """Render `report.md`, the per-section Markdown files, the plots and
+    `report.html` into the analysis output `folder`; returns report.md."""
+    folder = pathlib.Path(folder)
+    d = load(folder)
+    for name, section in SECTIONS.items():
+        lines = section(d)
+        if lines:
+            (folder / name).write_text("\n".join(lines) + "\n")
+    if with_plots:
+        from . import analysis_plots
+
+        analysis_plots.main(folder)
+    md = markdown(d)
+    pngs = plots(folder)
+    if pngs:
+        md += ["", "## Plots", ""]
+        for p in pngs:
+            md += [f"![{p.stem}]({p.name})", ""]
+    (folder / "report.md").write_text("\n".join(md) + "\n")
+    (folder / "report.html").write_text(markdown_to_html(md, folder, "Tail-sitter analysis report"))
+    return folder / "report.md"
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="tailsim.analysis_report", description=__doc__.split("\n\n")[0])
+    ap.add_argument("folder", nargs="?", default="out/analysis", help="output folder of the analysis campaign")
+    ap.add_argument("--no-plots", action="store_true", help="tables only")
+    args = ap.parse_args(argv)
+    path = write(args.folder, with_plots=not args.no_plots)
+    print(f"analysis report: {path} and {path.with_suffix('.html')}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
