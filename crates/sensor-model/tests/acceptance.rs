@@ -357,25 +357,38 @@ fn butterworth_minus_3_db_point_is_at_8_hz() {
 #[test]
 fn outputs_hold_the_latest_sample_at_each_rate() {
     let h = 0.02;
-    for (accel_rate, mag_rate, gps_rate) in [(200.0, 50.0, 4.0), (30.0, 7.0, 1.5), (1000.0, 3.0, 10.0)] {
+    for (accel_rate, mag_rate, gps_rate, pitot_rate) in [
+        (200.0, 50.0, 4.0, 50.0),
+        (30.0, 7.0, 1.5, 100.0),
+        (1000.0, 3.0, 10.0, 13.0),
+    ] {
         let p = Params {
             accel_rate,
             mag_rate,
             gps_rate,
+            pitot_rate,
             filter_enabled: false,
             accel_std: 0.0,
             mag_std: 0.0,
+            pitot_std: 0.0,
             gps_height_std: 0.0,
             ..Params::default()
         };
         let mut m = SensorModel::new(p).unwrap();
-        let mut truth = Truth::default();
+        // The start time's truth: the time-carrying values below at t = 0.
+        let mut truth = Truth {
+            airspeed: 10.0,
+            ..Truth::default()
+        };
         m.start(&truth, 0.0).unwrap();
         for k in 0..500 {
             let t = k as f64 * h;
             // The truth carries the time of its step: accel_x = t, height = t.
             truth.specific_force.x = t;
             truth.pos_ned.z = -t;
+            // Heading ψ = t (rad) and airspeed 10 + t (m/s) carry it to the magnetometer and pitot.
+            truth.quat = tailsitter_physics::quat_from_euler_321(0.0, 0.0, t);
+            truth.airspeed = 10.0 + t;
             let out = m.step(&truth, t, h).unwrap();
             // Latest sample instant before t + h, and the step that contains it.
             let held = |rate: f64| {
@@ -384,7 +397,6 @@ fn outputs_hold_the_latest_sample_at_each_rate() {
                 ((t_sample / h) + 1e-9).floor() * h
             };
             let expect_accel = held(accel_rate);
-            // The sample at t = 0 was taken at start with accel_x = 0 too.
             assert!(
                 (out.analog[0] - expect_accel).abs() < 1e-9,
                 "{accel_rate} Hz at t = {t}"
@@ -393,9 +405,14 @@ fn outputs_hold_the_latest_sample_at_each_rate() {
             let fixes = ((t + h) * gps_rate - 1e-9).ceil() as u32;
             assert_eq!(out.gps_fix_count, fixes, "{gps_rate} Hz at t = {t}");
             assert!((out.gps_height - held(gps_rate)).abs() < 1e-9, "GPS at t = {t}");
-            // The magnetometer sees a constant truth: its held value never changes (no noise).
-            let _ = mag_rate;
-            assert!((out.mag().norm() - p.mag_field_total).abs() < 1e-12);
+            // Magnetometer: the WMM field rotated by the heading of the held step.
+            let m_expected = dcm_321(0.0, 0.0, held(mag_rate)) * Vector3::from(WMM_XYZ_GAUSS);
+            assert!((out.mag() - m_expected).norm() < 1e-4, "{mag_rate} Hz at t = {t}");
+            // Pitot: indicated = true airspeed at ρ₀ (α = β = 0) of the held step.
+            assert!(
+                (out.pitot_airspeed() - (10.0 + held(pitot_rate))).abs() < 1e-9,
+                "{pitot_rate} Hz at t = {t}"
+            );
         }
     }
 }
