@@ -154,3 +154,26 @@ fn fmu_state_round_trip_continues_bit_identically() {
         assert!(m3.read_state(&mut StateReader::new(&bytes[..n])).is_err(), "{n}");
     }
 }
+
+#[test]
+fn declared_start_values_are_the_model_defaults() {
+    let p = tailsitter_sensors::params_from(&Variables::with_start_values()).unwrap();
+    let d = sensor_model::Params::default();
+    // Angles are declared in rad from the same degrees: equal to the last bits or nearly.
+    for (a, b) in [
+        (p.ref_latitude, d.ref_latitude),
+        (p.ref_longitude, d.ref_longitude),
+        (p.mag_declination, d.mag_declination),
+        (p.mag_inclination, d.mag_inclination),
+    ] {
+        assert!((a - b).abs() < 1e-12, "{a} vs {b}");
+    }
+    let same_angles = sensor_model::Params {
+        ref_latitude: d.ref_latitude,
+        ref_longitude: d.ref_longitude,
+        mag_declination: d.mag_declination,
+        mag_inclination: d.mag_inclination,
+        ..p
+    };
+    assert_eq!(same_angles, d);
+}
