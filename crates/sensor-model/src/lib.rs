@@ -319,16 +319,13 @@ pub struct State {
 }
 
 /// Number of u64 words of [`State::save`].
-pub const STATE_WORDS: usize = N_SENSORS * 6 + 1 + N_SENSORS + 2 * N_ANALOG + 8 + N_ANALOG + 2;
+pub const STATE_WORDS: usize = N_SENSORS * 4 + 1 + N_SENSORS + 2 * N_ANALOG + 8 + N_ANALOG + 2;
 
 impl State {
     /// Serialise to `STATE_WORDS` words (f64 as IEEE bits: bit-exact).
     pub fn save(&self, out: &mut dyn FnMut(u64)) {
         for r in &self.rng {
-            let (s, spare) = r.to_parts();
-            s.iter().for_each(|w| out(*w));
-            out(u64::from(spare.is_some()));
-            out(spare.unwrap_or(0.0).to_bits());
+            r.to_parts().iter().for_each(|w| out(*w));
         }
         out(self.t0.to_bits());
         self.next_sample.iter().for_each(|k| out(*k));
@@ -365,10 +362,7 @@ impl State {
         let mut rng = [NoiseRng::from_seed(0); N_SENSORS];
         for r in rng.iter_mut() {
             let s = [word()?, word()?, word()?, word()?];
-            let has_spare = flag(word()?, "spare")?;
-            let spare = f64::from_bits(word()?);
-            *r = NoiseRng::from_parts(s, has_spare.then_some(spare))
-                .ok_or_else(|| "sensor state: invalid noise generator state".to_string())?;
+            *r = NoiseRng::from_parts(s).ok_or_else(|| "sensor state: invalid noise generator state".to_string())?;
         }
         let finite = |x: f64, what: &str| {
             if x.is_finite() {

@@ -478,7 +478,11 @@ fn saved_state_continues_bit_identically() {
         assert!(State::restore(&mut || it.next()).is_err(), "{n}");
     }
     let mut bad = words.clone();
-    bad[4] = 7; // the first stream's spare flag
+    bad[..4].fill(0); // the first stream's state: the generator's fixed point
+    let mut it = bad.into_iter();
+    assert!(State::restore(&mut || it.next()).is_err());
+    let mut bad = words.clone();
+    bad[STATE_WORDS - 2] = 7; // the stuck flag
     let mut it = bad.into_iter();
     assert!(State::restore(&mut || it.next()).is_err());
 }
