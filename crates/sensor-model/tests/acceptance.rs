@@ -210,6 +210,11 @@ fn unfiltered_noise_matches_table_d1_and_means_are_unbiased() {
     for c in 0..10 {
         let s = &analog[c];
         let n = s.n as f64;
+        println!(
+            "unfiltered channel {c}: σ/σ_param = {:.4}, (mean − truth)·√n/σ = {:+.2}",
+            s.std() / sigma_analog[c],
+            (s.mean() - truth_analog[c]) * n.sqrt() / sigma_analog[c]
+        );
         assert!(
             (s.std() / sigma_analog[c] - 1.0).abs() < 0.05,
             "channel {c}: σ {} vs {}",
@@ -235,6 +240,11 @@ fn unfiltered_noise_matches_table_d1_and_means_are_unbiased() {
         let s = &gps[c];
         assert!(s.n >= 7_900, "{} fixes", s.n);
         let n = s.n as f64;
+        println!(
+            "gps {c}: σ/σ_param = {:.4}, (mean − truth)·√n/σ = {:+.2}",
+            s.std() / sigma_gps[c],
+            (s.mean() - truth_gps[c]) * n.sqrt() / sigma_gps[c]
+        );
         assert!((s.std() / sigma_gps[c] - 1.0).abs() < 0.05, "gps {c}: σ {}", s.std());
         assert!(
             (s.mean() - truth_gps[c]).abs() < 3.0 * sigma_gps[c] / n.sqrt(),
@@ -287,6 +297,7 @@ fn filtered_noise_matches_the_filter_noise_bandwidth() {
     for c in 0..10 {
         let s = &analog[c];
         let sigma = raw[c] * gain[c];
+        println!("filtered channel {c}: σ/σ_expected = {:.4}", s.std() / sigma);
         assert!(
             (s.std() / sigma - 1.0).abs() < 0.05,
             "channel {c}: σ {} vs {sigma}",
@@ -339,6 +350,7 @@ fn sine_gain(rate: f64, f: f64) -> f64 {
 fn butterworth_minus_3_db_point_is_at_8_hz() {
     for rate in [200.0, 50.0, 1000.0] {
         let g8 = sine_gain(rate, 8.0);
+        println!("{rate} Hz: |H(8 Hz)| = {g8:.5} (−3 dB = 0.70711)");
         assert!((g8 - 0.5f64.sqrt()).abs() < 0.005, "{rate} Hz: |H(8 Hz)| = {g8}");
         // Maximally flat below, −12 dB/octave above (second order): |H(32 Hz)| ≈ 1/16.
         assert!(sine_gain(rate, 1.0) > 0.999);
