@@ -31,6 +31,11 @@ const FMUS: &[(&str, &str, &[&str])] = &[
         "tailsitter_tsd",
         &["fmu-tsd/README.md", "crates/tsd-control/README.md"],
     ),
+    (
+        "fmu-sensors",
+        "tailsitter_sensors",
+        &["fmu-sensors/README.md", "crates/sensor-model/README.md"],
+    ),
 ];
 
 #[derive(Parser)]

@@ -1,0 +1,92 @@
+//! `fmi2DoStep` of the sensor FMU over a 20 ms communication step at the default
+//! rates (accelerometer and gyro 200 Hz, magnetometer and pitot 50 Hz, GPS 4 Hz),
+//! and with the accelerometers at the thesis's 1 kHz, called through the same
+//! generic C-ABI functions the exported symbols use. Issue bar: ≤ 5 µs per step.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use fmi2_export::ffi;
+use fmi2_export::fmi_sys::fmi2::*;
+use std::ffi::{c_char, c_void, CString};
+use std::hint::black_box;
+use tailsitter_sensors::{vr, SensorsModel, GUID};
+
+/// No-op host logger (see fmu-plant/benches/do_step.rs for why the transmute is sound).
+unsafe extern "C" fn quiet(
+    _env: fmi2ComponentEnvironment,
+    _name: fmi2String,
+    _status: fmi2Status,
+    _category: fmi2String,
+    _format: fmi2String,
+    _message: *const c_char,
+) {
+}
+
+fn bench(c: &mut Criterion) {
+    let logger: fmi2CallbackLogger =
+        // SAFETY: the layer never passes more than one variadic argument.
+        Some(unsafe { std::mem::transmute::<*const c_void, unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, fmi2Status, fmi2String, fmi2String, ...)>(quiet as *const c_void) });
+    let callbacks = fmi2CallbackFunctions {
+        logger,
+        allocateMemory: None,
+        freeMemory: None,
+        stepFinished: None,
+        componentEnvironment: std::ptr::null_mut(),
+    };
+    let name = CString::new("bench").unwrap();
+    let guid = CString::new(GUID).unwrap();
+    for (label, imu_rate) in [("default_rates", 200.0), ("imu_1kHz", 1000.0)] {
+        // SAFETY: valid, NUL-terminated strings and callbacks that outlive the instance.
+        let inst = unsafe {
+            ffi::instantiate::<SensorsModel>(
+                name.as_ptr(),
+                fmi2Type_fmi2CoSimulation,
+                guid.as_ptr(),
+                std::ptr::null(),
+                &callbacks,
+                0,
+                0,
+            )
+        };
+        assert!(!inst.is_null());
+        unsafe {
+            assert_eq!(
+                ffi::setup_experiment::<SensorsModel>(inst, 0, 0.0, 0.0, 0, 0.0),
+                fmi2Status_fmi2OK
+            );
+            assert_eq!(ffi::enter_initialization_mode::<SensorsModel>(inst), fmi2Status_fmi2OK);
+            let rates = [imu_rate, imu_rate];
+            let rate_vrs = [vr::accel_rate, vr::gyro_rate];
+            assert_eq!(
+                ffi::set_real::<SensorsModel>(inst, rate_vrs.as_ptr(), 2, rates.as_ptr()),
+                fmi2Status_fmi2OK
+            );
+            assert_eq!(ffi::exit_initialization_mode::<SensorsModel>(inst), fmi2Status_fmi2OK);
+            // A level flight at 25 m/s, rolling slowly: every channel non-trivial.
+            let vrs = [vr::airspeed, vr::vel_n, vr::p, vr::alpha];
+            let values = [25.0, 25.0, 0.1, 0.1];
+            assert_eq!(
+                ffi::set_real::<SensorsModel>(inst, vrs.as_ptr(), 4, values.as_ptr()),
+                fmi2Status_fmi2OK
+            );
+        }
+        let mut t = 0.0;
+        let h = 0.02;
+        c.bench_function(&format!("sensors_fmi2DoStep_20ms_{label}"), |b| {
+            b.iter(|| {
+                // SAFETY: live instance in StepComplete.
+                let status = unsafe { ffi::do_step::<SensorsModel>(inst, black_box(t), h, 1) };
+                assert_eq!(status, fmi2Status_fmi2OK);
+                t += h;
+            })
+        });
+        // SAFETY: live instance, freed once.
+        unsafe { ffi::free_instance::<SensorsModel>(inst) };
+    }
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(50);
+    targets = bench
+}
+criterion_main!(benches);

@@ -1,0 +1,179 @@
+//! The FMU binding through `FmuModel` (no C layer): start values, bad input and
+//! parameters as errors with finite outputs, FMU state continuing bit-identically.
+
+use fmi2_export::{FmuModel, Logger, StateReader, StateWriter, VariableStore};
+use tailsitter_sensors::{SensorsModel, Variables};
+
+fn outputs(v: &Variables) -> Vec<u64> {
+    [
+        v.gps_latitude,
+        v.gps_longitude,
+        v.gps_height,
+        v.gps_vel_n,
+        v.gps_vel_e,
+        v.gps_vel_d,
+        v.imu_accel_x,
+        v.imu_accel_y,
+        v.imu_accel_z,
+        v.imu_gyro_p,
+        v.imu_gyro_q,
+        v.imu_gyro_r,
+        v.mag_x,
+        v.mag_y,
+        v.mag_z,
+        v.pitot_airspeed,
+    ]
+    .iter()
+    .map(|x| x.to_bits())
+    .chain([v.gps_fix_count as u64, v.gps_valid as u64])
+    .collect()
+}
+
+fn started() -> (Variables, SensorsModel) {
+    let mut vars = Variables::with_start_values();
+    let mut model = SensorsModel::new(&vars);
+    model.initialize(&mut vars, 0.0, &mut Logger::null()).unwrap();
+    (vars, model)
+}
+
+#[test]
+fn start_values_give_a_level_aircraft_at_rest_at_the_reference_point() {
+    let (v, _) = started();
+    assert_eq!(v.gps_fix_count, 1);
+    assert!(v.gps_valid);
+    // GPS within 5σ of the reference point (σ from Table D.1).
+    assert!((v.gps_latitude - v.ref_latitude).abs() < 5.0 * v.gps_latlon_std);
+    assert!((v.gps_height - v.ref_height).abs() < 5.0 * v.gps_height_std);
+    // Accelerometer reads −g on z (filtered noise: σ·gain ≈ 0.04 m/s²).
+    assert!((v.imu_accel_z + 9.81).abs() < 5.0 * v.accel_std * v.accel_noise_gain);
+    // Level, heading north: the magnetometer sees the NED field; its down component is
+    // F sin I (negative: the field points up in the southern hemisphere).
+    let down = v.mag_field_total * v.mag_inclination.sin();
+    assert!((v.mag_z - down).abs() < 5.0 * v.mag_std * v.mag_noise_gain);
+    for g in [
+        v.accel_noise_gain,
+        v.gyro_noise_gain,
+        v.mag_noise_gain,
+        v.pitot_noise_gain,
+    ] {
+        assert!(g > 0.1 && g < 1.0, "{g}");
+    }
+}
+
+#[test]
+fn non_finite_input_is_an_error_and_outputs_stay_finite() {
+    let (mut v, mut m) = started();
+    let mut log = Logger::null();
+    m.do_step(&mut v, 0.0, 0.02, &mut log).unwrap();
+    let before = outputs(&v);
+    v.vel_e = f64::NAN;
+    let e = m.do_step(&mut v, 0.02, 0.02, &mut log).unwrap_err();
+    assert!(e.message.contains("vel_e"), "{e}");
+    assert_eq!(outputs(&v), before);
+    m.update_outputs(&mut v).unwrap();
+    assert_eq!(outputs(&v), before);
+    v.vel_e = 0.0;
+    v.quat_4 = 0.0;
+    assert!(m
+        .do_step(&mut v, 0.02, 0.02, &mut log)
+        .unwrap_err()
+        .message
+        .contains("quaternion"));
+}
+
+#[test]
+fn bad_parameters_fail_initialization_with_the_reason() {
+    for (set, what) in [
+        (
+            Box::new(|v: &mut Variables| v.filter_bandwidth = 30.0) as Box<dyn Fn(&mut Variables)>,
+            "filter_bandwidth",
+        ),
+        (Box::new(|v: &mut Variables| v.fault_mode = 3), "fault_mode"),
+        (Box::new(|v: &mut Variables| v.gyro_std = f64::NAN), "gyro_std"),
+        (Box::new(|v: &mut Variables| v.quat_1 = 0.7), "quaternion"),
+    ] {
+        let mut v = Variables::with_start_values();
+        set(&mut v);
+        let mut m = SensorsModel::new(&v);
+        let e = m.initialize(&mut v, 0.0, &mut Logger::null()).unwrap_err();
+        assert!(e.message.contains(what), "{what}: {e}");
+        // Nothing to step: an error, not a panic.
+        assert!(m.do_step(&mut v, 0.0, 0.02, &mut Logger::null()).is_err());
+    }
+}
+
+#[test]
+fn initialize_is_idempotent_and_seeded() {
+    let (a, _) = started();
+    let (b, _) = started();
+    assert_eq!(outputs(&a), outputs(&b));
+    let mut v = Variables::with_start_values();
+    v.seed = -7;
+    let mut m = SensorsModel::new(&v);
+    m.initialize(&mut v, 0.0, &mut Logger::null()).unwrap();
+    assert_ne!(outputs(&v)[6..16], outputs(&a)[6..16]);
+    // Re-initialising the same instance (as the layer does after fmi2Reset) starts over.
+    m.initialize(&mut v, 0.0, &mut Logger::null()).unwrap();
+    let first = outputs(&v);
+    m.do_step(&mut v, 0.0, 0.02, &mut Logger::null()).unwrap();
+    m.initialize(&mut v, 0.0, &mut Logger::null()).unwrap();
+    assert_eq!(outputs(&v), first);
+}
+
+#[test]
+fn fmu_state_round_trip_continues_bit_identically() {
+    let (mut v, mut m) = started();
+    let mut log = Logger::null();
+    v.airspeed = 18.0;
+    v.p = 0.2;
+    for k in 0..33 {
+        m.do_step(&mut v, k as f64 * 0.02, 0.02, &mut log).unwrap();
+    }
+    let mut w = StateWriter::new();
+    m.write_state(&mut w);
+    let bytes = w.into_bytes();
+    let saved_vars = v.clone();
+    let mut reference = Vec::new();
+    for k in 33..200 {
+        m.do_step(&mut v, k as f64 * 0.02, 0.02, &mut log).unwrap();
+        reference.push(outputs(&v));
+    }
+    // Restore into a fresh instance (as fmi2DeSerializeFMUstate does: variables, then model state).
+    let mut v2 = saved_vars;
+    let mut m2 = SensorsModel::new(&v2);
+    let mut r = StateReader::new(&bytes);
+    m2.read_state(&mut r).unwrap();
+    r.finish().unwrap();
+    for (i, k) in (33..200).enumerate() {
+        m2.do_step(&mut v2, k as f64 * 0.02, 0.02, &mut log).unwrap();
+        assert_eq!(outputs(&v2), reference[i], "step {k}");
+    }
+    // Truncated buffers are errors, never panics.
+    for n in 0..bytes.len() {
+        let mut m3 = SensorsModel::new(&v2);
+        assert!(m3.read_state(&mut StateReader::new(&bytes[..n])).is_err(), "{n}");
+    }
+}
+
+#[test]
+fn declared_start_values_are_the_model_defaults() {
+    let p = tailsitter_sensors::params_from(&Variables::with_start_values()).unwrap();
+    let d = sensor_model::Params::default();
+    // Angles are declared in rad from the same degrees: equal to the last bits or nearly.
+    for (a, b) in [
+        (p.ref_latitude, d.ref_latitude),
+        (p.ref_longitude, d.ref_longitude),
+        (p.mag_declination, d.mag_declination),
+        (p.mag_inclination, d.mag_inclination),
+    ] {
+        assert!((a - b).abs() < 1e-12, "{a} vs {b}");
+    }
+    let same_angles = sensor_model::Params {
+        ref_latitude: d.ref_latitude,
+        ref_longitude: d.ref_longitude,
+        mag_declination: d.mag_declination,
+        mag_inclination: d.mag_inclination,
+        ..p
+    };
+    assert_eq!(same_angles, d);
+}
