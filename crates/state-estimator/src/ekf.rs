@@ -12,7 +12,8 @@
 //!
 //! Updates (sequential, each χ²-gated, Joseph form): GPS position (geodetic → NED) and
 //! velocity at each new fix, magnetometer (C m_ned), pitot (body-x air-relative velocity
-//! e_xᵀ C (v − w)).
+//! e_xᵀ C (v − w)), and above `sideslip_min_airspeed` a zero-sideslip pseudo-measurement
+//! e_yᵀ C (v − w) = 0 (the cross-wind is otherwise unobservable).
 
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3, Vector4};
 use tailsitter_physics::{dcm_earth_to_body, euler_321_from_quat, quat_from_dcm, InputVector, AIRSPEED_EPS};
@@ -658,6 +659,7 @@ impl Ekf {
             self.fuse_gps(m, &mut rep);
             self.fuse_mag(m, &mut rep);
             self.fuse_pitot(m, &mut rep);
+            self.fuse_sideslip();
         }
         self.predict(h, imu_inflation);
         self.state.actuators.advance(&self.params.airframe, u, h);
@@ -942,6 +944,30 @@ impl Ekf {
         if let Err(reason) = self.update(&y, &hm, &r, GATE_1DOF) {
             rep.reject(Sensor::Pitot, reason);
         }
+    }
+
+    /// Zero-sideslip pseudo-measurement: e_yᵀ C (v − w) = 0 with σ = σ_β V̄, above
+    /// `sideslip_min_airspeed`. Synthetic: a gated-out value is skipped, not counted.
+    fn fuse_sideslip(&mut self) {
+        let t = &self.params.tuning;
+        if t.sigma_sideslip <= 0.0 {
+            return;
+        }
+        let s = &self.state;
+        let c = dcm_earth_to_body(&s.quat);
+        let a = s.vel - s.wind;
+        let airspeed = a.norm();
+        if airspeed < t.sideslip_min_airspeed {
+            return;
+        }
+        let cy = c.row(1).into_owned();
+        let y = SVector::<f64, 1>::new(-cy.dot(&a.transpose()));
+        let mut hm = SMatrix::<f64, 1, N_ERR>::zeros();
+        hm.fixed_view_mut::<1, 3>(0, ix::VEL).copy_from(&cy);
+        hm.fixed_view_mut::<1, 3>(0, ix::WIND).copy_from(&(-cy));
+        hm.fixed_view_mut::<1, 3>(0, ix::ATT).copy_from(&(cy * skew(&a)));
+        let r = SMatrix::<f64, 1, 1>::new((t.sigma_sideslip * airspeed).powi(2));
+        let _ = self.update(&y, &hm, &r, GATE_1DOF);
     }
 
     /// The current estimate (at the end of the last step).

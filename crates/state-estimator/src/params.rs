@@ -126,6 +126,12 @@ pub struct Tuning {
     /// The pitot is fused only above this reading (m/s): at lower airspeed (hover) the
     /// pressure is too small to resolve.
     pub pitot_min_airspeed: f64,
+    /// σ of the zero-sideslip pseudo-measurement (rad): above `sideslip_min_airspeed` the
+    /// aircraft is assumed to fly with β ≈ 0, which makes the cross-wind observable (the
+    /// pitot only measures along body x). 0 disables it.
+    pub sigma_sideslip: f64,
+    /// Airspeed above which the zero-sideslip pseudo-measurement is fused (m/s).
+    pub sideslip_min_airspeed: f64,
     /// After this many consecutive rejected GPS position (or velocity) fixes the filter
     /// resets that block to the GPS: the filter, not the GPS, has lost track.
     pub gps_reset_after: u32,
@@ -140,6 +146,8 @@ impl Default for Tuning {
             init_std_pos_no_gps: 50.0,
             init_std_vel_no_gps: 5.0,
             pitot_min_airspeed: 1.0,
+            sigma_sideslip: 0.1,
+            sideslip_min_airspeed: 10.0,
             gps_reset_after: 8,
         }
     }
@@ -189,6 +197,8 @@ impl EstimatorParams {
             ("accel_bias_walk", self.process.accel_bias_walk),
             ("wind_walk", self.process.wind_walk),
             ("pitot_min_airspeed", self.tuning.pitot_min_airspeed),
+            ("sigma_sideslip", self.tuning.sigma_sideslip),
+            ("sideslip_min_airspeed", self.tuning.sideslip_min_airspeed),
         ];
         for (name, v) in non_negative {
             if !(v.is_finite() && v >= 0.0) {
