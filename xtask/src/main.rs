@@ -31,6 +31,11 @@ const FMUS: &[(&str, &str, &[&str])] = &[
         "tailsitter_tsd",
         &["fmu-tsd/README.md", "crates/tsd-control/README.md"],
     ),
+    (
+        "fmu-ekf",
+        "tailsitter_ekf",
+        &["fmu-ekf/README.md", "crates/state-estimator/README.md"],
+    ),
 ];
 
 #[derive(Parser)]
