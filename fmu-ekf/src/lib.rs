@@ -187,8 +187,8 @@ impl FmuModel for EkfModel {
     }
 
     /// Initialise from the inputs set for the start time: attitude by accelerometer levelling
-    /// + magnetometer (TRIAD), position and velocity from a valid GPS fix, motor and servos at
-    /// the steady state of the commands ([`Ekf::initialize`]); logged.
+    /// and magnetometer (TRIAD), position and velocity from a valid GPS fix, motor and servos
+    /// at the steady state of the commands ([`Ekf::initialize`]); logged.
     fn initialize(&mut self, vars: &mut Variables, _start_time: f64, log: &mut Logger<'_>) -> Result<(), ModelError> {
         let mut ekf = Self::ekf_from(vars)?;
         let r = ekf.initialize(&measurements(vars), &commands(vars));

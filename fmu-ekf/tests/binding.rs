@@ -159,7 +159,7 @@ impl Sim {
         v.mag_z = m.z + 0.02 * n.next();
         // Indicated airspeed along body x: the body-x air-relative velocity (still air).
         v.pitot_airspeed = self.x[idx::U] + 0.5 * n.next();
-        if self.k % 12 == 0 {
+        if self.k.is_multiple_of(12) {
             let p = Vector3::new(self.x[idx::POS_N], self.x[idx::POS_E], self.x[idx::POS_D]);
             let (la, lo, h) = self.frame.to_geodetic(&p);
             v.gps_latitude = la + 6.2832e-7 * n.next();
@@ -460,7 +460,7 @@ fn c_abi_serialize_reset_nan_and_gps_restart() {
         assert!(outputs(c).iter().all(|x| x.is_finite()));
 
         // GPS restart: the fix counter goes back; logged, the fix is used.
-        while sim.k % 12 != 0 {
+        while !sim.k.is_multiple_of(12) {
             step(&mut sim, &mut v, &mut t);
         }
         v.gps_fix_count = -1; // set_inputs adds 1 at this fix: 0 < previous count

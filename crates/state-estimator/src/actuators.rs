@@ -73,7 +73,7 @@ mod tests {
     #[test]
     fn follows_the_plants_actuator_states() {
         let a = Airframe::default();
-        let plant = Plant::new(a.clone());
+        let plant = Plant::new(a);
         let mut x = plant.trim_vertical_climb(3.0).unwrap().state;
         let u0 = plant.trim_vertical_climb(3.0).unwrap().inputs;
         let mut act = Actuators::steady(&a, &u0);

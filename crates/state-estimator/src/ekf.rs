@@ -483,7 +483,7 @@ impl Ekf {
             return Err(Reason::NonFinite);
         }
         let n = m.mag.norm();
-        if !(n <= limits::MAG) {
+        if n > limits::MAG {
             return Err(Reason::OutOfRange(n));
         }
         Ok(())
@@ -709,7 +709,7 @@ impl Ekf {
                 1e12
             };
             let d = p[(i, i)];
-            if !(d >= 1e-12) {
+            if d.is_nan() || d < 1e-12 {
                 p[(i, i)] = 1e-12;
             } else if d > max {
                 // Scale the row and column so the correlations are kept.

@@ -55,14 +55,13 @@ pub fn ecef_to_geodetic(r: &Vector3<f64>) -> (f64, f64, f64) {
     let mut height = 0.0;
     for _ in 0..5 {
         let n = prime_vertical_radius(lat);
-        let (sl, cl) = lat.sin_cos();
+        let cl = lat.cos();
         height = if cl.abs() > 1e-10 {
             p / cl - n
         } else {
             r.z.abs() - n * (1.0 - WGS84_E2)
         };
         lat = r.z.atan2(p * (1.0 - WGS84_E2 * n / (n + height)));
-        let _ = sl;
     }
     (lat, longitude, height)
 }
@@ -133,7 +132,7 @@ mod tests {
         let r = geodetic_to_ecef(0.0, 0.0, 0.0);
         assert!((r - Vector3::new(WGS84_A, 0.0, 0.0)).norm() < 1e-6);
         let r = geodetic_to_ecef(std::f64::consts::FRAC_PI_2, 0.0, 0.0);
-        assert!((r.z - 6_356_752.3142).abs() < 1e-3 && r.x.abs() < 1e-6);
+        assert!((r.z - 6_356_752.314_2).abs() < 1e-3 && r.x.abs() < 1e-6);
     }
 
     #[test]

@@ -206,19 +206,22 @@ impl EstimatorParams {
             }
         }
         let e = &self.earth;
-        if !(e.ref_latitude.abs() <= 1.5) {
+        if !e.ref_latitude.is_finite() || e.ref_latitude.abs() > 1.5 {
             return Err(format!(
                 "ref_latitude = {} rad must be within ±1.5 rad (the NED frame degenerates at the poles)",
                 e.ref_latitude
             ));
         }
-        if !(e.ref_longitude.abs() <= std::f64::consts::PI) {
+        if !e.ref_longitude.is_finite() || e.ref_longitude.abs() > std::f64::consts::PI {
             return Err(format!("ref_longitude = {} rad must be within ±π", e.ref_longitude));
         }
         if !(e.ref_height.is_finite() && e.ref_height.abs() <= 1e5) {
             return Err(format!("ref_height = {} m must be within ±1e5 m", e.ref_height));
         }
-        if !(e.mag_inclination.abs() < 1.5 && e.mag_declination.abs() <= std::f64::consts::PI) {
+        if !(e.mag_inclination.is_finite() && e.mag_declination.is_finite())
+            || e.mag_inclination.abs() >= 1.5
+            || e.mag_declination.abs() > std::f64::consts::PI
+        {
             return Err(format!(
                 "mag_inclination = {} rad must be within ±1.5 rad (a horizontal component is needed for heading) and mag_declination = {} rad within ±π",
                 e.mag_inclination, e.mag_declination
