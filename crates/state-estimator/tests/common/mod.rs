@@ -150,10 +150,22 @@ impl SensorSim {
     /// Measurements at step `k` of `truth` (time k H). The GPS samples the true state at the
     /// first communication point of each 250 ms period and holds it until the next fix.
     pub fn measure(&mut self, ekf: &Ekf, truth: &Truth, k: usize) -> Measurements {
-        let x = &truth.x[k];
-        let u = &truth.u[k.min(truth.len() - 1)];
-        let wind = truth.wind;
-        let y = truth.plant.outputs(x, u, &wind);
+        let u = truth.u[k.min(truth.len() - 1)];
+        self.measure_state(ekf, &truth.plant, &truth.x[k], &u, &truth.wind, k)
+    }
+
+    /// Measurements of the plant state `x` (commands `u`, wind) at step `k` (time k H).
+    pub fn measure_state(
+        &mut self,
+        ekf: &Ekf,
+        plant: &Plant,
+        x: &StateVector,
+        u: &InputVector,
+        wind: &Vector3<f64>,
+        k: usize,
+    ) -> Measurements {
+        let wind = *wind;
+        let y = plant.outputs(x, u, &wind);
         let n = self.params.noise;
         let c = dcm_earth_to_body(&quat(x));
         let pos = Vector3::new(x[idx::POS_N], x[idx::POS_E], x[idx::POS_D]);
