@@ -1,0 +1,232 @@
+//! Parameters of the estimator: sensor noise (thesis Table D.1), process noise, the
+//! reference point and Earth field, initial uncertainties.
+
+use nalgebra::Vector3;
+use tailsitter_physics::Airframe;
+
+/// Measurement noise σ of the sensors (defaults: thesis Table D.1) and the IMU period.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SensorNoise {
+    /// GPS latitude and longitude σ (rad) (Table D.1: 6.2832e-7 rad ≈ 4 m).
+    pub sigma_gps_latlon: f64,
+    /// GPS height σ (m) (Table D.1: 4 m).
+    pub sigma_gps_height: f64,
+    /// GPS velocity σ per NED axis (m/s) (Table D.1: 0.5 m/s).
+    pub sigma_gps_vel: f64,
+    /// Accelerometer σ per axis and sample (m/s²) (Table D.1: 0.1414 m/s²).
+    pub sigma_accel: f64,
+    /// Rate-gyro σ per axis and sample (rad/s) (Table D.1: 27.925e-3 rad/s).
+    pub sigma_gyro: f64,
+    /// Magnetometer σ per axis (Gauss) (Table D.1: 0.02 Gauss).
+    pub sigma_mag: f64,
+    /// Pitot airspeed σ (m/s) (not in Table D.1; 0.5 m/s, see the crate README).
+    pub sigma_pitot: f64,
+    /// Period of the IMU samples (s): converts the per-sample σ to a noise density (20 ms).
+    pub imu_period: f64,
+}
+
+impl Default for SensorNoise {
+    fn default() -> Self {
+        Self {
+            sigma_gps_latlon: 6.2832e-7,
+            sigma_gps_height: 4.0,
+            sigma_gps_vel: 0.5,
+            sigma_accel: 0.1414,
+            sigma_gyro: 27.925e-3,
+            sigma_mag: 0.02,
+            sigma_pitot: 0.5,
+            imu_period: 0.02,
+        }
+    }
+}
+
+/// Process noise beyond the IMU's own noise.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ProcessNoise {
+    /// Acceleration model-error density (m/s^{3/2}): covers the zero-order hold of the
+    /// specific force over a step while the aircraft manoeuvres.
+    pub accel_model: f64,
+    /// Angular-rate model-error density (rad/s^{1/2}): the same for the rates.
+    pub gyro_model: f64,
+    /// Gyro-bias random walk (rad/s/√s).
+    pub gyro_bias_walk: f64,
+    /// Accelerometer-bias random walk (m/s²/√s).
+    pub accel_bias_walk: f64,
+    /// Wind random walk (m/s/√s).
+    pub wind_walk: f64,
+}
+
+impl Default for ProcessNoise {
+    fn default() -> Self {
+        Self {
+            accel_model: 0.01,
+            gyro_model: 0.0005,
+            gyro_bias_walk: 1e-4,
+            accel_bias_walk: 1e-3,
+            wind_walk: 0.1,
+        }
+    }
+}
+
+/// Reference point of the local NED frame and the Earth's fields there.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Earth {
+    /// Latitude of the NED origin (rad) (default −33.93°, Stellenbosch).
+    pub ref_latitude: f64,
+    /// Longitude of the NED origin (rad) (default 18.86°).
+    pub ref_longitude: f64,
+    /// Height of the NED origin above the WGS-84 ellipsoid (m) (default 0).
+    pub ref_height: f64,
+    /// Total magnetic field intensity (Gauss) (≈ 0.26 Gauss near Stellenbosch).
+    pub mag_total: f64,
+    /// Magnetic declination, east of true north positive (rad) (≈ −25°).
+    pub mag_declination: f64,
+    /// Magnetic inclination, below the horizontal positive (rad) (≈ −65°: field points up).
+    pub mag_inclination: f64,
+    /// Gravitational acceleration (m/s²), as the plant's `gravity` (9.81).
+    pub gravity: f64,
+}
+
+impl Default for Earth {
+    fn default() -> Self {
+        Self {
+            ref_latitude: (-33.93f64).to_radians(),
+            ref_longitude: 18.86f64.to_radians(),
+            ref_height: 0.0,
+            mag_total: 0.26,
+            mag_declination: (-25.0f64).to_radians(),
+            mag_inclination: (-65.0f64).to_radians(),
+            gravity: 9.81,
+        }
+    }
+}
+
+impl Earth {
+    /// The Earth field in NED components (Gauss): F(cos I cos D, cos I sin D, sin I).
+    pub fn mag_ned(&self) -> Vector3<f64> {
+        let (si, ci) = self.mag_inclination.sin_cos();
+        let (sd, cd) = self.mag_declination.sin_cos();
+        self.mag_total * Vector3::new(ci * cd, ci * sd, si)
+    }
+}
+
+/// Initial uncertainties of the states not set from a measurement, and behaviour limits.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tuning {
+    /// Initial wind σ per axis (m/s).
+    pub init_std_wind: f64,
+    /// Initial gyro-bias σ per axis (rad/s).
+    pub init_std_gyro_bias: f64,
+    /// Initial accelerometer-bias σ per axis (m/s²).
+    pub init_std_accel_bias: f64,
+    /// Initial position σ per axis without a GPS fix at initialisation (m).
+    pub init_std_pos_no_gps: f64,
+    /// Initial velocity σ per axis without a GPS fix at initialisation (m/s).
+    pub init_std_vel_no_gps: f64,
+    /// The pitot is fused only above this reading (m/s): at lower airspeed (hover) the
+    /// pressure is too small to resolve.
+    pub pitot_min_airspeed: f64,
+    /// σ of the zero-sideslip pseudo-measurement (rad): above `sideslip_min_airspeed` the
+    /// aircraft is assumed to fly with β ≈ 0, which makes the cross-wind observable (the
+    /// pitot only measures along body x). 0 disables it.
+    pub sigma_sideslip: f64,
+    /// Airspeed above which the zero-sideslip pseudo-measurement is fused (m/s).
+    pub sideslip_min_airspeed: f64,
+    /// After this many consecutive rejected GPS position (or velocity) fixes the filter
+    /// resets that block to the GPS: the filter, not the GPS, has lost track.
+    pub gps_reset_after: u32,
+}
+
+impl Default for Tuning {
+    fn default() -> Self {
+        Self {
+            init_std_wind: 3.0,
+            init_std_gyro_bias: 0.005,
+            init_std_accel_bias: 0.05,
+            init_std_pos_no_gps: 50.0,
+            init_std_vel_no_gps: 5.0,
+            pitot_min_airspeed: 1.0,
+            sigma_sideslip: 0.1,
+            sideslip_min_airspeed: 10.0,
+            gps_reset_after: 8,
+        }
+    }
+}
+
+/// Everything the estimator needs besides the measurements.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct EstimatorParams {
+    pub noise: SensorNoise,
+    pub process: ProcessNoise,
+    pub earth: Earth,
+    pub tuning: Tuning,
+    /// The airframe: motor and servo models (τ_T, thrust limits, servo τ, rate and
+    /// deflection limits) and the propeller for the induced velocity (ρ, disc area).
+    pub airframe: Airframe,
+}
+
+impl EstimatorParams {
+    /// Every value finite and in its domain; the error names the parameter.
+    pub fn validate(&self) -> Result<(), String> {
+        let positive = [
+            ("sigma_gps_latlon", self.noise.sigma_gps_latlon),
+            ("sigma_gps_height", self.noise.sigma_gps_height),
+            ("sigma_gps_vel", self.noise.sigma_gps_vel),
+            ("sigma_accel", self.noise.sigma_accel),
+            ("sigma_gyro", self.noise.sigma_gyro),
+            ("sigma_mag", self.noise.sigma_mag),
+            ("sigma_pitot", self.noise.sigma_pitot),
+            ("imu_period", self.noise.imu_period),
+            ("mag_total", self.earth.mag_total),
+            ("gravity", self.earth.gravity),
+            ("init_std_wind", self.tuning.init_std_wind),
+            ("init_std_gyro_bias", self.tuning.init_std_gyro_bias),
+            ("init_std_accel_bias", self.tuning.init_std_accel_bias),
+            ("init_std_pos_no_gps", self.tuning.init_std_pos_no_gps),
+            ("init_std_vel_no_gps", self.tuning.init_std_vel_no_gps),
+        ];
+        for (name, v) in positive {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(format!("{name} = {v} must be finite and > 0"));
+            }
+        }
+        let non_negative = [
+            ("accel_model_noise", self.process.accel_model),
+            ("gyro_model_noise", self.process.gyro_model),
+            ("gyro_bias_walk", self.process.gyro_bias_walk),
+            ("accel_bias_walk", self.process.accel_bias_walk),
+            ("wind_walk", self.process.wind_walk),
+            ("pitot_min_airspeed", self.tuning.pitot_min_airspeed),
+            ("sigma_sideslip", self.tuning.sigma_sideslip),
+            ("sideslip_min_airspeed", self.tuning.sideslip_min_airspeed),
+        ];
+        for (name, v) in non_negative {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(format!("{name} = {v} must be finite and >= 0"));
+            }
+        }
+        let e = &self.earth;
+        if !e.ref_latitude.is_finite() || e.ref_latitude.abs() > 1.5 {
+            return Err(format!(
+                "ref_latitude = {} rad must be within ±1.5 rad (the NED frame degenerates at the poles)",
+                e.ref_latitude
+            ));
+        }
+        if !e.ref_longitude.is_finite() || e.ref_longitude.abs() > std::f64::consts::PI {
+            return Err(format!("ref_longitude = {} rad must be within ±π", e.ref_longitude));
+        }
+        if !(e.ref_height.is_finite() && e.ref_height.abs() <= 1e5) {
+            return Err(format!("ref_height = {} m must be within ±1e5 m", e.ref_height));
+        }
+        if !(e.mag_inclination.is_finite() && e.mag_declination.is_finite())
+            || e.mag_inclination.abs() >= 1.5
+            || e.mag_declination.abs() > std::f64::consts::PI
+        {
+            return Err(format!(
+                "mag_inclination = {} rad must be within ±1.5 rad (a horizontal component is needed for heading) and mag_declination = {} rad within ±π",
+                e.mag_inclination, e.mag_declination
+            ));
+        }
+        self.airframe.validate().map_err(|e| e.to_string())
+    }
+}
