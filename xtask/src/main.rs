@@ -35,6 +35,8 @@ const FMUS: &[(&str, &str, &[&str])] = &[
         "fmu-sensors",
         "tailsitter_sensors",
         &["fmu-sensors/README.md", "crates/sensor-model/README.md"],
+    ),
+    (
         "fmu-ekf",
         "tailsitter_ekf",
         &["fmu-ekf/README.md", "crates/state-estimator/README.md"],
