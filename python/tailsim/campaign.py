@@ -12,8 +12,6 @@ See docs/CAMPAIGN.md for the sample space, the output schema and resuming.
 from __future__ import annotations
 
 import argparse
-import contextlib
-import io
 import json
 import os
 import pathlib
@@ -25,7 +23,7 @@ import zipfile
 from typing import Any, Callable, Mapping
 
 from .campaign_runner import FmuPlugin, digest, install_fmus, load_fmu_bytes, metric_columns, run_job
-from .campaign_sampling import MISSIONS, TABLE_5_1, CampaignSpec, jobs, sample_columns
+from .campaign_sampling import MISSIONS, CampaignSpec, jobs, sample_columns
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 #: Columns that depend on where and when a run was executed, not on what was run.
@@ -236,7 +234,10 @@ def run_campaign(
                     own_client = client = Client(cluster)
             if upload if upload is not None else bool(scheduler):
                 client.upload_file(_package_zip())
-            client.register_plugin(FmuPlugin(blobs), name=FmuPlugin.name)
+            # One plugin per set of FMUs, registered once (idempotent): re-registering would tear
+            # down the instances of runs still executing after an interrupted campaign.
+            name = f"{FmuPlugin.name}-" + digest("".join(sorted(digests.values())).encode())[:16]
+            client.register_plugin(FmuPlugin(blobs), name=name)
             token = uuid.uuid4().hex[:8]
             futures = client.map(
                 run_job,

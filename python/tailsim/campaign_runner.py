@@ -61,24 +61,43 @@ _dirs: list[str] = []
 _slaves: dict[tuple[int, str], "_Slave"] = {}  # (thread id, digest) -> instance
 
 
-class _Slave:
-    """An fmpy instance with a logger that keeps the last messages."""
+_logs: dict[str, collections.deque] = {}  # instance name -> its last messages
+_callbacks = None
+_logger_fn = None
 
-    def __init__(self, fmu: Fmu, name: str):
+
+def _shared_callbacks():
+    """One logger for the whole process, routing by instance name: fmpy's logger proxy
+    (which formats the variadic message) keeps a single Python target per process."""
+    global _callbacks
+    if _callbacks is None:
         from fmpy.fmi2 import fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
         from fmpy.logging import addLoggerProxy
 
+        def log(_env, instance, status, category, message):
+            name = instance.decode(errors="replace") if instance else ""
+            q = _logs.get(name)
+            if q is not None:
+                q.append(f"[{status}] {message.decode(errors='replace')}")
+
+        global _logger_fn
+        _logger_fn = fmi2CallbackLoggerTYPE(log)  # must outlive every instance
+        cb = fmi2CallbackFunctions()
+        cb.logger = _logger_fn
+        addLoggerProxy(ctypes.byref(cb))
+        _callbacks = cb
+    return _callbacks
+
+
+class _Slave:
+    """An fmpy instance (uniquely named) with the last messages the FMU logged for it."""
+
+    def __init__(self, fmu: Fmu, name: str):
+        self.name = f"{name}-{fmu.identifier}-{threading.get_ident()}"
         self.messages: collections.deque[str] = collections.deque(maxlen=8)
-
-        def log(_env, _instance, status, category, message):
-            self.messages.append(f"[{status}] {message.decode(errors='replace')}")
-
-        self._logger = fmi2CallbackLoggerTYPE(log)  # kept alive as long as the instance
-        self.callbacks = fmi2CallbackFunctions()
-        self.callbacks.logger = self._logger
-        addLoggerProxy(ctypes.byref(self.callbacks))
+        _logs[self.name] = self.messages
         self.fmu = fmu
-        self.slave = fmu.instantiate(name, self.callbacks)
+        self.slave = fmu.instantiate(self.name, _shared_callbacks())
         self.used = False
 
     def free(self) -> None:
@@ -86,6 +105,7 @@ class _Slave:
             self.slave.freeInstance()
         except Exception:  # noqa: BLE001 - already broken; drop it
             pass
+        _logs.pop(self.name, None)
 
 
 def install_fmus(blobs: Mapping[str, bytes]) -> dict[str, str]:
@@ -145,6 +165,7 @@ class FmuPlugin(_WorkerPlugin):
     """Ships the .fmu bytes to each worker; the worker extracts them into its own temp dir."""
 
     name = "tailsim-fmus"
+    idempotent = True  # a second registration under the same name is a no-op
 
     def __init__(self, blobs: Mapping[str, bytes]):
         self.blobs = dict(blobs)
@@ -153,6 +174,7 @@ class FmuPlugin(_WorkerPlugin):
         install_fmus(self.blobs)
 
     def teardown(self, worker=None):
+        # Called when the worker closes (the plugin is registered once per FMU set).
         release_all()
 
 
