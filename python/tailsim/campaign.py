@@ -27,7 +27,7 @@ from .campaign_sampling import MISSIONS, CampaignSpec, jobs, sample_columns
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 #: Columns that depend on where and when a run was executed, not on what was run.
-NONDETERMINISTIC = ("worker", "wall_time_s")
+NONDETERMINISTIC = ("worker", "wall_time_s", "cpu_time_s")
 SORT_KEYS = [("sample_id", "ascending"), ("controller", "ascending"), ("configuration", "ascending"), ("state_source", "ascending")]
 
 
@@ -50,7 +50,7 @@ def row_schema():
     fields += [(c, pa.float64()) for c in metric_columns()]
     for c in sample_columns()[1:]:
         fields.append((c, pa.int64() if c == "noise_seed" else pa.float64()))
-    fields += [("overrides", pa.string()), ("worker", pa.string()), ("wall_time_s", pa.float64())]
+    fields += [("overrides", pa.string()), ("worker", pa.string()), ("wall_time_s", pa.float64()), ("cpu_time_s", pa.float64())]
     return pa.schema(fields)
 
 
@@ -116,9 +116,11 @@ class _Writer:
         self.rows: list[dict] = []
         self.last = time.monotonic()
         self.written = 0
+        self.cpu: list[float] = []  # CPU time of each run recorded now
 
     def add(self, row: dict) -> None:
         self.rows.append(row)
+        self.cpu.append(row.get("cpu_time_s", float("nan")))
         if len(self.rows) >= self.flush_rows or time.monotonic() - self.last > self.flush_seconds:
             self.flush()
 
@@ -212,12 +214,16 @@ def run_campaign(
         bar = tqdm(total=len(todo), unit="run", desc="campaign", smoothing=0.05)
     missing = 0
     t0 = time.perf_counter()
+    t_compute = t_last = t0  # first submission (after any cluster start-up), last result
+    n_workers_used = 1
     cluster = own_client = None
     try:
         if serial:
             install_fmus(blobs)
+            t_compute = time.perf_counter()
             for j in todo:
                 row = run_job(j, spec_json, digests)
+                t_last = time.perf_counter()
                 writer.add(row)
                 if bar:
                     bar.update()
@@ -238,7 +244,9 @@ def run_campaign(
             # down the instances of runs still executing after an interrupted campaign.
             name = f"{FmuPlugin.name}-" + digest("".join(sorted(digests.values())).encode())[:16]
             client.register_plugin(FmuPlugin(blobs), name=name)
+            n_workers_used = sum(w.get("nthreads", 1) for w in client.scheduler_info()["workers"].values())
             token = uuid.uuid4().hex[:8]
+            t_compute = time.perf_counter()
             futures = client.map(
                 run_job,
                 todo,
@@ -256,6 +264,7 @@ def run_campaign(
                         continue
                     row = fut.result()
                     fut.release()
+                    t_last = time.perf_counter()
                     writer.add(row)
                     if bar:
                         bar.update()
@@ -272,12 +281,26 @@ def run_campaign(
             own_client.close()
         if cluster is not None:
             cluster.close()
-    elapsed = time.perf_counter() - t0
+    elapsed, compute = time.perf_counter() - t0, t_last - t_compute
     table = store.read()
+    import numpy as np
     import pyarrow.parquet as pq
 
+    cpu = writer.cpu
+
     pq.write_table(table, out / "results.parquet")
-    stats = {"runs_done_now": writer.written, "runs_total": table.num_rows, "not_recorded": missing, "elapsed_s": elapsed}
+    stats = {
+        "runs_done_now": writer.written,
+        "runs_total": table.num_rows,
+        "not_recorded": missing,
+        "elapsed_s": elapsed,
+        "compute_s": compute,
+        "worker_threads": n_workers_used,
+        "runs_per_s": writer.written / compute if compute > 0 else float("nan"),
+        "runs_per_s_per_worker_thread": writer.written / compute / n_workers_used if compute > 0 else float("nan"),
+        # Load-independent: runs per second of one dedicated core (mean CPU time of a run).
+        "runs_per_cpu_s": 1.0 / float(np.mean(cpu)) if cpu else float("nan"),
+    }
     (out / "last_run.json").write_text(json.dumps(stats, indent=1))
     return table
 
@@ -338,7 +361,8 @@ def main(argv: list[str] | None = None) -> int:
         )
         stats = json.loads((out / "last_run.json").read_text())
         print(
-            f"{stats['runs_done_now']} runs in {stats['elapsed_s']:.1f} s; {stats['runs_total']} in {out}/results.parquet"
+            f"{stats['runs_done_now']} runs in {stats['elapsed_s']:.1f} s ({stats['runs_per_s']:.2f} runs/s on "
+            f"{stats['worker_threads']} worker threads after start-up); {stats['runs_total']} in {out}/results.parquet"
             + (f"; {stats['not_recorded']} not recorded (run again to resume)" if stats["not_recorded"] else "")
         )
     if not a.no_report:

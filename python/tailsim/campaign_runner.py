@@ -364,7 +364,7 @@ def _worker_name() -> str:
 def run_job(job: Mapping[str, Any], spec_json: Mapping[str, Any], digests: Mapping[str, str]) -> dict[str, Any]:
     """Fly one run; always returns its row (failed runs included)."""
     spec = CampaignSpec.from_json(spec_json)
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.thread_time()
     row: dict[str, Any] = dict(job)
     row.update({k: float("nan") for k in metric_columns()})
     row.update(completed=False, failure="", detail="", worker=_worker_name())
@@ -416,6 +416,7 @@ def run_job(job: Mapping[str, Any], spec_json: Mapping[str, Any], digests: Mappi
         if not ctrl_ok:
             _discard(cd_)
     row["wall_time_s"] = time.perf_counter() - t0
+    row["cpu_time_s"] = time.thread_time() - c0  # CPU time of this run's thread (load-independent cost)
     return row
 
 
