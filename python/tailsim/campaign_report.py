@@ -169,18 +169,26 @@ def write_report(out: str | pathlib.Path, spec: CampaignSpec | None = None, tabl
         ]
 
     # 1. completion
-    md += ["## Completion", "", "| controller | runs | completed | P(complete) | 95 % Wilson interval | failures |", "|---|---|---|---|---|---|"]
+    md += ["## Completion", "", "| controller | runs | completed | P(complete) | 95 % Wilson interval | failures (phase reached) |", "|---|---|---|---|---|---|"]
     comp = {}
     for a in A:
         m = _arm_mask(cols, a)
         n, k = int(m.sum()), int(cols["completed"][m].sum())
         lo, hi = wilson_interval(k, n)
         comp[a] = (k, n, lo, hi)
-        reasons: dict[str, int] = {}
-        for r in cols["failure"][m]:
+        reasons: dict[str, dict[str, int]] = {}
+        for r, ph in zip(cols["failure"][m], cols["last_phase"][m]):
             if r:
-                reasons[str(r)] = reasons.get(str(r), 0) + 1
-        rs = ", ".join(f"{r}: {c}" for r, c in sorted(reasons.items())) or "none"
+                where = f"phase {int(ph)}" if np.isfinite(ph) else "before the first step"
+                reasons.setdefault(str(r), {})
+                reasons[str(r)][where] = reasons[str(r)].get(where, 0) + 1
+        rs = (
+            ", ".join(
+                f"{r}: {sum(c.values())} ({', '.join(f'{w}: {n}' for w, n in sorted(c.items()))})"
+                for r, c in sorted(reasons.items())
+            )
+            or "none"
+        )
         md.append(f"| {lab[a]} | {n} | {k} | {k / n:.3f} | [{lo:.3f}, {hi:.3f}] | {rs} |")
     md.append("")
     fig, ax = plt.subplots(figsize=(5, 3.5))
@@ -242,7 +250,9 @@ def write_report(out: str | pathlib.Path, spec: CampaignSpec | None = None, tabl
         for a in A:
             v = cols[m][_arm_mask(cols, a) & cols["completed"].astype(bool)].astype(float)
             data.append(v[np.isfinite(v)])
-        ax.violinplot([d if d.size else np.array([np.nan]) for d in data], showmedians=True)
+        vp = ax.violinplot([d if d.size else np.array([np.nan]) for d in data], showmedians=True)
+        for body, a in zip(vp["bodies"], A):
+            body.set(facecolor=color[a], edgecolor=color[a], alpha=0.5)
         ax.set_xticks(range(1, len(A) + 1), [lab[a] for a in A])
         ax.set(title=title)
     for ax, (m, title) in zip([axes[1, 1], axes[1, 2]], [("max_err", "max position error [m]"), ("rms_err", "RMS position error [m]")]):
