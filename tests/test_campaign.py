@@ -149,6 +149,20 @@ def test_reset_and_reuse_run_equals_closed_loop(fmus):
 # --- the Dask campaign --------------------------------------------------------------------
 
 
+def test_embedded_cluster_listens_on_loopback_only(client):
+    import psutil
+
+    me = psutil.Process()
+    listening = [
+        c.laddr.ip
+        for p in [me, *me.children(recursive=True)]
+        for c in p.net_connections(kind="inet")
+        if c.status == psutil.CONN_LISTEN
+    ]
+    assert len(listening) >= 3  # scheduler + 2 workers (+ nannies, HTTP servers)
+    assert set(listening) == {"127.0.0.1"}
+
+
 def test_distributed_equals_serial(client, serial, tmp_path):
     assert serial.num_rows == 2 * N
     assert all(serial.column("completed").to_pylist()), serial.column("detail").to_pylist()

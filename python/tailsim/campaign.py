@@ -157,8 +157,8 @@ def local_cluster(n_workers: int | None = None):
         threads_per_worker=1,
         processes=True,
         host="127.0.0.1",
-        dashboard_address=None,
-        worker_dashboard_address=None,
+        dashboard_address="127.0.0.1:0",  # the scheduler's HTTP server: loopback, any free port
+        worker_dashboard_address=None,  # workers' HTTP servers bind to their host, 127.0.0.1
     )
 
 
