@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import pathlib
 
 import numpy as np
 import pytest
@@ -169,6 +170,52 @@ def test_distributed_equals_serial(client, serial, tmp_path):
     table = run_campaign(short_spec(), tmp_path, DIST, client=client, progress=False)
     assert deterministic(table).equals(deterministic(serial))
     assert all(w.startswith("tcp://127.0.0.1:") for w in table.column("worker").to_pylist())
+
+
+def test_existing_cluster_without_tailsim_runs_the_same_campaign(serial, tmp_path):
+    """--scheduler: a separately started scheduler and workers (loopback), whose Python
+    cannot import tailsim (no PYTHONPATH, another cwd): the package and the FMUs are sent."""
+    import subprocess
+    import sys
+    import time
+
+    dask_cli = str(pathlib.Path(sys.executable).parent / "dask")
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    sched_file = tmp_path / "scheduler.json"
+    log = open(tmp_path / "cluster.log", "w")
+    common = dict(cwd=tmp_path, env=env, stdout=log, stderr=subprocess.STDOUT)
+    procs = [
+        subprocess.Popen(
+            [dask_cli, "scheduler", "--host", "127.0.0.1", "--port", "0", "--dashboard-address", "127.0.0.1:0",
+             "--scheduler-file", str(sched_file)],
+            **common,
+        )
+    ]
+    try:
+        deadline = time.monotonic() + 60
+        while not sched_file.exists() and time.monotonic() < deadline:
+            time.sleep(0.2)
+        procs.append(
+            subprocess.Popen(
+                [dask_cli, "worker", "--scheduler-file", str(sched_file), "--host", "127.0.0.1", "--nthreads", "1",
+                 "--nworkers", "2", "--dashboard-address", "127.0.0.1:0"],
+                **common,
+            )
+        )
+        address = json.loads(sched_file.read_text())["address"]
+        assert address.startswith("tcp://127.0.0.1:")
+        probe = subprocess.run([sys.executable, "-c", "import tailsim"], cwd=tmp_path, env=env, capture_output=True)
+        assert probe.returncode != 0  # the workers' Python does not have tailsim
+        table = run_campaign(short_spec(), tmp_path / "out", DIST, scheduler=address, progress=False)
+        assert deterministic(table).equals(deterministic(serial))
+    finally:
+        for p in reversed(procs):
+            p.terminate()
+        for p in reversed(procs):
+            try:
+                p.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                p.kill()
 
 
 def test_interrupted_campaign_resumes_to_the_same_content(client, serial, tmp_path):

@@ -12,17 +12,17 @@ See docs/CAMPAIGN.md for the sample space, the output schema and resuming.
 from __future__ import annotations
 
 import argparse
+import io
 import json
 import os
 import pathlib
 import sys
-import tempfile
 import time
 import uuid
 import zipfile
 from typing import Any, Callable, Mapping
 
-from .campaign_runner import FmuPlugin, digest, install_fmus, load_fmu_bytes, metric_columns, run_job
+from .campaign_runner import digest, install_fmus, load_fmu_bytes, metric_columns, run_job
 from .campaign_sampling import MISSIONS, CampaignSpec, jobs, sample_columns
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -162,14 +162,15 @@ def local_cluster(n_workers: int | None = None):
     )
 
 
-def _package_zip() -> str:
-    """tailsim as a zip, for workers that do not have it (Client.upload_file)."""
+def _package_zip() -> bytes:
+    """The tailsim package as zip bytes, for workers that do not have it."""
     pkg = pathlib.Path(__file__).resolve().parent
-    path = pathlib.Path(tempfile.mkdtemp(prefix="tailsim-upload-")) / "tailsim_pkg.zip"
-    with zipfile.ZipFile(path, "w") as z:
-        for f in pkg.glob("*.py"):
-            z.write(f, f"tailsim/{f.name}")
-    return str(path)
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w") as z:
+        for f in sorted(pkg.glob("*.py")):
+            info = zipfile.ZipInfo(f"tailsim/{f.name}", date_time=(2020, 1, 1, 0, 0, 0))
+            z.writestr(info, f.read_bytes())
+    return buf.getvalue()
 
 
 def run_campaign(
@@ -238,17 +239,25 @@ def run_campaign(
                 else:
                     cluster = local_cluster(n_workers)
                     own_client = client = Client(cluster)
+            from . import campaign_plugin
+
+            package = None
             if upload if upload is not None else bool(scheduler):
-                client.upload_file(_package_zip())
-            # One plugin per set of FMUs, registered once (idempotent): re-registering would tear
+                # Workers without tailsim: the plugin is pickled by value and brings the package.
+                import cloudpickle
+
+                cloudpickle.register_pickle_by_value(campaign_plugin)
+                package = _package_zip()
+            plugin = campaign_plugin.FmuPlugin(blobs, package)
+            # One plugin per content, registered once (idempotent): re-registering would tear
             # down the instances of runs still executing after an interrupted campaign.
-            name = f"{FmuPlugin.name}-" + digest("".join(sorted(digests.values())).encode())[:16]
-            client.register_plugin(FmuPlugin(blobs), name=name)
+            key = "".join(sorted(digests.values())) + (digest(package) if package else "")
+            client.register_plugin(plugin, name=f"{plugin.name}-{digest(key.encode())[:16]}")
             n_workers_used = sum(w.get("nthreads", 1) for w in client.scheduler_info()["workers"].values())
             token = uuid.uuid4().hex[:8]
             t_compute = time.perf_counter()
             futures = client.map(
-                run_job,
+                campaign_plugin.make_task() if package else run_job,
                 todo,
                 spec_json=spec_json,
                 digests=digests,
@@ -273,6 +282,9 @@ def run_campaign(
             except BaseException:
                 client.cancel(futures)
                 raise
+            n_workers_used = max(
+                n_workers_used, sum(w.get("nthreads", 1) for w in client.scheduler_info()["workers"].values()), 1
+            )
     finally:
         writer.flush()
         if bar:

@@ -155,29 +155,6 @@ def _discard(d: str) -> None:
         s.free()
 
 
-try:  # the Dask side: a worker plugin carrying the bytes to every (also a restarted) worker
-    from distributed import WorkerPlugin as _WorkerPlugin
-except ImportError:  # pragma: no cover - serial use without distributed
-    _WorkerPlugin = object
-
-
-class FmuPlugin(_WorkerPlugin):
-    """Ships the .fmu bytes to each worker; the worker extracts them into its own temp dir."""
-
-    name = "tailsim-fmus"
-    idempotent = True  # a second registration under the same name is a no-op
-
-    def __init__(self, blobs: Mapping[str, bytes]):
-        self.blobs = dict(blobs)
-
-    def setup(self, worker=None):
-        install_fmus(self.blobs)
-
-    def teardown(self, worker=None):
-        # Called when the worker closes (the plugin is registered once per FMU set).
-        release_all()
-
-
 # --- the closed loop ---------------------------------------------------------------------
 
 
