@@ -269,11 +269,15 @@ def test_failing_sample_is_a_recorded_failure(client, serial, tmp_path):
             assert r["completed"] and r["max_err"] == ref[key]["max_err"]
 
 
-def test_resume_refuses_a_different_campaign(tmp_path):
+def test_resume_refuses_a_different_campaign_unless_replace(serial, tmp_path):
     other = {"spec": short_spec(tau_aero=2.0).to_json(), "fmus": {}}
     (tmp_path / "campaign.json").write_text(json.dumps(other))
+    Store(tmp_path).write([{"key": "0/lqr/tuned/perfect", "sample_id": 0}])  # a run of the other campaign
     with pytest.raises(SystemExit, match="different campaign"):
         run_campaign(short_spec(), tmp_path, DIST, serial=True, progress=False)
+    assert Store(tmp_path).done_keys() == {"0/lqr/tuned/perfect"}  # nothing discarded
+    table = run_campaign(short_spec(), tmp_path, DIST, serial=True, progress=False, replace=True)
+    assert deterministic(table).equals(deterministic(serial))  # the other campaign's run is gone
 
 
 def test_report(serial, tmp_path):

@@ -134,17 +134,21 @@ class _Writer:
 # --- the campaign -------------------------------------------------------------------------
 
 
-def _check_campaign_file(out: pathlib.Path, spec: CampaignSpec, digests: Mapping[str, str]) -> None:
+def _check_campaign_file(out: pathlib.Path, spec: CampaignSpec, digests: Mapping[str, str], replace: bool) -> None:
     path = out / "campaign.json"
     meta = {"spec": spec.to_json(), "fmus": dict(digests)}
     if path.exists():
         old = json.loads(path.read_text())
         old_spec = CampaignSpec.from_json(old["spec"])
         if old_spec.identity() != spec.identity() or old["fmus"] != dict(digests):
-            raise SystemExit(
-                f"{out} holds a different campaign (spec or FMUs differ; only --samples may change on resume): "
-                "use another --out"
-            )
+            if not replace:
+                raise SystemExit(
+                    f"{out} holds a different campaign (spec or FMUs differ; only --samples may change on resume): "
+                    "use another --out, or --replace to discard it"
+                )
+            for p in Store(out).parts():
+                p.unlink()
+            (out / "results.parquet").unlink(missing_ok=True)
     path.write_text(json.dumps(meta, indent=1))
 
 
@@ -187,6 +191,7 @@ def run_campaign(
     flush_rows: int = 32,
     flush_seconds: float = 10.0,
     retries: int = 2,
+    replace: bool = False,
     on_row: Callable[[dict, Any], None] | None = None,
 ):
     """Run the campaign's missing runs and return all its rows (a pyarrow Table).
@@ -195,6 +200,8 @@ def run_campaign(
     cluster, or an embedded LocalCluster (n_workers, default one per core).
     serial: run in this process, without Dask (the reference for tests).
     upload: send the tailsim package to the workers (default: with `scheduler`).
+    replace: discard the runs in `out` if they belong to a different campaign
+    (other specification or FMUs) instead of refusing.
     on_row(row, client): called after each recorded row (tests use it to interrupt
     or to kill a worker).
     """
@@ -202,7 +209,7 @@ def run_campaign(
     out.mkdir(parents=True, exist_ok=True)
     blobs = load_fmu_bytes(dist, spec.controllers)
     digests = {n: digest(b) for n, b in blobs.items()}
-    _check_campaign_file(out, spec, digests)
+    _check_campaign_file(out, spec, digests, replace)
     store = Store(out)
     done = store.done_keys()
     todo = [j for j in jobs(spec) if j["key"] not in done]
@@ -338,6 +345,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--scheduler", help="tcp://HOST:PORT of an existing Dask scheduler")
     ap.add_argument("--workers", type=int, help="LocalCluster workers (default: one per core)")
     ap.add_argument("--serial", action="store_true", help="no Dask: run in this process")
+    ap.add_argument("--replace", action="store_true", help="discard --out's runs if they are of another campaign/FMUs")
     ap.add_argument("--no-upload", action="store_true", help="workers already have tailsim importable")
     ap.add_argument("--no-progress", action="store_true")
     ap.add_argument("--report-only", action="store_true", help="only (re)write the report of what is in --out")
@@ -369,6 +377,7 @@ def main(argv: list[str] | None = None) -> int:
             n_workers=a.workers,
             serial=a.serial,
             upload=False if a.no_upload else None,
+            replace=a.replace,
             progress=not a.no_progress,
         )
         stats = json.loads((out / "last_run.json").read_text())
