@@ -381,9 +381,15 @@ def main(argv: list[str] | None = None) -> int:
             progress=not a.no_progress,
         )
         stats = json.loads((out / "last_run.json").read_text())
+        if stats["runs_done_now"]:
+            done = (
+                f"{stats['runs_done_now']} runs in {stats['elapsed_s']:.1f} s ({stats['runs_per_s']:.2f} runs/s on "
+                f"{stats['worker_threads']} worker threads after start-up, {stats['runs_per_cpu_s']:.1f} runs per CPU-second)"
+            )
+        else:
+            done = "nothing to run (every run is already in the folder)"
         print(
-            f"{stats['runs_done_now']} runs in {stats['elapsed_s']:.1f} s ({stats['runs_per_s']:.2f} runs/s on "
-            f"{stats['worker_threads']} worker threads after start-up); {stats['runs_total']} in {out}/results.parquet"
+            f"{done}; {stats['runs_total']} runs in {out}/results.parquet"
             + (f"; {stats['not_recorded']} not recorded (run again to resume)" if stats["not_recorded"] else "")
         )
     if not a.no_report:
