@@ -269,6 +269,23 @@ def test_failing_sample_is_a_recorded_failure(client, serial, tmp_path):
             assert r["completed"] and r["max_err"] == ref[key]["max_err"]
 
 
+def test_tumble_mid_flight_is_a_divergence_and_the_next_run_is_clean(serial, tmp_path):
+    # Pitch-rate damping of the wrong sign (C_mq = +30 instead of −7.6): the aircraft
+    # tumbles and the plant stops with its envelope error (|q| > 50 rad/s).
+    spec = CampaignSpec(
+        seed=7, n_samples=2, mission_name="short", mission=dict(MISSIONS["short"]),
+        overrides={0: {"c_m_q_a0": 30.0, "c_m_q_a1": 30.0}},
+    )
+    rows = {r["key"]: r for r in run_campaign(spec, tmp_path, DIST, serial=True, progress=False).to_pylist()}
+    ref = {r["key"]: r for r in serial.to_pylist()}
+    for c in ("lqr", "tsd"):
+        r = rows[f"0/{c}/tuned/perfect"]
+        assert not r["completed"] and r["failure"] == "divergence" and "envelope" in r["detail"], r["detail"]
+        assert 0 < r["t_end"] < spec.stop_time and r["max_err_p0"] >= 0  # metrics of what was flown
+        clean = rows[f"1/{c}/tuned/perfect"]  # flown on fresh instances after the error
+        assert clean["completed"] and clean["max_err"] == ref[f"1/{c}/tuned/perfect"]["max_err"]
+
+
 def test_resume_refuses_a_different_campaign_unless_replace(serial, tmp_path):
     other = {"spec": short_spec(tau_aero=2.0).to_json(), "fmus": {}}
     (tmp_path / "campaign.json").write_text(json.dumps(other))

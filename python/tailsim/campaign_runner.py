@@ -251,6 +251,12 @@ def fly(
         failure, detail = "divergence", str(exc)
     except TimedOut as exc:
         failure, detail = "timeout", str(exc)
+    except Exception as exc:  # noqa: BLE001 - an error status mid-flight: keep what was flown
+        from fmpy.fmi1 import FMICallException
+
+        if not isinstance(exc, FMICallException):
+            raise
+        failure, detail = "fmi_error", f"{exc} at t = {k * h:.2f} s"
     for s in (p, c):
         if failure:
             try:  # after a divergence the instances are discarded anyway
@@ -374,18 +380,19 @@ def run_job(job: Mapping[str, Any], spec_json: Mapping[str, Any], digests: Mappi
             t0 + spec.timeout_s,
         )
         row.update(run_metrics(sig))
+        if failure == "fmi_error":
+            logs = _error_logs(pd_, cd_)
+            if any("left its envelope" in m for m in logs):
+                failure = "divergence"  # the plant's own tumble check (an error status by design)
+            detail = " | ".join([detail, *logs])
         row.update(completed=not failure, failure=failure, detail=detail)
         plant_ok = ctrl_ok = not failure
     except Exception as exc:  # noqa: BLE001 - a failed run is a result, not a crash
         from fmpy.fmi1 import FMICallException
 
         kind = "fmi_error" if isinstance(exc, FMICallException) else "exception"
-        logs = []
-        for d in (pd_, cd_):
-            s = _slaves.get((threading.get_ident(), d))
-            if s is not None:
-                logs += [m for m in s.messages if "[3]" in m or "[4]" in m]
-        row.update(completed=False, failure=kind, detail=f"{type(exc).__name__}: {exc}" + (" | " + " | ".join(logs) if logs else ""))
+        logs = _error_logs(pd_, cd_)
+        row.update(completed=False, failure=kind, detail=" | ".join([f"{type(exc).__name__}: {exc}", *logs]))
     finally:
         # An instance that went through a failure is not trusted again: free it.
         if not plant_ok:
@@ -395,6 +402,16 @@ def run_job(job: Mapping[str, Any], spec_json: Mapping[str, Any], digests: Mappi
     row["wall_time_s"] = time.perf_counter() - t0
     row["cpu_time_s"] = time.thread_time() - c0  # CPU time of this run's thread (load-independent cost)
     return row
+
+
+def _error_logs(*digests: str) -> list[str]:
+    """The error/fatal messages the FMUs logged for this thread's instances in this run."""
+    logs = []
+    for d in digests:
+        s = _slaves.get((threading.get_ident(), d))
+        if s is not None:
+            logs += [m for m in s.messages if m.startswith("[3]") or m.startswith("[4]")]
+    return logs
 
 
 def _scaled_names() -> set[str]:
