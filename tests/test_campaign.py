@@ -170,6 +170,9 @@ def test_distributed_equals_serial(client, serial, tmp_path):
     table = run_campaign(short_spec(), tmp_path, DIST, client=client, progress=False)
     assert deterministic(table).equals(deterministic(serial))
     assert all(w.startswith("tcp://127.0.0.1:") for w in table.column("worker").to_pylist())
+    # each worker keeps (at most) one instance per FMU, reset between its runs
+    held = list(client.run(R.instances).values())
+    assert any(held) and all(n == 1 for h in held for n in h.values()), held
 
 
 def test_existing_cluster_without_tailsim_runs_the_same_campaign(serial, tmp_path):

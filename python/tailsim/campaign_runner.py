@@ -138,6 +138,14 @@ def release_all() -> None:
         _dirs.clear()
 
 
+def instances() -> dict[str, int]:
+    """How many instances this process holds, by model identifier (for tests and monitoring)."""
+    out: dict[str, int] = {}
+    for s in _slaves.values():
+        out[s.fmu.identifier] = out.get(s.fmu.identifier, 0) + 1
+    return out
+
+
 def _instance(d: str, role: str) -> _Slave:
     key = (threading.get_ident(), d)
     s = _slaves.get(key)
