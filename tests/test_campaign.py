@@ -153,15 +153,20 @@ def test_reset_and_reuse_run_equals_closed_loop(fmus):
 def test_embedded_cluster_listens_on_loopback_only(client):
     import psutil
 
-    me = psutil.Process()
+    # the worker processes: every socket they listen on
+    pids = set(client.run(os.getpid).values())
+    assert len(pids) == 2 and os.getpid() not in pids
     listening = [
-        c.laddr.ip
-        for p in [me, *me.children(recursive=True)]
-        for c in p.net_connections(kind="inet")
-        if c.status == psutil.CONN_LISTEN
+        c.laddr.ip for pid in pids for c in psutil.Process(pid).net_connections(kind="inet") if c.status == psutil.CONN_LISTEN
     ]
-    assert len(listening) >= 3  # scheduler + 2 workers (+ nannies, HTTP servers)
-    assert set(listening) == {"127.0.0.1"}
+    # the scheduler and the nannies (in this process): their comm and HTTP ports
+    sched = client.cluster.scheduler
+    ports = {int(sched.address.rsplit(":", 1)[1]), sched.http_server.port}
+    ports |= {int(w["nanny"].rsplit(":", 1)[1]) for w in client.scheduler_info()["workers"].values()}
+    mine = [c for c in psutil.Process().net_connections(kind="inet") if c.status == psutil.CONN_LISTEN and c.laddr.port in ports]
+    assert len(mine) == len(ports) == 4
+    listening += [c.laddr.ip for c in mine]
+    assert len(listening) >= 6 and set(listening) == {"127.0.0.1"}, listening
 
 
 def test_distributed_equals_serial(client, serial, tmp_path):
