@@ -4,10 +4,10 @@
 //! The module defines `Variables` (one public field per variable, named as
 //! the variable), `vr::<name>` value-reference constants, the
 //! `fmi2_export::VariableStore` implementation, `MODEL_IDENTIFIER`, `GUID`,
-//! `MODEL_DESCRIPTION_XML`, and one `Variables::<group>()` constructor per
-//! parameter group.
+//! `MODEL_DESCRIPTION_XML`, and per group one `Variables::<group>()`
+//! constructor (parameters, inputs) or `Variables::set_<group>()` (outputs).
 
-use crate::{fmt_f64, Model, Start, VarType, Variable};
+use crate::{fmt_f64, Causality, Model, Start, VarType, Variable};
 use std::fmt::Write;
 
 fn rust_type(t: VarType) -> &'static str {
@@ -32,6 +32,82 @@ fn start_literal(v: &Variable) -> String {
         (None, VarType::String) => "String::new()".into(),
         (Some(s), t) => unreachable!("checked at load: {s:?} for {t:?}"),
     }
+}
+
+/// `impl Variables { fn <group>() }` reading the parameters or inputs of a group
+/// into its type, or `fn set_<group>()` writing the outputs of a group from it.
+fn group_accessor(model: &Model, group: &str, path: &str) -> String {
+    let members: Vec<&Variable> = model
+        .variables
+        .iter()
+        .filter(|v| v.decl.group.as_deref() == Some(group))
+        .collect();
+    if members.is_empty() {
+        return String::new();
+    }
+    let mut s = String::from("impl Variables {\n");
+    let fields: Vec<(&str, Option<usize>, &str)> = members
+        .iter()
+        .map(|v| {
+            let (top, index) = v.decl.group_field().expect("checked at load");
+            (top, index, v.name())
+        })
+        .collect();
+    let causality = members[0].decl.causality;
+    if matches!(causality, Causality::Output | Causality::Input) {
+        let _ = writeln!(
+            s,
+            "    /// Set the variables of group `{group}` from a `{path}`.\n    #[allow(dead_code)]\n    pub fn set_{group}(&mut self, value: &{path}) {{"
+        );
+        for (top, index, name) in &fields {
+            let sep = if top.is_empty() { "" } else { "." };
+            let element = index.map(|i| format!("[{i}]")).unwrap_or_default();
+            let _ = writeln!(s, "        self.{name} = value{sep}{top}{element}.into();");
+        }
+        s.push_str("    }\n");
+    }
+    if causality != Causality::Output {
+        let _ = writeln!(
+            s,
+            "    /// The `{path}` built from the variables of group `{group}`.\n    #[allow(dead_code)]\n    pub fn {group}(&self) -> {path} {{"
+        );
+        // Fields in order of first appearance; vector elements gathered into one array.
+        let mut tops: Vec<&str> = Vec::new();
+        for (top, _, _) in &fields {
+            if !tops.contains(top) {
+                tops.push(top);
+            }
+        }
+        let value_of = |top: &str| -> String {
+            let mut elements: Vec<(usize, &str)> = fields
+                .iter()
+                .filter(|(t, _, _)| *t == top)
+                .map(|(_, i, n)| (i.unwrap_or(usize::MAX), *n))
+                .collect();
+            if elements.len() == 1 && elements[0].0 == usize::MAX {
+                return format!("self.{}", elements[0].1);
+            }
+            elements.sort();
+            assert!(
+                elements.iter().enumerate().all(|(k, (i, _))| k == *i),
+                "group '{group}': elements of '{top}' must be [0], [1], … once each"
+            );
+            let list: Vec<String> = elements.iter().map(|(_, n)| format!("self.{n}")).collect();
+            format!("[{}].into()", list.join(", "))
+        };
+        if tops == [""] {
+            let _ = writeln!(s, "        let value: {path} = {};\n        value", value_of(""));
+        } else {
+            let _ = writeln!(s, "        {path} {{");
+            for top in &tops {
+                let _ = writeln!(s, "            {top}: {},", value_of(top));
+            }
+            let _ = writeln!(s, "        }}");
+        }
+        s.push_str("    }\n");
+    }
+    s.push_str("}\n");
+    s
 }
 
 fn bound(x: Option<f64>, default: &str) -> String {
@@ -88,15 +164,7 @@ pub fn variables_module(model: &Model, xml_file: &str) -> String {
 
     // Groups.
     for (group, path) in &model.groups {
-        let _ = writeln!(w, "impl Variables {{\n    /// The `{path}` built from the parameters of group `{group}`.\n    #[allow(dead_code)]\n    pub fn {group}(&self) -> {path} {{\n        {path} {{");
-        for v in model
-            .variables
-            .iter()
-            .filter(|v| v.decl.group.as_deref() == Some(group))
-        {
-            let _ = writeln!(w, "            {0}: self.{0},", v.name());
-        }
-        let _ = writeln!(w, "        }}\n    }}\n}}\n");
+        let _ = writeln!(w, "{}", group_accessor(model, group, path));
     }
 
     // VariableStore.

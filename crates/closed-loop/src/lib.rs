@@ -7,7 +7,7 @@
 
 use flight_mission::{Command, ControllerInput, Diagnostics, FlightController, Measurement, MissionParams, Notice};
 use nalgebra::Vector3;
-use tailsitter_physics::{idx, InputVector, Plant, StateVector};
+use tailsitter_physics::{idx, InputVector, Outputs, Plant, StateVector};
 
 /// How the master orders the two units within a communication step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -109,7 +109,12 @@ impl Scenario {
 
 /// What the controller would measure: the plant outputs of the same names.
 pub fn measure(plant: &Plant, x: &StateVector, u: &InputVector, wind: &Vector3<f64>) -> Measurement {
-    let y = plant.outputs(x, u, wind);
+    measurement(x, &plant.outputs(x, u, wind))
+}
+
+/// The plant outputs grouped as a [`Measurement`], from the state and the
+/// computed outputs: what the plant FMU writes to its output ports.
+pub fn measurement(x: &StateVector, y: &Outputs) -> Measurement {
     Measurement {
         pos_ned: Vector3::new(x[idx::POS_N], x[idx::POS_E], x[idx::POS_D]),
         vel_ned: y.vel_ned,
@@ -311,13 +316,9 @@ impl std::fmt::Display for MissionCheck {
     }
 }
 
-/// Pitch θ (3-2-1) from the quaternion through DCM element (1,3) = −sin θ (A.2.5),
-/// well defined at θ = 90°.
+/// Pitch θ (3-2-1) of a plant state ([`tailsitter_physics::pitch_321`]).
 pub fn pitch(x: &StateVector) -> f64 {
-    let q = x.fixed_rows::<4>(idx::Q1).into_owned();
-    (-tailsitter_physics::dcm_earth_to_body(&q)[(0, 2)])
-        .clamp(-1.0, 1.0)
-        .asin()
+    tailsitter_physics::pitch_321(&x.fixed_rows::<4>(idx::Q1).into_owned())
 }
 
 /// Fly `controller` with `plant` from state `x0` through `scenario`.
@@ -354,7 +355,7 @@ pub fn fly<C: FlightController>(plant: &Plant, x0: StateVector, controller: &mut
                 measurement,
                 ref_offset_ned: scenario.ref_offset(t),
             };
-            match controller.update(&input) {
+            match controller.sample(&input) {
                 Ok(out) => {
                     if let Some(notice) = out.notice {
                         trace.notices.push((t, notice));

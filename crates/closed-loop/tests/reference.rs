@@ -131,7 +131,10 @@ fn check(controller: &str, rows: &[Vec<f64>]) {
             }
         }
     }
-    println!("{controller}: worst relative deviation {:.1e} ({} at t = {})", worst.0, worst.1, worst.2);
+    println!(
+        "{controller}: worst relative deviation {:.1e} ({} at t = {})",
+        worst.0, worst.1, worst.2
+    );
     assert!(
         worst.0 <= TOLERANCE,
         "{controller}: {} at t = {} deviates by {:e} from {}",

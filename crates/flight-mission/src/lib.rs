@@ -12,6 +12,9 @@
 use nalgebra::{Vector3, Vector4};
 use std::fmt;
 
+mod unit;
+pub use unit::{HeldOutput, SampledUnit};
+
 /// Mission parameters (DESIGN.md §3), the same names and defaults in both controllers.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MissionParams {
@@ -171,6 +174,13 @@ impl Phase {
     /// Whether the aircraft hangs on its propellers in this phase.
     pub fn is_vertical(self) -> bool {
         matches!(self, Phase::Vertical1 | Phase::Vertical2)
+    }
+}
+
+/// The `phase` output.
+impl From<Phase> for i32 {
+    fn from(phase: Phase) -> i32 {
+        phase.code()
     }
 }
 
@@ -356,13 +366,11 @@ pub struct ControllerOutput {
     pub notice: Option<Notice>,
 }
 
-impl ControllerOutput {
-    /// Number of values [`Self::save`] writes.
-    pub const SAVED_LEN: usize = 13;
+impl HeldOutput for ControllerOutput {
+    const SAVED_LEN: usize = 13;
 
-    /// Write command and diagnostics as f64s (for FMU-state serialisation;
-    /// the notice is transient and not saved).
-    pub fn save(&self, out: &mut impl FnMut(f64)) {
+    /// Command and diagnostics (the notice is transient and not saved).
+    fn save(&self, out: &mut impl FnMut(f64)) {
         let c = &self.command;
         let d = &self.diagnostics;
         for x in [
@@ -384,8 +392,8 @@ impl ControllerOutput {
         }
     }
 
-    /// Read back what [`Self::save`] wrote; `None` if values are missing or the phase is invalid.
-    pub fn restore(next: &mut impl FnMut() -> Option<f64>) -> Option<Self> {
+    /// `None` if values are missing or the phase is invalid.
+    fn restore(next: &mut impl FnMut() -> Option<f64>) -> Option<Self> {
         let mut v = [0.0; Self::SAVED_LEN];
         for x in v.iter_mut() {
             *x = next()?;
@@ -414,6 +422,10 @@ impl ControllerOutput {
             notice: None,
         })
     }
+
+    fn notice(&self) -> Option<Notice> {
+        self.notice
+    }
 }
 
 /// A failure that leaves the controller without a valid command.
@@ -428,96 +440,12 @@ impl fmt::Display for ControlError {
 
 impl std::error::Error for ControlError {}
 
-/// A tail-sitter flight controller: plain state, no middleware.
-pub trait FlightController: Clone + Send + 'static {
-    /// Compute the command for the sample at `input.t`, updating the internal
-    /// state (integrators, schedules) as if `sample_time` passed since the last call.
-    /// Must return finite commands or an error; must not allocate on success.
-    fn update(&mut self, input: &ControllerInput) -> Result<ControllerOutput, ControlError>;
-}
+/// A tail-sitter flight controller: a [`SampledUnit`] from the measured plant
+/// outputs to the commands (plain state, no middleware). Implemented for every
+/// sampled unit with these input and output types.
+pub trait FlightController: SampledUnit<Input = ControllerInput, Output = ControllerOutput> {}
 
-/// A value store holding the controller ports of DESIGN.md §2 (the inputs
-/// named like the plant outputs, `ref_offset_*`, the commands and the
-/// diagnostics): the mapping between those ports and the controller's types.
-/// Implemented with [`impl_controller_ports!`] for the generated `Variables`
-/// of each controller FMU, so both map their ports identically.
-pub trait ControllerPorts {
-    /// The controller input at time `t`; `Err(name)` names the first non-finite input.
-    fn controller_input(&self, t: f64) -> Result<ControllerInput, &'static str>;
-    /// Write the command and the diagnostics to the output ports.
-    fn write_output(&mut self, output: &ControllerOutput);
-}
-
-/// Implements [`ControllerPorts`] for a struct with one field per port, named
-/// as in DESIGN.md §2 (`pos_n`, …, `induced_velocity`, `ref_offset_n/e/d`,
-/// `thrust_cmd`, …, `vertical_flap_cmd`, `ref_pos_n/e/d`, `ref_airspeed`,
-/// `phase`, `pos_error`): a missing or misnamed port does not compile.
-#[macro_export]
-macro_rules! impl_controller_ports {
-    ($vars:ty) => {
-        impl $crate::ControllerPorts for $vars {
-            fn controller_input(&self, t: f64) -> Result<$crate::ControllerInput, &'static str> {
-                use $crate::nalgebra::{Vector3, Vector4};
-                let measurement = $crate::Measurement {
-                    pos_ned: Vector3::new(self.pos_n, self.pos_e, self.pos_d),
-                    vel_ned: Vector3::new(self.vel_n, self.vel_e, self.vel_d),
-                    vel_body: Vector3::new(self.u, self.v, self.w),
-                    rates: Vector3::new(self.p, self.q, self.r),
-                    quat: Vector4::new(self.quat_1, self.quat_2, self.quat_3, self.quat_4),
-                    airspeed: self.airspeed,
-                    alpha: self.alpha,
-                    beta: self.beta,
-                    thrust: self.thrust,
-                    surfaces: [
-                        self.elevator,
-                        self.aileron,
-                        self.rudder,
-                        self.flap_collective,
-                        self.flap_differential,
-                        self.vertical_flap,
-                    ],
-                    specific_force_body: Vector3::new(self.accel_x, self.accel_y, self.accel_z),
-                    induced_velocity: self.induced_velocity,
-                };
-                if let Some(name) = measurement.first_non_finite() {
-                    return Err(name);
-                }
-                for (name, value) in [
-                    ("ref_offset_n", self.ref_offset_n),
-                    ("ref_offset_e", self.ref_offset_e),
-                    ("ref_offset_d", self.ref_offset_d),
-                ] {
-                    if !value.is_finite() {
-                        return Err(name);
-                    }
-                }
-                Ok($crate::ControllerInput {
-                    t,
-                    measurement,
-                    ref_offset_ned: Vector3::new(self.ref_offset_n, self.ref_offset_e, self.ref_offset_d),
-                })
-            }
-
-            fn write_output(&mut self, output: &$crate::ControllerOutput) {
-                let c = &output.command;
-                self.thrust_cmd = c.thrust;
-                self.elevator_cmd = c.elevator;
-                self.aileron_cmd = c.aileron;
-                self.rudder_cmd = c.rudder;
-                self.flap_collective_cmd = c.flap_collective;
-                self.flap_differential_cmd = c.flap_differential;
-                self.vertical_flap_cmd = c.vertical_flap;
-                let d = &output.diagnostics;
-                self.ref_pos_n = d.ref_pos_ned.x;
-                self.ref_pos_e = d.ref_pos_ned.y;
-                self.ref_pos_d = d.ref_pos_ned.z;
-                self.ref_airspeed = d.ref_airspeed;
-                self.phase = d.phase.code();
-                self.pos_error = d.pos_error;
-            }
-        }
-    };
-}
+impl<T: SampledUnit<Input = ControllerInput, Output = ControllerOutput>> FlightController for T {}
 
 #[doc(hidden)]
 pub use nalgebra;
@@ -609,81 +537,8 @@ mod tests {
         assert_eq!(m.phase_at(100.0).0, Phase::Vertical2);
     }
 
-    /// The ports of DESIGN.md §2, as the generated `Variables` of a controller FMU hold them.
-    #[derive(Default)]
-    struct Ports {
-        pos_n: f64,
-        pos_e: f64,
-        pos_d: f64,
-        vel_n: f64,
-        vel_e: f64,
-        vel_d: f64,
-        u: f64,
-        v: f64,
-        w: f64,
-        p: f64,
-        q: f64,
-        r: f64,
-        quat_1: f64,
-        quat_2: f64,
-        quat_3: f64,
-        quat_4: f64,
-        airspeed: f64,
-        alpha: f64,
-        beta: f64,
-        thrust: f64,
-        elevator: f64,
-        aileron: f64,
-        rudder: f64,
-        flap_collective: f64,
-        flap_differential: f64,
-        vertical_flap: f64,
-        accel_x: f64,
-        accel_y: f64,
-        accel_z: f64,
-        induced_velocity: f64,
-        ref_offset_n: f64,
-        ref_offset_e: f64,
-        ref_offset_d: f64,
-        thrust_cmd: f64,
-        elevator_cmd: f64,
-        aileron_cmd: f64,
-        rudder_cmd: f64,
-        flap_collective_cmd: f64,
-        flap_differential_cmd: f64,
-        vertical_flap_cmd: f64,
-        ref_pos_n: f64,
-        ref_pos_e: f64,
-        ref_pos_d: f64,
-        ref_airspeed: f64,
-        phase: i32,
-        pos_error: f64,
-    }
-
-    crate::impl_controller_ports!(Ports);
-
     #[test]
-    fn ports_map_field_by_field() {
-        let mut ports = Ports {
-            pos_e: 2.0,
-            quat_4: 1.0,
-            rudder: 0.1,
-            accel_z: -9.81,
-            ref_offset_d: -5.0,
-            ..Default::default()
-        };
-        let input = ports.controller_input(3.0).unwrap();
-        assert_eq!(input.t, 3.0);
-        assert_eq!(input.measurement.pos_ned, Vector3::new(0.0, 2.0, 0.0));
-        assert_eq!(input.measurement.quat, Vector4::new(0.0, 0.0, 0.0, 1.0));
-        assert_eq!(input.measurement.surfaces[2], 0.1);
-        assert_eq!(input.measurement.specific_force_body.z, -9.81);
-        assert_eq!(input.ref_offset_ned, Vector3::new(0.0, 0.0, -5.0));
-        ports.beta = f64::NAN;
-        assert_eq!(ports.controller_input(0.0).unwrap_err(), "beta");
-        ports.beta = 0.0;
-        ports.ref_offset_e = f64::INFINITY;
-        assert_eq!(ports.controller_input(0.0).unwrap_err(), "ref_offset_e");
+    fn held_output_round_trips() {
         let output = ControllerOutput {
             command: Command {
                 thrust: 50.0,
@@ -708,13 +563,6 @@ mod tests {
         assert_eq!(ControllerOutput::restore(&mut || it.next()), None, "invalid phase");
         let mut it = saved[..5].iter().copied();
         assert_eq!(ControllerOutput::restore(&mut || it.next()), None, "truncated");
-        ports.write_output(&output);
-        assert_eq!(
-            (ports.thrust_cmd, ports.vertical_flap_cmd, ports.elevator_cmd),
-            (50.0, -0.2, 0.0)
-        );
-        assert_eq!((ports.ref_pos_n, ports.ref_pos_e, ports.ref_pos_d), (1.0, 2.0, 3.0));
-        assert_eq!((ports.ref_airspeed, ports.phase, ports.pos_error), (25.0, 2, 0.5));
     }
 
     /// Regression (fuzzing): huge but finite positions made `pos_error` infinite.

@@ -20,7 +20,8 @@ pub mod trajectory;
 pub mod weights;
 
 use flight_mission::{
-    Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, FlightController, MissionParams, Notice,
+    Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, MissionParams, Notice, ParamError,
+    SampledUnit,
 };
 use nalgebra::{SMatrix, SVector, Vector3};
 use tailsitter_physics::Airframe;
@@ -552,8 +553,58 @@ impl LqrController {
     }
 }
 
-impl FlightController for LqrController {
-    fn update(&mut self, input: &ControllerInput) -> Result<ControllerOutput, ControlError> {
+/// Everything an [`LqrController`] is built from: the FMU's parameters.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LqrConfig {
+    /// The controller's own model of the airframe (may differ from the plant's).
+    pub airframe: Airframe,
+    pub mission: MissionParams,
+    pub params: LqrParams,
+    /// Weight tables in a JSON file (`weights_file`); empty: the built-in tables.
+    pub weights_file: String,
+}
+
+impl LqrConfig {
+    /// The nominal airframe, the given mission, default tuning and weights.
+    pub fn with_mission(mission: MissionParams) -> Self {
+        Self {
+            airframe: Airframe::default(),
+            mission,
+            params: LqrParams::default(),
+            weights_file: String::new(),
+        }
+    }
+}
+
+impl SampledUnit for LqrController {
+    type Config = LqrConfig;
+    type Input = ControllerInput;
+    type Output = ControllerOutput;
+
+    fn build(c: &LqrConfig) -> Result<Self, ParamError> {
+        if c.weights_file.is_empty() {
+            Self::new(c.airframe, c.mission, c.params.clone())
+        } else {
+            let json = std::fs::read_to_string(&c.weights_file)
+                .map_err(|e| ParamError(format!("weights_file {:?}: {e}", c.weights_file)))?;
+            Self::with_weights_json(c.airframe, c.mission, c.params.clone(), &json)
+        }
+        .map_err(|e| ParamError(e.0))
+    }
+
+    fn sample_time(c: &LqrConfig) -> f64 {
+        c.mission.sample_time
+    }
+
+    fn save(&self, out: &mut impl FnMut(f64)) {
+        Self::save(self, out)
+    }
+
+    fn restore(&mut self, next: &mut impl FnMut() -> Option<f64>) -> Result<(), ControlError> {
+        Self::restore(self, next)
+    }
+
+    fn sample(&mut self, input: &ControllerInput) -> Result<ControllerOutput, ControlError> {
         let m = &input.measurement;
         if let Some(name) = m.first_non_finite() {
             return Err(ControlError(format!("measurement {name} is not finite")));

@@ -236,7 +236,7 @@ fn timing_per_update() {
             measurement: smp.measurement,
             ref_offset_ned: Vector3::zeros(),
         };
-        std::hint::black_box(flight_mission::FlightController::update(&mut c, &input).unwrap());
+        std::hint::black_box(flight_mission::SampledUnit::sample(&mut c, &input).unwrap());
     }
     let total = t0.elapsed().as_secs_f64();
     let n = trace.samples.len() as f64;
@@ -257,7 +257,7 @@ fn timing_per_update() {
             measurement: smp.measurement,
             ref_offset_ned: Vector3::zeros(),
         };
-        std::hint::black_box(flight_mission::FlightController::update(&mut c2, &input).unwrap());
+        std::hint::black_box(flight_mission::SampledUnit::sample(&mut c2, &input).unwrap());
     }
     println!(
         "update without relinearisation: {:.1} µs ({} gain computations)",

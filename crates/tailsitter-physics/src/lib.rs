@@ -23,8 +23,8 @@ pub mod plant;
 pub use aero::{ForcesMoments, Surfaces, AIRSPEED_EPS};
 pub use airframe::{Airframe, Coefficients, InvalidParameter};
 pub use attitude::{
-    dcm_earth_to_body, dcm_from_euler_231, euler_231, euler_231_from_quat, euler_321_from_quat, quat_derivative,
-    quat_from_dcm, quat_from_euler_231, quat_from_euler_321,
+    dcm_earth_to_body, dcm_from_euler_231, euler_231, euler_231_from_quat, euler_321_from_quat, pitch_321,
+    quat_derivative, quat_from_dcm, quat_from_euler_231, quat_from_euler_321,
 };
 pub use error::PhysicsError;
 pub use plant::{Envelope, Outputs, Plant, Trim, MAX_SUBSTEPS};

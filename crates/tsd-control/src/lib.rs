@@ -42,8 +42,8 @@ pub use params::TsdParams;
 pub use trajectory::{Reference, Trajectory};
 
 use flight_mission::{
-    Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, FlightController, MissionParams, Notice,
-    ParamError, Phase,
+    Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, MissionParams, Notice, ParamError, Phase,
+    SampledUnit,
 };
 use nalgebra::{Matrix3, Quaternion, RowVector3, UnitQuaternion, Vector3};
 use tailsitter_physics::Airframe;
@@ -183,7 +183,7 @@ fn lerp(a: f64, b: f64, s: f64) -> f64 {
 impl TsdController {
     /// A controller for `mission` with tuning `params`, using `airframe` (its own model of
     /// the aircraft, not necessarily the plant's) for gains and feedback linearisation.
-    pub fn new(params: TsdParams, mission: MissionParams, airframe: Airframe) -> Result<Self, ParamError> {
+    pub fn new(airframe: Airframe, mission: MissionParams, params: TsdParams) -> Result<Self, ParamError> {
         params.validate()?;
         mission.validate()?;
         airframe
@@ -203,7 +203,7 @@ impl TsdController {
 
     /// The nominal airframe and Table 4.3 poles for `mission`.
     pub fn with_mission(mission: MissionParams) -> Result<Self, ParamError> {
-        Self::new(TsdParams::default(), mission, Airframe::default())
+        Self::new(Airframe::default(), mission, TsdParams::default())
     }
 
     /// Tuning parameters.
@@ -243,11 +243,11 @@ impl TsdController {
         out(self.saturated as f64);
     }
 
-    /// Restore what [`Self::save`] wrote; `None` (too few values) leaves `self` unchanged.
-    pub fn restore(&mut self, next: &mut impl FnMut() -> Option<f64>) -> Option<()> {
+    /// Restore what [`Self::save`] wrote; a truncated state is an error and leaves `self` unchanged.
+    pub fn restore(&mut self, next: &mut impl FnMut() -> Option<f64>) -> Result<(), ControlError> {
         let mut v = [0.0; STATE_LEN];
         for slot in v.iter_mut() {
-            *slot = next()?;
+            *slot = next().ok_or_else(|| ControlError("truncated TSD controller state".into()))?;
         }
         self.initialized = v[0] != 0.0;
         self.integrators = Integrators {
@@ -261,7 +261,7 @@ impl TsdController {
         } else {
             0
         };
-        Some(())
+        Ok(())
     }
 
     /// Mixing ratios (r_n, r_v): δfc = r_n·δm, δe = δm (4.2.12–4.2.13, Table 4.1) and
@@ -410,8 +410,48 @@ impl TsdController {
     }
 }
 
-impl FlightController for TsdController {
-    fn update(&mut self, input: &ControllerInput) -> Result<ControllerOutput, ControlError> {
+/// Everything a [`TsdController`] is built from: the FMU's parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TsdConfig {
+    /// The controller's own model of the airframe (may differ from the plant's).
+    pub airframe: Airframe,
+    pub mission: MissionParams,
+    pub params: TsdParams,
+}
+
+impl TsdConfig {
+    /// The nominal airframe, the given mission and the default tuning (Table 4.3 poles).
+    pub fn with_mission(mission: MissionParams) -> Self {
+        Self {
+            airframe: Airframe::default(),
+            mission,
+            params: TsdParams::default(),
+        }
+    }
+}
+
+impl SampledUnit for TsdController {
+    type Config = TsdConfig;
+    type Input = ControllerInput;
+    type Output = ControllerOutput;
+
+    fn build(c: &TsdConfig) -> Result<Self, ParamError> {
+        Self::new(c.airframe, c.mission, c.params)
+    }
+
+    fn sample_time(c: &TsdConfig) -> f64 {
+        c.mission.sample_time
+    }
+
+    fn save(&self, out: &mut impl FnMut(f64)) {
+        Self::save(self, out)
+    }
+
+    fn restore(&mut self, next: &mut impl FnMut() -> Option<f64>) -> Result<(), ControlError> {
+        Self::restore(self, next)
+    }
+
+    fn sample(&mut self, input: &ControllerInput) -> Result<ControllerOutput, ControlError> {
         let meas = &input.measurement;
         if let Some(name) = meas.first_non_finite() {
             return Err(Self::err(format!(
@@ -853,7 +893,7 @@ mod tests {
         assert_eq!(a.integrators, b.integrators);
         assert_eq!((a.initialized, a.saturated), (b.initialized, b.saturated));
         let mut empty = std::iter::empty();
-        assert!(b.restore(&mut || empty.next()).is_none());
+        assert!(b.restore(&mut || empty.next()).is_err());
     }
 
     #[test]
@@ -862,7 +902,7 @@ mod tests {
             normal_pole_re_level: 1.0,
             ..Default::default()
         };
-        let e = TsdController::new(p, MissionParams::default(), Airframe::default()).unwrap_err();
+        let e = TsdController::new(Airframe::default(), MissionParams::default(), p).unwrap_err();
         assert!(e.0.contains("normal_pole_re_level"), "{e}");
     }
 }
