@@ -187,6 +187,5 @@ fn non_finite_input_is_an_error_naming_the_variable() {
 fn parameter_start_values_are_the_library_defaults() {
     let vars = Variables::with_start_values();
     assert_eq!(vars.lqr(), LqrParams::default());
-    assert_eq!(vars.mission(), MissionParams::default());
     assert!(vars.weights_file.is_empty());
 }

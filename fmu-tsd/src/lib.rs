@@ -36,7 +36,6 @@ mod tests {
     fn declared_start_values_are_the_library_defaults() {
         let vars = Variables::with_start_values();
         assert_eq!(vars.tsd(), tsd_control::TsdParams::default());
-        assert_eq!(vars.mission(), flight_mission::MissionParams::default());
     }
 
     #[test]

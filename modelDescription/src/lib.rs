@@ -318,6 +318,19 @@ pub fn load(dir: &Path, model_identifier: &str, version: &str) -> Result<Model, 
     Ok(model)
 }
 
+/// The variables of one declaration file (`<dir>/<file>`, a model or a fragment)
+/// with its includes resolved, without the checks of a complete model: for the
+/// build scripts that generate the defaults of a parameter group. Also returns
+/// every file read, for `cargo:rerun-if-changed`.
+pub fn load_declarations(dir: &Path, file: &str) -> Result<(Vec<VariableDecl>, Vec<PathBuf>), DeclError> {
+    let mut sources = Vec::new();
+    let root = read_decl(&dir.join(file), &mut sources)?;
+    let mut groups = BTreeMap::new();
+    let mut decls = Vec::new();
+    collect(dir, &root, &mut sources, &mut groups, &mut decls, 0)?;
+    Ok((decls, sources))
+}
+
 fn read_decl(path: &Path, sources: &mut Vec<PathBuf>) -> Result<DeclFile, DeclError> {
     let text = std::fs::read_to_string(path).map_err(|e| DeclError(format!("{}: {e}", path.display())))?;
     sources.push(path.to_path_buf());

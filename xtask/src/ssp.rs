@@ -27,26 +27,31 @@ use quick_xml::events::{BytesDecl, BytesStart, Event};
 use quick_xml::Writer;
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
+use std::sync::LazyLock;
 
 /// The plant every system holds.
 pub const PLANT: &str = "tailsitter_plant";
 /// Controllers a system is written for (each when its FMU exists).
 pub const CONTROLLERS: &[&str] = &["tailsitter_lqr", "tailsitter_tsd"];
-/// Default experiment: the default mission (DESIGN.md §3) is 35 s long.
+/// Default experiment: the default mission (docs/DESIGN.md §3) is 35 s long.
 pub const STOP_TIME: f64 = 35.0;
 /// Communication step = the controllers' default `sample_time`.
 pub const STEP_SIZE: f64 = 0.02;
-/// Mission parameters (DESIGN.md §3), bound on the controller.
-pub const MISSION: &[(&str, f64)] = &[
-    ("t_vertical_1", 5.0),
-    ("t_transition_1", 5.0),
-    ("t_level", 10.0),
-    ("t_transition_2", 10.0),
-    ("t_vertical_2", 5.0),
-    ("v_level", 25.0),
-    ("v_vertical", 3.0),
-    ("sample_time", STEP_SIZE),
-];
+/// Mission parameters (docs/DESIGN.md §3) with their declared defaults, bound on the
+/// controller: the `mission` group of `modelDescription/fragments/controller_interface.json`.
+pub static MISSION: LazyLock<Vec<(&'static str, f64)>> = LazyLock::new(|| {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../modelDescription");
+    let (decls, _) = model_description::load_declarations(&dir, "fragments/controller_interface.json")
+        .unwrap_or_else(|e| panic!("controller interface declaration: {e}"));
+    decls
+        .into_iter()
+        .filter(|d| d.group.as_deref() == Some("mission"))
+        .map(|d| match d.start {
+            Some(model_description::Start::Number(x)) => (&*d.name.leak(), x),
+            other => panic!("mission parameter {} has start {other:?}", d.name),
+        })
+        .collect()
+});
 
 const NS_SSD: &str = "http://ssp-standard.org/SSP1/SystemStructureDescription";
 const NS_SSC: &str = "http://ssp-standard.org/SSP1/SystemStructureCommon";

@@ -152,15 +152,7 @@ pub struct LqrController {
 }
 
 /// Names of the commands, for [`Notice::Saturated`].
-const COMMAND_NAMES: [&str; NU] = [
-    "thrust_cmd",
-    "elevator_cmd",
-    "aileron_cmd",
-    "rudder_cmd",
-    "flap_collective_cmd",
-    "flap_differential_cmd",
-    "vertical_flap_cmd",
-];
+use tailsitter_physics::idx::INPUT_NAMES as COMMAND_NAMES;
 
 /// The result of one gain computation.
 #[derive(Debug, Clone, Copy)]

@@ -125,14 +125,6 @@ pub mod idx {
         "flap_differential",
         "vertical_flap",
     ];
-    /// Input names (FMU input names), by index.
-    pub const INPUT_NAMES: [&str; super::N_INPUTS] = [
-        "thrust_cmd",
-        "elevator_cmd",
-        "aileron_cmd",
-        "rudder_cmd",
-        "flap_collective_cmd",
-        "flap_differential_cmd",
-        "vertical_flap_cmd",
-    ];
+    include!(concat!(env!("OUT_DIR"), "/input_names.rs"));
+    const _: () = assert!(INPUT_NAMES.len() == super::N_INPUTS);
 }

@@ -27,29 +27,6 @@ fn zero_wind() -> Vector3<f64> {
 }
 
 #[test]
-fn default_matches_json_start_values() {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../modelDescription/tailsitter_plant.json"
-    );
-    let text = std::fs::read_to_string(path).expect("read tailsitter_plant.json");
-    let json: serde_json::Value = serde_json::from_str(&text).unwrap();
-    let vars = json["variables"].as_array().unwrap();
-    let group: Vec<_> = vars.iter().filter(|v| v["group"] == "airframe").collect();
-    let ours = Airframe::default().named_values();
-    assert_eq!(group.len(), ours.len(), "number of airframe parameters");
-    for v in group {
-        let name = v["name"].as_str().unwrap();
-        let start = v["start"].as_f64().unwrap();
-        let (_, value) = ours
-            .iter()
-            .find(|(n, _)| *n == name)
-            .unwrap_or_else(|| panic!("no field {name}"));
-        assert_eq!(*value, start, "{name}");
-    }
-}
-
-#[test]
 fn validate_names_the_parameter() {
     assert!(Airframe::default().validate().is_ok());
     let e = Airframe {

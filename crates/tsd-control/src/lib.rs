@@ -165,15 +165,7 @@ pub struct TsdController {
 }
 
 /// Names of the commands, bit order of the saturation mask.
-const COMMAND_NAMES: [&str; 7] = [
-    "thrust_cmd",
-    "elevator_cmd",
-    "aileron_cmd",
-    "rudder_cmd",
-    "flap_collective_cmd",
-    "flap_differential_cmd",
-    "vertical_flap_cmd",
-];
+use tailsitter_physics::idx::INPUT_NAMES as COMMAND_NAMES;
 
 #[inline]
 fn lerp(a: f64, b: f64, s: f64) -> f64 {
