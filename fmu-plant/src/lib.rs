@@ -75,9 +75,7 @@ impl PlantModel {
     fn write_outputs(&self, vars: &mut Variables) {
         let y = self.plant.outputs(&self.x, &Self::inputs(vars), &vars.wind());
         vars.set_measurement(&closed_loop::measurement(&self.x, &y));
-        vars.phi = y.euler_321.x;
-        vars.theta = y.euler_321.y;
-        vars.psi = y.euler_321.z;
+        vars.set_outputs(&y);
     }
 }
 

@@ -3,7 +3,7 @@
 //!
 //! Layout of the archive:
 //! - `SystemStructure.ssd`: one system with the components `plant` and `controller`
-//!   (`resources/<modelIdentifier>.fmu`), connected by port name (DESIGN.md §2): every controller
+//!   (`resources/<modelIdentifier>.fmu`), connected by port name (docs/DESIGN.md §2): every controller
 //!   input named like a plant output reads it, every controller output named like a plant input
 //!   drives it. The mission parameters (§3) are an inline parameter set on the controller, the
 //!   plant's initial trim speed is bound to `v_vertical`. Default experiment 0–35 s, with the OSP
@@ -237,7 +237,7 @@ pub struct Connection {
     pub name: String,
 }
 
-/// Connections by name (DESIGN.md §2): plant outputs → controller inputs, controller outputs →
+/// Connections by name (docs/DESIGN.md §2): plant outputs → controller inputs, controller outputs →
 /// plant inputs. Errors if types differ or a plant command input (`*_cmd`) is left undriven.
 pub fn connections(plant: &FmuInfo, controller: &FmuInfo) -> Result<Vec<Connection>, String> {
     let mut out = Vec::new();
@@ -386,7 +386,7 @@ pub fn system_description(plant: &FmuInfo, controller: &FmuInfo) -> Result<Strin
         .find(|(n, _)| *n == "v_vertical")
         .map(|m| m.1)
         .unwrap_or(3.0);
-    // The plant starts in the trimmed vertical climb at the mission's climb speed (DESIGN.md §3).
+    // The plant starts in the trimmed vertical climb at the mission's climb speed (docs/DESIGN.md §3).
     let plant_parameters = bindings(
         plant,
         &[
@@ -402,7 +402,7 @@ pub fn system_description(plant: &FmuInfo, controller: &FmuInfo) -> Result<Strin
     }
     let name = format!("{}_closed_loop", controller.model_identifier);
     let description = format!(
-        "Tail-sitter closed loop: {} flying {} (DESIGN.md section 2 port wiring by name, section 3 mission).",
+        "Tail-sitter closed loop: {} flying {} (docs/DESIGN.md section 2 port wiring by name, section 3 mission).",
         controller.model_identifier, plant.model_identifier
     );
     let mut w = Writer::new_with_indent(Vec::new(), b' ', 2);

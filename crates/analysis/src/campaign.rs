@@ -957,8 +957,8 @@ fn robustness_section(intro: &str, results: &[RobustnessResult], cfg: &Config) -
     (rb, csv)
 }
 
-/// Why our open-loop modes differ from Tables 3.2/3.3 (DESIGN.md §4, §6).
-pub const OPEN_LOOP_NOTES: &str = "Differences from the thesis (DESIGN.md §4/§6): the thesis's modes were computed \
+/// Why our open-loop modes differ from Tables 3.2/3.3 (docs/DESIGN.md §4, §6).
+pub const OPEN_LOOP_NOTES: &str = "Differences from the thesis (docs/DESIGN.md §4/§6): the thesis's modes were computed \
 from its AVL-based model with numbers it does not publish (span, inertia cross-terms, the trim it linearised at: α = 5.9° \
 in AVL against our α ≈ 7.5°, δe ≈ −6° once the elevator's own lift counts). Its short period −10.44 ± 24.2i does not follow from its own published derivatives: with C_mα = −1.65, C_mq = −7.64, C_Lα = 4.25, I_y = 0.42 kg m², m = 9 kg, S = 0.574 m², c̄ = 0.366 m at 25 m/s (q̄Sc̄ ≈ 80 N m), M_α ≈ q̄Sc̄C_mα/I_y ≈ −315 s⁻², M_q ≈ q̄Sc̄²C_mq/(2V I_y) ≈ −10.7 s⁻¹ and Z_α/V ≈ q̄SC_Lα/(mV) ≈ 4.2 s⁻¹, so ζω ≈ (10.7 + 4.2)/2 ≈ 7.4 s⁻¹ and ω ≈ √(315 + 10.7·4.2) ≈ 19 rad/s — our −7.4 ± 16.5i (ω_n 18.1), not the thesis's ω_n 26.4 rad/s, which would need about twice the pitch stiffness C_mα/I_y. Lateral modes depend on the span b = 1.569 m (S/c̄) we assume, which sets the \
 roll damping L_p ∝ b² and hence the roll pole (ours ≈ −8 against −10.3) and the Dutch roll. The spiral mode is unstable in \

@@ -3,7 +3,7 @@
 //!
 //! (x_k, c_k) ↦ (x_{k+1}, c_{k+1}): controller update at t_k on the measurement of x_k
 //! (giving the command and its next internal state c_{k+1}), then the nonlinear plant
-//! over one `sample_time` with that command held (Gauss–Seidel, DESIGN.md §2),
+//! over one `sample_time` with that command held (Gauss–Seidel, docs/DESIGN.md §2),
 //!
 //! at the operating point the closed loop itself reaches on the default mission at the
 //! analysis time (e.g. t = 18 s, late in level flight, or t = 4 s in the 3 m/s vertical

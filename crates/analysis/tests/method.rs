@@ -207,7 +207,7 @@ fn tail_sitter_map_matches_zoh_of_linearisation() {
         .collect();
     assert_eq!(ours.len(), 20);
 
-    let (a, b) = plant.linearize(&trim.state, &trim.inputs, &Vector3::zeros());
+    let (a, b) = plant.linearise(&trim.state, &trim.inputs, &Vector3::zeros());
     let mut aug = DMatrix::<f64>::zeros(27, 27);
     for i in 0..20 {
         for j in 0..20 {

@@ -1,6 +1,6 @@
 //! The closed loop of the tail-sitter plant ([`tailsitter_physics::Plant`]) and
 //! any [`FlightController`], without FMI: the same wiring and timing a
-//! co-simulation master uses (DESIGN.md §2 Timing), for tests, analysis
+//! co-simulation master uses (docs/DESIGN.md §2 Timing), for tests, analysis
 //! campaigns and benchmarks of the controller libraries.
 //!
 //! Frames: NED earth axes for positions, velocities and wind; SI units.
@@ -323,7 +323,7 @@ pub fn pitch(x: &StateVector) -> f64 {
 
 /// Fly `controller` with `plant` from state `x0` through `scenario`.
 ///
-/// Timing (DESIGN.md §2): at each communication point t the controller is
+/// Timing (docs/DESIGN.md §2): at each communication point t the controller is
 /// handed the plant outputs at t; it samples when its own clock is due (here:
 /// every multiple of `mission.sample_time`, the first at t = 0) and holds its
 /// command otherwise. The plant then advances over [t, t + h) with the

@@ -15,7 +15,7 @@ use std::fmt;
 mod unit;
 pub use unit::{HeldOutput, SampledUnit};
 
-/// Mission parameters (DESIGN.md §3), the same names and defaults in both controllers.
+/// Mission parameters (docs/DESIGN.md §3), the same names and defaults in both controllers.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MissionParams {
     /// Vertical climb before the first transition [s].
@@ -165,7 +165,7 @@ impl From<Phase> for i32 {
     }
 }
 
-/// What a controller measures: the plant outputs of the same names (DESIGN.md §2).
+/// What a controller measures: the plant outputs of the same names (docs/DESIGN.md §2).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Measurement {
     /// NED position of the CG [m] (`pos_n`, `pos_e`, `pos_d`).
@@ -299,7 +299,7 @@ pub struct ControllerInput {
     pub ref_offset_ned: Vector3<f64>,
 }
 
-/// Diagnostic outputs, the same in both controllers (DESIGN.md §2).
+/// Diagnostic outputs, the same in both controllers (docs/DESIGN.md §2).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Diagnostics {
     /// Reference position including the offset [m], NED.

@@ -476,7 +476,7 @@ impl LqrController {
         }
     }
 
-    /// Append the controller's state (everything `update` depends on besides its
+    /// Append the controller's state (everything `sample` depends on besides its
     /// construction parameters) as f64s.
     pub fn save(&self, out: &mut impl FnMut(f64)) {
         let origin = self

@@ -1,4 +1,4 @@
-//! Airframe parameters (thesis App. C, DESIGN.md §4) and the interpolation of the
+//! Airframe parameters (thesis App. C, docs/DESIGN.md §4) and the interpolation of the
 //! stability and control derivatives in α.
 
 use core::fmt;

@@ -2,10 +2,10 @@
 //! *A Comparison of Control Systems for the Flight Transition of VTOL Unmanned Aerial
 //! Vehicles* (ch. 2, App. A, C, D).
 //!
-//! * [`Airframe`]: parameters (App. C, DESIGN.md §4) and the force/moment model
+//! * [`Airframe`]: parameters (App. C, docs/DESIGN.md §4) and the force/moment model
 //!   [`Airframe::forces_moments`] (§2.3) that controllers use for their own models.
 //! * [`Plant`]: the 20-state plant: derivatives, fixed-step RK4 [`Plant::advance`], outputs,
-//!   trims ([`Plant::trim_level`], [`Plant::trim_vertical_climb`]) and [`Plant::linearize`].
+//!   trims ([`Plant::trim_level`], [`Plant::trim_vertical_climb`]) and [`Plant::linearise`].
 //! * [`attitude`]: quaternion (A.2.8, scalar last), DCMs and Euler angles (3-2-1, 2-3-1).
 //!
 //! Frames: earth NED (treated as inertial), body (x forward/nose — up in hover — y right
@@ -18,6 +18,7 @@ pub mod aero;
 pub mod airframe;
 pub mod attitude;
 pub mod error;
+pub mod numeric;
 pub mod plant;
 
 pub use aero::{ForcesMoments, Surfaces, AIRSPEED_EPS};

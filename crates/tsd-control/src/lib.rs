@@ -29,7 +29,7 @@
 //! they are initialised at the first sample so the first command equals the measured
 //! actuator state (bumpless start from the plant's trim), wound back by back-calculation
 //! with the tracking gain (§4.2.1) when a command saturates, and only finite values are
-//! committed. `update` does not allocate (static nalgebra types only).
+//! committed. `sample` does not allocate (static nalgebra types only).
 //!
 //! Frames: earth NED, body (x nose, y right wing, z belly), wind axes (x along the air
 //! velocity, z in the plane of symmetry). Units SI, angles rad.
