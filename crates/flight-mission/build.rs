@@ -1,7 +1,9 @@
-//! Generates `impl Default for MissionParams` and `MissionParams::named_values`
-//! into `OUT_DIR/mission_generated.rs` from the `mission` group of
-//! `modelDescription/fragments/controller_interface.json`, the single source of
-//! the mission parameters' names and defaults.
+//! Generates from `modelDescription/fragments/controller_interface.json`, the
+//! single source of the controller ports and the mission parameters:
+//! - `OUT_DIR/mission_generated.rs`: `impl Default for MissionParams` and
+//!   `MissionParams::named_values` (group `mission`);
+//! - `OUT_DIR/measurement_generated.rs`: `Measurement::first_non_finite`, naming
+//!   the port of a non-finite value (group `measurement`).
 
 use std::path::PathBuf;
 
@@ -19,6 +21,13 @@ fn main() {
         &format!("modelDescription/{file}"),
     );
     std::fs::write(out.join("mission_generated.rs"), text).expect("write mission_generated.rs");
+    let check = model_description::rust::group_first_non_finite(
+        &decls,
+        "measurement",
+        "Measurement",
+        &format!("modelDescription/{file}"),
+    );
+    std::fs::write(out.join("measurement_generated.rs"), check).expect("write measurement_generated.rs");
     for s in sources {
         println!("cargo:rerun-if-changed={}", s.display());
     }

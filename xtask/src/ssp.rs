@@ -33,10 +33,6 @@ use std::sync::LazyLock;
 pub const PLANT: &str = "tailsitter_plant";
 /// Controllers a system is written for (each when its FMU exists).
 pub const CONTROLLERS: &[&str] = &["tailsitter_lqr", "tailsitter_tsd"];
-/// Default experiment: the default mission (docs/DESIGN.md §3) is 35 s long.
-pub const STOP_TIME: f64 = 35.0;
-/// Communication step = the controllers' default `sample_time`.
-pub const STEP_SIZE: f64 = 0.02;
 /// Mission parameters (docs/DESIGN.md §3) with their declared defaults, bound on the
 /// controller: the `mission` group of `modelDescription/fragments/controller_interface.json`.
 pub static MISSION: LazyLock<Vec<(&'static str, f64)>> = LazyLock::new(|| {
@@ -52,6 +48,30 @@ pub static MISSION: LazyLock<Vec<(&'static str, f64)>> = LazyLock::new(|| {
         })
         .collect()
 });
+
+/// A mission parameter's declared default.
+fn mission_default(name: &str) -> f64 {
+    MISSION
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|m| m.1)
+        .unwrap_or_else(|| panic!("mission parameter {name} not declared"))
+}
+
+/// Default experiment: the default mission (docs/DESIGN.md §3), from t = 0 to the end
+/// of its last phase.
+fn stop_time() -> f64 {
+    [
+        "t_vertical_1",
+        "t_transition_1",
+        "t_level",
+        "t_transition_2",
+        "t_vertical_2",
+    ]
+    .iter()
+    .map(|n| mission_default(n))
+    .sum()
+}
 
 const NS_SSD: &str = "http://ssp-standard.org/SSP1/SystemStructureDescription";
 const NS_SSC: &str = "http://ssp-standard.org/SSP1/SystemStructureCommon";
@@ -381,11 +401,7 @@ pub fn system_description(plant: &FmuInfo, controller: &FmuInfo) -> Result<Strin
     let (plant_inputs, controller_inputs) = (inputs_of("plant"), inputs_of("controller"));
     let mission: Vec<_> = MISSION.iter().map(|(n, v)| (*n, "Real", real(*v))).collect();
     let controller_parameters = bindings(controller, &mission)?;
-    let v_vertical = MISSION
-        .iter()
-        .find(|(n, _)| *n == "v_vertical")
-        .map(|m| m.1)
-        .unwrap_or(3.0);
+    let v_vertical = mission_default("v_vertical");
     // The plant starts in the trimmed vertical climb at the mission's climb speed (docs/DESIGN.md §3).
     let plant_parameters = bindings(
         plant,
@@ -461,7 +477,7 @@ pub fn system_description(plant: &FmuInfo, controller: &FmuInfo) -> Result<Strin
                 })?;
             }
             w.create_element("ssd:DefaultExperiment")
-                .with_attributes([("startTime", "0.0"), ("stopTime", real(STOP_TIME).as_str())])
+                .with_attributes([("startTime", "0.0"), ("stopTime", real(stop_time()).as_str())])
                 .write_inner_content(|w| {
                     w.create_element("ssd:Annotations").write_inner_content(|w| {
                         w.create_element("ssc:Annotation")
@@ -469,7 +485,7 @@ pub fn system_description(plant: &FmuInfo, controller: &FmuInfo) -> Result<Strin
                             .write_inner_content(|w| {
                                 w.create_element("osp:Algorithm").write_inner_content(|w| {
                                     w.create_element("osp:FixedStepAlgorithm")
-                                        .with_attribute(("baseStepSize", real(STEP_SIZE).as_str()))
+                                        .with_attribute(("baseStepSize", real(mission_default("sample_time")).as_str()))
                                         .write_empty()?;
                                     Ok(())
                                 })?;

@@ -21,7 +21,7 @@ pub enum Ordering {
     Jacobi,
 }
 
-/// Earth-frame wind profile [m/s], NED.
+/// Earth-frame wind profile (m/s), NED.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum Wind {
     #[default]
@@ -72,9 +72,9 @@ impl Wind {
 pub struct Scenario {
     /// The mission the controller flies (used here for phases and the stop time).
     pub mission: MissionParams,
-    /// End of the run [s].
+    /// End of the run (s).
     pub stop_time: f64,
-    /// Communication step of the master [s].
+    /// Communication step of the master (s).
     pub comm_step: f64,
     pub ordering: Ordering,
     pub wind: Wind,
@@ -154,7 +154,7 @@ pub fn plant_inputs(c: &Command) -> InputVector {
 /// The closed loop at one communication point.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Sample {
-    /// Time [s].
+    /// Time (s).
     pub t: f64,
     /// Plant state at `t`.
     pub x: StateVector,
@@ -164,14 +164,14 @@ pub struct Sample {
     pub command: Command,
     /// Controller diagnostics of its sample at `t`.
     pub diagnostics: Diagnostics,
-    /// Wind at `t` [m/s], NED.
+    /// Wind at `t` (m/s), NED.
     pub wind: Vector3<f64>,
-    /// Pitch θ of the 3-2-1 Euler angles [rad] (well defined near 90°: from the DCM).
+    /// Pitch θ of the 3-2-1 Euler angles (rad) (well defined near 90°: from the DCM).
     pub theta: f64,
 }
 
 impl Sample {
-    /// |position − reference position| [m].
+    /// |position − reference position| (m).
     pub fn pos_error(&self) -> f64 {
         (self.measurement.pos_ned - self.diagnostics.ref_pos_ned).norm()
     }
@@ -191,9 +191,9 @@ pub struct Trace {
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct PhaseErrors {
     pub samples: usize,
-    /// Maximum position error [m].
+    /// Maximum position error (m).
     pub max: f64,
-    /// RMS position error [m].
+    /// RMS position error (m).
     pub rms: f64,
 }
 
@@ -222,7 +222,7 @@ impl Trace {
         out
     }
 
-    /// Maximum position error over the whole run [m].
+    /// Maximum position error over the whole run (m).
     pub fn max_pos_error(&self) -> f64 {
         self.samples.iter().map(Sample::pos_error).fold(0.0, f64::max)
     }
@@ -232,7 +232,7 @@ impl Trace {
         self.samples.iter().filter(move |s| s.t >= t0 - 1e-9 && s.t < t1 - 1e-9)
     }
 
-    /// Maximum angle of attack [rad] with `t0 ≤ t < t1`.
+    /// Maximum angle of attack (rad) with `t0 ≤ t < t1`.
     pub fn max_alpha(&self, t0: f64, t1: f64) -> f64 {
         self.window(t0, t1)
             .map(|s| s.measurement.alpha)
@@ -243,11 +243,11 @@ impl Trace {
 /// The acceptance criteria of the controller issues, evaluated on a trace.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MissionCheck {
-    /// Max |airspeed − v_level| over the last 5 s of level flight [m/s].
+    /// Max |airspeed − v_level| over the last 5 s of level flight (m/s).
     pub level_airspeed_error: f64,
-    /// Max |θ − θ_trim| over the last 5 s of level flight [rad].
+    /// Max |θ − θ_trim| over the last 5 s of level flight (rad).
     pub level_pitch_error: f64,
-    /// |θ − 90°| at the end [rad].
+    /// |θ − 90°| at the end (rad).
     pub final_pitch_error: f64,
     /// Every sampled value finite.
     pub all_finite: bool,
@@ -257,7 +257,7 @@ pub struct MissionCheck {
 
 impl MissionCheck {
     /// Evaluate `trace` of `mission`; `theta_level_trim` is the plant's trimmed
-    /// pitch in level flight at `v_level` [rad].
+    /// pitch in level flight at `v_level` (rad).
     pub fn of(trace: &Trace, mission: &MissionParams, theta_level_trim: f64) -> Self {
         let s = mission.phase_starts();
         let (t0, t1) = ((s[3] - 5.0).max(s[2]), s[3]);

@@ -126,7 +126,7 @@ fn check(controller: &str, rows: &[Vec<f64>]) {
     for (got, want) in rows.iter().zip(&stored) {
         for ((g, w), name) in got.iter().zip(want).zip(&names) {
             let err = (g - w).abs() / w.abs().max(1.0);
-            if !(err <= worst.0) {
+            if err > worst.0 || err.is_nan() {
                 worst = (err, name, want[0]);
             }
         }

@@ -18,21 +18,21 @@ pub use unit::{HeldOutput, SampledUnit};
 /// Mission parameters (docs/DESIGN.md §3), the same names and defaults in both controllers.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MissionParams {
-    /// Vertical climb before the first transition [s].
+    /// Vertical climb before the first transition (s).
     pub t_vertical_1: f64,
-    /// T1, duration of the transition vertical → level [s].
+    /// T1, duration of the transition vertical → level (s).
     pub t_transition_1: f64,
-    /// Level flight [s].
+    /// Level flight (s).
     pub t_level: f64,
-    /// T2, duration of the transition level → vertical [s].
+    /// T2, duration of the transition level → vertical (s).
     pub t_transition_2: f64,
-    /// Vertical flight after the second transition [s].
+    /// Vertical flight after the second transition (s).
     pub t_vertical_2: f64,
-    /// V_L, level-flight airspeed [m/s].
+    /// V_L, level-flight airspeed (m/s).
     pub v_level: f64,
-    /// V_V, vertical climb speed [m/s].
+    /// V_V, vertical climb speed (m/s).
     pub v_vertical: f64,
-    /// Controller sample period T_s [s] (§3.2.4).
+    /// Controller sample period T_s (s) (§3.2.4).
     pub sample_time: f64,
 }
 
@@ -95,7 +95,7 @@ impl MissionParams {
         [0.0, t1, t2, t3, t4, t5]
     }
 
-    /// Nominal end of the mission [s]; the last phase continues after it.
+    /// Nominal end of the mission (s); the last phase continues after it.
     pub fn end_time(&self) -> f64 {
         self.phase_starts()[5]
     }
@@ -168,106 +168,52 @@ impl From<Phase> for i32 {
 /// What a controller measures: the plant outputs of the same names (docs/DESIGN.md §2).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Measurement {
-    /// NED position of the CG [m] (`pos_n`, `pos_e`, `pos_d`).
+    /// NED position of the CG (m) (`pos_n`, `pos_e`, `pos_d`).
     pub pos_ned: Vector3<f64>,
-    /// Inertial velocity, earth axes [m/s] (`vel_n`, `vel_e`, `vel_d`).
+    /// Inertial velocity, earth axes (m/s) (`vel_n`, `vel_e`, `vel_d`).
     pub vel_ned: Vector3<f64>,
-    /// Inertial velocity, body axes [m/s] (`u`, `v`, `w`).
+    /// Inertial velocity, body axes (m/s) (`u`, `v`, `w`).
     pub vel_body: Vector3<f64>,
-    /// Body rates p, q, r [rad/s].
+    /// Body rates p, q, r (rad/s).
     pub rates: Vector3<f64>,
     /// Attitude quaternion (A.2.8), scalar part last (`quat_4`).
     pub quat: Vector4<f64>,
-    /// Air-relative speed V̄ [m/s].
+    /// Air-relative speed V̄ (m/s).
     pub airspeed: f64,
-    /// Angle of attack α [rad] (2.2.12).
+    /// Angle of attack α (rad) (2.2.12).
     pub alpha: f64,
-    /// Sideslip β [rad] (2.2.13).
+    /// Sideslip β (rad) (2.2.13).
     pub beta: f64,
-    /// Thrust state T [N].
+    /// Thrust state T (N).
     pub thrust: f64,
-    /// Actual deflections δe, δa, δr, δfc, δfd, δv [rad].
+    /// Actual deflections δe, δa, δr, δfc, δfd, δv (rad).
     pub surfaces: [f64; 6],
-    /// Specific force in body axes [m/s²] (`accel_x`, `accel_y`, `accel_z`).
+    /// Specific force in body axes (m/s²) (`accel_x`, `accel_y`, `accel_z`).
     pub specific_force_body: Vector3<f64>,
-    /// Propeller induced velocity w [m/s] (2.3.21).
+    /// Propeller induced velocity w (m/s) (2.3.21).
     pub induced_velocity: f64,
 }
 
-impl Measurement {
-    /// The name of the first non-finite value, if any.
-    pub fn first_non_finite(&self) -> Option<&'static str> {
-        const V3: [[&str; 3]; 5] = [
-            ["pos_n", "pos_e", "pos_d"],
-            ["vel_n", "vel_e", "vel_d"],
-            ["u", "v", "w"],
-            ["p", "q", "r"],
-            ["accel_x", "accel_y", "accel_z"],
-        ];
-        let vectors = [
-            &self.pos_ned,
-            &self.vel_ned,
-            &self.vel_body,
-            &self.rates,
-            &self.specific_force_body,
-        ];
-        for (vector, names) in vectors.iter().zip(V3.iter()) {
-            for (value, name) in vector.iter().zip(names.iter()) {
-                if !value.is_finite() {
-                    return Some(name);
-                }
-            }
-        }
-        const QUAT: [&str; 4] = ["quat_1", "quat_2", "quat_3", "quat_4"];
-        for (value, name) in self.quat.iter().zip(QUAT.iter()) {
-            if !value.is_finite() {
-                return Some(name);
-            }
-        }
-        const SURFACES: [&str; 6] = [
-            "elevator",
-            "aileron",
-            "rudder",
-            "flap_collective",
-            "flap_differential",
-            "vertical_flap",
-        ];
-        for (value, name) in self.surfaces.iter().zip(SURFACES.iter()) {
-            if !value.is_finite() {
-                return Some(name);
-            }
-        }
-        for (value, name) in [
-            (self.airspeed, "airspeed"),
-            (self.alpha, "alpha"),
-            (self.beta, "beta"),
-            (self.thrust, "thrust"),
-            (self.induced_velocity, "induced_velocity"),
-        ] {
-            if !value.is_finite() {
-                return Some(name);
-            }
-        }
-        None
-    }
-}
+// `Measurement::first_non_finite`, generated by build.rs from the `measurement`
+// group of modelDescription/fragments/controller_interface.json.
+include!(concat!(env!("OUT_DIR"), "/measurement_generated.rs"));
 
 /// Commands to the plant inputs of the same names (`thrust_cmd`, `elevator_cmd`, …).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Command {
-    /// Total commanded thrust T_c [N] (2.3.16).
+    /// Total commanded thrust T_c (N) (2.3.16).
     pub thrust: f64,
-    /// δe [rad].
+    /// δe (rad).
     pub elevator: f64,
-    /// δa [rad].
+    /// δa (rad).
     pub aileron: f64,
-    /// δr [rad].
+    /// δr (rad).
     pub rudder: f64,
-    /// δfc [rad].
+    /// δfc (rad).
     pub flap_collective: f64,
-    /// δfd [rad].
+    /// δfd (rad).
     pub flap_differential: f64,
-    /// δv [rad].
+    /// δv (rad).
     pub vertical_flap: f64,
 }
 
@@ -291,24 +237,24 @@ impl Command {
 /// Everything a controller is handed at a sample.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ControllerInput {
-    /// Mission time of the sample [s].
+    /// Mission time of the sample (s).
     pub t: f64,
     /// The measured plant outputs.
     pub measurement: Measurement,
-    /// `ref_offset_n/e/d`: added to the reference position [m], NED.
+    /// `ref_offset_n/e/d`: added to the reference position (m), NED.
     pub ref_offset_ned: Vector3<f64>,
 }
 
 /// Diagnostic outputs, the same in both controllers (docs/DESIGN.md §2).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Diagnostics {
-    /// Reference position including the offset [m], NED.
+    /// Reference position including the offset (m), NED.
     pub ref_pos_ned: Vector3<f64>,
-    /// Reference airspeed [m/s].
+    /// Reference airspeed (m/s).
     pub ref_airspeed: f64,
     /// Current mission phase.
     pub phase: Phase,
-    /// |measured − reference| position [m].
+    /// |measured − reference| position (m).
     pub pos_error: f64,
 }
 

@@ -33,10 +33,10 @@ use model::{ix, linearise, state_of, wrap_pi, EulerRep, I_POS, NA, NU, NX, U, X}
 use trajectory::{TrajPoint, Trajectory, TrajectoryMode, TrajectoryOptions};
 use weights::{load_set, WeightSchedule, Weights, DEFAULT_WEIGHTS_JSON};
 
-/// Smallest reference airspeed the (V, α, β) model for control supports \[m/s\].
+/// Smallest reference airspeed the (V, α, β) model for control supports (m/s).
 pub const MIN_AIRSPEED: f64 = 0.5;
 
-/// Bound on the magnitude of the wind estimate \[m/s\].
+/// Bound on the magnitude of the wind estimate (m/s).
 pub const MAX_WIND_ESTIMATE: f64 = 20.0;
 
 /// Size of the augmented ZOH exponential: states + integrator + inputs.
@@ -49,7 +49,7 @@ pub type Gain = SMatrix<f64, NU, NA>;
 /// parameter names).
 #[derive(Debug, Clone, PartialEq)]
 pub struct LqrParams {
-    /// T_l: period of relinearisation and gain computation \[s\] (§3.1.3, §3.2.4: 0.2 s).
+    /// T_l: period of relinearisation and gain computation (s) (§3.1.3, §3.2.4: 0.2 s).
     pub relinearisation_period: f64,
     /// 0 = exact steady-state DARE (structured doubling), 1 = the thesis's backward
     /// iteration over `riccati_horizon` steps (3.1.3–3.1.5).
@@ -60,13 +60,13 @@ pub struct LqrParams {
     pub r_scale: f64,
     /// Index of the weight set in the weights JSON (0 = thesis Table 3.4).
     pub weight_set: i32,
-    /// Time over which the weights blend from one phase's table to the next \[s\].
+    /// Time over which the weights blend from one phase's table to the next (s).
     pub weight_blend_time: f64,
-    /// Reference 3-2-1 pitch above which the 2-3-1 Euler set is used \[rad\].
+    /// Reference 3-2-1 pitch above which the 2-3-1 Euler set is used (rad).
     pub euler_switch_pitch: f64,
-    /// Limit of the airspeed-error integrator |∫ΔV dt| \[m\].
+    /// Limit of the airspeed-error integrator |∫ΔV dt| (m).
     pub integrator_limit: f64,
-    /// Leak λ of the airspeed integrator, ẋ_I = V − V_t − λ x_I \[1/s\]. Must be > 0: with
+    /// Leak λ of the airspeed integrator, ẋ_I = V − V_t − λ x_I (1/s). Must be > 0: with
     /// λ = 0 the integrator minus the along-track position is an uncontrollable mode at
     /// z = 1 (ẋ_I = ΔV = along-track Δṗ in straight flight) and no stabilising DARE
     /// solution exists.
@@ -75,9 +75,9 @@ pub struct LqrParams {
     /// steady-state position error in a steady wind or with a model mismatch); 0 = the
     /// thesis's structure, integral action on airspeed only (3.2.12–3.2.14).
     pub position_integral: i32,
-    /// Limit of each position-error integrator |∫Δp dt| \[m·s\].
+    /// Limit of each position-error integrator |∫Δp dt| (m·s).
     pub position_integrator_limit: f64,
-    /// Leak of the position integrators \[1/s\], ẋ_Ip = p − p_t − λ_p x_Ip. Not needed for
+    /// Leak of the position integrators (1/s), ẋ_Ip = p − p_t − λ_p x_Ip. Not needed for
     /// stabilisability (see `solve_gain`); > 0 trades the zero steady-state error for less
     /// integrator memory.
     pub position_integrator_leak: f64,
@@ -86,13 +86,13 @@ pub struct LqrParams {
     /// reference attitude, weighted by sin²θ_ref (full in vertical flight, none in level
     /// flight); 0 = the thesis's no-wind reference (V_t, α_t, β_t = 0).
     pub wind_compensation: i32,
-    /// Time constant of the wind estimate ŵ = low-pass(v_inertial − DCMᵀ v_air) \[s\].
+    /// Time constant of the wind estimate ŵ = low-pass(v_inertial − DCMᵀ v_air) (s).
     pub wind_filter_time: f64,
     /// Trajectory: 0 = thesis closed forms (3.3.3–3.3.4, 3.3.13–3.3.17), 1 = force balance.
     pub trajectory_mode: i32,
-    /// α_max of (3.3.4) \[rad\] (trajectory_mode 0 only).
+    /// α_max of (3.3.4) (rad) (trajectory_mode 0 only).
     pub alpha_max: f64,
-    /// Banked-turn radius ρ in the level segment \[m\] (3.3.18–3.3.21); 0 = straight, < 0 left.
+    /// Banked-turn radius ρ in the level segment (m) (3.3.18–3.3.21); 0 = straight, < 0 left.
     pub turn_radius: f64,
 }
 
@@ -140,9 +140,9 @@ pub struct LqrController {
     // ---- state ----
     origin: Option<Vector3<f64>>,
     integrator: f64,
-    /// ∫ΔN, ∫ΔE, ∫Δh \[m·s\].
+    /// ∫ΔN, ∫ΔE, ∫Δh (m·s).
     pos_integrator: Vector3<f64>,
-    /// Low-pass wind estimate, NED \[m/s\]; NaN before the first sample.
+    /// Low-pass wind estimate, NED (m/s); NaN before the first sample.
     wind: Vector3<f64>,
     gain: Gain,
     have_gain: bool,
@@ -318,7 +318,7 @@ impl LqrController {
         self.params.position_integral != 0
     }
 
-    /// The position integrators ∫ΔN, ∫ΔE, ∫Δh \[m·s\] and the wind estimate (NED, m/s).
+    /// The position integrators ∫ΔN, ∫ΔE, ∫Δh (m·s) and the wind estimate (NED, m/s).
     pub fn integrator_states(&self) -> (f64, Vector3<f64>, Vector3<f64>) {
         (self.integrator, self.pos_integrator, self.wind)
     }

@@ -4,7 +4,7 @@
 //!
 //! With `TSD_SCAN_WIND=1` it also hovers 35 s (vertical flight) in a constant 5 m/s wind
 //! from N, E, S, W, NE and flies the default mission in a 3 m/s crosswind (from the east),
-//! printing max / final position error [m].
+//! printing max / final position error (m).
 
 use closed_loop::{fly, MissionCheck, Ordering, Scenario, Wind};
 use flight_mission::MissionParams;

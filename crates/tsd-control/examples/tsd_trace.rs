@@ -2,7 +2,7 @@
 //!
 //! `cargo run --release -p tsd-control --example tsd_trace -- <case> [every_s]`
 //! with case one of `default`, `fast`, `jacobi`, `vstep-n`, `vstep-e`, `lstep-d`, `lstep-e`, `hover`
-//! (40 s of vertical flight); a constant wind with `TSD_WIND=n,e,d` [m/s, NED].
+//! (40 s of vertical flight); a constant wind with `TSD_WIND=n,e,d` (m/s, NED).
 
 use closed_loop::{measure, pitch, plant_inputs, Ordering, Scenario};
 use flight_mission::{ControllerInput, MissionParams, SampledUnit};

@@ -54,15 +54,15 @@ pub const STATE_LEN: usize = 6;
 /// Internal signals of the last sample, for tests, plots and tuning.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Internals {
-    /// Guidance command Σ, NED [m/s²] (4.3.24).
+    /// Guidance command Σ, NED (m/s²) (4.3.24).
     pub sigma_cmd: Vector3<f64>,
-    /// Axial, lateral, normal specific-acceleration commands A_Wc, B_Wc, C_Wc [m/s²].
+    /// Axial, lateral, normal specific-acceleration commands A_Wc, B_Wc, C_Wc (m/s²).
     pub accel_cmd: Vector3<f64>,
-    /// Measured A_W, B_W, C_W [m/s²].
+    /// Measured A_W, B_W, C_W (m/s²).
     pub accel: Vector3<f64>,
     /// Commanded normal vector k^Wc, NED.
     pub normal_cmd: Vector3<f64>,
-    /// NVD error angle φ (4.3.5) [rad].
+    /// NVD error angle φ (4.3.5) (rad).
     pub roll_error: f64,
     /// Weight of the computed (vs prescribed) normal vector, 0..1.
     pub normal_weight: f64,
@@ -79,15 +79,15 @@ pub struct Internals {
 /// The flight condition the loops are scheduled on (measured).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FlightCondition {
-    /// Airspeed V̄ [m/s].
+    /// Airspeed V̄ (m/s).
     pub airspeed: f64,
-    /// Angle of attack α [rad] (derivatives interpolated in it).
+    /// Angle of attack α (rad) (derivatives interpolated in it).
     pub alpha: f64,
-    /// Thrust T [N].
+    /// Thrust T (N).
     pub thrust: f64,
-    /// Induced velocity w [m/s]: the slip-stream surfaces see V̄ + 2w.
+    /// Induced velocity w (m/s): the slip-stream surfaces see V̄ + 2w.
     pub induced_velocity: f64,
-    /// Air-velocity component along the body x axis, V̄ cos α cos β [m/s]: the variable of
+    /// Air-velocity component along the body x axis, V̄ cos α cos β (m/s): the variable of
     /// the low-speed frame blend κ ([`TsdController::frame_weight`]). Equal to V̄ when the
     /// air flows from the nose; in hover in a crosswind it stays at the climb rate.
     pub axial_airspeed: f64,
@@ -100,7 +100,7 @@ pub struct LoopDesign {
     pub schedule: f64,
     /// Weight κ of the wind axes vs the reference-path frame (low-speed frame).
     pub kappa: f64,
-    /// Airspeed used in the models, V̄ floored at `min_airspeed` [m/s].
+    /// Airspeed used in the models, V̄ floored at `min_airspeed` (m/s).
     pub v: f64,
     /// Mixing ratios (δfc/δe, δv/δr).
     pub mixing: (f64, f64),
@@ -114,7 +114,7 @@ pub struct LoopDesign {
     pub normal_poly: [f64; 3],
     /// Normal loop gains (K_C, K_Q, K_E).
     pub normal_gains: RowVector3<f64>,
-    /// Pitch damping a22 and mixed control effectiveness b2 of the normal loop [1/s, 1/s²].
+    /// Pitch damping a22 and mixed control effectiveness b2 of the normal loop (1/s, 1/s²).
     pub a22_n: f64,
     pub b2: f64,
     /// Roll model (a21, a22, a23, b21) (4.2.26).
@@ -136,8 +136,8 @@ pub struct LoopDesign {
     pub b32: f64,
 }
 
-/// Integrator state of the four inner loops: the thrust contribution [N] and, for the
-/// surface loops, the contribution to the control *acceleration* b·δ [rad/s²] (pitch, roll,
+/// Integrator state of the four inner loops: the thrust contribution (N) and, for the
+/// surface loops, the contribution to the control *acceleration* b·δ (rad/s²) (pitch, roll,
 /// yaw): the command is recovered as u_I/b with the current control effectiveness b, so
 /// a trim held by an integrator stays trimmed when the dynamic pressure over the surfaces
 /// changes (e.g. the slip-stream when thrust comes on) — integrators in the natural units
