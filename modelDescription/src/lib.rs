@@ -160,9 +160,32 @@ pub struct VariableDecl {
     /// (direct feedthrough). Empty = depends on states only.
     #[serde(default)]
     pub depends_on: Vec<String>,
-    /// Name of a parameter group (see [`ModelDecl::groups`]) this variable is a field of.
+    /// Name of a group (see [`DeclFile::groups`]) this variable is a field of:
+    /// parameters and inputs are read into the group's struct, outputs written from it.
     #[serde(default)]
     pub group: Option<String>,
+    /// Where the variable sits in its group's struct: `field`, `field[i]` (an
+    /// element of a vector or array field) or `[i]` (the group's type is itself a
+    /// vector). Default: the field named like the variable.
+    #[serde(default)]
+    pub field: Option<String>,
+}
+
+impl VariableDecl {
+    /// The field path in the group's struct: ([`Self::field`] or the name) split
+    /// into the field name (empty for the whole value) and the element index.
+    pub fn group_field(&self) -> Result<(&str, Option<usize>), DeclError> {
+        let path = self.field.as_deref().unwrap_or(&self.name);
+        match path.split_once('[') {
+            None if is_rust_identifier(path) => Ok((path, None)),
+            Some((top, rest)) if top.is_empty() || is_rust_identifier(top) => rest
+                .strip_suffix(']')
+                .and_then(|i| i.parse().ok())
+                .map(|i| (top, Some(i)))
+                .ok_or_else(|| DeclError(format!("variable '{}': bad field '{path}'", self.name))),
+            _ => err(format!("variable '{}': bad field '{path}'", self.name)),
+        }
+    }
 }
 
 /// The default experiment of the model description.
@@ -186,10 +209,11 @@ pub struct DeclFile {
     pub description: Option<String>,
     #[serde(default)]
     pub default_experiment: Option<DefaultExperiment>,
-    /// Group name → Rust struct path. The generator emits
-    /// `Variables::<group>() -> <path>` built field by field from the
-    /// variables of that group, so the struct and the declaration cannot drift
-    /// without a compile error.
+    /// Group name → Rust type path. The generator emits
+    /// `Variables::<group>() -> <path>` built field by field from the parameters
+    /// or inputs of that group, or `Variables::set_<group>(&<path>)` writing its
+    /// outputs, so the struct and the declaration cannot drift without a compile
+    /// error (a field missing from the declaration does not compile).
     #[serde(default)]
     pub groups: BTreeMap<String, String>,
     /// Other declaration files (relative paths) whose variables are inserted first.
@@ -292,6 +316,19 @@ pub fn load(dir: &Path, model_identifier: &str, version: &str) -> Result<Model, 
     check(&model)?;
     model.guid = guid_of(&model);
     Ok(model)
+}
+
+/// The variables of one declaration file (`<dir>/<file>`, a model or a fragment)
+/// with its includes resolved, without the checks of a complete model: for the
+/// build scripts that generate the defaults of a parameter group. Also returns
+/// every file read, for `cargo:rerun-if-changed`.
+pub fn load_declarations(dir: &Path, file: &str) -> Result<(Vec<VariableDecl>, Vec<PathBuf>), DeclError> {
+    let mut sources = Vec::new();
+    let root = read_decl(&dir.join(file), &mut sources)?;
+    let mut groups = BTreeMap::new();
+    let mut decls = Vec::new();
+    collect(dir, &root, &mut sources, &mut groups, &mut decls, 0)?;
+    Ok((decls, sources))
 }
 
 fn read_decl(path: &Path, sources: &mut Vec<PathBuf>) -> Result<DeclFile, DeclError> {
@@ -445,9 +482,25 @@ fn check(model: &Model) -> Result<(), DeclError> {
             if !model.groups.contains_key(g) {
                 return err(format!("variable '{n}': group '{g}' not declared in \"groups\""));
             }
-            if d.causality != Causality::Parameter {
-                return err(format!("variable '{n}': only parameters can belong to a group"));
+            if !matches!(d.causality, Causality::Parameter | Causality::Input | Causality::Output) {
+                return err(format!(
+                    "variable '{n}': a {} cannot belong to a group",
+                    d.causality.as_str()
+                ));
             }
+            d.group_field()?;
+            let writes = d.causality == Causality::Output;
+            if model
+                .variables
+                .iter()
+                .any(|o| o.decl.group.as_ref() == Some(g) && (o.decl.causality == Causality::Output) != writes)
+            {
+                return err(format!(
+                    "group '{g}' mixes outputs with parameters or inputs (variable '{n}')"
+                ));
+            }
+        } else if d.field.is_some() {
+            return err(format!("variable '{n}': field without group"));
         }
     }
     Ok(())

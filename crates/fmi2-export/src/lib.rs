@@ -12,6 +12,7 @@ pub mod instance;
 pub mod logger;
 pub mod model;
 pub mod state;
+pub mod test_host;
 pub mod testing;
 pub mod variables;
 

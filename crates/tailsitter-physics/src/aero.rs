@@ -6,7 +6,7 @@
 //! * V̄ = |v_a|, α = atan2(w_a, u_a) (2.2.12), β = asin(v_a / V̄) (2.2.13); α = β = 0 when
 //!   V̄ < [`AIRSPEED_EPS`] so every output is finite in hover.
 //! * Induced velocity w from momentum theory (2.3.19–2.3.21), [`Airframe::induced_velocity`].
-//! * Slip-stream speed V_s = V̄ + 2w (far wake, DESIGN.md §4, (3.3.17)).
+//! * Slip-stream speed V_s = V̄ + 2w (far wake, docs/DESIGN.md §4, (3.3.17)).
 //! * Free-stream terms (wing/body: C_L0, C_Lα, C_Lq, C_D, C_Yβ, rate terms, C_m0, C_mα, C_mq,
 //!   C_lβ, C_nβ, and the **ailerons** C_{Y,l,n}δa) use q̄ = ½ρV̄² and the free-stream
 //!   wind axes (A.2.7, exact).

@@ -1,6 +1,7 @@
 //! The 20-state plant: state derivatives (§2.2, §2.3, App. D.5), fixed-step RK4, outputs,
 //! trims and linearisation.
 
+use crate::numeric::central_differences;
 use nalgebra::{SMatrix, Vector3, Vector4};
 
 use crate::aero::{ForcesMoments, Surfaces};
@@ -360,7 +361,7 @@ impl Plant {
 
     /// Jacobians (A, B) of [`Plant::derivatives`] at (x, u) by central differences
     /// (perturbation 1e-6·max(1, |value|)).
-    pub fn linearize(
+    pub fn linearise(
         &self,
         x: &StateVector,
         u: &InputVector,
@@ -368,24 +369,21 @@ impl Plant {
     ) -> (SMatrix<f64, N_STATES, N_STATES>, SMatrix<f64, N_STATES, N_INPUTS>) {
         let mut a = SMatrix::<f64, N_STATES, N_STATES>::zeros();
         let mut b = SMatrix::<f64, N_STATES, N_INPUTS>::zeros();
-        for j in 0..N_STATES {
-            let d = 1e-6 * x[j].abs().max(1.0);
-            let mut xp = *x;
-            let mut xm = *x;
-            xp[j] += d;
-            xm[j] -= d;
-            let col = (self.derivatives(&xp, u, wind_ned) - self.derivatives(&xm, u, wind_ned)) / (2.0 * d);
-            a.set_column(j, &col);
-        }
-        for j in 0..N_INPUTS {
-            let d = 1e-6 * u[j].abs().max(1.0);
-            let mut up = *u;
-            let mut um = *u;
-            up[j] += d;
-            um[j] -= d;
-            let col = (self.derivatives(x, &up, wind_ned) - self.derivatives(x, &um, wind_ned)) / (2.0 * d);
-            b.set_column(j, &col);
-        }
+        let step = |_, v: f64| Some(1e-6 * v.abs().max(1.0));
+        central_differences(
+            x,
+            N_STATES,
+            step,
+            |xp| self.derivatives(xp, u, wind_ned),
+            |j, col| a.set_column(j, &col),
+        );
+        central_differences(
+            u,
+            N_INPUTS,
+            step,
+            |up| self.derivatives(x, up, wind_ned),
+            |j, col| b.set_column(j, &col),
+        );
         (a, b)
     }
 
@@ -452,15 +450,13 @@ impl Plant {
                 break;
             }
             let mut jac = nalgebra::Matrix3::<f64>::zeros();
-            for j in 0..3 {
-                let d = 1e-6 * z[j].abs().max(1.0);
-                let mut zp = z;
-                let mut zm = z;
-                zp[j] += d;
-                zm[j] -= d;
-                let col = (self.trim_residual(v_ned, &zp) - self.trim_residual(v_ned, &zm)) / (2.0 * d);
-                jac.set_column(j, &col);
-            }
+            central_differences(
+                &z,
+                3,
+                |_, v| Some(1e-6 * v.abs().max(1.0)),
+                |zd| self.trim_residual(v_ned, zd),
+                |j, col| jac.set_column(j, &col),
+            );
             let Some(dz) = jac.lu().solve(&r) else {
                 return Err(PhysicsError::Trim(format!(
                     "singular trim Jacobian at θ = {}, δe = {}, T = {}",
