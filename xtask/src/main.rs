@@ -312,7 +312,12 @@ version {version}, GUID <code>{guid}</code>.</p>\n{platforms}\n{body}\n{tables}<
 
 /// The "Platforms and interfaces" table of documentation/index.html.
 fn platforms_section(model: &model_description::Model, platforms: &[Platform]) -> String {
-    let interfaces = "FMI 2.0 Co-Simulation";
+    let interfaces = if model.model_exchange() {
+        "FMI 2.0 Co-Simulation and Model Exchange (one binary serves both; Model Exchange: \
+         continuous states with <code>der_*</code> derivatives, no event indicators)"
+    } else {
+        "FMI 2.0 Co-Simulation"
+    };
     let mut rows = String::new();
     for platform in platforms {
         let (folder, built, runtime) = match platform {
