@@ -11,9 +11,9 @@ server_tcp.exe, which loads our DLL under wine64), and the closed loop flies the
 default mission with it through the same fmpy master as the linux64 run. The
 trajectories must agree with the linux64 run to WIN64_TOL (see there).
 
-CI flies the first WINE_SECONDS_SHORT s (vertical flight and the start of
-transition 1) with each controller; the whole 35 s mission:
-    TAILSIM_WINE_FULL=1 .venv/bin/python -m pytest tests/test_win64.py -s
+The whole 35 s default mission, four pairings: about 40 s of wall time here (the
+first Wine start creates ~/.wine, some 20 s more), so CI runs it in full.
+Figures: .venv/bin/python -m pytest tests/test_win64.py -s
 """
 
 from __future__ import annotations
@@ -58,9 +58,8 @@ WINDOWS_SYSTEM_DLLS = {"kernel32.dll", "ntdll.dll", "msvcrt.dll", "userenv.dll",
 OBJDUMP = "x86_64-w64-mingw32-objdump"
 MINGW_GCC = "x86_64-w64-mingw32-gcc"
 
-# Seconds of the default mission flown under Wine in the normal test run.
-WINE_SECONDS_SHORT = 8.0
-FULL = os.environ.get("TAILSIM_WINE_FULL") == "1"
+# The default mission (the controllers' default experiment).
+MISSION_SECONDS = 35.0
 
 
 def test_every_fmu_has_both_binaries():
@@ -146,25 +145,37 @@ def win64_only_copy(model: str, tmp: pathlib.Path, shim: pathlib.Path) -> pathli
     return out
 
 
+class _KeepLoaded(Fmu):
+    """An Fmu whose slaves never unload their library: fmpy's freeInstance dlcloses the
+    remoting client (client_tcp.so) while its RPC threads may still run, which crashed
+    the test process at random later points (seen once in a full run). Tests only: the
+    few mapped copies are released at process exit."""
+
+    def instantiate(self, name, callbacks=None):
+        slave = super().instantiate(name, callbacks)
+        slave.freeLibrary = lambda: None
+        return slave
+
+
 @pytest.fixture(scope="module")
 def win64_fmus(tmp_path_factory):
     _wine64()
     os.environ.setdefault("WINEDEBUG", "-all")
     tmp = tmp_path_factory.mktemp("win64")
     shim = _prng_shim(tmp)
-    fmus = {m: Fmu(win64_only_copy(m, tmp, shim), tmp / "x" / m) for m in MODELS}
+    fmus = {m: _KeepLoaded(win64_only_copy(m, tmp, shim), tmp / "x" / m) for m in MODELS}
     yield fmus
     for f in fmus.values():
         f.cleanup()
 
 
-# Agreement of win64 (MinGW, msvcrt/mingw libm under Wine) with linux64 (glibc libm).
-# The Rust code is the same and IEEE-754 arithmetic is deterministic; only the libm
-# functions (sin, cos, atan2, asin, exp, pow, …) may differ in the last ulp. Such a
-# difference of ~1e-16 relative is amplified by the closed loop (the controllers'
-# gain scheduling and the plant's instability in hover), so we allow 1e-6 in SI units
-# over the whole mission: many orders above rounding, many below anything physical.
-WIN64_TOL = 1e-6
+# Agreement of win64 (MinGW: msvcrt's/mingw's libm under Wine) with linux64 (glibc's
+# libm). The Rust code and its IEEE-754 arithmetic are the same; only libm functions
+# (sin, cos, atan2, asin, exp, powf, …) may differ in the last ulp. Such ~1e-16 relative
+# differences are amplified by the closed loop (gain scheduling, the unstable hover
+# dynamics) over 35 s: measured ≤ 5.6e-10 (thrust, N) and 3.2e-11 m in position with
+# LQR, ~1e-13 with TSD. 1e-8 in SI units keeps a 20× margin, far below anything physical.
+WIN64_TOL = 1e-8
 COMPARED = ["pos_n", "pos_e", "pos_d", "u", "v", "w", "p", "q", "r",
             "quat_1", "quat_2", "quat_3", "quat_4", "thrust", "elevator", "aileron", "rudder"]
 
@@ -179,7 +190,7 @@ PAIRINGS = [("win64", "linux64", "tailsitter_lqr"), ("win64", "linux64", "tailsi
 @pytest.mark.parametrize("plant_platform,controller_platform,controller", PAIRINGS)
 def test_win64_mission_under_wine_agrees_with_linux64(plant_platform, controller_platform, controller,
                                                       fmus, win64_fmus):
-    stop = 35.0 if FULL else WINE_SECONDS_SHORT
+    stop = MISSION_SECONDS
     pick = {"linux64": fmus, "win64": win64_fmus}
     t0 = time.perf_counter()
     win = ClosedLoop(pick[plant_platform]["tailsitter_plant"], pick[controller_platform][controller]).run(
