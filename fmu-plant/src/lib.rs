@@ -76,6 +76,53 @@ impl PlantModel {
         let y = self.plant.outputs(&self.x, &Self::inputs(vars), &vars.wind());
         vars.set_measurement(&closed_loop::measurement(&self.x, &y));
         vars.set_outputs(&y);
+        self.write_derivatives(vars);
+    }
+
+    /// Model Exchange: write ẋ = f(x, u, wind) ([`Plant::derivatives`]) into the `der_*`
+    /// variables. An ME solver integrates the quaternion without the renormalisation the
+    /// CS integrator applies after each RK4 step, so f is evaluated at the unit
+    /// quaternion (the attitude the state represents); its norm drift stays within the
+    /// solver tolerance. The thrust and servo derivatives keep those states in range by
+    /// construction: the targets are saturated (the state relaxes towards a value inside
+    /// the range, so at a bound the derivative never points outwards) and the servo rate
+    /// is a saturation of the derivative itself — no clamp of the state is needed, so a
+    /// variable-step solver sees a continuous right-hand side and no events.
+    fn write_derivatives(&self, vars: &mut Variables) {
+        use tailsitter_physics::idx::{Q1, Q4};
+        let mut x = self.x;
+        let n = x.fixed_rows::<4>(Q1).norm();
+        if n > 0.0 && n.is_finite() {
+            for k in Q1..=Q4 {
+                x[k] /= n;
+            }
+        }
+        let dx = self.plant.derivatives(&x, &Self::inputs(vars), &vars.wind());
+        let der = [
+            &mut vars.der_pos_n,
+            &mut vars.der_pos_e,
+            &mut vars.der_pos_d,
+            &mut vars.der_u,
+            &mut vars.der_v,
+            &mut vars.der_w,
+            &mut vars.der_quat_1,
+            &mut vars.der_quat_2,
+            &mut vars.der_quat_3,
+            &mut vars.der_quat_4,
+            &mut vars.der_p,
+            &mut vars.der_q,
+            &mut vars.der_r,
+            &mut vars.der_thrust,
+            &mut vars.der_elevator,
+            &mut vars.der_aileron,
+            &mut vars.der_rudder,
+            &mut vars.der_flap_collective,
+            &mut vars.der_flap_differential,
+            &mut vars.der_vertical_flap,
+        ];
+        for (slot, value) in der.into_iter().zip(dx.iter()) {
+            *slot = *value;
+        }
     }
 }
 
@@ -132,6 +179,20 @@ impl FmuModel for PlantModel {
             ))
         })?;
         self.write_outputs(vars);
+        Ok(())
+    }
+
+    /// Model Exchange: `x` is in the order of `Variables::CONTINUOUS_STATES`, which the
+    /// declaration lists in `tailsitter_physics::idx` order (checked by a test).
+    fn set_continuous_states(&mut self, vars: &mut Variables, x: &[f64]) -> Result<(), ModelError> {
+        self.rebuild_if_stale(vars)?;
+        if x.len() != N_STATES {
+            return Err(ModelError::new(format!(
+                "{} states given, the plant has {N_STATES}",
+                x.len()
+            )));
+        }
+        self.x.copy_from_slice(x);
         Ok(())
     }
 

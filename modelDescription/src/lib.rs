@@ -169,6 +169,15 @@ pub struct VariableDecl {
     /// vector). Default: the field named like the variable.
     #[serde(default)]
     pub field: Option<String>,
+    /// Model Exchange: this variable is the time derivative of the named continuous
+    /// state (`derivative` attribute). The continuous-state vector of
+    /// fmi2GetContinuousStates is the states of the derivatives in declaration order.
+    #[serde(default)]
+    pub derivative_of: Option<String>,
+    /// `nominal` attribute (Real only; > 0): the scale of the value, e.g. for the
+    /// error control of an ME solver.
+    #[serde(default)]
+    pub nominal: Option<f64>,
 }
 
 impl VariableDecl {
@@ -258,6 +267,26 @@ pub struct Model {
     /// Name-based UUID (v5) over the interface: changes whenever any variable,
     /// the identifier or the version changes.
     pub guid: String,
+}
+
+impl Model {
+    /// (state, derivative) of every continuous state, in the order of the derivatives'
+    /// declarations (= ModelStructure/Derivatives = the continuous-state vector).
+    pub fn continuous_states(&self) -> Vec<(&Variable, &Variable)> {
+        self.variables
+            .iter()
+            .filter_map(|d| {
+                let state = d.decl.derivative_of.as_deref()?;
+                let state = self.variables.iter().find(|v| v.name() == state)?;
+                Some((state, d))
+            })
+            .collect()
+    }
+
+    /// Whether the FMU also offers Model Exchange: it declares continuous states.
+    pub fn model_exchange(&self) -> bool {
+        self.variables.iter().any(|v| v.decl.derivative_of.is_some())
+    }
 }
 
 /// Generation tool recorded in the XML.
@@ -478,6 +507,39 @@ fn check(model: &Model) -> Result<(), DeclError> {
                 return err(format!("variable '{n}': dependsOn '{dep}' is not an input"));
             }
         }
+        if let Some(x) = d.nominal {
+            if d.var_type != VarType::Real || !(x.is_finite() && x > 0.0) {
+                return err(format!("variable '{n}': nominal must be a finite number > 0 on a Real"));
+            }
+        }
+        if let Some(state) = &d.derivative_of {
+            let Some(s) = model.variables.iter().find(|v| v.name() == state) else {
+                return err(format!("variable '{n}': derivativeOf '{state}' is not declared"));
+            };
+            let continuous_real =
+                |v: &Variable| v.decl.var_type == VarType::Real && v.variability == Variability::Continuous;
+            if !continuous_real(v) || !matches!(d.causality, Causality::Local | Causality::Output) {
+                return err(format!(
+                    "variable '{n}': a derivative must be a continuous Real local or output"
+                ));
+            }
+            if !continuous_real(s) || !matches!(s.decl.causality, Causality::Local | Causality::Output) {
+                return err(format!(
+                    "variable '{n}': state '{state}' must be a continuous Real local or output"
+                ));
+            }
+            if s.decl.derivative_of.is_some() {
+                return err(format!("variable '{n}': state '{state}' is itself a derivative"));
+            }
+            let twice = model
+                .variables
+                .iter()
+                .filter(|o| o.decl.derivative_of.as_deref() == Some(state.as_str()))
+                .count();
+            if twice > 1 {
+                return err(format!("state '{state}' has {twice} derivatives"));
+            }
+        }
         if let Some(g) = &d.group {
             if !model.groups.contains_key(g) {
                 return err(format!("variable '{n}': group '{g}' not declared in \"groups\""));
@@ -523,6 +585,13 @@ fn guid_of(model: &Model) -> String {
             d.max,
             d.unit
         ));
+        // Only when present, so the GUIDs of models without them do not change.
+        if let Some(state) = &d.derivative_of {
+            text.push_str(&format!("derivative_of {state}\n"));
+        }
+        if let Some(x) = d.nominal {
+            text.push_str(&format!("nominal {x:?}\n"));
+        }
     }
     let namespace = uuid::Uuid::NAMESPACE_URL;
     format!("{{{}}}", uuid::Uuid::new_v5(&namespace, text.as_bytes()))

@@ -186,6 +186,23 @@ pub fn variables_module(model: &Model, xml_file: &str) -> String {
         );
     }
     let _ = writeln!(w, "    ];\n");
+    let states = model.continuous_states();
+    if !states.is_empty() {
+        let _ = writeln!(
+            w,
+            "    const CONTINUOUS_STATES: &'static [fmi2_export::ContinuousState] = &["
+        );
+        for (s, d) in states {
+            let _ = writeln!(
+                w,
+                "        fmi2_export::ContinuousState {{ state: {}, derivative: {}, nominal: {} }},",
+                s.value_reference,
+                d.value_reference,
+                fmt_f64(s.decl.nominal.unwrap_or(1.0))
+            );
+        }
+        let _ = writeln!(w, "    ];\n");
+    }
     let _ = writeln!(w, "    fn with_start_values() -> Self {{\n        Self {{");
     for v in &model.variables {
         let _ = writeln!(w, "            {}: {},", v.name(), start_literal(&v.decl));

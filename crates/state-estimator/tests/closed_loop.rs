@@ -142,7 +142,7 @@ fn fly_on_estimates<C: FlightController>(c: &mut C, seed: u64, butterworth: bool
             ref_offset_ned: Vector3::zeros(),
         };
         let out = c
-            .update(&input)
+            .sample(&input)
             .unwrap_or_else(|e| panic!("controller failed at t = {t}: {e}"));
         let u = closed_loop::plant_inputs(&out.command);
         let pos = Vector3::new(x[idx::POS_N], x[idx::POS_E], x[idx::POS_D]);
@@ -190,7 +190,7 @@ fn lqr_flies_the_mission_on_the_estimates() {
 #[test]
 fn tsd_flies_the_mission_on_the_estimates() {
     let m = MissionParams::default();
-    let mut c = TsdController::new(TsdParams::default(), m, Airframe::default()).unwrap();
+    let mut c = TsdController::new(Airframe::default(), m, TsdParams::default()).unwrap();
     let f = fly_on_estimates(&mut c, 2, false);
     eprintln!(
         "TSD on estimates: max |true position − reference| {:.2} m ({:.2} m after 5 s), max position estimation error {:.2} m (≤ {:.2} × 3σ), max attitude error {:.2}°, rejected {}",
@@ -232,7 +232,7 @@ fn lqr_flies_the_mission_with_butterworth_filtered_sensors() {
 #[ignore = "known issue: TSD + estimator + unmodelled 8 Hz Butterworth"]
 fn tsd_flies_the_mission_with_butterworth_filtered_sensors() {
     let m = MissionParams::default();
-    let mut c = TsdController::new(TsdParams::default(), m, Airframe::default()).unwrap();
+    let mut c = TsdController::new(Airframe::default(), m, TsdParams::default()).unwrap();
     let f = fly_on_estimates(&mut c, 2, true);
     eprintln!(
         "TSD on estimates, 8 Hz Butterworth: max |true position − reference| {:.2} m, max attitude error {:.2}°",

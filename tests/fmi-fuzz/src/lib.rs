@@ -201,6 +201,8 @@ pub struct Fmu {
     pub guid: String,
     pub vars: Vec<Var>,
     pub default_step: f64,
+    /// Number of continuous states (> 0: the FMU also offers Model Exchange).
+    pub n_states: usize,
     pub api: Api,
 }
 
@@ -248,9 +250,10 @@ impl Fmu {
         let api = unsafe { Api::load(&path) }?;
         Ok(Self {
             id: id.to_string(),
-            guid: model.guid,
+            guid: model.guid.clone(),
             vars,
             default_step: model.default_experiment.step_size,
+            n_states: model.continuous_states().len(),
             api,
         })
     }
