@@ -2,7 +2,7 @@
 //! writes the trajectory (t, N, E, D, full precision) as CSV for before/after comparisons
 //! and prints the CPU time of one whole mission (median over `runs`).
 //!
-//! `cargo run --release -p lqr-control --example mission_benchmark -- [default|violent] [out.csv] [runs=5]`
+//! `cargo run --release -p lqr-control --example mission_benchmark -- [default|violent] [out.csv|-] [runs=5] [plant integration step (s)]`
 //!
 //! `violent`: the fast mission (T1 = 3 s, T2 = 4 s, α up to ≈ 44°) with a 1 − cos gust of
 //! 6 m/s (north, up) over 2 s at t = 12 s and 5 m position steps at 20 s and 23 s (the mission ends at 27 s).
@@ -46,8 +46,11 @@ fn scenario(name: &str) -> Scenario {
     }
 }
 
-fn fly_once(s: &Scenario) -> (Trace, u64) {
-    let plant = Plant::new(Airframe::default());
+fn fly_once(s: &Scenario, integration_step: Option<f64>) -> (Trace, u64) {
+    let mut plant = Plant::new(Airframe::default());
+    if let Some(step) = integration_step {
+        plant.integration_step = step;
+    }
     let x0 = plant.trim_vertical_climb(s.mission.v_vertical).expect("trim").state;
     let mut c = LqrController::new(Airframe::default(), s.mission, LqrParams::default()).expect("controller");
     let trace = fly(&plant, x0, &mut c, s);
@@ -59,18 +62,19 @@ fn main() {
     let name = args.first().map(String::as_str).unwrap_or("default");
     let out = args.get(1).cloned();
     let runs: usize = args.get(2).and_then(|a| a.parse().ok()).unwrap_or(5);
+    let integration_step: Option<f64> = args.get(3).and_then(|a| a.parse().ok());
     let s = scenario(name);
     let mut times = Vec::new();
     let mut last = None;
     for _ in 0..runs.max(1) {
         let c0 = thread_cpu_time();
-        let r = fly_once(&s);
+        let r = fly_once(&s, integration_step);
         times.push((thread_cpu_time() - c0) * 1e3);
         last = Some(r);
     }
     let (trace, solves) = last.expect("one run");
     times.sort_by(|a, b| a.total_cmp(b));
-    if let Some(path) = out {
+    if let Some(path) = out.filter(|p| p != "-") {
         let mut f = std::io::BufWriter::new(std::fs::File::create(&path).expect("csv"));
         writeln!(f, "t,N,E,D").expect("write");
         for smp in &trace.samples {
