@@ -144,7 +144,17 @@ impl Airframe {
         // when V̄ = |V_x|; hover √k). Since V'² = (w + V_x)² + (V̄² − V_x²) ≥ (w + V_x)² and
         // w_ax + V_x ≥ 0, f(w_ax) ≥ 0: it is an upper bound of the root.
         let mut lo = 0.0;
-        let mut hi = 0.5 * (-vx + (vx * vx + 4.0 * k).sqrt());
+        // (Written without cancellation for V_x > 0: (−V_x + √(V_x² + 4k))/2 = 2k/(V_x + √(…)).)
+        let root = (vx * vx + 4.0 * k).sqrt();
+        let mut hi = if vx > 0.0 {
+            2.0 * k / (vx + root)
+        } else {
+            0.5 * (root - vx)
+        };
+        if v2 == vx * vx {
+            // Purely axial flow (vertical flight): w_ax is the root, (2.3.18).
+            return hi;
+        }
         let mut w = hi;
         for _ in 0..100 {
             // f = w²(w² + 2V_x w + V̄²) − k², f', f''.
