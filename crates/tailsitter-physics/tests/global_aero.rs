@@ -414,3 +414,25 @@ fn control_effectiveness_degrades_after_stall() {
     assert!(pitch(core::f64::consts::FRAC_PI_2, t) < 0.0);
     assert!(pitch(core::f64::consts::FRAC_PI_2, t).abs() > 0.95 * pitch(0.0, t).abs());
 }
+
+/// The default stall band gives the whole aircraft C_Lmax ≈ 0.9 c_l,max of a thick symmetric
+/// section (1.05, NACA 0015 at Re 7·10⁵, Sheldahl & Klimas) = 0.945, near α = 15°.
+#[test]
+fn default_lift_maximum_is_a_finite_wing_value() {
+    let a = Airframe::default();
+    let g = GlobalAero::default();
+    let v = 20.0;
+    let qs = 0.5 * a.air_density * v * v * a.wing_area;
+    let (mut cl_max, mut at) = (0.0, 0.0);
+    for i in 0..=400 {
+        let alpha = (i as f64 * 0.1).to_radians();
+        let (fm, _) = g.forces_moments(&a, &v_air(v, alpha, 0.0), &Vector3::zeros(), 0.0, &Surfaces::default());
+        let cl = -fm.force_body.dot(&Vector3::new(-alpha.sin(), 0.0, alpha.cos())) / qs;
+        if cl > cl_max {
+            cl_max = cl;
+            at = alpha.to_degrees();
+        }
+    }
+    assert!((cl_max - 0.9 * 1.05).abs() < 0.05, "C_Lmax {cl_max} at {at}°");
+    assert!((12.0..=18.0).contains(&at), "C_Lmax at {at}°");
+}
