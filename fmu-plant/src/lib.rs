@@ -6,7 +6,9 @@
 
 use fmi2_export::{FmuModel, Logger, ModelError, StateError, StateReader, StateWriter};
 use nalgebra::Vector3;
-use tailsitter_physics::{dcm_earth_to_body, quat_from_euler_321, Plant, StateVector, Trim, N_STATES};
+use tailsitter_physics::{
+    dcm_earth_to_body, quat_from_euler_321, AeroModel, GlobalAero, Ground, Plant, StateVector, Trim, N_STATES,
+};
 
 /// Generated from the declaration: `Variables`, `vr`, `GUID`, `MODEL_IDENTIFIER`, `MODEL_DESCRIPTION_XML`.
 #[allow(clippy::all)]
@@ -18,6 +20,18 @@ pub use generated::{vr, Variables, GUID, MODEL_DESCRIPTION_XML, MODEL_IDENTIFIER
 /// `initial_condition` values.
 const INITIAL_VERTICAL_CLIMB: i32 = 0;
 const INITIAL_LEVEL_FLIGHT: i32 = 1;
+const INITIAL_ON_GROUND: i32 = 2;
+
+/// Regime and ground-contact events of one instance, reported once each through the logger.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct Events {
+    /// The aircraft has left attached flow at least once (warned).
+    left_attached: bool,
+    /// Contact points touching after the last step.
+    contact_points: u32,
+    /// Downward speed of the contact points at the last touchdown (m/s).
+    touchdown_speed: f64,
+}
 
 /// One plant instance: the physics with its parameters, and the 20-element state.
 #[derive(Debug, Clone)]
@@ -26,6 +40,8 @@ pub struct PlantModel {
     x: StateVector,
     /// The parameters in `Variables` changed under `plant` (FMU state restored): rebuild before use.
     stale: bool,
+    /// Regime and ground-contact events (issue 13).
+    events: Events,
 }
 
 impl PlantModel {
@@ -37,7 +53,48 @@ impl PlantModel {
             .map_err(|e| ModelError::new(format!("invalid airframe parameter: {e}")))?;
         let mut plant = Plant::new(airframe);
         plant.integration_step = vars.integration_step;
+        plant.aero = Self::global_aero(vars)?;
+        plant.ground = Self::ground(vars)?;
         Ok(plant)
+    }
+
+    /// Aerodynamic model selection and global-model parameters.
+    fn global_aero(vars: &Variables) -> Result<GlobalAero, ModelError> {
+        let model = AeroModel::from_index(vars.aero_model).ok_or_else(|| {
+            ModelError::new(format!(
+                "aero_model = {}: expected 0 (thesis linear model) or 1 (global model)",
+                vars.aero_model
+            ))
+        })?;
+        let aero = GlobalAero {
+            model,
+            alpha_attached: vars.alpha_attached,
+            alpha_stalled: vars.alpha_stalled,
+            beta_attached: vars.beta_attached,
+            beta_stalled: vars.beta_stalled,
+            c_D_90: vars.c_D_90,
+        };
+        aero.validate()
+            .map_err(|e| ModelError::new(format!("invalid aerodynamic parameter: {e}")))?;
+        Ok(aero)
+    }
+
+    /// Ground plane and contact points.
+    fn ground(vars: &Variables) -> Result<Ground, ModelError> {
+        let ground = Ground {
+            height: vars.ground_height,
+            gear_length: vars.gear_length,
+            gear_half_span: vars.gear_half_span,
+            gear_half_height: vars.gear_half_height,
+            nose_length: vars.nose_length,
+            stiffness: vars.ground_stiffness,
+            damping: vars.ground_damping,
+            friction: vars.ground_friction,
+        };
+        ground
+            .validate()
+            .map_err(|e| ModelError::new(format!("invalid ground parameter: {e}")))?;
+        Ok(ground)
     }
 
     fn rebuild_if_stale(&mut self, vars: &Variables) -> Result<(), ModelError> {
@@ -53,9 +110,24 @@ impl PlantModel {
         let trim = match vars.initial_condition {
             INITIAL_VERTICAL_CLIMB => plant.trim_vertical_climb(vars.initial_speed),
             INITIAL_LEVEL_FLIGHT => plant.trim_level(vars.initial_speed),
+            INITIAL_ON_GROUND => {
+                let x = plant.resting_on_ground(0.0, 0.0, 0.0);
+                let u = tailsitter_physics::InputVector::zeros();
+                return Ok(Trim {
+                    state: x,
+                    inputs: u,
+                    alpha: 0.0,
+                    theta: core::f64::consts::FRAC_PI_2,
+                    thrust: x[tailsitter_physics::idx::THRUST],
+                    elevator: 0.0,
+                    induced_velocity: 0.0,
+                    airspeed: 0.0,
+                    residual: 0.0,
+                });
+            }
             other => {
                 return Err(ModelError::new(format!(
-                    "initial_condition = {other}: expected 0 (vertical climb) or 1 (level flight)"
+                    "initial_condition = {other}: expected 0 (vertical climb), 1 (level flight) or 2 (on the ground)"
                 )))
             }
         };
@@ -122,6 +194,56 @@ impl PlantModel {
         vars.accel_y = y.specific_force_body.y;
         vars.accel_z = y.specific_force_body.z;
         vars.induced_velocity = y.induced_velocity;
+        vars.stall_fraction = y.stall_fraction;
+        vars.aero_regime = y.aero_regime.index();
+        vars.ground_contact_points = y.ground.points as i32;
+        vars.touchdown_speed = self.events.touchdown_speed;
+    }
+
+    /// After a step ending at `t` (outputs already written): warn the first time the aircraft
+    /// leaves attached flow, and report every touchdown (a warning above
+    /// [`tailsitter_physics::ground::HARD_TOUCHDOWN_SPEED`]). `before` is the contact state at
+    /// the start of the step. Allocates only when it logs.
+    fn report_events(
+        &mut self,
+        vars: &mut Variables,
+        before: tailsitter_physics::ContactState,
+        t: f64,
+        log: &mut Logger<'_>,
+    ) {
+        if !self.events.left_attached && vars.stall_fraction > 0.0 {
+            self.events.left_attached = true;
+            let model = match self.plant.aero.model {
+                AeroModel::Thesis => "the thesis's linear model (aero_model = 0) is now used outside its validity",
+                AeroModel::Global => "the global model's post-stall part is active (aero_model = 1)",
+            };
+            log.warning(format_args!(
+                "t = {t} s: the aircraft left attached flow for the first time (stall_fraction = {:.3}, \
+                 alpha = {:.1} deg, beta = {:.1} deg, airspeed = {:.2} m/s): {model}",
+                vars.stall_fraction,
+                vars.alpha.to_degrees(),
+                vars.beta.to_degrees(),
+                vars.airspeed
+            ));
+        }
+        let after = self.plant.ground.contact_state(&self.plant.airframe, &self.x);
+        if before.points == 0 && after.points > 0 {
+            let speed = before.sink_rate.max(after.sink_rate).max(0.0);
+            self.events.touchdown_speed = speed;
+            vars.touchdown_speed = speed;
+            if speed > tailsitter_physics::ground::HARD_TOUCHDOWN_SPEED {
+                log.warning(format_args!(
+                    "t = {t} s: hard touchdown on the ground at {speed:.2} m/s ({} contact points, \
+                     airspeed {:.2} m/s, pitch rate {:.2} rad/s)",
+                    after.points, vars.airspeed, vars.q
+                ));
+            } else {
+                log.info(format_args!("t = {t} s: touchdown at {speed:.2} m/s"));
+            }
+        } else if before.points > 0 && after.points == 0 {
+            log.info(format_args!("t = {t} s: lift-off"));
+        }
+        self.events.contact_points = after.points;
     }
 }
 
@@ -135,6 +257,7 @@ impl FmuModel for PlantModel {
             plant: Plant::new(vars.airframe()),
             x: StateVector::zeros(),
             stale: true,
+            events: Events::default(),
         }
     }
 
@@ -152,13 +275,16 @@ impl FmuModel for PlantModel {
         x.fixed_rows_mut::<4>(tailsitter_physics::idx::Q1).copy_from(&q);
         x[tailsitter_physics::idx::POS_N] = vars.initial_pos_n;
         x[tailsitter_physics::idx::POS_E] = vars.initial_pos_e;
-        x[tailsitter_physics::idx::POS_D] = vars.initial_pos_d;
+        if vars.initial_condition != INITIAL_ON_GROUND {
+            x[tailsitter_physics::idx::POS_D] = vars.initial_pos_d;
+        }
         vars.trim_thrust = trim.inputs[tailsitter_physics::idx::THRUST_CMD];
         vars.trim_elevator = trim.inputs[tailsitter_physics::idx::ELEVATOR_CMD];
         vars.trim_alpha = trim.alpha;
         self.plant = plant;
         self.x = x;
         self.stale = false;
+        self.events = Events::default();
         self.write_outputs(vars);
         Ok(())
     }
@@ -169,10 +295,11 @@ impl FmuModel for PlantModel {
         Ok(())
     }
 
-    fn do_step(&mut self, vars: &mut Variables, t: f64, h: f64, _log: &mut Logger<'_>) -> Result<(), ModelError> {
+    fn do_step(&mut self, vars: &mut Variables, t: f64, h: f64, log: &mut Logger<'_>) -> Result<(), ModelError> {
         self.rebuild_if_stale(vars)?;
         let u = Self::inputs(vars);
         let wind = Self::wind(vars);
+        let before = self.plant.ground.contact_state(&self.plant.airframe, &self.x);
         self.plant.advance(&mut self.x, &u, &wind, h).map_err(|e| {
             ModelError::new(format!(
                 "plant left its envelope in the step from t = {t} s to {} s: {e}",
@@ -180,6 +307,7 @@ impl FmuModel for PlantModel {
             ))
         })?;
         self.write_outputs(vars);
+        self.report_events(vars, before, t + h, log);
         Ok(())
     }
 
@@ -187,6 +315,9 @@ impl FmuModel for PlantModel {
         for value in self.x.iter() {
             w.f64(*value);
         }
+        w.f64(f64::from(u8::from(self.events.left_attached)));
+        w.f64(f64::from(self.events.contact_points));
+        w.f64(self.events.touchdown_speed);
     }
 
     fn read_state(&mut self, r: &mut StateReader<'_>) -> Result<(), StateError> {
@@ -195,6 +326,14 @@ impl FmuModel for PlantModel {
             *value = r.f64()?;
         }
         debug_assert_eq!(x.len(), N_STATES);
+        let left_attached = r.f64()? != 0.0;
+        let contact_points = r.f64()?;
+        let touchdown_speed = r.f64()?;
+        self.events = Events {
+            left_attached,
+            contact_points: contact_points.clamp(0.0, 7.0) as u32,
+            touchdown_speed,
+        };
         self.x = x;
         // The parameters come back with the variables: rebuild the physics from them.
         self.stale = true;

@@ -349,7 +349,11 @@ impl GlobalAero {
             return alpha;
         }
         let t = (x - a0) / (lim - a0);
-        let y = if t >= 2.0 { lim } else { a0 + (lim - a0) * (t - 0.25 * t * t) };
+        let y = if t >= 2.0 {
+            lim
+        } else {
+            a0 + (lim - a0) * (t - 0.25 * t * t)
+        };
         y.copysign(alpha)
     }
 
@@ -390,7 +394,11 @@ impl GlobalAero {
             let v = v_cg + omega.cross(&r);
             let vn = v.norm();
             let sy = if vn < AIRSPEED_EPS { 0.0 } else { v.y / vn };
-            let f = Vector3::new(0.0, -half_rho * a.wing_area * vn * cy90 / (0.56 + 0.44 * sy.abs()) * v.y, 0.0);
+            let f = Vector3::new(
+                0.0,
+                -half_rho * a.wing_area * vn * cy90 / (0.56 + 0.44 * sy.abs()) * v.y,
+                0.0,
+            );
             force += f;
             moment += r.cross(&f);
         }
@@ -455,14 +463,22 @@ impl GlobalAero {
         moment += m_rate * (1.0 - sigma);
 
         // Ailerons (free stream), effectiveness fading with the chordwise flow after stall.
-        let sx = if fr.speed < AIRSPEED_EPS { 1.0 } else { fr.v.x / fr.speed };
+        let sx = if fr.speed < AIRSPEED_EPS {
+            1.0
+        } else {
+            fr.v.x / fr.speed
+        };
         let e_free = 1.0 - sigma + sigma * sx;
         force += fr.yw * (e_free * qs * c.c_Y_da * d.aileron);
         moment += (fr.xw * (c.c_l_da * b) + fr.zw * (c.c_n_da * b)) * (e_free * qs * d.aileron);
 
         // Surfaces in the slip-stream (thesis: q̄_s, slip-stream axes, derivatives at the
         // free-stream α), effectiveness fading with the local chordwise flow after stall.
-        let sxs = if fs.speed < AIRSPEED_EPS { 1.0 } else { fs.v.x / fs.speed };
+        let sxs = if fs.speed < AIRSPEED_EPS {
+            1.0
+        } else {
+            fs.v.x / fs.speed
+        };
         let e_s = 1.0 - sigma_s + sigma_s * sxs;
         let lift_s = qss * (c.c_L_de * d.elevator + c.c_L_dfc * d.flap_collective);
         let side_s = qss * (c.c_Y_dr * d.rudder + c.c_Y_dv * d.vertical_flap);

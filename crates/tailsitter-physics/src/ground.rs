@@ -157,9 +157,7 @@ impl Ground {
     /// is higher than this above the ground.
     #[inline]
     fn reach(&self, a: &Airframe) -> f64 {
-        let g = (self.gear_length * self.gear_length
-            + (self.gear_half_span.max(self.gear_half_height)).powi(2))
-        .sqrt();
+        let g = (self.gear_length * self.gear_length + (self.gear_half_span.max(self.gear_half_height)).powi(2)).sqrt();
         g.max(self.nose_length).max(0.5 * a.wing_span)
     }
 

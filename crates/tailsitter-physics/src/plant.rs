@@ -369,10 +369,7 @@ impl Plant {
         let (fm, c) = self.eval(x, wind_ned);
         let q = Vector4::new(x[Q1], x[Q2], x[Q3], x[Q4]);
         let v_air = Vector3::new(x[U], x[V], x[W]) - c * wind_ned;
-        let stall_fraction = self
-            .aero
-            .diagnostics(&self.airframe, &v_air, x[THRUST])
-            .stall_fraction;
+        let stall_fraction = self.aero.diagnostics(&self.airframe, &v_air, x[THRUST]).stall_fraction;
         let (f_ground, _) = self.ground.contact(&self.airframe, x, &c);
         Outputs {
             vel_ned: c.tr_mul(&Vector3::new(x[U], x[V], x[W])),

@@ -28,7 +28,10 @@ fn v_air(v: f64, alpha: f64, beta: f64) -> Vector3<f64> {
 struct Lcg(u64);
 impl Lcg {
     fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         (self.0 >> 11) as f64 / (1u64 << 53) as f64
     }
     fn range(&mut self, lo: f64, hi: f64) -> f64 {
@@ -141,13 +144,65 @@ fn set(a: &mut Airframe, name: &str, value: f64) {
         ($($f:ident),*) => { match name { $(stringify!($f) => a.$f = value,)* _ => {} } };
     }
     fields!(
-        c_D0, c_L0, c_m0, c_L_alpha_a0, c_L_alpha_a1, c_m_alpha_a0, c_m_alpha_a1, c_Y_beta_a0, c_Y_beta_a1,
-        c_l_beta_a0, c_l_beta_a1, c_n_beta_a0, c_n_beta_a1, c_Y_p_a0, c_Y_p_a1, c_l_p_a0, c_l_p_a1, c_n_p_a0,
-        c_n_p_a1, c_L_q_a0, c_L_q_a1, c_m_q_a0, c_m_q_a1, c_Y_r_a0, c_Y_r_a1, c_l_r_a0, c_l_r_a1, c_n_r_a0,
-        c_n_r_a1, c_L_de_a0, c_L_de_a1, c_m_de_a0, c_m_de_a1, c_Y_da_a0, c_Y_da_a1, c_l_da_a0, c_l_da_a1,
-        c_n_da_a0, c_n_da_a1, c_Y_dr_a0, c_Y_dr_a1, c_l_dr_a0, c_l_dr_a1, c_n_dr_a0, c_n_dr_a1, c_L_dfc_a0,
-        c_L_dfc_a1, c_m_dfc_a0, c_m_dfc_a1, c_l_dfd_a0, c_l_dfd_a1, c_n_dfd_a0, c_n_dfd_a1, c_Y_dv_a0,
-        c_Y_dv_a1, c_l_dv_a0, c_l_dv_a1, c_n_dv_a0, c_n_dv_a1
+        c_D0,
+        c_L0,
+        c_m0,
+        c_L_alpha_a0,
+        c_L_alpha_a1,
+        c_m_alpha_a0,
+        c_m_alpha_a1,
+        c_Y_beta_a0,
+        c_Y_beta_a1,
+        c_l_beta_a0,
+        c_l_beta_a1,
+        c_n_beta_a0,
+        c_n_beta_a1,
+        c_Y_p_a0,
+        c_Y_p_a1,
+        c_l_p_a0,
+        c_l_p_a1,
+        c_n_p_a0,
+        c_n_p_a1,
+        c_L_q_a0,
+        c_L_q_a1,
+        c_m_q_a0,
+        c_m_q_a1,
+        c_Y_r_a0,
+        c_Y_r_a1,
+        c_l_r_a0,
+        c_l_r_a1,
+        c_n_r_a0,
+        c_n_r_a1,
+        c_L_de_a0,
+        c_L_de_a1,
+        c_m_de_a0,
+        c_m_de_a1,
+        c_Y_da_a0,
+        c_Y_da_a1,
+        c_l_da_a0,
+        c_l_da_a1,
+        c_n_da_a0,
+        c_n_da_a1,
+        c_Y_dr_a0,
+        c_Y_dr_a1,
+        c_l_dr_a0,
+        c_l_dr_a1,
+        c_n_dr_a0,
+        c_n_dr_a1,
+        c_L_dfc_a0,
+        c_L_dfc_a1,
+        c_m_dfc_a0,
+        c_m_dfc_a1,
+        c_l_dfd_a0,
+        c_l_dfd_a1,
+        c_n_dfd_a0,
+        c_n_dfd_a1,
+        c_Y_dv_a0,
+        c_Y_dv_a1,
+        c_l_dv_a0,
+        c_l_dv_a1,
+        c_n_dv_a0,
+        c_n_dv_a1
     );
 }
 
@@ -200,7 +255,9 @@ fn continuous_symmetric_and_bounded_over_the_sphere() {
     for &speed in &[0.0, 0.5, 5.0, 15.0, 30.0] {
         for &thrust in &[0.0, 60.0, 150.0] {
             let eval = |al: f64, be: f64| g.forces_moments(&a, &v_air(speed, al, be), &zero, thrust, &s0).0;
-            let wi = a.induced_velocity(speed, speed, thrust).max(a.induced_velocity(speed, -speed, thrust));
+            let wi = a
+                .induced_velocity(speed, speed, thrust)
+                .max(a.induced_velocity(speed, -speed, thrust));
             let qbar = 0.5 * a.air_density * speed * speed;
             let qbar_s = 0.5 * a.air_density * (speed + 2.0 * wi).powi(2);
             // Flat-plate limit C_N ≤ 2 on every part of the wing, at its own dynamic pressure.
@@ -212,7 +269,11 @@ fn continuous_symmetric_and_bounded_over_the_sphere() {
                     let f = eval(al, be);
                     let aero = f.force_body - Vector3::new(thrust, 0.0, 0.0);
                     assert!(aero.iter().chain(f.moment_body.iter()).all(|x| x.is_finite()));
-                    assert!(aero.norm() <= bound, "|F| {} > {bound} at V {speed} T {thrust} α {al} β {be}", aero.norm());
+                    assert!(
+                        aero.norm() <= bound,
+                        "|F| {} > {bound} at V {speed} T {thrust} α {al} β {be}",
+                        aero.norm()
+                    );
                     // Mirror symmetry.
                     let m = eval(al, -be);
                     let tol = 1e-9 * (1.0 + f.force_body.norm() + f.moment_body.norm());
@@ -231,12 +292,18 @@ fn continuous_symmetric_and_bounded_over_the_sphere() {
                     let fa = |d: f64| eval(al + d, be);
                     let second = (fa(h).force_body - 2.0 * f.force_body + fa(-h).force_body).norm()
                         + (fa(h).moment_body - 2.0 * f.moment_body + fa(-h).moment_body).norm();
-                    assert!(second <= 1e-2 * scale * h, "kink in α at α {al} β {be} V {speed} T {thrust}: {second}");
+                    assert!(
+                        second <= 1e-2 * scale * h,
+                        "kink in α at α {al} β {be} V {speed} T {thrust}: {second}"
+                    );
                     if be.abs() < 1.5 {
                         let fb = |d: f64| eval(al, be + d);
                         let second = (fb(h).force_body - 2.0 * f.force_body + fb(-h).force_body).norm()
                             + (fb(h).moment_body - 2.0 * f.moment_body + fb(-h).moment_body).norm();
-                        assert!(second <= 1e-2 * scale * h, "kink in β at α {al} β {be} V {speed} T {thrust}: {second}");
+                        assert!(
+                            second <= 1e-2 * scale * h,
+                            "kink in β at α {al} β {be} V {speed} T {thrust}: {second}"
+                        );
                     }
                 }
             }
@@ -274,10 +341,16 @@ fn no_slope_jump_at_the_seams() {
             let f0 = eval(al, be);
             let right = (eval(al + h, be) - f0) / h;
             let left = (f0 - eval(al - h, be)) / h;
-            assert!((right - left).abs() <= 1e-3 * (1.0 + right.abs()), "α seam at {al}: {left} vs {right}");
+            assert!(
+                (right - left).abs() <= 1e-3 * (1.0 + right.abs()),
+                "α seam at {al}: {left} vs {right}"
+            );
             let right = (eval(al, be + h) - f0) / h;
             let left = (f0 - eval(al, be - h)) / h;
-            assert!((right - left).abs() <= 1e-3 * (1.0 + right.abs()), "β seam at {be}: {left} vs {right}");
+            assert!(
+                (right - left).abs() <= 1e-3 * (1.0 + right.abs()),
+                "β seam at {be}: {left} vs {right}"
+            );
         }
     }
 }
@@ -330,7 +403,8 @@ fn thrust_off_gliding_and_tumbling_lose_energy() {
         let mut x = StateVector::zeros();
         let q = quat_from_euler_321(rng.range(-3.0, 3.0), rng.range(-1.5, 1.5), rng.range(-3.0, 3.0));
         x.fixed_rows_mut::<4>(Q1).copy_from(&q);
-        let v = dcm_earth_to_body(&q) * Vector3::new(rng.range(-15.0, 15.0), rng.range(-15.0, 15.0), rng.range(-10.0, 10.0));
+        let v = dcm_earth_to_body(&q)
+            * Vector3::new(rng.range(-15.0, 15.0), rng.range(-15.0, 15.0), rng.range(-10.0, 10.0));
         x[U] = v.x;
         x[V] = v.y;
         x[W] = v.z;
@@ -370,13 +444,25 @@ fn slipstream_keeps_immersed_wing_attached_in_hover_wind() {
     // η = 2D/b with D = √(2A/π): two 16-inch (0.406 m) propellers over a 1.569 m span.
     assert!((eta - 2.0 * 0.406 / 1.569).abs() < 2e-3);
     let hover = a.mass * a.gravity;
-    let (_, d) = g.forces_moments(&a, &Vector3::new(0.0, 0.0, 5.0), &Vector3::zeros(), hover, &Surfaces::default());
+    let (_, d) = g.forces_moments(
+        &a,
+        &Vector3::new(0.0, 0.0, 5.0),
+        &Vector3::zeros(),
+        hover,
+        &Surfaces::default(),
+    );
     assert_eq!(d.sigma_free, 1.0);
     let w = a.induced_velocity(5.0, 0.0, hover);
     assert!((d.alpha_slipstream - (5.0f64).atan2(2.0 * w)).abs() < 1e-12);
     assert!(d.sigma_slipstream < 0.2 && d.stall_fraction < 1.0 && d.stall_fraction > 1.0 - eta);
     // Thrust off: everything stalls.
-    let (_, d0) = g.forces_moments(&a, &Vector3::new(0.0, 0.0, 5.0), &Vector3::zeros(), 0.0, &Surfaces::default());
+    let (_, d0) = g.forces_moments(
+        &a,
+        &Vector3::new(0.0, 0.0, 5.0),
+        &Vector3::zeros(),
+        0.0,
+        &Surfaces::default(),
+    );
     assert_eq!(d0.stall_fraction, 1.0);
     assert_eq!(AeroRegime::of(d0.stall_fraction), AeroRegime::Stalled);
 }
@@ -394,7 +480,10 @@ fn control_effectiveness_degrades_after_stall() {
             ..Surfaces::default()
         };
         let m1 = g.forces_moments(&a, &va, &Vector3::zeros(), thrust, &da).0.moment_body;
-        let m0 = g.forces_moments(&a, &va, &Vector3::zeros(), thrust, &Surfaces::default()).0.moment_body;
+        let m0 = g
+            .forces_moments(&a, &va, &Vector3::zeros(), thrust, &Surfaces::default())
+            .0
+            .moment_body;
         (m1 - m0).norm()
     };
     assert!(roll(60f64.to_radians(), 0.0) < 0.6 * roll(0.05, 0.0));
@@ -405,8 +494,16 @@ fn control_effectiveness_degrades_after_stall() {
             elevator: 0.2,
             ..Surfaces::default()
         };
-        let m1 = g.forces_moments(&a, &va, &Vector3::zeros(), thrust, &de).0.moment_body.y;
-        let m0 = g.forces_moments(&a, &va, &Vector3::zeros(), thrust, &Surfaces::default()).0.moment_body.y;
+        let m1 = g
+            .forces_moments(&a, &va, &Vector3::zeros(), thrust, &de)
+            .0
+            .moment_body
+            .y;
+        let m0 = g
+            .forces_moments(&a, &va, &Vector3::zeros(), thrust, &Surfaces::default())
+            .0
+            .moment_body
+            .y;
         m1 - m0
     };
     // Hover thrust, 3 m/s broadside: the elevator in the wash keeps > 95 % of its attached effect.

@@ -106,7 +106,10 @@ fn lands_from_a_drop_and_comes_to_rest() {
     }
     let v_td = touchdown.expect("never touched down");
     let expected = (2.0 * a.gravity * h).sqrt();
-    assert!((v_td - expected).abs() < a.gravity * 0.005 + 1e-3, "touchdown {v_td} vs {expected}");
+    assert!(
+        (v_td - expected).abs() < a.gravity * 0.005 + 1e-3,
+        "touchdown {v_td} vs {expected}"
+    );
     for _ in 0..200 {
         p.advance(&mut x, &u, &still(), 0.02).unwrap();
     }
@@ -133,7 +136,10 @@ fn friction_stops_a_slide() {
     let d = x[POS_E];
     let coulomb = v0 * v0 / (2.0 * p.ground.friction * a.gravity);
     assert!(x.fixed_rows::<3>(U).norm() < 1e-3, "still sliding");
-    assert!(d > 0.5 * coulomb && d < 2.0 * coulomb, "slid {d} m, Coulomb {coulomb} m");
+    assert!(
+        d > 0.5 * coulomb && d < 2.0 * coulomb,
+        "slid {d} m, Coulomb {coulomb} m"
+    );
     assert!((pitch(&x) - core::f64::consts::FRAC_PI_2).abs() < 0.05);
 }
 
@@ -169,5 +175,50 @@ fn crashes_are_finite() {
         }
         let y = p.outputs(&x, &u, &still());
         assert!(y.specific_force_body.iter().all(|v| v.is_finite()));
+    }
+}
+
+/// `Ground::default()` and `GlobalAero::default()` are the FMU's start values.
+#[test]
+fn defaults_match_json_start_values() {
+    use tailsitter_physics::{AeroModel, GlobalAero};
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../modelDescription/tailsitter_plant.json"
+    );
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    let start = |name: &str| {
+        json["variables"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|v| v["name"] == name)
+            .unwrap_or_else(|| panic!("no variable {name}"))["start"]
+            .as_f64()
+            .unwrap()
+    };
+    let g = Ground::default();
+    for (name, value) in [
+        ("ground_height", g.height),
+        ("gear_length", g.gear_length),
+        ("gear_half_span", g.gear_half_span),
+        ("gear_half_height", g.gear_half_height),
+        ("nose_length", g.nose_length),
+        ("ground_stiffness", g.stiffness),
+        ("ground_damping", g.damping),
+        ("ground_friction", g.friction),
+    ] {
+        assert_eq!(start(name), value, "{name}");
+    }
+    let a = GlobalAero::default();
+    assert_eq!(start("aero_model") as i32, AeroModel::Global.index());
+    for (name, value) in [
+        ("alpha_attached", a.alpha_attached),
+        ("alpha_stalled", a.alpha_stalled),
+        ("beta_attached", a.beta_attached),
+        ("beta_stalled", a.beta_stalled),
+        ("c_D_90", a.c_D_90),
+    ] {
+        assert!((start(name) - value).abs() <= 1e-15 * value.abs().max(1.0), "{name}");
     }
 }
