@@ -66,8 +66,10 @@
 //! free part stalls. Stall fraction (share of the wing in post-stall flow):
 //! σ ((1 − η) + η σ_s), output as `stall_fraction`.
 //!
-//! **Rotation.** In attached flow the thesis's rate terms (C_Lq, C_mq, C_Yp, …, ¼ρV̄S…).
-//! After stall each half wing (area S/2, at (x_cp, ±b/4, 0)) and the side surfaces feel the
+//! **Rotation.** In attached flow the thesis's rate terms (C_Lq, C_mq, C_Yp, …, ¼ρV̄S…),
+//! weighted by the attached share: (1 − σ) at the free stream plus σ η (1 − σ_s) at the
+//! immersed part's local flow (¼ρV_sS…, so the wing in the propeller wash damps pitch and
+//! roll in hover). After stall each half wing (area S/2, at (x_cp, ±b/4, 0)) and the side surfaces feel the
 //! local velocity of their own point, v + ω × r, and their force acts there: the plate damps
 //! rotation itself (pitch, roll and yaw), the thesis's rate terms are blended out with σ, and
 //! every post-stall force does non-positive work F·(v + ω × r) ≤ 0 in still air.
@@ -89,7 +91,7 @@
 use nalgebra::Vector3;
 
 use crate::aero::{ForcesMoments, Surfaces, AIRSPEED_EPS};
-use crate::airframe::{Airframe, InvalidParameter};
+use crate::airframe::{Airframe, Coefficients, InvalidParameter};
 
 /// Which aerodynamic model the plant uses (FMU parameter `aero_model`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -335,6 +337,21 @@ impl GlobalAero {
         (force, moment)
     }
 
+    /// The thesis's rate terms (2.3.5–2.3.11) at one flow: ¼ρVS(…), stability-axis p_s, r_s.
+    #[inline]
+    fn thesis_rates(a: &Airframe, f: &Flow, c: &Coefficients, omega: &Vector3<f64>) -> Wrench {
+        let kr = 0.25 * a.air_density * f.speed * a.wing_area;
+        let (b, cbar) = (a.wing_span, a.mean_chord);
+        let (p, q, r) = (omega.x, omega.y, omega.z);
+        let ps = p * f.ca + r * f.sa;
+        let rs = r * f.ca - p * f.sa;
+        let force = f.yw * (kr * b * (c.c_Y_p * ps + c.c_Y_r * rs)) + f.zw * (-kr * cbar * c.c_L_q * q);
+        let moment = f.xw * (kr * b * b * (c.c_l_p * ps + c.c_l_r * rs))
+            + f.yw * (kr * cbar * cbar * c.c_m_q * q)
+            + f.zw * (kr * b * b * (c.c_n_p * ps + c.c_n_r * rs));
+        (force, moment)
+    }
+
     /// The α at which the derivatives of Tables C.3/C.4 are interpolated. The thesis clamps
     /// it at ±`alpha_interp_limit` L (11.8°), a kink inside the blend band; here it is α for
     /// |α| ≤ α_a (so attached flow is the thesis's model exactly) and saturates C¹ beyond:
@@ -424,7 +441,6 @@ impl GlobalAero {
         let b = a.wing_span;
         let cbar = a.mean_chord;
         let qs = 0.5 * rho * fr.speed * fr.speed * s;
-        let kr = 0.25 * rho * fr.speed * s;
 
         // Slip-stream flow over the immersed part and the surfaces behind the propellers.
         let wi = a.induced_velocity(fr.speed, fr.v.x, thrust);
@@ -450,17 +466,20 @@ impl GlobalAero {
             moment = moment * (1.0 - sigma) + (mp * (1.0 - eta) + m_imm * eta) * sigma;
         }
 
-        // Rate damping (2.3.5), free stream, stability-axis roll/yaw rates: the thesis's terms
-        // in attached flow; after stall the plate's own point velocities damp the rotation.
-        let (p, q, r) = (omega_body.x, omega_body.y, omega_body.z);
-        let ps = p * fr.ca + r * fr.sa;
-        let rs = r * fr.ca - p * fr.sa;
-        let f_rate = fr.yw * (kr * b * (c.c_Y_p * ps + c.c_Y_r * rs)) + fr.zw * (-kr * cbar * c.c_L_q * q);
-        let m_rate = fr.xw * (kr * b * b * (c.c_l_p * ps + c.c_l_r * rs))
-            + fr.yw * (kr * cbar * cbar * c.c_m_q * q)
-            + fr.zw * (kr * b * b * (c.c_n_p * ps + c.c_n_r * rs));
+        // Rate damping (2.3.5), stability-axis roll/yaw rates: the thesis's terms for the
+        // attached share of the wing — the free stream's, and once it stalls the immersed
+        // part's at its local flow; the stalled share is damped by its plate's own point
+        // velocities (post_stall).
+        let (f_rate, m_rate) = Self::thesis_rates(a, &fr, &c, omega_body);
         force += f_rate * (1.0 - sigma);
         moment += m_rate * (1.0 - sigma);
+        let w_imm = sigma * eta * (1.0 - sigma_s);
+        if w_imm > 0.0 {
+            let cs = a.coefficients(self.coefficient_alpha(a, fs.alpha));
+            let (f_rate, m_rate) = Self::thesis_rates(a, &fs, &cs, omega_body);
+            force += f_rate * w_imm;
+            moment += m_rate * w_imm;
+        }
 
         // Ailerons (free stream), effectiveness fading with the chordwise flow after stall.
         let sx = if fr.speed < AIRSPEED_EPS {
