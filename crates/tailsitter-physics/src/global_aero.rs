@@ -286,19 +286,19 @@ impl GlobalAero {
                 return bad(name, value, "finite");
             }
         }
-        if !(self.alpha_attached >= 0.0) {
+        if self.alpha_attached < 0.0 {
             return bad("alpha_attached", self.alpha_attached, ">= 0");
         }
         if !(self.alpha_stalled > self.alpha_attached && self.alpha_stalled <= half_pi) {
             return bad("alpha_stalled", self.alpha_stalled, "> alpha_attached and <= pi/2");
         }
-        if !(self.beta_attached >= 0.0) {
+        if self.beta_attached < 0.0 {
             return bad("beta_attached", self.beta_attached, ">= 0");
         }
         if !(self.beta_stalled > self.beta_attached && self.beta_stalled <= half_pi) {
             return bad("beta_stalled", self.beta_stalled, "> beta_attached and <= pi/2");
         }
-        if !(self.c_D_90 > 0.0) {
+        if self.c_D_90 <= 0.0 {
             return bad("c_D_90", self.c_D_90, "positive");
         }
         Ok(())

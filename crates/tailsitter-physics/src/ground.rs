@@ -167,7 +167,7 @@ impl Ground {
     pub fn contact(&self, a: &Airframe, x: &StateVector, c: &Matrix3<f64>) -> (Vector3<f64>, Vector3<f64>) {
         let mut force = Vector3::zeros();
         let mut moment = Vector3::zeros();
-        if !(x[POS_D] + self.reach(a) > self.height) {
+        if x[POS_D] + self.reach(a) <= self.height || x[POS_D].is_nan() {
             return (force, moment);
         }
         let pos = Vector3::new(x[POS_N], x[POS_E], x[POS_D]);
