@@ -98,7 +98,8 @@ use crate::airframe::{Airframe, Coefficients, InvalidParameter};
 pub enum AeroModel {
     /// 0: the thesis's linear derivatives at every angle ([`Airframe::forces_moments`]).
     Thesis,
-    /// 1: the global model of this module (default).
+    /// 1: the global model of this module (the FMU's default; [`crate::Plant::new`] uses
+    /// [`AeroModel::Thesis`]).
     #[default]
     Global,
 }

@@ -46,7 +46,9 @@ pub struct Plant {
     pub integration_step: f64,
     /// Envelope checked after every substep.
     pub envelope: Envelope,
-    /// Aerodynamic model selection and global-model parameters (default: global model).
+    /// Aerodynamic model selection and global-model parameters. [`Plant::new`] selects the
+    /// thesis's model ([`AeroModel::Thesis`], the controllers' design model); the FMU's
+    /// default (`aero_model` = 1) is the global model.
     pub aero: GlobalAero,
     /// Ground plane and contact points (default: [`Ground::none`]).
     pub ground: Ground,
@@ -104,13 +106,17 @@ pub struct Trim {
 }
 
 impl Plant {
-    /// Plant with `integration_step` = 0.002 s and the default envelope.
+    /// Plant with `integration_step` = 0.002 s, the default envelope, the thesis's
+    /// aerodynamic model (set `aero.model` for the global one) and no ground.
     pub fn new(airframe: Airframe) -> Self {
         Self {
             airframe,
             integration_step: 0.002,
             envelope: Envelope::default(),
-            aero: GlobalAero::default(),
+            aero: GlobalAero {
+                model: AeroModel::Thesis,
+                ..GlobalAero::default()
+            },
             ground: Ground::none(),
         }
     }
