@@ -7,8 +7,10 @@ use tailsitter_physics::{
     dcm_earth_to_body, quat_from_euler_321, Airframe, Ground, InputVector, PhysicsError, Plant, StateVector,
 };
 
+/// The FMU's defaults: global aerodynamics (tail-first flight is physical) and the ground.
 fn plant() -> Plant {
     let mut p = Plant::new(Airframe::default());
+    p.aero.model = tailsitter_physics::AeroModel::Global;
     p.ground = Ground::default();
     p
 }
