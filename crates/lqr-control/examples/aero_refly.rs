@@ -34,10 +34,10 @@ fn summary<C: FlightController>(name: &str, model: AeroModel, scenario: &Scenari
         max_d = max_d.max(s.x[tailsitter_physics::idx::POS_D]);
     }
     println!(
-        "{name:<34} aero_model {}: survived {:<5} mission check {:<5} max |alpha| {:6.1} deg, max pos error {:7.2} m, \
+        "{name:<34} aero_model {}: crashed {:<5} mission check {:<5} max |alpha| {:6.1} deg, max pos error {:7.2} m, \
          max stall fraction {:.2}, lowest pos_d {:6.2} m, ground contact {}{}",
         model.index(),
-        trace.completed(),
+        !trace.completed() || ground > 0,
         check.passed(),
         max_alpha.to_degrees(),
         trace.max_pos_error(),

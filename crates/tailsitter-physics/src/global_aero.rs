@@ -201,7 +201,8 @@ pub struct AeroDiagnostics {
     pub sigma_free: f64,
     /// Stall weight σ_s of the slip-stream (immersed part).
     pub sigma_slipstream: f64,
-    /// Angle of attack of the immersed part's local flow (rad).
+    /// Angle of attack of the immersed part's local flow (rad) ([`GlobalAero::forces_moments`]
+    /// leaves it 0 while the free stream is attached, where it is not needed).
     pub alpha_slipstream: f64,
 }
 
@@ -227,6 +228,32 @@ struct Flow {
 }
 
 impl Flow {
+    /// Speed and wind axes only (α = β = 0 placeholders): for a flow whose angles are known
+    /// not to be needed.
+    #[inline]
+    fn axes_of(v: Vector3<f64>) -> Self {
+        let speed = v.norm();
+        if speed < AIRSPEED_EPS {
+            return Self::of(v);
+        }
+        let xw = v / speed;
+        let h = (v.x * v.x + v.z * v.z).sqrt();
+        let (sa, ca) = if h > 0.0 { (v.z / h, v.x / h) } else { (0.0, 1.0) };
+        let zw = Vector3::new(-sa, 0.0, ca);
+        let yw = zw.cross(&xw);
+        Self {
+            v,
+            speed,
+            alpha: 0.0,
+            beta: 0.0,
+            xw,
+            yw,
+            zw,
+            sa,
+            ca,
+        }
+    }
+
     #[inline]
     fn of(v: Vector3<f64>) -> Self {
         let speed = v.norm();
@@ -325,8 +352,7 @@ impl GlobalAero {
     /// with the control lift `cl_ctrl` in the induced drag (2.3.12–13), as in
     /// [`Airframe::forces_moments`].
     #[inline]
-    fn thesis_static(&self, a: &Airframe, f: &Flow, cl_ctrl: f64) -> Wrench {
-        let c = a.coefficients(self.coefficient_alpha(a, f.alpha));
+    fn thesis_static(a: &Airframe, f: &Flow, c: &Coefficients, cl_ctrl: f64) -> Wrench {
         let qs = 0.5 * a.air_density * f.speed * f.speed * a.wing_area;
         let cl_wing = a.c_L0 + c.c_L_alpha * f.alpha;
         let cl = cl_wing + cl_ctrl;
@@ -447,39 +473,53 @@ impl GlobalAero {
         let wi = a.induced_velocity(fr.speed, fr.v.x, thrust);
         let vs = fr.speed + 2.0 * wi;
         let qss = 0.5 * rho * vs * vs * s;
-        let fs = Flow::of(Vector3::new(fr.v.x + 2.0 * wi, fr.v.y, fr.v.z));
+        let v_wake = Vector3::new(fr.v.x + 2.0 * wi, fr.v.y, fr.v.z);
 
         let sigma = self.stall_weight(fr.alpha, fr.beta);
-        let sigma_s = self.stall_weight(fs.alpha, fs.beta);
+        // With the free stream attached the slip-stream is too: u ≥ 0 there, so
+        // |α_s| ≤ |α| and |β_s| ≤ |β| (V_s ≥ V̄), σ_s = 0 and its angles are not needed.
+        let (fs, sigma_s) = if sigma > 0.0 {
+            let fs = Flow::of(v_wake);
+            let sigma_s = self.stall_weight(fs.alpha, fs.beta);
+            (fs, sigma_s)
+        } else {
+            (Flow::axes_of(v_wake), 0.0)
+        };
         let eta = Self::immersed_fraction(a);
 
-        // Static wing terms.
-        let cl_ctrl = c.c_L_de * d.elevator + c.c_L_dfc * d.flap_collective;
-        let (mut force, mut moment) = self.thesis_static(a, &fr, cl_ctrl);
+        // Attached share of the free stream: the thesis's static (2.3.6–2.3.13) and rate
+        // (2.3.5) terms. Stalled share: the plate (post_stall, damped by its point
+        // velocities) and, for the immersed part, its own local flow — attached (thesis terms
+        // at ¼ρV_sS…, q̄_s) or stalled.
+        let mut force = Vector3::zeros();
+        let mut moment = Vector3::zeros();
+        let w_attached = 1.0 - sigma;
+        if w_attached > 0.0 {
+            let cl_ctrl = c.c_L_de * d.elevator + c.c_L_dfc * d.flap_collective;
+            let (ft, mt) = Self::thesis_static(a, &fr, &c, cl_ctrl);
+            let (fq, mq) = Self::thesis_rates(a, &fr, &c, omega_body);
+            force += (ft + fq) * w_attached;
+            moment += (mt + mq) * w_attached;
+        }
         if sigma > 0.0 {
             let (fp, mp) = self.post_stall(a, &fr.v, omega_body);
-            let cs = a.coefficients(self.coefficient_alpha(a, fs.alpha));
-            let (ft_s, mt_s) = self.thesis_static(a, &fs, cs.c_L_de * d.elevator + cs.c_L_dfc * d.flap_collective);
-            let (fp_s, mp_s) = self.post_stall(a, &fs.v, omega_body);
-            let f_imm = ft_s * (1.0 - sigma_s) + fp_s * sigma_s;
-            let m_imm = mt_s * (1.0 - sigma_s) + mp_s * sigma_s;
-            force = force * (1.0 - sigma) + (fp * (1.0 - eta) + f_imm * eta) * sigma;
-            moment = moment * (1.0 - sigma) + (mp * (1.0 - eta) + m_imm * eta) * sigma;
-        }
-
-        // Rate damping (2.3.5), stability-axis roll/yaw rates: the thesis's terms for the
-        // attached share of the wing — the free stream's, and once it stalls the immersed
-        // part's at its local flow; the stalled share is damped by its plate's own point
-        // velocities (post_stall).
-        let (f_rate, m_rate) = Self::thesis_rates(a, &fr, &c, omega_body);
-        force += f_rate * (1.0 - sigma);
-        moment += m_rate * (1.0 - sigma);
-        let w_imm = sigma * eta * (1.0 - sigma_s);
-        if w_imm > 0.0 {
-            let cs = a.coefficients(self.coefficient_alpha(a, fs.alpha));
-            let (f_rate, m_rate) = Self::thesis_rates(a, &fs, &cs, omega_body);
-            force += f_rate * w_imm;
-            moment += m_rate * w_imm;
+            force += fp * (sigma * (1.0 - eta));
+            moment += mp * (sigma * (1.0 - eta));
+            let w_imm_attached = sigma * eta * (1.0 - sigma_s);
+            if w_imm_attached > 0.0 {
+                let cs = a.coefficients(self.coefficient_alpha(a, fs.alpha));
+                let cl_ctrl = cs.c_L_de * d.elevator + cs.c_L_dfc * d.flap_collective;
+                let (ft, mt) = Self::thesis_static(a, &fs, &cs, cl_ctrl);
+                let (fq, mq) = Self::thesis_rates(a, &fs, &cs, omega_body);
+                force += (ft + fq) * w_imm_attached;
+                moment += (mt + mq) * w_imm_attached;
+            }
+            let w_imm_stalled = sigma * eta * sigma_s;
+            if w_imm_stalled > 0.0 {
+                let (fp, mp) = self.post_stall(a, &fs.v, omega_body);
+                force += fp * w_imm_stalled;
+                moment += mp * w_imm_stalled;
+            }
         }
 
         // Ailerons (free stream), effectiveness fading with the chordwise flow after stall.
