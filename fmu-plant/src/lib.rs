@@ -195,8 +195,8 @@ impl PlantModel {
         vars.accel_z = y.specific_force_body.z;
         vars.induced_velocity = y.induced_velocity;
         vars.stall_fraction = y.stall_fraction;
-        vars.aero_regime = y.aero_regime.index();
-        vars.ground_contact_points = y.ground.points as i32;
+        vars.aero_regime = f64::from(y.aero_regime.index());
+        vars.ground_contact_points = f64::from(y.ground.points);
         vars.touchdown_speed = self.events.touchdown_speed;
     }
 

@@ -58,7 +58,7 @@ fn ground_start_take_off_and_hard_landing_are_reported() {
     vars.thrust_cmd = 0.0;
     let mut model = PlantModel::new(&vars);
     model.initialize(&mut vars, 0.0, &mut log).unwrap();
-    assert_eq!(vars.ground_contact_points, 4);
+    assert_eq!(vars.ground_contact_points, 4.0);
     assert_eq!(vars.trim_thrust, 0.0);
     assert!((vars.theta - core::f64::consts::FRAC_PI_2).abs() < 1e-9);
     let d0 = vars.pos_d;
@@ -69,7 +69,7 @@ fn ground_start_take_off_and_hard_landing_are_reported() {
         model.do_step(&mut vars, t, 0.02, &mut log).unwrap();
         t += 0.02;
     }
-    assert_eq!(vars.ground_contact_points, 4);
+    assert_eq!(vars.ground_contact_points, 4.0);
     assert!((vars.pos_d - d0).abs() < 1e-6 && vars.touchdown_speed == 0.0);
     // Take off, climb, cut the motors: it falls back and lands hard (tail first).
     vars.thrust_cmd = 130.0;
@@ -77,14 +77,14 @@ fn ground_start_take_off_and_hard_landing_are_reported() {
         model.do_step(&mut vars, t, 0.02, &mut log).unwrap();
         t += 0.02;
     }
-    assert_eq!(vars.ground_contact_points, 0);
+    assert_eq!(vars.ground_contact_points, 0.0);
     assert!(messages_containing("ground", "lift-off") >= 1);
     vars.thrust_cmd = 0.0;
     let mut landed = false;
     for _ in 0..300 {
         model.do_step(&mut vars, t, 0.02, &mut log).unwrap();
         t += 0.02;
-        landed |= vars.ground_contact_points > 0;
+        landed |= vars.ground_contact_points > 0.0;
         assert!(vars.pos_d.is_finite() && vars.accel_x.is_finite());
     }
     assert!(landed);
@@ -106,7 +106,7 @@ fn leaving_attached_flow_is_reported_once() {
         let mut model = PlantModel::new(&vars);
         model.initialize(&mut vars, 0.0, &mut log).unwrap();
         vars.thrust_cmd = vars.trim_thrust;
-        assert_eq!((vars.stall_fraction, vars.aero_regime), (0.0, 0));
+        assert_eq!((vars.stall_fraction, vars.aero_regime), (0.0, 0.0));
         let before = messages_containing(&name, expected);
         vars.wind_n = 6.0;
         let mut t = 0.0;
@@ -114,7 +114,7 @@ fn leaving_attached_flow_is_reported_once() {
             model.do_step(&mut vars, t, 0.02, &mut log).unwrap();
             t += 0.02;
         }
-        assert!(vars.stall_fraction > 0.0 && vars.aero_regime >= 1);
+        assert!(vars.stall_fraction > 0.0 && vars.aero_regime >= 1.0);
         assert_eq!(messages_containing(&name, expected) - before, 1);
     }
 }
