@@ -18,6 +18,8 @@ pub mod aero;
 pub mod airframe;
 pub mod attitude;
 pub mod error;
+pub mod global_aero;
+pub mod ground;
 pub mod numeric;
 pub mod plant;
 
@@ -28,6 +30,8 @@ pub use attitude::{
     quat_derivative, quat_from_dcm, quat_from_euler_231, quat_from_euler_321,
 };
 pub use error::PhysicsError;
+pub use global_aero::{AeroDiagnostics, AeroModel, AeroRegime, GlobalAero};
+pub use ground::{ContactState, Ground};
 pub use plant::{Envelope, Outputs, Plant, Trim, MAX_SUBSTEPS};
 
 use nalgebra::SVector;
