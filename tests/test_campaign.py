@@ -25,7 +25,12 @@ N = 3  # samples of the campaign tests: 6 runs of the short (11 s) mission
 
 
 def short_spec(**kw) -> CampaignSpec:
-    return CampaignSpec(seed=7, n_samples=N, mission_name="short", mission=dict(MISSIONS["short"]), **kw)
+    # The machinery tests fly the thesis aerodynamics: the short mission's 3 s / 4 s
+    # transitions stall under the global model for most samples (a physics result, not
+    # what these tests are about).
+    kw.setdefault("aero_model", 0)
+    kw.setdefault("n_samples", N)
+    return CampaignSpec(seed=7, mission_name="short", mission=dict(MISSIONS["short"]), **kw)
 
 
 @pytest.fixture(scope="module")
@@ -129,6 +134,7 @@ def test_reset_and_reuse_run_equals_closed_loop(fmus):
     plant, ctrl = fmus["tailsitter_plant"], fmus["tailsitter_lqr"]
     nominal = {n: float(v.start) for n, v in plant.variables.items() if v.causality == "parameter" and v.type == "Real"}
     pp = plant_parameters(j, nominal)
+    pp["aero_model"] = spec.aero_model
     ref = ClosedLoop(plant, ctrl, pp, dict(spec.mission)).run(
         stop_time=spec.stop_time, step_size=spec.step_size, wind=wind_function(j)
     )
@@ -280,10 +286,7 @@ def test_failing_sample_is_a_recorded_failure(client, serial, tmp_path):
 def test_tumble_mid_flight_is_a_divergence_and_the_next_run_is_clean(serial, tmp_path):
     # Pitch-rate damping of the wrong sign (C_mq = +30 instead of −7.6): the aircraft
     # tumbles and the plant stops with its envelope error (|q| > 50 rad/s).
-    spec = CampaignSpec(
-        seed=7, n_samples=2, mission_name="short", mission=dict(MISSIONS["short"]),
-        overrides={0: {"c_m_q_a0": 30.0, "c_m_q_a1": 30.0}},
-    )
+    spec = short_spec(n_samples=2, overrides={0: {"c_m_q_a0": 30.0, "c_m_q_a1": 30.0}})
     rows = {r["key"]: r for r in run_campaign(spec, tmp_path, DIST, serial=True, progress=False).to_pylist()}
     ref = {r["key"]: r for r in serial.to_pylist()}
     for c in ("lqr", "tsd"):

@@ -337,6 +337,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--configurations", default="tuned")
     ap.add_argument("--state-sources", default="perfect")
     ap.add_argument("--mission", choices=sorted(MISSIONS), default="default")
+    ap.add_argument("--aero-model", type=int, choices=(0, 1), default=1, help="plant aerodynamics: 1 global (default), 0 thesis")
     ap.add_argument("--tau-aero", type=float, default=1.5)
     ap.add_argument("--tau-mass", type=float, default=1.1)
     ap.add_argument("--wind-max", type=float, default=5.0, help="largest steady horizontal wind (m/s)")
@@ -363,6 +364,7 @@ def main(argv: list[str] | None = None) -> int:
             state_sources=tuple(a.state_sources.split(",")),
             tau_aero=a.tau_aero,
             tau_mass=a.tau_mass,
+            aero_model=a.aero_model,
             wind_max=a.wind_max,
             gust_max=a.gust_max,
             mission_name=a.mission,

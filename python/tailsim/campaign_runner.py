@@ -371,6 +371,7 @@ def run_job(job: Mapping[str, Any], spec_json: Mapping[str, Any], digests: Mappi
         plant, ctrl = ps.fmu, cs.fmu
         nominal = {n: v.start for n, v in plant.variables.items() if v.causality == "parameter"}
         pp = plant_parameters(job, {k: float(v) for k, v in nominal.items() if k in _scaled_names()})
+        pp["aero_model"] = spec.aero_model
         pp.update(json.loads(job.get("overrides") or "{}"))
         cp = dict(spec.mission)
         cp.update(CONFIGURATIONS[job["configuration"]][job["controller"]])

@@ -118,6 +118,9 @@ class CampaignSpec:
     #: Extra plant-parameter values for some samples {sample_id: {name: value}}:
     #: what-if studies and fault injection (an invalid value makes a failed run).
     overrides: Mapping[int, Mapping[str, float]] = field(default_factory=dict)
+    #: The plant's `aero_model` for every run: 1 = global (post-stall, the FMU's default),
+    #: 0 = the thesis's linear derivatives at every angle.
+    aero_model: int = 1
 
     def __post_init__(self):
         for c in self.controllers:
@@ -131,6 +134,8 @@ class CampaignSpec:
             if s not in STATE_SOURCES:
                 why = "not implemented yet" if s in PLANNED_STATE_SOURCES else "unknown"
                 raise ValueError(f"state source {s!r}: {why} (available: {STATE_SOURCES})")
+        if self.aero_model not in (0, 1):
+            raise ValueError(f"aero_model = {self.aero_model!r}: expected 0 (thesis) or 1 (global)")
         if not (self.tau_aero >= 1.0 and self.tau_mass >= 1.0):
             raise ValueError("tau_aero and tau_mass must be ≥ 1")
 

@@ -1,6 +1,6 @@
-//! Re-fly the TSD controller (untuned) with the thesis (0) and global (1) aerodynamic models:
-//! default and fast missions, hover wind steps of 5 and 7 m/s (issue 13).
-//! `cargo run --release -p tsd-control --example aero_refly`
+//! Re-fly both controllers (untuned) with the thesis (0) and global (1) aerodynamic models:
+//! default and fast missions, hover wind steps of 5 and 7 m/s.
+//! `cargo run --release -p closed-loop --example aero_refly [lqr|tsd]` (default: both)
 
 use closed_loop::{fly, MissionCheck, Scenario, Trace, Wind};
 use flight_mission::{FlightController, MissionParams};
@@ -82,5 +82,15 @@ fn all<C: FlightController>(make: &dyn Fn(&MissionParams) -> C) {
 }
 
 fn main() {
-    all(&|m: &MissionParams| tsd_control::TsdController::with_mission(*m).unwrap());
+    let which = std::env::args().nth(1).unwrap_or_else(|| "both".into());
+    if which == "lqr" || which == "both" {
+        println!("== LQR");
+        all(&|m: &MissionParams| {
+            lqr_control::LqrController::new(Airframe::default(), *m, lqr_control::LqrParams::default()).unwrap()
+        });
+    }
+    if which == "tsd" || which == "both" {
+        println!("== TSD");
+        all(&|m: &MissionParams| tsd_control::TsdController::with_mission(*m).unwrap());
+    }
 }
