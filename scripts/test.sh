@@ -14,4 +14,19 @@ cargo xtask dist
 echo "== Rust tests"
 cargo test --workspace --locked
 echo "== Python tests (fmpy)"
-.venv/bin/python -m pytest tests -q
+.venv/bin/python -m pytest tests -q --ignore=tests/test_win64.py
+# The win64 FMUs under Wine through fmpy's remoting client, in a process of their own:
+# that client (fmpy's, not ours) has crashed its host process at random when instantiated
+# under load; a crash must not take the rest of the suite with it. One retry on a crash
+# (signal exit), never on a failed assertion.
+echo "== win64 FMUs under Wine (fmpy remoting)"
+set +e
+.venv/bin/python -m pytest tests/test_win64.py -q
+rc=$?
+if [ "$rc" -ge 128 ]; then
+    echo "fmpy's remoting client crashed (exit $rc); running the win64 tests once more"
+    .venv/bin/python -m pytest tests/test_win64.py -q
+    rc=$?
+fi
+set -e
+exit "$rc"

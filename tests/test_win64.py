@@ -173,9 +173,11 @@ def win64_fmus(tmp_path_factory):
 # libm). The Rust code and its IEEE-754 arithmetic are the same; only libm functions
 # (sin, cos, atan2, asin, exp, powf, …) may differ in the last ulp. Such ~1e-16 relative
 # differences are amplified by the closed loop (gain scheduling, the unstable hover
-# dynamics) over 35 s: measured ≤ 5.6e-10 (thrust, N) and 3.2e-11 m in position with
-# LQR, ~1e-13 with TSD. 1e-8 in SI units keeps a 20× margin, far below anything physical.
-WIN64_TOL = 1e-8
+# dynamics) over 35 s: on the thesis aerodynamics (aero_model = 0) measured ≤ 5.6e-10
+# (thrust, N) and 3.2e-11 m in position with LQR, ~1e-13 with TSD. On the default global
+# model the LQR's back transition stalls (α ≈ 52°), a far more sensitive flight: 1.0e-8
+# (u, m/s). 1e-7 in SI units keeps a 10× margin, far below anything physical.
+WIN64_TOL = 1e-7
 COMPARED = ["pos_n", "pos_e", "pos_d", "u", "v", "w", "p", "q", "r",
             "quat_1", "quat_2", "quat_3", "quat_4", "thrust", "elevator", "aileron", "rudder"]
 
