@@ -120,6 +120,9 @@ struct Mirror {
     start: f64,
     time: f64,
     stop: Option<f64>,
+    /// The state was captured by (or, re-sealed by the fuzzer, claims) a Model Exchange
+    /// instance: a Co-Simulation instance must refuse to restore it.
+    model_exchange: bool,
 }
 
 impl Mirror {
@@ -129,6 +132,7 @@ impl Mirror {
             start: 0.0,
             time: 0.0,
             stop: None,
+            model_exchange: false,
         }
     }
 }
@@ -212,11 +216,15 @@ fn machine_of(payload: &[u8]) -> Option<Mirror> {
     let time = f(9)?;
     let has_stop = *payload.get(17)? == 1;
     let stop = f(18)?;
+    // Machine layout (fmi2-export): state u8, start, time, has_stop, stop, has_tolerance,
+    // tolerance, initialized, dirty, model_exchange → the flag is byte 37.
+    let model_exchange = *payload.get(37)? == 1;
     Some(Mirror {
         st,
         start,
         time,
         stop: has_stop.then_some(stop),
+        model_exchange,
     })
 }
 
@@ -688,7 +696,13 @@ impl<'a> Fuzzer<'a> {
                     2 => (fake.ptr(), Expect::Error, None, "fake"),
                     _ if !states.is_empty() => {
                         let (p, m) = *self.rng.pick(states);
-                        (p, Expect::Ok, Some(m), "own")
+                        if m.model_exchange {
+                            // Only re-sealed, mutated buffers get here (the fuzzer's CS
+                            // instances capture CS states): another interface's state.
+                            (p, Expect::Error, None, "own, Model Exchange flag")
+                        } else {
+                            (p, Expect::Ok, Some(m), "own")
+                        }
                     }
                     _ => (
                         self.donors[f].state,
