@@ -98,7 +98,7 @@ pub struct LqrParams {
     pub turn_radius: f64,
     /// 0 = tuned (these parameters as given), 1 = thesis (§3.2–3.5, see
     /// [`Self::effective`]): backward iteration over `riccati_horizon`, airspeed-integrator
-    /// leak 0, Table 3.4 verbatim (weight set 0), the closed-form trajectory (3.3.x), the
+    /// leak 0, Table 3.4 verbatim (weight set 0, switched without blending), the closed-form trajectory (3.3.x), the
     /// no-wind reference, airspeed integral only, and the reference re-anchored at the
     /// measured position at the start of every mission segment (§3.5.1).
     pub configuration: i32,
@@ -108,7 +108,8 @@ impl LqrParams {
     /// The parameters the controller flies with: `self` for `configuration` 0 (tuned);
     /// for 1 (thesis) the structure and tuning as printed: the 200-step (`riccati_horizon`)
     /// backward Riccati iteration (3.1.3–3.1.5), airspeed-integrator leak 0 (3.2.12–3.2.14),
-    /// weight set 0 (Table 3.4 verbatim), trajectory mode 0 (closed forms 3.3.3–3.3.17),
+    /// weight set 0 (Table 3.4 verbatim) switched at the phase boundaries without blending
+    /// (§3.4), trajectory mode 0 (closed forms 3.3.3–3.3.17),
     /// no wind compensation and no position integrators (the thesis has neither).
     pub fn effective(&self) -> Result<Self, ControlError> {
         match self.configuration {
@@ -117,6 +118,7 @@ impl LqrParams {
                 riccati_method: 1,
                 integrator_leak: 0.0,
                 weight_set: 0,
+                weight_blend_time: 0.0,
                 trajectory_mode: 0,
                 wind_compensation: 0,
                 position_integral: 0,
