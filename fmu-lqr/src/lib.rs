@@ -6,7 +6,6 @@
 //! fragment, and timing, state and messages in `controller-fmu` (docs/DESIGN.md §2).
 
 use lqr_control::{LqrConfig, LqrController};
-use tailsitter_physics::Airframe;
 
 /// Generated from the declaration: `Variables`, `vr`, `GUID`, `MODEL_IDENTIFIER`, `MODEL_DESCRIPTION_XML`.
 #[allow(clippy::all)]
@@ -15,9 +14,10 @@ mod generated {
 }
 pub use generated::{vr, Variables, GUID, MODEL_DESCRIPTION_XML, MODEL_IDENTIFIER};
 
-// The nominal airframe is the controller's model of the aircraft.
+// The design model (parameter group `design_airframe`, default = the plant's nominal
+// airframe) is the controller's model of the aircraft; it may differ from the plant's.
 controller_fmu::flight_controller_binding!(Lqr, LqrController, "LQR", |vars| LqrConfig {
-    airframe: Airframe::default(),
+    airframe: vars.design_airframe(),
     mission: vars.mission(),
     params: vars.lqr(),
     weights_file: vars.weights_file.clone(),

@@ -28,9 +28,19 @@ fn commands(v: &Variables) -> InputVector {
 /// Fly the mission through the binding with communication step `h`; returns the
 /// plant states at every communication point.
 fn fly_fmu(h: f64, stop: f64) -> Vec<(f64, StateVector, InputVector, i32, f64)> {
+    fly_fmu_with(h, stop, |_| {})
+}
+
+/// [`fly_fmu`] with parameters set by `setup` before initialisation (the plant stays nominal).
+fn fly_fmu_with(
+    h: f64,
+    stop: f64,
+    setup: impl FnOnce(&mut Variables),
+) -> Vec<(f64, StateVector, InputVector, i32, f64)> {
     let plant = Plant::new(Airframe::default());
     let mut x = plant.trim_vertical_climb(3.0).unwrap().state;
     let mut vars = Variables::with_start_values();
+    setup(&mut vars);
     let mut model = LqrModel::new(&vars);
     let mut log = Logger::null();
     let u0 = commands(&vars);
@@ -188,4 +198,49 @@ fn parameter_start_values_are_the_library_defaults() {
     let vars = Variables::with_start_values();
     assert_eq!(vars.lqr(), LqrParams::default());
     assert!(vars.weights_file.is_empty());
+}
+
+#[test]
+fn design_model_start_values_are_the_plant_defaults() {
+    assert_eq!(Variables::with_start_values().design_airframe(), Airframe::default());
+}
+
+#[test]
+fn design_model_mismatch_is_flown_by_the_binding() {
+    // Design C_m_alpha x 1.2 (the thesis's §5 mismatch), plant nominal: the binding flies
+    // exactly what the library controller with that design airframe flies, and not the
+    // nominal design's flight.
+    let mut design = Airframe::default();
+    design.c_m_alpha_a0 *= 1.2;
+    design.c_m_alpha_a1 *= 1.2;
+    let m = MissionParams::default();
+    let plant = Plant::new(Airframe::default());
+    let x0 = plant.trim_vertical_climb(3.0).unwrap().state;
+    let mut c = LqrController::new(design, m, LqrParams::default()).unwrap();
+    let mut s = Scenario::mission(m);
+    s.stop_time = 15.0;
+    let trace = fly(&plant, x0, &mut c, &s);
+    let perturbed = fly_fmu_with(0.02, 15.0, |v| {
+        v.c_m_alpha_a0 = design.c_m_alpha_a0;
+        v.c_m_alpha_a1 = design.c_m_alpha_a1;
+    });
+    let nominal = fly_fmu(0.02, 15.0);
+    for (smp, (t, x, _, _, _)) in trace.samples.iter().zip(perturbed.iter()) {
+        assert!((smp.x - x).norm() < 1e-9, "t = {t}: state differs from the library's");
+    }
+    // Through the transition (5-10 s) the gains and feed-forward differ: the states part
+    // by far more than round-off (1 mm in position).
+    let (_, xp, _, _, _) = perturbed.last().unwrap();
+    let (_, xn, _, _, _) = nominal.last().unwrap();
+    let dp = (xp.fixed_rows::<3>(0) - xn.fixed_rows::<3>(0)).norm();
+    assert!(dp > 1e-3, "position difference {dp} m at 15 s");
+}
+
+#[test]
+fn invalid_design_parameter_is_an_error_naming_it() {
+    let mut vars = Variables::with_start_values();
+    vars.i_yy = -1.0;
+    let mut model = LqrModel::new(&vars);
+    let e = model.initialize(&mut vars, 0.0, &mut Logger::null()).unwrap_err();
+    assert!(e.message.contains("i_yy"), "{e}");
 }

@@ -230,6 +230,28 @@ pub struct DeclFile {
     pub include: Vec<String>,
     #[serde(default)]
     pub variables: Vec<VariableDecl>,
+    /// Parameter groups imported from another declaration (one source for, e.g., the
+    /// plant's airframe parameters and a controller's design model of them): appended
+    /// after this file's own variables, so their value references follow the others.
+    #[serde(default)]
+    pub import_groups: Vec<GroupImport>,
+}
+
+/// Import of every parameter of one group of another declaration file, with the
+/// same names, types, starts, bounds and units, into a group of this model.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, rename_all = "camelCase")]
+pub struct GroupImport {
+    /// Declaration file (relative path), e.g. `tailsitter_plant.json`.
+    pub file: String,
+    /// The group of that file whose parameters are imported, e.g. `airframe`.
+    pub group: String,
+    /// The group the imported parameters form here (same Rust type), e.g. `design_airframe`.
+    #[serde(rename = "as")]
+    pub as_group: String,
+    /// Text put before each imported description.
+    #[serde(default)]
+    pub description_prefix: String,
 }
 
 /// A fully resolved variable: declaration plus value reference and defaults applied.
@@ -389,6 +411,38 @@ fn collect(
         }
     }
     out.extend(file.variables.iter().cloned());
+    for import in &file.import_groups {
+        let src = read_decl(&dir.join(&import.file), sources)?;
+        let mut src_groups = BTreeMap::new();
+        let mut src_decls = Vec::new();
+        collect(dir, &src, sources, &mut src_groups, &mut src_decls, depth + 1)?;
+        let ty = src_groups
+            .get(&import.group)
+            .cloned()
+            .ok_or_else(|| DeclError(format!("import: {} declares no group '{}'", import.file, import.group)))?;
+        if let Some(old) = groups.insert(import.as_group.clone(), ty.clone()) {
+            if old != ty {
+                return err(format!("group '{}' declared as both {old} and {ty}", import.as_group));
+            }
+        }
+        let before = out.len();
+        out.extend(
+            src_decls
+                .into_iter()
+                .filter(|d| d.group.as_deref() == Some(import.group.as_str()) && d.causality == Causality::Parameter)
+                .map(|mut d| {
+                    d.group = Some(import.as_group.clone());
+                    d.description = format!("{}{}", import.description_prefix, d.description);
+                    d
+                }),
+        );
+        if out.len() == before {
+            return err(format!(
+                "import: group '{}' of {} has no parameters",
+                import.group, import.file
+            ));
+        }
+    }
     Ok(())
 }
 

@@ -66,10 +66,12 @@ pub struct LqrParams {
     pub euler_switch_pitch: f64,
     /// Limit of the airspeed-error integrator |∫ΔV dt| (m).
     pub integrator_limit: f64,
-    /// Leak λ of the airspeed integrator, ẋ_I = V − V_t − λ x_I (1/s). Must be > 0: with
-    /// λ = 0 the integrator minus the along-track position is an uncontrollable mode at
-    /// z = 1 (ẋ_I = ΔV = along-track Δṗ in straight flight) and no stabilising DARE
-    /// solution exists.
+    /// Leak λ of the airspeed integrator, ẋ_I = V − V_t − λ x_I (1/s). Must be > 0 with the
+    /// DARE (`riccati_method` 0): with λ = 0 the integrator minus the along-track position
+    /// is an uncontrollable mode at z = 1 (ẋ_I = ΔV = along-track Δṗ in straight flight)
+    /// and no stabilising DARE solution exists. λ = 0 is accepted with the finite-horizon
+    /// backward iteration (`riccati_method` 1), which returns gains regardless, as the
+    /// thesis does (§3.1.3, 3.2.12–3.2.14); the closed loop then keeps that mode at z ≈ 1.
     pub integrator_leak: f64,
     /// 1 (default) = integral action on the earth-frame position error ∫ΔN, ∫ΔE, ∫Δh (zero
     /// steady-state position error in a steady wind or with a model mismatch); 0 = the
@@ -94,6 +96,46 @@ pub struct LqrParams {
     pub alpha_max: f64,
     /// Banked-turn radius ρ in the level segment (m) (3.3.18–3.3.21); 0 = straight, < 0 left.
     pub turn_radius: f64,
+    /// 0 = tuned (these parameters as given), 1 = thesis (§3.2–3.5, see
+    /// [`Self::effective`]): backward iteration over `riccati_horizon`, airspeed-integrator
+    /// leak 0, Table 3.4 verbatim (weight set 0, switched without blending), the closed-form trajectory (3.3.x), the
+    /// no-wind reference, airspeed integral only, and the reference re-anchored at the
+    /// measured position at the start of every mission segment (§3.5.1).
+    pub configuration: i32,
+}
+
+impl LqrParams {
+    /// The parameters the controller flies with: `self` for `configuration` 0 (tuned);
+    /// for 1 (thesis) the structure and tuning as printed: the 200-step (`riccati_horizon`)
+    /// backward Riccati iteration (3.1.3–3.1.5), airspeed-integrator leak 0 (3.2.12–3.2.14),
+    /// weight set 0 (Table 3.4 verbatim) switched at the phase boundaries without blending
+    /// (§3.4), trajectory mode 0 (closed forms 3.3.3–3.3.17),
+    /// no wind compensation and no position integrators (the thesis has neither).
+    pub fn effective(&self) -> Result<Self, ControlError> {
+        match self.configuration {
+            0 => Ok(self.clone()),
+            1 => Ok(Self {
+                riccati_method: 1,
+                integrator_leak: 0.0,
+                weight_set: 0,
+                weight_blend_time: 0.0,
+                trajectory_mode: 0,
+                wind_compensation: 0,
+                position_integral: 0,
+                ..self.clone()
+            }),
+            c => Err(ControlError(format!(
+                "configuration = {c}: expected 0 (tuned) or 1 (thesis)"
+            ))),
+        }
+    }
+
+    /// Whether the reference is re-anchored at the measured position at the start of every
+    /// mission segment (§3.5.1: "the current aircraft position is used as a starting point"
+    /// of each new trajectory) — the thesis configuration; otherwise anchored once.
+    pub fn reanchors(&self) -> bool {
+        self.configuration == 1
+    }
 }
 
 impl Default for LqrParams {
@@ -116,6 +158,7 @@ impl Default for LqrParams {
             trajectory_mode: 1,
             alpha_max: 15f64.to_radians(),
             turn_radius: 0.0,
+            configuration: 0,
         }
     }
 }
@@ -139,6 +182,8 @@ pub struct LqrController {
     schedule: WeightSchedule,
     // ---- state ----
     origin: Option<Vector3<f64>>,
+    /// Mission phase the origin was last anchored in (re-anchoring, thesis configuration).
+    anchored_phase: i32,
     integrator: f64,
     /// ∫ΔN, ∫ΔE, ∫Δh (m·s).
     pos_integrator: Vector3<f64>,
@@ -183,6 +228,7 @@ impl LqrController {
             .validate()
             .map_err(|e| ControlError(format!("controller airframe: {e}")))?;
         mission.validate().map_err(|e| ControlError(e.0))?;
+        let params = params.effective()?;
         if mission.v_vertical < MIN_AIRSPEED {
             return Err(ControlError(format!(
                 "v_vertical = {} m/s: the LQR's model uses airspeed, α and β as states (§2.4), undefined in \
@@ -194,7 +240,6 @@ impl LqrController {
             ("relinearisation_period", params.relinearisation_period),
             ("r_scale", params.r_scale),
             ("integrator_limit", params.integrator_limit),
-            ("integrator_leak", params.integrator_leak),
             ("position_integrator_limit", params.position_integrator_limit),
             ("wind_filter_time", params.wind_filter_time),
         ];
@@ -202,6 +247,13 @@ impl LqrController {
             if !(v.is_finite() && v > 0.0) {
                 return Err(ControlError(format!("{name} = {v}: must be finite and > 0")));
             }
+        }
+        let leak = params.integrator_leak;
+        if !(leak.is_finite() && (leak > 0.0 || leak == 0.0 && params.riccati_method == 1)) {
+            return Err(ControlError(format!(
+                "integrator_leak = {leak}: must be finite and > 0 (= 0 only with riccati_method = 1, the \
+                 backward iteration: with the DARE the undamped integrator is an uncontrollable mode at z = 1)"
+            )));
         }
         if !(params.position_integrator_leak.is_finite() && params.position_integrator_leak >= 0.0) {
             return Err(ControlError(format!(
@@ -269,6 +321,7 @@ impl LqrController {
             trajectory,
             schedule,
             origin: None,
+            anchored_phase: 0,
             integrator: 0.0,
             pos_integrator: Vector3::zeros(),
             wind: Vector3::new(f64::NAN, f64::NAN, f64::NAN),
@@ -393,7 +446,15 @@ impl LqrController {
             riccati_backward(&phi, &gamma, &q, &r, self.params.riccati_horizon as usize, None)?.0
         };
         let rho = spectral_radius_bound(&(phi - gamma * k));
-        if rho.is_nan() || rho >= 1.0 {
+        // With the undamped integrator (leak 0, thesis) the integrator-minus-along-track
+        // mode sits at z = 1 whatever the gain: accept the marginal bound (a Jordan block at
+        // z = 1 raises the 2¹⁶-power bound to at most (2¹⁶)^(1/2¹⁶) ≈ 1 + 1.7e-4).
+        let limit = if self.params.integrator_leak == 0.0 {
+            1.0 + 1e-3
+        } else {
+            1.0
+        };
+        if rho.is_nan() || rho >= limit {
             return Err(RiccatiError::Unstable(rho));
         }
         Ok(GainSolution {
@@ -502,6 +563,7 @@ impl LqrController {
         for v in self.wind.iter() {
             out(*v);
         }
+        out(f64::from(self.anchored_phase));
     }
 
     /// Positions in the [`Self::save`] layout of the controller's continuous states, with
@@ -541,6 +603,11 @@ impl LqrController {
         for v in self.wind.iter_mut() {
             *v = take()?;
         }
+        let phase = take()?;
+        if !(0.0..=4.0).contains(&phase) || phase.fract() != 0.0 {
+            return Err(ControlError(format!("LQR controller state: anchored phase {phase}")));
+        }
+        self.anchored_phase = phase as i32;
         Ok(())
     }
 }
@@ -605,11 +672,17 @@ impl SampledUnit for LqrController {
         if !t.is_finite() {
             return Err(ControlError(format!("sample time t = {t} is not finite")));
         }
-        let origin = *self
-            .origin
-            .get_or_insert(Vector3::new(m.pos_ned.x, m.pos_ned.y, -m.pos_ned.z));
+        let measured_neh = Vector3::new(m.pos_ned.x, m.pos_ned.y, -m.pos_ned.z);
         let reference = self.trajectory.at(t);
         let off = &input.ref_offset_ned;
+        let phase = self.mission.phase_at(t).0 as i32;
+        if self.params.reanchors() && self.origin.is_some() && phase != self.anchored_phase {
+            // §3.5.1: each new trajectory starts at the current position, so the reference
+            // position equals the measured one at the first sample of the segment.
+            self.origin = Some(measured_neh - reference.pos_neh - Vector3::new(off.x, off.y, -off.z));
+        }
+        self.anchored_phase = phase;
+        let origin = *self.origin.get_or_insert(measured_neh);
         // Reference position: start + trajectory + offset, as (N, E, h).
         let ref_neh = origin + reference.pos_neh + Vector3::new(off.x, off.y, -off.z);
         let rep = self.rep_for(&reference);

@@ -177,6 +177,7 @@ impl TsdController {
     /// the aircraft, not necessarily the plant's) for gains and feedback linearisation.
     pub fn new(airframe: Airframe, mission: MissionParams, params: TsdParams) -> Result<Self, ParamError> {
         params.validate()?;
+        let params = params.effective()?;
         mission.validate()?;
         airframe
             .validate()

@@ -90,6 +90,10 @@ pub struct TsdParams {
     /// (servo, thrust and the specific-acceleration poles) at the acceleration steps of the
     /// unsmoothed trajectory (§4.3.3) (s).
     pub feedforward_lead: f64,
+    /// 0 = tuned (these parameters as given), 1 = thesis: the wind axes at every speed
+    /// (`wind_frame_speed_low` = 0, `wind_frame_speed_high` = 1e-6 m/s, §4.2) and no
+    /// feed-forward preview (`feedforward_lead` = 0, (4.3.24)); see [`Self::effective`].
+    pub configuration: i32,
 }
 
 impl Default for TsdParams {
@@ -131,6 +135,7 @@ impl Default for TsdParams {
             wind_frame_speed_low: 4.0,
             wind_frame_speed_high: 10.0,
             feedforward_lead: 0.15,
+            configuration: 0,
         }
     }
 }
@@ -175,6 +180,25 @@ impl TsdParams {
             ("wind_frame_speed_high", self.wind_frame_speed_high),
             ("feedforward_lead", self.feedforward_lead),
         ]
+    }
+
+    /// The parameters the controller flies with: `self` for `configuration` 0 (tuned); for
+    /// 1 (thesis) the thesis's vertical-flight frame, the wind axes at every speed (§4.2:
+    /// the low-speed path frame is a deviation of this repository), and the feed-forward
+    /// Σ^RE taken at the sample time (4.3.24), no preview.
+    pub fn effective(&self) -> Result<Self, ParamError> {
+        match self.configuration {
+            0 => Ok(*self),
+            1 => Ok(Self {
+                wind_frame_speed_low: 0.0,
+                wind_frame_speed_high: 1e-6,
+                feedforward_lead: 0.0,
+                ..*self
+            }),
+            c => Err(ParamError(format!(
+                "configuration = {c}: expected 0 (tuned) or 1 (thesis)"
+            ))),
+        }
     }
 
     /// All finite; every pole's real part negative (stable design); anti-windup gain,
