@@ -42,6 +42,7 @@ pub fn params_from(v: &Variables) -> EstimatorParams {
     n.sigma_pitot_dp = v.sigma_pitot_dp;
     p.filter.enabled = v.filter_enabled;
     p.filter.bandwidth = v.filter_bandwidth;
+    p.filter.latency = v.measurement_latency;
     n.imu_period = v.imu_period;
     let q = &mut p.process;
     q.accel_model = v.accel_model_noise;

@@ -670,7 +670,7 @@ impl Ekf {
         let imu_inflation = match Self::imu_ok(m) {
             Ok(()) => {
                 let s = &mut self.state;
-                if self.params.filter.enabled && s.last_step > 0.0 && h > 0.0 {
+                if self.params.filter.delay() > 0.0 && s.last_step > 0.0 && h > 0.0 {
                     let accel_dot = (m.accel - s.imu_accel) / h;
                     let gyro_dot = (m.gyro - s.imu_gyro) / h;
                     s.imu_accel_ddot = (accel_dot - s.imu_accel_dot) / h;

@@ -183,6 +183,10 @@ pub struct AnalogFilter {
     pub enabled: bool,
     /// −3 dB frequency f_c of the Butterworth (Hz) (8 Hz).
     pub bandwidth: f64,
+    /// Transport delay of the measurement inputs (s) (0): the age of the latest sample at
+    /// the communication point beyond the filter's delay, e.g. one communication step when
+    /// a Jacobi master gives the estimator the sensors' outputs of the previous step.
+    pub latency: f64,
 }
 
 impl Default for AnalogFilter {
@@ -190,6 +194,7 @@ impl Default for AnalogFilter {
         Self {
             enabled: true,
             bandwidth: 8.0,
+            latency: 0.0,
         }
     }
 }
@@ -197,13 +202,15 @@ impl Default for AnalogFilter {
 impl AnalogFilter {
     /// Low-frequency group delay of the second-order Butterworth (s):
     /// H(s) = Ω²/(s² + √2Ωs + Ω²) has phase −atan(√2Ωω/(Ω² − ω²)) ≈ −√2 ω/Ω for ω ≪ Ω, so
-    /// τ = √2/Ω = √2/(2π f_c) (28.1 ms at 8 Hz); 0 when the filter is off.
+    /// τ = √2/Ω = √2/(2π f_c) (28.1 ms at 8 Hz; 0 when the filter is off), plus the
+    /// transport `latency`.
     pub fn delay(&self) -> f64 {
-        if self.enabled {
+        let filter = if self.enabled {
             std::f64::consts::SQRT_2 / (2.0 * std::f64::consts::PI * self.bandwidth)
         } else {
             0.0
-        }
+        };
+        filter + self.latency
     }
 }
 
@@ -266,6 +273,12 @@ impl EstimatorParams {
             return Err(format!(
                 "filter_bandwidth = {} Hz must be finite and > 0",
                 self.filter.bandwidth
+            ));
+        }
+        if !(self.filter.latency.is_finite() && (0.0..=1.0).contains(&self.filter.latency)) {
+            return Err(format!(
+                "measurement_latency = {} s must be within [0, 1] s",
+                self.filter.latency
             ));
         }
         let e = &self.earth;
