@@ -42,6 +42,20 @@ each sensor's noise sequence depends on its sample index only. The estimator
 still reads the latest sample once per h (the sample taken in
 [t, t + h_s)), and the GPS fix instants (every 0.25 s) fall on the h_s grid.
 
+Known limits (tests/test_avionics.py, xfail): the estimator compensates the
+sensors' 8 Hz Butterworth to first order (crates/state-estimator/README.md);
+the TSD's normal-acceleration / pitch loop (which limit-cycles at ≈ 4.5 Hz
+without compensation) keeps little margin. It flies Gauss-Seidel at 20 ms, but
+not under Jacobi: the estimator then fuses the sensors' outputs of the previous
+step and the plant flies the previous command, two extra 20 ms delays in that
+loop (it fails with the Butterworth off too; `measurement_latency` = h does not
+save it); nor with plant and sensors at 5 ms (19 m in level flight: the latest
+sample is then that of t itself, not of a truth held for 15 ms, so the loop's
+effective delay is a few ms longer). The LQR flies all three. A model-based
+prediction of the rates and specific force over the delay (the aircraft model
+driven by the estimator's actuator states) would remove the differentiation
+and its noise.
+
 The result is a `tailsim.master.RunResult` whose signals hold the plant's
 outputs (the truth) under their names, the controller's outputs, the
 estimator's outputs as `est_<name>` (its diagnostics `est_std_*` as they are),
