@@ -24,3 +24,5 @@ if [ "$analysis" = 1 ]; then
 fi
 echo "== flying the missions"
 PYTHONPATH=python .venv/bin/python -m tailsim.compare --out out "${runner_args[@]+"${runner_args[@]}"}"
+echo "== Monte-Carlo campaign (out/campaign; the full run: docs/CAMPAIGN.md)"
+PYTHONPATH=python .venv/bin/python -m tailsim.campaign --samples 16 --seed 1 --out out/campaign --replace --no-progress

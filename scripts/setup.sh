@@ -1,19 +1,44 @@
 #!/usr/bin/env bash
-# Set up a fresh machine: system packages (libclang for fmi-sys' bindgen),
-# the Rust crates (fetched by cargo on first build) and the pinned Python venv.
-# Idempotent: re-running only checks.
+# Set up a fresh machine: system packages (libclang for fmi-sys' bindgen; MinGW-w64
+# and Wine for the win64 binaries), the Rust target x86_64-pc-windows-gnu, the Rust
+# crates (fetched by cargo on first build) and the pinned Python venv.
+# Idempotent and non-interactive: re-running only checks.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 # fmi-sys runs bindgen, which loads libclang's C API at build time. Test for the library
 # bindgen really loads (scripts/find-libclang.sh), not for any file named libclang*: the
 # base image ships libclang-cpp14, which matches such a name but has no C API.
+SUDO=""; [ "$(id -u)" = 0 ] || SUDO="sudo"
+apt_updated=""
+apt_install() {
+    [ -n "$apt_updated" ] || { $SUDO apt-get update -qq; apt_updated=1; }
+    $SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "$@" >/dev/null
+}
+
 if ! scripts/find-libclang.sh >/dev/null; then
     echo "== installing libclang-dev (needed by fmi-sys' bindgen)"
-    SUDO=""; [ "$(id -u)" = 0 ] || SUDO="sudo"
-    $SUDO apt-get update -qq
-    $SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq libclang-dev >/dev/null
+    apt_install libclang-dev
     scripts/find-libclang.sh >/dev/null || { echo "setup: libclang-dev installed but no loadable libclang found" >&2; exit 1; }
+fi
+
+# win64 binaries (binaries/win64/<id>.dll): rustc's x86_64-pc-windows-gnu target links
+# with MinGW-w64's gcc and import libraries; tests run the DLLs under Wine (wine64).
+if ! command -v x86_64-w64-mingw32-gcc >/dev/null || ! command -v x86_64-w64-mingw32-objdump >/dev/null; then
+    echo "== installing gcc-mingw-w64-x86-64 (links the win64 DLLs)"
+    apt_install gcc-mingw-w64-x86-64
+fi
+if ! rustup target list --installed | grep -qx x86_64-pc-windows-gnu; then
+    echo "== adding the Rust target x86_64-pc-windows-gnu"
+    rustup target add x86_64-pc-windows-gnu
+fi
+if [ ! -x /usr/lib/wine/wine64 ] && ! command -v wine64 >/dev/null; then
+    echo "== installing wine64 (runs the win64 DLLs in the tests, through fmpy's remoting)"
+    apt_install wine64
+fi
+# Debian installs the loader as /usr/lib/wine/wine64, outside PATH; fmpy looks for `wine64`.
+if ! command -v wine64 >/dev/null; then
+    $SUDO ln -sf /usr/lib/wine/wine64 /usr/local/bin/wine64
 fi
 
 if [ ! -x .venv/bin/python ] || ! cmp -s tests/requirements.txt .venv/requirements.installed; then

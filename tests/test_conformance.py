@@ -49,12 +49,15 @@ def test_fmutool_check_passes(model):
 def test_archive_holds_binary_and_documentation(model):
     with zipfile.ZipFile(fmu_path(model)) as z:
         names = set(z.namelist())
-        assert {"modelDescription.xml", f"binaries/linux64/{model}.so", "documentation/index.html"} <= names
+        assert {"modelDescription.xml", f"binaries/linux64/{model}.so", f"binaries/win64/{model}.dll",
+                "documentation/index.html"} <= names
         doc = z.read("documentation/index.html").decode()
     md = read_model_description(str(fmu_path(model)))
     assert doc.lstrip().lower().startswith("<!doctype html>")
     assert len(doc) > 2000, "documentation/index.html is a stub"
     assert md.guid in doc, "the documentation names the GUID of the interface it documents"
+    assert "Platforms and interfaces" in doc and "binaries/win64/" in doc and "binaries/linux64/" in doc
+    assert ("Model Exchange" in doc) == (md.modelExchange is not None)
     for v in md.modelVariables:
         assert f"<code>{v.name}</code>" in doc, f"{v.name} undocumented"
 
@@ -63,7 +66,14 @@ def test_metadata_present(model):
     md = read_model_description(str(fmu_path(model)))
     assert md.fmiVersion == "2.0"
     assert md.coSimulation is not None and md.coSimulation.modelIdentifier == model
-    assert md.modelExchange is None
+    if model == "tailsitter_plant":
+        # One archive, both interfaces, one binary (as the Reference FMUs ship).
+        me = md.modelExchange
+        assert me is not None and me.modelIdentifier == model
+        assert md.numberOfEventIndicators == 0 and len(md.derivatives) == 20
+        assert all(d.variable.derivative.nominal for d in md.derivatives)
+    else:
+        assert md.modelExchange is None
     for attr in ("author", "version", "generationTool", "description", "guid"):
         assert (getattr(md, attr) or "").strip(), f"{attr} missing"
     assert re.fullmatch(r"\{[0-9a-f]{8}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{12}\}", md.guid), md.guid

@@ -2,7 +2,7 @@
 //! Gauss-Seidel loop with the plant, compared with the library controller, for
 //! several communication steps, plus FMU-state save/restore.
 
-use closed_loop::{fly, measure, Scenario};
+use closed_loop::{fly, measure, plant_inputs, Scenario};
 use flight_mission::{Measurement, MissionParams};
 use fmi2_export::{FmuModel, Logger, StateReader, StateWriter, VariableStore};
 use lqr_control::{LqrController, LqrParams};
@@ -10,36 +10,7 @@ use tailsitter_lqr::{LqrModel, Variables};
 use tailsitter_physics::{Airframe, InputVector, Plant, StateVector};
 
 fn set_inputs(v: &mut Variables, m: &Measurement) {
-    v.pos_n = m.pos_ned.x;
-    v.pos_e = m.pos_ned.y;
-    v.pos_d = m.pos_ned.z;
-    v.vel_n = m.vel_ned.x;
-    v.vel_e = m.vel_ned.y;
-    v.vel_d = m.vel_ned.z;
-    v.u = m.vel_body.x;
-    v.v = m.vel_body.y;
-    v.w = m.vel_body.z;
-    v.p = m.rates.x;
-    v.q = m.rates.y;
-    v.r = m.rates.z;
-    v.quat_1 = m.quat[0];
-    v.quat_2 = m.quat[1];
-    v.quat_3 = m.quat[2];
-    v.quat_4 = m.quat[3];
-    v.airspeed = m.airspeed;
-    v.alpha = m.alpha;
-    v.beta = m.beta;
-    v.thrust = m.thrust;
-    v.elevator = m.surfaces[0];
-    v.aileron = m.surfaces[1];
-    v.rudder = m.surfaces[2];
-    v.flap_collective = m.surfaces[3];
-    v.flap_differential = m.surfaces[4];
-    v.vertical_flap = m.surfaces[5];
-    v.accel_x = m.specific_force_body.x;
-    v.accel_y = m.specific_force_body.y;
-    v.accel_z = m.specific_force_body.z;
-    v.induced_velocity = m.induced_velocity;
+    v.set_measurement(m);
 }
 
 fn commands(v: &Variables) -> InputVector {
@@ -114,16 +85,7 @@ fn binding_matches_the_library_controller() {
     let trace = fly(&plant, x0, &mut c, &s);
     let fmu = fly_fmu(0.02, 12.0);
     for (smp, (t, x, u, _, _)) in trace.samples.iter().zip(fmu.iter()) {
-        let c = &smp.command;
-        let uc = InputVector::from([
-            c.thrust,
-            c.elevator,
-            c.aileron,
-            c.rudder,
-            c.flap_collective,
-            c.flap_differential,
-            c.vertical_flap,
-        ]);
+        let uc = plant_inputs(&smp.command);
         assert!((smp.t - t).abs() < 1e-12);
         assert!((smp.x - x).norm() < 1e-9, "t = {t}: state differs");
         assert!(
@@ -225,6 +187,5 @@ fn non_finite_input_is_an_error_naming_the_variable() {
 fn parameter_start_values_are_the_library_defaults() {
     let vars = Variables::with_start_values();
     assert_eq!(vars.lqr(), LqrParams::default());
-    assert_eq!(vars.mission(), MissionParams::default());
     assert!(vars.weights_file.is_empty());
 }

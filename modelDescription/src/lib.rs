@@ -160,9 +160,41 @@ pub struct VariableDecl {
     /// (direct feedthrough). Empty = depends on states only.
     #[serde(default)]
     pub depends_on: Vec<String>,
-    /// Name of a parameter group (see [`ModelDecl::groups`]) this variable is a field of.
+    /// Name of a group (see [`DeclFile::groups`]) this variable is a field of:
+    /// parameters and inputs are read into the group's struct, outputs written from it.
     #[serde(default)]
     pub group: Option<String>,
+    /// Where the variable sits in its group's struct: `field`, `field[i]` (an
+    /// element of a vector or array field) or `[i]` (the group's type is itself a
+    /// vector). Default: the field named like the variable.
+    #[serde(default)]
+    pub field: Option<String>,
+    /// Model Exchange: this variable is the time derivative of the named continuous
+    /// state (`derivative` attribute). The continuous-state vector of
+    /// fmi2GetContinuousStates is the states of the derivatives in declaration order.
+    #[serde(default)]
+    pub derivative_of: Option<String>,
+    /// `nominal` attribute (Real only; > 0): the scale of the value, e.g. for the
+    /// error control of an ME solver.
+    #[serde(default)]
+    pub nominal: Option<f64>,
+}
+
+impl VariableDecl {
+    /// The field path in the group's struct: ([`Self::field`] or the name) split
+    /// into the field name (empty for the whole value) and the element index.
+    pub fn group_field(&self) -> Result<(&str, Option<usize>), DeclError> {
+        let path = self.field.as_deref().unwrap_or(&self.name);
+        match path.split_once('[') {
+            None if is_rust_identifier(path) => Ok((path, None)),
+            Some((top, rest)) if top.is_empty() || is_rust_identifier(top) => rest
+                .strip_suffix(']')
+                .and_then(|i| i.parse().ok())
+                .map(|i| (top, Some(i)))
+                .ok_or_else(|| DeclError(format!("variable '{}': bad field '{path}'", self.name))),
+            _ => err(format!("variable '{}': bad field '{path}'", self.name)),
+        }
+    }
 }
 
 /// The default experiment of the model description.
@@ -186,10 +218,11 @@ pub struct DeclFile {
     pub description: Option<String>,
     #[serde(default)]
     pub default_experiment: Option<DefaultExperiment>,
-    /// Group name → Rust struct path. The generator emits
-    /// `Variables::<group>() -> <path>` built field by field from the
-    /// variables of that group, so the struct and the declaration cannot drift
-    /// without a compile error.
+    /// Group name → Rust type path. The generator emits
+    /// `Variables::<group>() -> <path>` built field by field from the parameters
+    /// or inputs of that group, or `Variables::set_<group>(&<path>)` writing its
+    /// outputs, so the struct and the declaration cannot drift without a compile
+    /// error (a field missing from the declaration does not compile).
     #[serde(default)]
     pub groups: BTreeMap<String, String>,
     /// Other declaration files (relative paths) whose variables are inserted first.
@@ -234,6 +267,26 @@ pub struct Model {
     /// Name-based UUID (v5) over the interface: changes whenever any variable,
     /// the identifier or the version changes.
     pub guid: String,
+}
+
+impl Model {
+    /// (state, derivative) of every continuous state, in the order of the derivatives'
+    /// declarations (= ModelStructure/Derivatives = the continuous-state vector).
+    pub fn continuous_states(&self) -> Vec<(&Variable, &Variable)> {
+        self.variables
+            .iter()
+            .filter_map(|d| {
+                let state = d.decl.derivative_of.as_deref()?;
+                let state = self.variables.iter().find(|v| v.name() == state)?;
+                Some((state, d))
+            })
+            .collect()
+    }
+
+    /// Whether the FMU also offers Model Exchange: it declares continuous states.
+    pub fn model_exchange(&self) -> bool {
+        self.variables.iter().any(|v| v.decl.derivative_of.is_some())
+    }
 }
 
 /// Generation tool recorded in the XML.
@@ -292,6 +345,19 @@ pub fn load(dir: &Path, model_identifier: &str, version: &str) -> Result<Model, 
     check(&model)?;
     model.guid = guid_of(&model);
     Ok(model)
+}
+
+/// The variables of one declaration file (`<dir>/<file>`, a model or a fragment)
+/// with its includes resolved, without the checks of a complete model: for the
+/// build scripts that generate the defaults of a parameter group. Also returns
+/// every file read, for `cargo:rerun-if-changed`.
+pub fn load_declarations(dir: &Path, file: &str) -> Result<(Vec<VariableDecl>, Vec<PathBuf>), DeclError> {
+    let mut sources = Vec::new();
+    let root = read_decl(&dir.join(file), &mut sources)?;
+    let mut groups = BTreeMap::new();
+    let mut decls = Vec::new();
+    collect(dir, &root, &mut sources, &mut groups, &mut decls, 0)?;
+    Ok((decls, sources))
 }
 
 fn read_decl(path: &Path, sources: &mut Vec<PathBuf>) -> Result<DeclFile, DeclError> {
@@ -441,13 +507,62 @@ fn check(model: &Model) -> Result<(), DeclError> {
                 return err(format!("variable '{n}': dependsOn '{dep}' is not an input"));
             }
         }
+        if let Some(x) = d.nominal {
+            if d.var_type != VarType::Real || !(x.is_finite() && x > 0.0) {
+                return err(format!("variable '{n}': nominal must be a finite number > 0 on a Real"));
+            }
+        }
+        if let Some(state) = &d.derivative_of {
+            let Some(s) = model.variables.iter().find(|v| v.name() == state) else {
+                return err(format!("variable '{n}': derivativeOf '{state}' is not declared"));
+            };
+            let continuous_real =
+                |v: &Variable| v.decl.var_type == VarType::Real && v.variability == Variability::Continuous;
+            if !continuous_real(v) || !matches!(d.causality, Causality::Local | Causality::Output) {
+                return err(format!(
+                    "variable '{n}': a derivative must be a continuous Real local or output"
+                ));
+            }
+            if !continuous_real(s) || !matches!(s.decl.causality, Causality::Local | Causality::Output) {
+                return err(format!(
+                    "variable '{n}': state '{state}' must be a continuous Real local or output"
+                ));
+            }
+            if s.decl.derivative_of.is_some() {
+                return err(format!("variable '{n}': state '{state}' is itself a derivative"));
+            }
+            let twice = model
+                .variables
+                .iter()
+                .filter(|o| o.decl.derivative_of.as_deref() == Some(state.as_str()))
+                .count();
+            if twice > 1 {
+                return err(format!("state '{state}' has {twice} derivatives"));
+            }
+        }
         if let Some(g) = &d.group {
             if !model.groups.contains_key(g) {
                 return err(format!("variable '{n}': group '{g}' not declared in \"groups\""));
             }
-            if d.causality != Causality::Parameter {
-                return err(format!("variable '{n}': only parameters can belong to a group"));
+            if !matches!(d.causality, Causality::Parameter | Causality::Input | Causality::Output) {
+                return err(format!(
+                    "variable '{n}': a {} cannot belong to a group",
+                    d.causality.as_str()
+                ));
             }
+            d.group_field()?;
+            let writes = d.causality == Causality::Output;
+            if model
+                .variables
+                .iter()
+                .any(|o| o.decl.group.as_ref() == Some(g) && (o.decl.causality == Causality::Output) != writes)
+            {
+                return err(format!(
+                    "group '{g}' mixes outputs with parameters or inputs (variable '{n}')"
+                ));
+            }
+        } else if d.field.is_some() {
+            return err(format!("variable '{n}': field without group"));
         }
     }
     Ok(())
@@ -470,6 +585,13 @@ fn guid_of(model: &Model) -> String {
             d.max,
             d.unit
         ));
+        // Only when present, so the GUIDs of models without them do not change.
+        if let Some(state) = &d.derivative_of {
+            text.push_str(&format!("derivative_of {state}\n"));
+        }
+        if let Some(x) = d.nominal {
+            text.push_str(&format!("nominal {x:?}\n"));
+        }
     }
     let namespace = uuid::Uuid::NAMESPACE_URL;
     format!("{{{}}}", uuid::Uuid::new_v5(&namespace, text.as_bytes()))

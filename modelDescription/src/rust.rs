@@ -4,10 +4,10 @@
 //! The module defines `Variables` (one public field per variable, named as
 //! the variable), `vr::<name>` value-reference constants, the
 //! `fmi2_export::VariableStore` implementation, `MODEL_IDENTIFIER`, `GUID`,
-//! `MODEL_DESCRIPTION_XML`, and one `Variables::<group>()` constructor per
-//! parameter group.
+//! `MODEL_DESCRIPTION_XML`, and per group one `Variables::<group>()`
+//! constructor (parameters, inputs) or `Variables::set_<group>()` (outputs).
 
-use crate::{fmt_f64, Model, Start, VarType, Variable};
+use crate::{fmt_f64, Causality, Model, Start, VarType, Variable, VariableDecl};
 use std::fmt::Write;
 
 fn rust_type(t: VarType) -> &'static str {
@@ -19,8 +19,7 @@ fn rust_type(t: VarType) -> &'static str {
     }
 }
 
-fn start_literal(v: &Variable) -> String {
-    let d = &v.decl;
+fn start_literal(d: &VariableDecl) -> String {
     match (&d.start, d.var_type) {
         (Some(Start::Number(x)), VarType::Real) => fmt_f64(*x),
         (Some(Start::Number(x)), VarType::Integer) => format!("{}", *x as i64),
@@ -32,6 +31,82 @@ fn start_literal(v: &Variable) -> String {
         (None, VarType::String) => "String::new()".into(),
         (Some(s), t) => unreachable!("checked at load: {s:?} for {t:?}"),
     }
+}
+
+/// `impl Variables { fn <group>() }` reading the parameters or inputs of a group
+/// into its type, or `fn set_<group>()` writing the outputs of a group from it.
+fn group_accessor(model: &Model, group: &str, path: &str) -> String {
+    let members: Vec<&Variable> = model
+        .variables
+        .iter()
+        .filter(|v| v.decl.group.as_deref() == Some(group))
+        .collect();
+    if members.is_empty() {
+        return String::new();
+    }
+    let mut s = String::from("impl Variables {\n");
+    let fields: Vec<(&str, Option<usize>, &str)> = members
+        .iter()
+        .map(|v| {
+            let (top, index) = v.decl.group_field().expect("checked at load");
+            (top, index, v.name())
+        })
+        .collect();
+    let causality = members[0].decl.causality;
+    if matches!(causality, Causality::Output | Causality::Input) {
+        let _ = writeln!(
+            s,
+            "    /// Set the variables of group `{group}` from a `{path}`.\n    #[allow(dead_code)]\n    pub fn set_{group}(&mut self, value: &{path}) {{"
+        );
+        for (top, index, name) in &fields {
+            let sep = if top.is_empty() { "" } else { "." };
+            let element = index.map(|i| format!("[{i}]")).unwrap_or_default();
+            let _ = writeln!(s, "        self.{name} = value{sep}{top}{element}.into();");
+        }
+        s.push_str("    }\n");
+    }
+    if causality != Causality::Output {
+        let _ = writeln!(
+            s,
+            "    /// The `{path}` built from the variables of group `{group}`.\n    #[allow(dead_code)]\n    pub fn {group}(&self) -> {path} {{"
+        );
+        // Fields in order of first appearance; vector elements gathered into one array.
+        let mut tops: Vec<&str> = Vec::new();
+        for (top, _, _) in &fields {
+            if !tops.contains(top) {
+                tops.push(top);
+            }
+        }
+        let value_of = |top: &str| -> String {
+            let mut elements: Vec<(usize, &str)> = fields
+                .iter()
+                .filter(|(t, _, _)| *t == top)
+                .map(|(_, i, n)| (i.unwrap_or(usize::MAX), *n))
+                .collect();
+            if elements.len() == 1 && elements[0].0 == usize::MAX {
+                return format!("self.{}", elements[0].1);
+            }
+            elements.sort();
+            assert!(
+                elements.iter().enumerate().all(|(k, (i, _))| k == *i),
+                "group '{group}': elements of '{top}' must be [0], [1], … once each"
+            );
+            let list: Vec<String> = elements.iter().map(|(_, n)| format!("self.{n}")).collect();
+            format!("[{}].into()", list.join(", "))
+        };
+        if tops == [""] {
+            let _ = writeln!(s, "        let value: {path} = {};\n        value", value_of(""));
+        } else {
+            let _ = writeln!(s, "        {path} {{");
+            for top in &tops {
+                let _ = writeln!(s, "            {top}: {},", value_of(top));
+            }
+            let _ = writeln!(s, "        }}");
+        }
+        s.push_str("    }\n");
+    }
+    s.push_str("}\n");
+    s
 }
 
 fn bound(x: Option<f64>, default: &str) -> String {
@@ -73,7 +148,7 @@ pub fn variables_module(model: &Model, xml_file: &str) -> String {
     );
     for v in &model.variables {
         let d = &v.decl;
-        let unit = d.unit.as_deref().map(|u| format!(" [{u}]")).unwrap_or_default();
+        let unit = d.unit.as_deref().map(|u| format!(" ({u})")).unwrap_or_default();
         let _ = writeln!(w, "    /// {} ({}){unit}", d.description, d.causality.as_str());
         let _ = writeln!(w, "    pub {}: {},", d.name, rust_type(d.var_type));
     }
@@ -88,15 +163,7 @@ pub fn variables_module(model: &Model, xml_file: &str) -> String {
 
     // Groups.
     for (group, path) in &model.groups {
-        let _ = writeln!(w, "impl Variables {{\n    /// The `{path}` built from the parameters of group `{group}`.\n    #[allow(dead_code)]\n    pub fn {group}(&self) -> {path} {{\n        {path} {{");
-        for v in model
-            .variables
-            .iter()
-            .filter(|v| v.decl.group.as_deref() == Some(group))
-        {
-            let _ = writeln!(w, "            {0}: self.{0},", v.name());
-        }
-        let _ = writeln!(w, "        }}\n    }}\n}}\n");
+        let _ = writeln!(w, "{}", group_accessor(model, group, path));
     }
 
     // VariableStore.
@@ -119,9 +186,26 @@ pub fn variables_module(model: &Model, xml_file: &str) -> String {
         );
     }
     let _ = writeln!(w, "    ];\n");
+    let states = model.continuous_states();
+    if !states.is_empty() {
+        let _ = writeln!(
+            w,
+            "    const CONTINUOUS_STATES: &'static [fmi2_export::ContinuousState] = &["
+        );
+        for (s, d) in states {
+            let _ = writeln!(
+                w,
+                "        fmi2_export::ContinuousState {{ state: {}, derivative: {}, nominal: {} }},",
+                s.value_reference,
+                d.value_reference,
+                fmt_f64(s.decl.nominal.unwrap_or(1.0))
+            );
+        }
+        let _ = writeln!(w, "    ];\n");
+    }
     let _ = writeln!(w, "    fn with_start_values() -> Self {{\n        Self {{");
     for v in &model.variables {
-        let _ = writeln!(w, "            {}: {},", v.name(), start_literal(v));
+        let _ = writeln!(w, "            {}: {},", v.name(), start_literal(&v.decl));
     }
     let _ = writeln!(w, "        }}\n    }}\n");
     let _ = writeln!(
@@ -304,5 +388,82 @@ fn accessors(w: &mut String, model: &Model, t: VarType, suffix: &str, ty: &str, 
             let _ = writeln!(w, "            {} => self.{} = {assign},", v.value_reference, v.name());
         }
         let _ = writeln!(w, "            _ => return false,\n        }}\n        true\n    }}\n");
+    }
+}
+
+/// The Rust items a pure crate generates from the declaration of one of its
+/// parameter structs (`type_name`, parameters of `group`): `impl Default` with
+/// the declared start values and `named_values()`, every field with its
+/// parameter name in declaration order (Real groups only). `source` names the
+/// declaration in the `@generated` header.
+pub fn group_defaults(decls: &[VariableDecl], group: &str, type_name: &str, source: &str) -> String {
+    let members: Vec<&VariableDecl> = decls
+        .iter()
+        .filter(|d| d.group.as_deref() == Some(group) && d.causality == Causality::Parameter)
+        .collect();
+    assert!(!members.is_empty(), "{source}: no parameter in group '{group}'");
+    let mut s = String::new();
+    let w = &mut s;
+    let _ = writeln!(
+        w,
+        "// @generated by build.rs from {source} (group `{group}`): do not edit.\n"
+    );
+    let _ = writeln!(
+        w,
+        "impl Default for {type_name} {{\n    /// The start values declared in {source}.\n    fn default() -> Self {{\n        Self {{"
+    );
+    for d in &members {
+        let _ = writeln!(w, "            {}: {},", field_of(d), start_literal(d));
+    }
+    let _ = writeln!(w, "        }}\n    }}\n}}\n");
+    if members.iter().all(|d| d.var_type == VarType::Real) {
+        let _ = writeln!(
+            w,
+            "impl {type_name} {{\n    /// Every field with its parameter name, in declaration order.\n    pub fn named_values(&self) -> [(&'static str, f64); {}] {{\n        [",
+            members.len()
+        );
+        for d in &members {
+            let _ = writeln!(w, "            ({:?}, self.{}),", d.name, field_of(d));
+        }
+        let _ = writeln!(w, "        ]\n    }}\n}}");
+    }
+    s
+}
+
+/// `impl <type_name> { fn first_non_finite() }`: the name of the first variable of
+/// `group` (declaration order) whose field in a `type_name` is not finite.
+pub fn group_first_non_finite(decls: &[VariableDecl], group: &str, type_name: &str, source: &str) -> String {
+    let mut s = format!(
+        "// @generated by build.rs from {source} (group `{group}`): do not edit.\n\nimpl {type_name} {{\n    /// The port name of the first value that is not finite, if any (declaration order).\n    pub fn first_non_finite(&self) -> Option<&'static str> {{\n        for (value, name) in [\n"
+    );
+    for d in decls.iter().filter(|d| d.group.as_deref() == Some(group)) {
+        let (top, index) = d.group_field().expect("checked field");
+        let sep = if top.is_empty() { "" } else { "." };
+        let element = index.map(|i| format!("[{i}]")).unwrap_or_default();
+        let _ = writeln!(s, "            (self{sep}{top}{element}, {:?}),", d.name);
+    }
+    s.push_str("        ] {\n            if !value.is_finite() {\n                return Some(name);\n            }\n        }\n        None\n    }\n}\n");
+    s
+}
+
+/// `pub const <NAME>: [&str; n]`: the names of the variables of `group`, in declaration order.
+pub fn group_names(decls: &[VariableDecl], group: &str, const_name: &str, doc: &str) -> String {
+    let names: Vec<String> = decls
+        .iter()
+        .filter(|d| d.group.as_deref() == Some(group))
+        .map(|d| format!("{:?}", d.name))
+        .collect();
+    format!(
+        "/// {doc}\npub const {const_name}: [&str; {}] = [{}];\n",
+        names.len(),
+        names.join(", ")
+    )
+}
+
+/// The struct field of a scalar parameter (its `field`, or its name).
+fn field_of(d: &VariableDecl) -> &str {
+    match d.group_field() {
+        Ok((top, None)) if !top.is_empty() => top,
+        _ => panic!("parameter '{}': a parameter group needs scalar fields", d.name),
     }
 }

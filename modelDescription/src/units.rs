@@ -57,6 +57,10 @@ pub const UNITS: &[Unit] = &[
     unit("kg.m2", 1, 2, 0, 0),
     unit("kg/m3", 1, -3, 0, 0),
     unit("N", 1, 1, -2, 0),
+    unit("N/s", 1, 1, -3, 0),
+    unit("rad/s2", 0, 0, -2, 1),
+    unit("N/m", 1, 0, -2, 0),
+    unit("N.s/m", 1, 0, -1, 0),
     Unit {
         name: "rad",
         kg: 0,

@@ -38,6 +38,9 @@ fn write_all(w: &mut W, model: &Model) -> Result<()> {
             ("numberOfEventIndicators", n_events),
         ])
         .write_inner_content(|w| {
+            if model.model_exchange() {
+                model_exchange(w, model)?;
+            }
             co_simulation(w, model)?;
             unit_definitions(w, model)?;
             log_categories(w)?;
@@ -51,12 +54,31 @@ fn write_all(w: &mut W, model: &Model) -> Result<()> {
                 .write_empty()?;
             w.create_element("ModelVariables").write_inner_content(|w| {
                 for v in &model.variables {
-                    scalar_variable(w, v)?;
+                    scalar_variable(w, model, v)?;
                 }
                 Ok(())
             })?;
             model_structure(w, model)
         })?;
+    Ok(())
+}
+
+/// `<ModelExchange>`: the same binary (same modelIdentifier) serves both interfaces,
+/// as the Reference FMUs do. No event indicators, no time events: the model is smooth
+/// between input changes, which the importer handles at its communication points.
+fn model_exchange(w: &mut W, model: &Model) -> Result<()> {
+    w.create_element("ModelExchange")
+        .with_attributes([
+            ("modelIdentifier", model.model_identifier.as_str()),
+            ("needsExecutionTool", "false"),
+            ("completedIntegratorStepNotNeeded", "true"),
+            ("canBeInstantiatedOnlyOncePerProcess", "false"),
+            ("canNotUseMemoryManagementFunctions", "true"),
+            ("canGetAndSetFMUstate", "true"),
+            ("canSerializeFMUstate", "true"),
+            ("providesDirectionalDerivative", "false"),
+        ])
+        .write_empty()?;
     Ok(())
 }
 
@@ -130,7 +152,7 @@ fn log_categories(w: &mut W) -> Result<()> {
     Ok(())
 }
 
-fn scalar_variable(w: &mut W, v: &Variable) -> Result<()> {
+fn scalar_variable(w: &mut W, model: &Model, v: &Variable) -> Result<()> {
     let d = &v.decl;
     let vr = v.value_reference.to_string();
     w.create_element("ScalarVariable")
@@ -165,11 +187,17 @@ fn scalar_variable(w: &mut W, v: &Variable) -> Result<()> {
             if let Some(hi) = d.max {
                 attrs.push(("max", number(hi)));
             }
+            if let Some(x) = d.nominal {
+                attrs.push(("nominal", fmt_f64(x)));
+            }
             match &d.start {
                 Some(Start::Number(x)) => attrs.push(("start", number(*x))),
                 Some(Start::Bool(b)) => attrs.push(("start", b.to_string())),
                 Some(Start::Text(s)) => attrs.push(("start", s.clone())),
                 None => {}
+            }
+            if let Some(state) = &d.derivative_of {
+                attrs.push(("derivative", index_of(model, state).to_string()));
             }
             w.create_element(tag)
                 .with_attributes(attrs.iter().map(|(k, v)| (*k, v.as_str())))
@@ -198,8 +226,12 @@ fn model_structure(w: &mut W, model: &Model) -> Result<()> {
     let initial: Vec<&Variable> = model
         .variables
         .iter()
-        .filter(|v| matches!(v.decl.causality, Causality::Output | Causality::CalculatedParameter))
+        .filter(|v| {
+            matches!(v.decl.causality, Causality::Output | Causality::CalculatedParameter)
+                || v.decl.derivative_of.is_some()
+        })
         .collect();
+    let derivatives: Vec<&Variable> = model.continuous_states().into_iter().map(|(_, d)| d).collect();
     w.create_element("ModelStructure").write_inner_content(|w| {
         if !outputs.is_empty() {
             w.create_element("Outputs").write_inner_content(|w| {
@@ -214,6 +246,18 @@ fn model_structure(w: &mut W, model: &Model) -> Result<()> {
                     let deps = deps.join(" ");
                     w.create_element("Unknown")
                         .with_attributes([("index", index.as_str()), ("dependencies", deps.as_str())])
+                        .write_empty()?;
+                }
+                Ok(())
+            })?;
+        }
+        if !derivatives.is_empty() {
+            // No `dependencies` attribute: a derivative may depend on every state and input.
+            w.create_element("Derivatives").write_inner_content(|w| {
+                for v in &derivatives {
+                    let index = index_of(model, v.name()).to_string();
+                    w.create_element("Unknown")
+                        .with_attribute(("index", index.as_str()))
                         .write_empty()?;
                 }
                 Ok(())

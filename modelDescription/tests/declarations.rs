@@ -203,6 +203,10 @@ fn malformed_declarations_are_rejected() {
             r#"{"name":"a","causality":"parameter","start":1,"group":"g","description":"d"}"#.to_string(),
             "group 'g'",
         ),
+        (
+            r#"{"name":"a","causality":"parameter","start":1,"field":"x","description":"d"}"#.to_string(),
+            "field without group",
+        ),
     ];
     for (vars, expected) in cases {
         let e = load_text(&decl(&vars)).expect_err(&vars);
@@ -210,5 +214,50 @@ fn malformed_declarations_are_rejected() {
             e.contains(expected) && e.contains('a'),
             "{vars}: got '{e}', expected '{expected}'"
         );
+    }
+}
+
+/// The port ↔ struct-field mapping is declared on both sides of a connection (plant
+/// outputs, controller inputs; controller outputs, plant inputs): the same name must
+/// sit in the same group and field on both sides, or the wiring by name would carry
+/// a value into another field.
+#[test]
+fn connected_ports_map_to_the_same_field() {
+    let plant = load(&dir(), "tailsitter_plant", "0").unwrap();
+    let mapping = |v: &model_description::Variable| {
+        (
+            v.decl.group.clone(),
+            v.decl.group_field().unwrap().0.to_string(),
+            v.decl.group_field().unwrap().1,
+        )
+    };
+    for id in ["tailsitter_lqr", "tailsitter_tsd"] {
+        let controller = load(&dir(), id, "0").unwrap();
+        let mut connected = 0;
+        for c in controller
+            .variables
+            .iter()
+            .filter(|v| matches!(v.decl.causality, Causality::Input | Causality::Output))
+        {
+            let Some(p) = plant.variables.iter().find(|p| p.name() == c.name()) else {
+                continue;
+            };
+            assert_ne!(p.decl.causality, c.decl.causality, "{id}.{}", c.name());
+            // Groups that both sides use (the Measurement and the Command structs).
+            let shared =
+                |v: &model_description::Variable| matches!(v.decl.group.as_deref(), Some("measurement" | "command"));
+            if shared(p) || shared(c) {
+                assert_eq!(
+                    mapping(p),
+                    mapping(c),
+                    "{id}.{} and tailsitter_plant.{}",
+                    c.name(),
+                    p.name()
+                );
+            }
+            connected += 1;
+        }
+        // 33 plant outputs read, 7 commands driven.
+        assert_eq!(connected, 40, "{id}");
     }
 }

@@ -188,6 +188,94 @@ class ClosedLoop:
             n for n in controller.names("output") if controller.variables[n].type == "Integer"
         ]
 
+    def _step_loop(self, p, c, iterator, h, n, wind, ref_offset, data, rec_p, rec_c, rec_ci):
+        """The communication steps (DESIGN.md §2 Timing), recording row k of `data` at t = k h.
+
+        Per step and unit one get and one set of Real values (plus the controller's Integer
+        outputs), through fmpy's low-level `fmi2GetReal`/`fmi2SetReal` on ctypes arrays
+        prepared once: no per-step list, dict or ctypes-array building. The calls, their
+        order and the values passed are those of the plain master (same trajectories, bit
+        for bit): the controller inputs are the plant outputs read before the plant's wind
+        is set; the recorded plant outputs are read after the wind and the command are set.
+        """
+        import ctypes
+        import time as wall
+
+        real = ctypes.c_double
+        vr_t = ctypes.c_uint
+
+        def vrs(refs):
+            return (vr_t * len(refs))(*refs)
+
+        pv, cv = self.plant.variables, self.controller.variables
+        n_in, n_cmd = len(self._c_vr_in), len(self._c_vr_out)
+        # Controller inputs: [plant outputs wired by name..., ref_offset n, e, d].
+        c_in_vr = vrs(self._c_vr_in + [cv[f"ref_offset_{k}"].valueReference for k in "ned"])
+        p_out_vr = vrs(self._p_vr_out)
+        c_in = (real * (n_in + 3))()
+        # Plant inputs: [wind n, e, d, commands wired by name...].
+        p_in_vr = vrs([pv[f"wind_{k}"].valueReference for k in "ned"] + self._p_vr_in)
+        p_in = (real * (3 + n_cmd))()
+        p_in_np = np.ctypeslib.as_array(p_in)
+        cmd_vr = vrs(self._c_vr_out)
+        # Recording buffers (numpy views of the ctypes arrays).
+        rec_p_vr, rec_c_vr, rec_ci_vr = vrs(rec_p), vrs(rec_c), vrs(rec_ci)
+        rec_p_buf, rec_c_buf = (real * len(rec_p))(), (real * len(rec_c))()
+        rec_ci_buf = (ctypes.c_int * len(rec_ci))()
+        rec_p_np, rec_c_np = np.ctypeslib.as_array(rec_p_buf), np.ctypeslib.as_array(rec_c_buf)
+        rec_ci_np = np.ctypeslib.as_array(rec_ci_buf) if rec_ci else None
+        n_rp, n_rc, n_rci = len(rec_p), len(rec_c), len(rec_ci)
+        c0, c1, c2 = 1 + n_rp, 1 + n_rp + n_rc, 1 + n_rp + n_rc + n_rci
+        # Gauss-Seidel: the command is read with the recorded controller outputs.
+        rec_c_pos = {r: i for i, r in enumerate(rec_c)}
+        cmd_in_rec = [rec_c_pos.get(r) for r in self._c_vr_out]
+        gs_from_rec = self.ordering == "gauss-seidel" and None not in cmd_in_rec
+        cmd_idx = np.array(cmd_in_rec if gs_from_rec else [], dtype=np.intp)
+        cmd_ptr = ctypes.cast(ctypes.addressof(p_in) + 3 * ctypes.sizeof(real), ctypes.POINTER(real))  # p_in[3:]
+        jacobi = self.ordering == "jacobi"
+        p_comp, c_comp = p.component, c.component
+        p_get, p_set, p_step = p.fmi2GetReal, p.fmi2SetReal, p.fmi2DoStep
+        c_get, c_set, c_step, c_get_int = c.fmi2GetReal, c.fmi2SetReal, c.fmi2DoStep, c.fmi2GetInteger
+        n_c_in, n_p_in = n_in + 3, 3 + n_cmd
+        clock = wall.perf_counter
+        t_ctrl = t_plant = 0.0
+        for k in iterator:
+            t = k * h
+            w, off = wind(t), ref_offset(t)
+            p_get(p_comp, p_out_vr, n_in, c_in)  # y_p, straight into the controller's buffer
+            if jacobi:
+                c_get(c_comp, cmd_vr, n_cmd, cmd_ptr)  # command of the previous sample
+            c_in[n_in], c_in[n_in + 1], c_in[n_in + 2] = off
+            c_set(c_comp, c_in_vr, n_c_in, c_in)
+            p_in[0], p_in[1], p_in[2] = w
+            # The controller also samples at the last point, so the recorded
+            # reference and command belong to the same time as the plant outputs.
+            t0 = clock()
+            c_step(c_comp, t, h, 1)
+            t_ctrl += clock() - t0
+            c_get(c_comp, rec_c_vr, n_rc, rec_c_buf)
+            if not jacobi:
+                if gs_from_rec:
+                    p_in_np[3:] = rec_c_np[cmd_idx]
+                else:
+                    c_get(c_comp, cmd_vr, n_cmd, cmd_ptr)
+            p_set(p_comp, p_in_vr, n_p_in, p_in)
+            p_get(p_comp, rec_p_vr, n_rp, rec_p_buf)
+            row = data[k]
+            row[0] = t
+            row[1:c0] = rec_p_np
+            row[c0:c1] = rec_c_np
+            if n_rci:
+                c_get_int(c_comp, rec_ci_vr, n_rci, rec_ci_buf)
+                row[c1:c2] = rec_ci_np
+            row[c2 : c2 + 3] = w
+            row[c2 + 3 : c2 + 6] = off
+            if k < n:
+                t0 = clock()
+                p_step(p_comp, t, h, 1)
+                t_plant += clock() - t0
+        return t_ctrl, t_plant
+
     def run(
         self,
         stop_time: float | None = None,
@@ -233,33 +321,7 @@ class ClosedLoop:
                 from tqdm import tqdm
 
                 iterator = tqdm(iterator, desc=description or f"{self.controller.identifier}", unit="step", leave=False)
-            for k in iterator:
-                t = k * h
-                w, off = wind(t), ref_offset(t)
-                y_p = p.getReal(self._p_vr_out)
-                if self.ordering == "jacobi":
-                    u_c = c.getReal(self._c_vr_out)  # command of the previous sample
-                c.setReal(self._c_vr_in, y_p)
-                c.setReal(offset_vr, list(off))
-                p.setReal(wind_vr, list(w))
-                # The controller also samples at the last point, so the recorded
-                # reference and command belong to the same time as the plant outputs.
-                t0 = wall.perf_counter()
-                c.doStep(currentCommunicationPoint=t, communicationStepSize=h)
-                t_ctrl += wall.perf_counter() - t0
-                if self.ordering == "gauss-seidel":
-                    u_c = c.getReal(self._c_vr_out)
-                p.setReal(self._p_vr_in, u_c)
-                data[k, 0] = t
-                col = 1
-                for vals in (p.getReal(rec_p), c.getReal(rec_c), c.getInteger(rec_ci) if rec_ci else []):
-                    data[k, col : col + len(vals)] = vals
-                    col += len(vals)
-                data[k, col : col + 6] = list(w) + list(off)
-                if k < n:
-                    t0 = wall.perf_counter()
-                    p.doStep(currentCommunicationPoint=t, communicationStepSize=h)
-                    t_plant += wall.perf_counter() - t0
+            t_ctrl, t_plant = self._step_loop(p, c, iterator, h, n, wind, ref_offset, data, rec_p, rec_c, rec_ci)
             for s in (p, c):
                 s.terminate()
         finally:

@@ -1,6 +1,8 @@
 //! Project tasks, run as `cargo xtask <task>`:
-//! - `dist`: build the FMU libraries in release mode and write `dist/<modelIdentifier>.fmu`
-//!   (modelDescription.xml, binaries/linux64/<id>.so, documentation/index.html);
+//! - `dist`: build the FMU libraries in release mode for linux64 (x86_64-unknown-linux-gnu) and
+//!   win64 (x86_64-pc-windows-gnu, cross-linked with MinGW-w64) and write
+//!   `dist/<modelIdentifier>.fmu` (modelDescription.xml, binaries/linux64/<id>.so,
+//!   binaries/win64/<id>.dll, documentation/index.html);
 //! - `ssp`: write the SSP 1.0 closed-loop systems `dist/<controller>.ssp` from the packaged FMUs
 //!   (`dist` writes them too);
 //! - `regen`: rewrite the reviewed copies `modelDescription/generated/<id>.xml` and the
@@ -60,6 +62,9 @@ enum Task {
         /// Output folder.
         #[arg(long, default_value = "dist")]
         out: PathBuf,
+        /// Platforms to build and pack (FMI 2.0 folder names).
+        #[arg(long, value_delimiter = ',', default_value = "linux64,win64")]
+        platforms: Vec<Platform>,
     },
     /// Write dist/<controller>.ssp (plant + controller closed loop, SSP 1.0) from the packaged FMUs.
     Ssp {
@@ -69,6 +74,38 @@ enum Task {
     },
     /// Regenerate modelDescription/generated/<id>.xml from the declarations.
     Regen,
+}
+
+/// A binary platform of an FMI 2.0 archive.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum Platform {
+    /// `binaries/linux64/<id>.so`, built for the host (x86_64-unknown-linux-gnu).
+    Linux64,
+    /// `binaries/win64/<id>.dll`, cross-built for x86_64-pc-windows-gnu.
+    Win64,
+}
+
+/// The Rust target of the win64 binaries (GNU ABI: links with Debian's MinGW-w64, no MSVC).
+const WIN64_TARGET: &str = "x86_64-pc-windows-gnu";
+/// The MinGW-w64 C compiler rustc links win64 binaries with (Debian `gcc-mingw-w64-x86-64`).
+const MINGW_GCC: &str = "x86_64-w64-mingw32-gcc";
+
+impl Platform {
+    /// Folder under `binaries/` and file name of the library of model `id`.
+    fn archive_path(self, id: &str) -> String {
+        match self {
+            Platform::Linux64 => format!("binaries/linux64/{id}.so"),
+            Platform::Win64 => format!("binaries/win64/{id}.dll"),
+        }
+    }
+
+    /// Where cargo writes the release library of model `id`.
+    fn built_path(self, root: &Path, id: &str) -> PathBuf {
+        match self {
+            Platform::Linux64 => root.join(format!("target/release/lib{id}.so")),
+            Platform::Win64 => root.join(format!("target/{WIN64_TARGET}/release/{id}.dll")),
+        }
+    }
 }
 
 fn workspace_root() -> PathBuf {
@@ -99,7 +136,7 @@ fn load(id: &str) -> Result<model_description::Model, String> {
 fn main() {
     let cli = Cli::parse();
     let result = match cli.task {
-        Task::Dist { only, out } => dist(&only, &out),
+        Task::Dist { only, out, platforms } => dist(&only, &out, &platforms),
         Task::Ssp { out } => ssp::write_all(&absolute(&out)).map(|_| ()),
         Task::Regen => regen(),
     };
@@ -130,7 +167,7 @@ fn regen() -> Result<(), String> {
     Ok(())
 }
 
-fn dist(only: &[String], out: &Path) -> Result<(), String> {
+fn dist(only: &[String], out: &Path, platforms: &[Platform]) -> Result<(), String> {
     let root = workspace_root();
     let selected: Vec<_> = FMUS
         .iter()
@@ -142,21 +179,22 @@ fn dist(only: &[String], out: &Path) -> Result<(), String> {
             FMUS.iter().map(|f| f.1).collect::<Vec<_>>()
         ));
     }
-    let mut cargo = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
-    cargo.current_dir(&root).args(["build", "--release", "--locked"]);
-    for (krate, _, _) in &selected {
-        cargo.args(["-p", krate]);
+    if platforms.is_empty() {
+        return Err("--platforms is empty".into());
     }
-    let status = cargo.status().map_err(|e| format!("running cargo: {e}"))?;
-    if !status.success() {
-        return Err("cargo build --release failed".into());
+    for platform in platforms {
+        build(&root, &selected, *platform)?;
     }
     let out = absolute(out);
     std::fs::create_dir_all(&out).map_err(|e| e.to_string())?;
     for (_, id, docs) in selected {
         let model = load(id)?;
-        let lib = root.join(format!("target/release/lib{id}.so"));
-        let binary = std::fs::read(&lib).map_err(|e| format!("{}: {e}", lib.display()))?;
+        let mut binaries = Vec::new();
+        for platform in platforms {
+            let lib = platform.built_path(&root, id);
+            let bytes = std::fs::read(&lib).map_err(|e| format!("{}: {e}", lib.display()))?;
+            binaries.push((platform.archive_path(id), bytes));
+        }
         let mut readme = String::new();
         for doc in *docs {
             let path = root.join(doc);
@@ -165,7 +203,7 @@ fn dist(only: &[String], out: &Path) -> Result<(), String> {
             readme.push_str("\n\n");
         }
         let path = out.join(format!("{id}.fmu"));
-        write_fmu(&path, &model, &binary, &readme)?;
+        write_fmu(&path, &model, &binaries, &documentation(&model, &readme, platforms))?;
         println!(
             "wrote {} ({} variables, guid {})",
             path.display(),
@@ -181,26 +219,79 @@ fn dist(only: &[String], out: &Path) -> Result<(), String> {
     Ok(())
 }
 
-fn write_fmu(path: &Path, model: &model_description::Model, binary: &[u8], readme: &str) -> Result<(), String> {
+/// `cargo build --release` of the selected FMU crates for one platform.
+fn build(root: &Path, selected: &[&(&str, &str, &[&str])], platform: Platform) -> Result<(), String> {
+    let mut cargo = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
+    cargo.current_dir(root).args(["build", "--release", "--locked"]);
+    if platform == Platform::Win64 {
+        win64_environment(&mut cargo)?;
+        cargo.args(["--target", WIN64_TARGET]);
+    }
+    for (krate, _, _) in selected {
+        cargo.args(["-p", krate]);
+    }
+    let status = cargo.status().map_err(|e| format!("running cargo: {e}"))?;
+    if !status.success() {
+        return Err(format!("cargo build --release for {platform:?} failed"));
+    }
+    Ok(())
+}
+
+/// Check the win64 cross tool chain and point bindgen at MinGW's compiler headers.
+///
+/// fmi-sys runs bindgen on the FMI headers for the target; for windows-gnu, clang parses
+/// MinGW's `<malloc.h>`, which includes `<mm_malloc.h>` from the compiler's own include
+/// folder, which the libclang bindgen loads does not find by itself. MinGW gcc knows it
+/// (`-print-file-name=include`).
+fn win64_environment(cargo: &mut Command) -> Result<(), String> {
+    let setup = "run scripts/setup.sh (installs the rustup target x86_64-pc-windows-gnu and \
+                 Debian's gcc-mingw-w64-x86-64), or pass --platforms linux64";
+    let installed = Command::new("rustup")
+        .args(["target", "list", "--installed"])
+        .output()
+        .map(|o| {
+            String::from_utf8_lossy(&o.stdout)
+                .lines()
+                .any(|l| l.trim() == WIN64_TARGET)
+        })
+        .unwrap_or(true); // no rustup: let cargo report a missing target itself
+    if !installed {
+        return Err(format!("the Rust target {WIN64_TARGET} is not installed: {setup}"));
+    }
+    let include = Command::new(MINGW_GCC)
+        .arg("-print-file-name=include")
+        .output()
+        .map_err(|e| format!("{MINGW_GCC}: {e}: {setup}"))?;
+    let include = String::from_utf8_lossy(&include.stdout).trim().to_string();
+    if include.is_empty() || !Path::new(&include).join("mm_malloc.h").exists() {
+        return Err(format!(
+            "{MINGW_GCC} reports no include folder with mm_malloc.h ({include:?}): {setup}"
+        ));
+    }
+    let key = "BINDGEN_EXTRA_CLANG_ARGS_x86_64_pc_windows_gnu";
+    if std::env::var_os(key).is_none() {
+        cargo.env(key, format!("-isystem {include}"));
+    }
+    Ok(())
+}
+
+fn write_fmu(
+    path: &Path,
+    model: &model_description::Model,
+    binaries: &[(String, Vec<u8>)],
+    documentation: &str,
+) -> Result<(), String> {
     let file = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let mut zip = zip::ZipWriter::new(file);
     let options = zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
-    let id = &model.model_identifier;
-    let entries: [(String, Vec<u8>); 3] = [
-        (
-            "modelDescription.xml".into(),
-            model_description::xml::model_description(model).into_bytes(),
-        ),
-        (format!("binaries/linux64/{id}.so"), binary.to_vec()),
-        (
-            "documentation/index.html".into(),
-            documentation(model, readme).into_bytes(),
-        ),
-    ];
+    let xml = model_description::xml::model_description(model).into_bytes();
+    let entries = [("modelDescription.xml", &xml[..])]
+        .into_iter()
+        .chain(binaries.iter().map(|(name, bytes)| (name.as_str(), &bytes[..])))
+        .chain([("documentation/index.html", documentation.as_bytes())]);
     for (name, bytes) in entries {
-        zip.start_file(name.as_str(), options)
-            .map_err(|e| format!("{name}: {e}"))?;
-        zip.write_all(&bytes).map_err(|e| format!("{name}: {e}"))?;
+        zip.start_file(name, options).map_err(|e| format!("{name}: {e}"))?;
+        zip.write_all(bytes).map_err(|e| format!("{name}: {e}"))?;
     }
     zip.finish().map_err(|e| e.to_string())?;
     Ok(())
@@ -208,7 +299,7 @@ fn write_fmu(path: &Path, model: &model_description::Model, binary: &[u8], readm
 
 /// documentation/index.html: the model's README (its equations) rendered from
 /// Markdown, then a table of every port and parameter from the declaration.
-fn documentation(model: &model_description::Model, readme: &str) -> String {
+fn documentation(model: &model_description::Model, readme: &str, platforms: &[Platform]) -> String {
     let mut body = String::new();
     pulldown_cmark::html::push_html(
         &mut body,
@@ -219,11 +310,45 @@ fn documentation(model: &model_description::Model, readme: &str) -> String {
 body{{font-family:sans-serif;max-width:70em;margin:2em auto;line-height:1.4}}\
 table{{border-collapse:collapse;font-size:90%}}td,th{{border:1px solid #ccc;padding:2px 6px;vertical-align:top}}\
 th{{background:#eee}}code{{background:#f4f4f4}}</style>\n</head>\n<body>\n<h1>{name}</h1>\n<p>modelIdentifier <code>{id}</code>, \
-version {version}, GUID <code>{guid}</code>. FMI 2.0 Co-Simulation, linux64.</p>\n{body}\n{tables}</body>\n</html>\n",
+version {version}, GUID <code>{guid}</code>.</p>\n{platforms}\n{body}\n{tables}</body>\n</html>\n",
         name = model_description::html::escape_text(&model.model_name),
         id = model.model_identifier,
         version = model.version,
         guid = model.guid,
         tables = model_description::html::variable_tables(model),
+        platforms = platforms_section(model, platforms),
+    )
+}
+
+/// The "Platforms and interfaces" table of documentation/index.html.
+fn platforms_section(model: &model_description::Model, platforms: &[Platform]) -> String {
+    let interfaces = if model.model_exchange() {
+        "FMI 2.0 Co-Simulation and Model Exchange (one binary serves both; Model Exchange: \
+         continuous states with <code>der_*</code> derivatives, no event indicators)"
+    } else {
+        "FMI 2.0 Co-Simulation"
+    };
+    let mut rows = String::new();
+    for platform in platforms {
+        let (folder, built, runtime) = match platform {
+            Platform::Linux64 => (
+                platform.archive_path(&model.model_identifier),
+                "x86_64-unknown-linux-gnu",
+                "glibc, libgcc_s (every x86-64 Linux)",
+            ),
+            Platform::Win64 => (
+                platform.archive_path(&model.model_identifier),
+                "x86_64-pc-windows-gnu (MinGW-w64)",
+                "Windows 10 or later system DLLs only (KERNEL32, ntdll, msvcrt, …); no MinGW runtime DLL",
+            ),
+        };
+        rows.push_str(&format!(
+            "<tr><td><code>{folder}</code></td><td>{built}</td><td>{runtime}</td></tr>\n"
+        ));
+    }
+    format!(
+        "<h2>Platforms and interfaces</h2>\n<p>{interfaces}.</p>\n<table>\n<tr><th>binary</th><th>built for</th>\
+<th>needs at run time</th></tr>\n{rows}</table>\n<p>Not shipped: aarch64 Linux (FMI 2.0 has no folder name \
+distinct from x86-64's <code>linux64</code>), macOS (needs Apple's SDK), FMI 3.0.</p>\n"
     )
 }

@@ -3,7 +3,7 @@
 //!
 //! Layout of the archive:
 //! - `SystemStructure.ssd`: one system with the components `plant` and `controller`
-//!   (`resources/<modelIdentifier>.fmu`), connected by port name (DESIGN.md §2): every controller
+//!   (`resources/<modelIdentifier>.fmu`), connected by port name (docs/DESIGN.md §2): every controller
 //!   input named like a plant output reads it, every controller output named like a plant input
 //!   drives it. The mission parameters (§3) are an inline parameter set on the controller, the
 //!   plant's initial trim speed is bound to `v_vertical`. Default experiment 0–35 s, with the OSP
@@ -27,26 +27,51 @@ use quick_xml::events::{BytesDecl, BytesStart, Event};
 use quick_xml::Writer;
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
+use std::sync::LazyLock;
 
 /// The plant every system holds.
 pub const PLANT: &str = "tailsitter_plant";
 /// Controllers a system is written for (each when its FMU exists).
 pub const CONTROLLERS: &[&str] = &["tailsitter_lqr", "tailsitter_tsd"];
-/// Default experiment: the default mission (DESIGN.md §3) is 35 s long.
-pub const STOP_TIME: f64 = 35.0;
-/// Communication step = the controllers' default `sample_time`.
-pub const STEP_SIZE: f64 = 0.02;
-/// Mission parameters (DESIGN.md §3), bound on the controller.
-pub const MISSION: &[(&str, f64)] = &[
-    ("t_vertical_1", 5.0),
-    ("t_transition_1", 5.0),
-    ("t_level", 10.0),
-    ("t_transition_2", 10.0),
-    ("t_vertical_2", 5.0),
-    ("v_level", 25.0),
-    ("v_vertical", 3.0),
-    ("sample_time", STEP_SIZE),
-];
+/// Mission parameters (docs/DESIGN.md §3) with their declared defaults, bound on the
+/// controller: the `mission` group of `modelDescription/fragments/controller_interface.json`.
+pub static MISSION: LazyLock<Vec<(&'static str, f64)>> = LazyLock::new(|| {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../modelDescription");
+    let (decls, _) = model_description::load_declarations(&dir, "fragments/controller_interface.json")
+        .unwrap_or_else(|e| panic!("controller interface declaration: {e}"));
+    decls
+        .into_iter()
+        .filter(|d| d.group.as_deref() == Some("mission"))
+        .map(|d| match d.start {
+            Some(model_description::Start::Number(x)) => (&*d.name.leak(), x),
+            other => panic!("mission parameter {} has start {other:?}", d.name),
+        })
+        .collect()
+});
+
+/// A mission parameter's declared default.
+fn mission_default(name: &str) -> f64 {
+    MISSION
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|m| m.1)
+        .unwrap_or_else(|| panic!("mission parameter {name} not declared"))
+}
+
+/// Default experiment: the default mission (docs/DESIGN.md §3), from t = 0 to the end
+/// of its last phase.
+fn stop_time() -> f64 {
+    [
+        "t_vertical_1",
+        "t_transition_1",
+        "t_level",
+        "t_transition_2",
+        "t_vertical_2",
+    ]
+    .iter()
+    .map(|n| mission_default(n))
+    .sum()
+}
 
 const NS_SSD: &str = "http://ssp-standard.org/SSP1/SystemStructureDescription";
 const NS_SSC: &str = "http://ssp-standard.org/SSP1/SystemStructureCommon";
@@ -232,7 +257,7 @@ pub struct Connection {
     pub name: String,
 }
 
-/// Connections by name (DESIGN.md §2): plant outputs → controller inputs, controller outputs →
+/// Connections by name (docs/DESIGN.md §2): plant outputs → controller inputs, controller outputs →
 /// plant inputs. Errors if types differ or a plant command input (`*_cmd`) is left undriven.
 pub fn connections(plant: &FmuInfo, controller: &FmuInfo) -> Result<Vec<Connection>, String> {
     let mut out = Vec::new();
@@ -376,12 +401,8 @@ pub fn system_description(plant: &FmuInfo, controller: &FmuInfo) -> Result<Strin
     let (plant_inputs, controller_inputs) = (inputs_of("plant"), inputs_of("controller"));
     let mission: Vec<_> = MISSION.iter().map(|(n, v)| (*n, "Real", real(*v))).collect();
     let controller_parameters = bindings(controller, &mission)?;
-    let v_vertical = MISSION
-        .iter()
-        .find(|(n, _)| *n == "v_vertical")
-        .map(|m| m.1)
-        .unwrap_or(3.0);
-    // The plant starts in the trimmed vertical climb at the mission's climb speed (DESIGN.md §3).
+    let v_vertical = mission_default("v_vertical");
+    // The plant starts in the trimmed vertical climb at the mission's climb speed (docs/DESIGN.md §3).
     let plant_parameters = bindings(
         plant,
         &[
@@ -397,7 +418,7 @@ pub fn system_description(plant: &FmuInfo, controller: &FmuInfo) -> Result<Strin
     }
     let name = format!("{}_closed_loop", controller.model_identifier);
     let description = format!(
-        "Tail-sitter closed loop: {} flying {} (DESIGN.md section 2 port wiring by name, section 3 mission).",
+        "Tail-sitter closed loop: {} flying {} (docs/DESIGN.md section 2 port wiring by name, section 3 mission).",
         controller.model_identifier, plant.model_identifier
     );
     let mut w = Writer::new_with_indent(Vec::new(), b' ', 2);
@@ -456,7 +477,7 @@ pub fn system_description(plant: &FmuInfo, controller: &FmuInfo) -> Result<Strin
                 })?;
             }
             w.create_element("ssd:DefaultExperiment")
-                .with_attributes([("startTime", "0.0"), ("stopTime", real(STOP_TIME).as_str())])
+                .with_attributes([("startTime", "0.0"), ("stopTime", real(stop_time()).as_str())])
                 .write_inner_content(|w| {
                     w.create_element("ssd:Annotations").write_inner_content(|w| {
                         w.create_element("ssc:Annotation")
@@ -464,7 +485,7 @@ pub fn system_description(plant: &FmuInfo, controller: &FmuInfo) -> Result<Strin
                             .write_inner_content(|w| {
                                 w.create_element("osp:Algorithm").write_inner_content(|w| {
                                     w.create_element("osp:FixedStepAlgorithm")
-                                        .with_attribute(("baseStepSize", real(STEP_SIZE).as_str()))
+                                        .with_attribute(("baseStepSize", real(mission_default("sample_time")).as_str()))
                                         .write_empty()?;
                                     Ok(())
                                 })?;

@@ -3,7 +3,7 @@
 //!
 //! (x_k, c_k) ↦ (x_{k+1}, c_{k+1}): controller update at t_k on the measurement of x_k
 //! (giving the command and its next internal state c_{k+1}), then the nonlinear plant
-//! over one `sample_time` with that command held (Gauss–Seidel, DESIGN.md §2),
+//! over one `sample_time` with that command held (Gauss–Seidel, docs/DESIGN.md §2),
 //!
 //! at the operating point the closed loop itself reaches on the default mission at the
 //! analysis time (e.g. t = 18 s, late in level flight, or t = 4 s in the 3 m/s vertical
@@ -25,28 +25,26 @@ use tailsitter_physics::{idx, InputVector, Plant, StateVector};
 
 use crate::linalg::{eigen, z_to_s, Eigen, C64};
 
-/// A controller whose internal state can be read and written as f64s, with the indices
-/// of the continuous dynamic states (integrators) among them.
+/// A controller whose internal state ([`flight_mission::SampledUnit::save`]) can be
+/// perturbed, with the indices of the continuous dynamic states (integrators) in it.
 pub trait Analysable: FlightController + std::fmt::Debug + Sync {
     /// The controller's complete internal state.
-    fn save_state(&self) -> Vec<f64>;
-    /// Restore what [`Analysable::save_state`] wrote.
-    fn load_state(&mut self, s: &[f64]);
-    /// Indices of the continuous dynamic states in the saved vector, with their names.
-    fn dynamic_states(&self) -> Vec<(usize, &'static str)>;
-}
-
-impl Analysable for lqr_control::LqrController {
     fn save_state(&self) -> Vec<f64> {
         let mut v = Vec::new();
         self.save(&mut |x| v.push(x));
         v
     }
+    /// Restore what [`Analysable::save_state`] wrote.
     fn load_state(&mut self, s: &[f64]) {
         let mut it = s.iter().copied();
         self.restore(&mut || it.next())
-            .expect("LQR state restores what save wrote");
+            .expect("a controller state restores what save wrote");
     }
+    /// Indices of the continuous dynamic states in the saved vector, with their names.
+    fn dynamic_states(&self) -> Vec<(usize, &'static str)>;
+}
+
+impl Analysable for lqr_control::LqrController {
     /// Layout of `LqrController::save`: [has_origin, origin(3), integrator, …, ∫ΔN, ∫ΔE, ∫Δh]:
     /// the airspeed integrator (3.2.12–3.2.14) and, with `position_integral = 1`, the three
     /// position integrators are the continuous states.
@@ -56,16 +54,6 @@ impl Analysable for lqr_control::LqrController {
 }
 
 impl Analysable for tsd_control::TsdController {
-    fn save_state(&self) -> Vec<f64> {
-        let mut v = Vec::new();
-        self.save(&mut |x| v.push(x));
-        v
-    }
-    fn load_state(&mut self, s: &[f64]) {
-        let mut it = s.iter().copied();
-        self.restore(&mut || it.next())
-            .expect("TSD state restores what save wrote");
-    }
     /// Layout of `TsdController::save`: [initialized, thrust, normal, roll, directional
     /// integrators, saturation mask]: the four inner-loop integrators (§4.2).
     fn dynamic_states(&self) -> Vec<(usize, &'static str)> {
@@ -216,7 +204,7 @@ fn step<C: Analysable>(
     };
     let mut xn = x;
     let mut sn = s;
-    if let Ok(out) = c.update(&input) {
+    if let Ok(out) = c.sample(&input) {
         let _ = plant.advance(&mut xn, &plant_inputs(&out.command), &wind, ts);
         sn = c.save_state();
     }

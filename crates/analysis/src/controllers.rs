@@ -1,10 +1,9 @@
 //! The two controllers of the thesis behind one type, so campaigns treat them alike.
 
-use flight_mission::{ControlError, ControllerInput, ControllerOutput, FlightController, MissionParams};
-use lqr_control::{LqrController, LqrParams};
+use flight_mission::{ControlError, ControllerInput, ControllerOutput, MissionParams, ParamError, SampledUnit};
+use lqr_control::{LqrConfig, LqrController};
 use serde::{Deserialize, Serialize};
-use tailsitter_physics::Airframe;
-use tsd_control::{TsdController, TsdParams};
+use tsd_control::{TsdConfig, TsdController};
 
 use crate::closed::Analysable;
 
@@ -34,10 +33,10 @@ impl Kind {
     pub fn make(self, mission: &MissionParams) -> AnyController {
         match self {
             Kind::Lqr => AnyController::Lqr(Box::new(
-                LqrController::new(Airframe::default(), *mission, LqrParams::default()).expect("default LQR"),
+                LqrController::build(&LqrConfig::with_mission(*mission)).expect("default LQR"),
             )),
             Kind::Tsd => AnyController::Tsd(Box::new(
-                TsdController::new(TsdParams::default(), *mission, Airframe::default()).expect("default TSD"),
+                TsdController::build(&TsdConfig::with_mission(*mission)).expect("default TSD"),
             )),
         }
     }
@@ -52,28 +51,46 @@ pub enum AnyController {
     Tsd(Box<TsdController>),
 }
 
-impl FlightController for AnyController {
-    fn update(&mut self, input: &ControllerInput) -> Result<ControllerOutput, ControlError> {
+impl SampledUnit for AnyController {
+    /// Which controller, flying which mission (default tuning, nominal airframe).
+    type Config = (Kind, MissionParams);
+    type Input = ControllerInput;
+    type Output = ControllerOutput;
+
+    fn build((kind, mission): &(Kind, MissionParams)) -> Result<Self, ParamError> {
+        Ok(match kind {
+            Kind::Lqr => AnyController::Lqr(Box::new(SampledUnit::build(&LqrConfig::with_mission(*mission))?)),
+            Kind::Tsd => AnyController::Tsd(Box::new(SampledUnit::build(&TsdConfig::with_mission(*mission))?)),
+        })
+    }
+
+    fn sample_time((_, mission): &(Kind, MissionParams)) -> f64 {
+        mission.sample_time
+    }
+
+    fn sample(&mut self, input: &ControllerInput) -> Result<ControllerOutput, ControlError> {
         match self {
-            AnyController::Lqr(c) => c.update(input),
-            AnyController::Tsd(c) => c.update(input),
+            AnyController::Lqr(c) => c.sample(input),
+            AnyController::Tsd(c) => c.sample(input),
+        }
+    }
+
+    fn save(&self, out: &mut impl FnMut(f64)) {
+        match self {
+            AnyController::Lqr(c) => SampledUnit::save(c.as_ref(), out),
+            AnyController::Tsd(c) => SampledUnit::save(c.as_ref(), out),
+        }
+    }
+
+    fn restore(&mut self, next: &mut impl FnMut() -> Option<f64>) -> Result<(), ControlError> {
+        match self {
+            AnyController::Lqr(c) => SampledUnit::restore(c.as_mut(), next),
+            AnyController::Tsd(c) => SampledUnit::restore(c.as_mut(), next),
         }
     }
 }
 
 impl Analysable for AnyController {
-    fn save_state(&self) -> Vec<f64> {
-        match self {
-            AnyController::Lqr(c) => c.save_state(),
-            AnyController::Tsd(c) => c.save_state(),
-        }
-    }
-    fn load_state(&mut self, s: &[f64]) {
-        match self {
-            AnyController::Lqr(c) => c.load_state(s),
-            AnyController::Tsd(c) => c.load_state(s),
-        }
-    }
     fn dynamic_states(&self) -> Vec<(usize, &'static str)> {
         match self {
             AnyController::Lqr(c) => c.dynamic_states(),

@@ -63,14 +63,8 @@ pub fn eigen(a: &DMatrix<f64>) -> Vec<Eigen> {
 pub fn jacobian(f: impl Fn(&DVector<f64>) -> DVector<f64>, z0: &DVector<f64>, h: &[f64]) -> DMatrix<f64> {
     let n = z0.len();
     let mut cols = Vec::with_capacity(n);
-    for j in 0..n {
-        let mut zp = z0.clone();
-        let mut zm = z0.clone();
-        zp[j] += h[j];
-        zm[j] -= h[j];
-        cols.push((f(&zp) - f(&zm)) / (2.0 * h[j]));
-    }
-    let m = cols.first().map_or(0, |c| c.len());
+    tailsitter_physics::numeric::central_differences(z0, n, |j, _| Some(h[j]), f, |_, col| cols.push(col));
+    let m = cols.first().map_or(0, |c: &DVector<f64>| c.len());
     DMatrix::from_fn(m, n, |i, j| cols[j][i])
 }
 

@@ -1,6 +1,6 @@
 //! Open-loop modes of the plant (thesis §3.4.2 "Modal Analysis", Tables 3.2 and 3.3).
 //!
-//! The 20-state plant is linearised at a trim ([`Plant::linearize`]) and transformed to the
+//! The 20-state plant is linearised at a trim ([`Plant::linearise`]) and transformed to the
 //! thesis's rigid-body coordinates z = (V̄, α, β, p, q, r, φ, θ, ψ) (Table 3.1; 3-2-1 Euler
 //! angles in level flight, 2-3-1 in vertical flight where 3-2-1 is singular, A.2.6):
 //! A_z = (∂z/∂x)·A_x·(∂x/∂z), both chart Jacobians by central differences. Position
@@ -8,8 +8,9 @@
 //! (decoupled first-order lags at −1/τ_T = −10 and −1/τ_s = −20 rad/s with the commands
 //! held) are left out, which also removes the quaternion's redundant norm direction.
 
-use nalgebra::{DMatrix, SMatrix, Vector3};
+use nalgebra::{DMatrix, SMatrix, SVector, Vector3};
 use serde::{Deserialize, Serialize};
+use tailsitter_physics::numeric::central_differences;
 use tailsitter_physics::{
     euler_231_from_quat, euler_321_from_quat, idx, quat_from_euler_231, quat_from_euler_321, PhysicsError, Plant,
     StateVector, Trim,
@@ -73,29 +74,27 @@ fn x_of(z: &[f64], base: &StateVector, set: EulerSet) -> StateVector {
 /// The 9×9 rigid-body state matrix at a trim (still air).
 pub fn rigid_body_matrix(plant: &Plant, trim: &Trim, set: EulerSet) -> DMatrix<f64> {
     let wind = Vector3::zeros();
-    let (ax, _) = plant.linearize(&trim.state, &trim.inputs, &wind);
+    let (ax, _) = plant.linearise(&trim.state, &trim.inputs, &wind);
     let z0 = z_of(&trim.state, set);
     let h = 1e-6;
     // ∂x/∂z (20×9)
     let mut xz = SMatrix::<f64, 20, 9>::zeros();
-    for j in 0..9 {
-        let (mut zp, mut zm) = (z0, z0);
-        zp[j] += h;
-        zm[j] -= h;
-        let col = (x_of(&zp, &trim.state, set) - x_of(&zm, &trim.state, set)) / (2.0 * h);
-        xz.set_column(j, &col);
-    }
+    central_differences(
+        &z0,
+        9,
+        |_, _| Some(h),
+        |z| x_of(z, &trim.state, set),
+        |j, col| xz.set_column(j, &col),
+    );
     // ∂z/∂x (9×20)
     let mut zx = SMatrix::<f64, 9, 20>::zeros();
-    for j in 0..20 {
-        let (mut xp, mut xm) = (trim.state, trim.state);
-        xp[j] += h;
-        xm[j] -= h;
-        let (a, b) = (z_of(&xp, set), z_of(&xm, set));
-        for i in 0..9 {
-            zx[(i, j)] = (a[i] - b[i]) / (2.0 * h);
-        }
-    }
+    central_differences(
+        &trim.state,
+        20,
+        |_, _| Some(h),
+        |x| SVector::<f64, 9>::from(z_of(x, set)),
+        |j, col| zx.set_column(j, &col),
+    );
     let az = zx * ax * xz;
     DMatrix::from_fn(9, 9, |i, j| az[(i, j)])
 }
@@ -312,7 +311,7 @@ mod tests {
         let plant = Plant::new(tailsitter_physics::Airframe::default());
         let m = level_modes(&plant, 25.0).unwrap();
         let sp = m.modes.iter().find(|m| m.name == "short period").expect("short period");
-        // DESIGN.md §4: ≈ −7 ± 17i with these airframe numbers.
+        // docs/DESIGN.md §4: ≈ −7 ± 17i with these airframe numbers.
         assert!(sp.re < -4.0 && sp.re > -11.0, "{sp:?}");
         assert!(sp.im > 12.0 && sp.im < 22.0, "{sp:?}");
         for name in ["phugoid", "Dutch roll", "roll", "spiral"] {

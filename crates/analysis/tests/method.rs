@@ -5,7 +5,9 @@ use analysis::closed::{closed_loop_poles, poles_of_map, Analysable, Condition, O
 use analysis::controllers::Kind;
 use analysis::linalg::{eigenvalues, match_poles, z_to_s, C64};
 use analysis::sensitivity::{factors, nominal_index, track};
-use flight_mission::{Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, FlightController, Phase};
+use flight_mission::{
+    Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, ParamError, Phase, SampledUnit,
+};
 use nalgebra::{DMatrix, DVector, Vector3};
 use tailsitter_physics::{idx, Airframe, Plant};
 
@@ -111,7 +113,7 @@ fn analytic_sensitivity_of_a_scalar_loop() {
 
 /// A linear controller on the tail-sitter: trim commands plus rate damping and an
 /// integrator on q (its only dynamic state).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 struct RateDamper {
     trim: Command,
     kq: f64,
@@ -122,8 +124,29 @@ struct RateDamper {
     integ: f64,
 }
 
-impl FlightController for RateDamper {
-    fn update(&mut self, input: &ControllerInput) -> Result<ControllerOutput, ControlError> {
+impl SampledUnit for RateDamper {
+    type Config = RateDamper;
+    type Input = ControllerInput;
+    type Output = ControllerOutput;
+
+    fn build(config: &RateDamper) -> Result<Self, ParamError> {
+        Ok(config.clone())
+    }
+
+    fn sample_time(config: &RateDamper) -> f64 {
+        config.ts
+    }
+
+    fn save(&self, out: &mut impl FnMut(f64)) {
+        out(self.integ);
+    }
+
+    fn restore(&mut self, next: &mut impl FnMut() -> Option<f64>) -> Result<(), ControlError> {
+        self.integ = next().ok_or_else(|| ControlError("truncated".into()))?;
+        Ok(())
+    }
+
+    fn sample(&mut self, input: &ControllerInput) -> Result<ControllerOutput, ControlError> {
         let w = input.measurement.rates;
         let mut c = self.trim;
         c.elevator -= self.kq * w.y + self.ki * self.integ;
@@ -144,12 +167,6 @@ impl FlightController for RateDamper {
 }
 
 impl Analysable for RateDamper {
-    fn save_state(&self) -> Vec<f64> {
-        vec![self.integ]
-    }
-    fn load_state(&mut self, s: &[f64]) {
-        self.integ = s[0];
-    }
     fn dynamic_states(&self) -> Vec<(usize, &'static str)> {
         vec![(0, "∫q")]
     }
@@ -190,7 +207,7 @@ fn tail_sitter_map_matches_zoh_of_linearisation() {
         .collect();
     assert_eq!(ours.len(), 20);
 
-    let (a, b) = plant.linearize(&trim.state, &trim.inputs, &Vector3::zeros());
+    let (a, b) = plant.linearise(&trim.state, &trim.inputs, &Vector3::zeros());
     let mut aug = DMatrix::<f64>::zeros(27, 27);
     for i in 0..20 {
         for j in 0..20 {

@@ -1,6 +1,6 @@
 //! The closed loop of the tail-sitter plant ([`tailsitter_physics::Plant`]) and
 //! any [`FlightController`], without FMI: the same wiring and timing a
-//! co-simulation master uses (DESIGN.md §2 Timing), for tests, analysis
+//! co-simulation master uses (docs/DESIGN.md §2 Timing), for tests, analysis
 //! campaigns and benchmarks of the controller libraries.
 //!
 //! Frames: NED earth axes for positions, velocities and wind; SI units.
@@ -9,7 +9,7 @@ use flight_mission::{Command, ControllerInput, Diagnostics, FlightController, Me
 use std::sync::OnceLock;
 
 use nalgebra::Vector3;
-use tailsitter_physics::{idx, InputVector, Plant, StateVector};
+use tailsitter_physics::{idx, InputVector, Outputs, Plant, StateVector};
 
 /// The acceptance criteria of a flown mission, read from
 /// `modelDescription/fragments/mission_criteria.json` (compiled in): the one source the
@@ -83,7 +83,7 @@ pub enum Ordering {
     Jacobi,
 }
 
-/// Earth-frame wind profile [m/s], NED.
+/// Earth-frame wind profile (m/s), NED.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum Wind {
     #[default]
@@ -134,9 +134,9 @@ impl Wind {
 pub struct Scenario {
     /// The mission the controller flies (used here for phases and the stop time).
     pub mission: MissionParams,
-    /// End of the run [s].
+    /// End of the run (s).
     pub stop_time: f64,
-    /// Communication step of the master [s].
+    /// Communication step of the master (s).
     pub comm_step: f64,
     pub ordering: Ordering,
     pub wind: Wind,
@@ -171,7 +171,12 @@ impl Scenario {
 
 /// What the controller would measure: the plant outputs of the same names.
 pub fn measure(plant: &Plant, x: &StateVector, u: &InputVector, wind: &Vector3<f64>) -> Measurement {
-    let y = plant.outputs(x, u, wind);
+    measurement(x, &plant.outputs(x, u, wind))
+}
+
+/// The plant outputs grouped as a [`Measurement`], from the state and the
+/// computed outputs: what the plant FMU writes to its output ports.
+pub fn measurement(x: &StateVector, y: &Outputs) -> Measurement {
     Measurement {
         pos_ned: Vector3::new(x[idx::POS_N], x[idx::POS_E], x[idx::POS_D]),
         vel_ned: y.vel_ned,
@@ -211,7 +216,7 @@ pub fn plant_inputs(c: &Command) -> InputVector {
 /// The closed loop at one communication point.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Sample {
-    /// Time [s].
+    /// Time (s).
     pub t: f64,
     /// Plant state at `t`.
     pub x: StateVector,
@@ -221,14 +226,14 @@ pub struct Sample {
     pub command: Command,
     /// Controller diagnostics of its sample at `t`.
     pub diagnostics: Diagnostics,
-    /// Wind at `t` [m/s], NED.
+    /// Wind at `t` (m/s), NED.
     pub wind: Vector3<f64>,
-    /// Pitch θ of the 3-2-1 Euler angles [rad] (well defined near 90°: from the DCM).
+    /// Pitch θ of the 3-2-1 Euler angles (rad) (well defined near 90°: from the DCM).
     pub theta: f64,
 }
 
 impl Sample {
-    /// |position − reference position| [m].
+    /// |position − reference position| (m).
     pub fn pos_error(&self) -> f64 {
         (self.measurement.pos_ned - self.diagnostics.ref_pos_ned).norm()
     }
@@ -248,9 +253,9 @@ pub struct Trace {
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct PhaseErrors {
     pub samples: usize,
-    /// Maximum position error [m].
+    /// Maximum position error (m).
     pub max: f64,
-    /// RMS position error [m].
+    /// RMS position error (m).
     pub rms: f64,
 }
 
@@ -279,7 +284,7 @@ impl Trace {
         out
     }
 
-    /// Maximum position error over the whole run [m].
+    /// Maximum position error over the whole run (m).
     pub fn max_pos_error(&self) -> f64 {
         self.samples.iter().map(Sample::pos_error).fold(0.0, f64::max)
     }
@@ -291,7 +296,7 @@ impl Trace {
             .filter(move |s| s.t >= t0 - EDGE_TOLERANCE && s.t < t1 - EDGE_TOLERANCE)
     }
 
-    /// Maximum angle of attack [rad] with `t0 ≤ t < t1`.
+    /// Maximum angle of attack (rad) with `t0 ≤ t < t1`.
     pub fn max_alpha(&self, t0: f64, t1: f64) -> f64 {
         self.window(t0, t1)
             .map(|s| s.measurement.alpha)
@@ -332,11 +337,11 @@ impl From<&Sample> for CheckSample {
 /// The acceptance criteria of the controller issues, evaluated on a trace.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MissionCheck {
-    /// Max |airspeed − v_level| over the last 5 s of level flight [m/s].
+    /// Max |airspeed − v_level| over the last 5 s of level flight (m/s).
     pub level_airspeed_error: f64,
-    /// Max |θ − θ_trim| over the last 5 s of level flight [rad].
+    /// Max |θ − θ_trim| over the last 5 s of level flight (rad).
     pub level_pitch_error: f64,
-    /// |θ − 90°| at the end [rad].
+    /// |θ − 90°| at the end (rad).
     pub final_pitch_error: f64,
     /// Every sampled value finite.
     pub all_finite: bool,
@@ -346,7 +351,7 @@ pub struct MissionCheck {
 
 impl MissionCheck {
     /// Evaluate `trace` of `mission`; `theta_level_trim` is the plant's trimmed
-    /// pitch in level flight at `v_level` [rad].
+    /// pitch in level flight at `v_level` (rad).
     pub fn of(trace: &Trace, mission: &MissionParams, theta_level_trim: f64) -> Self {
         let samples: Vec<CheckSample> = trace.samples.iter().map(CheckSample::from).collect();
         Self::of_samples(&samples, mission, theta_level_trim)
@@ -424,18 +429,14 @@ impl std::fmt::Display for MissionCheck {
     }
 }
 
-/// Pitch θ (3-2-1) from the quaternion through DCM element (1,3) = −sin θ (A.2.5),
-/// well defined at θ = 90°.
+/// Pitch θ (3-2-1) of a plant state ([`tailsitter_physics::pitch_321`]).
 pub fn pitch(x: &StateVector) -> f64 {
-    let q = x.fixed_rows::<4>(idx::Q1).into_owned();
-    (-tailsitter_physics::dcm_earth_to_body(&q)[(0, 2)])
-        .clamp(-1.0, 1.0)
-        .asin()
+    tailsitter_physics::pitch_321(&x.fixed_rows::<4>(idx::Q1).into_owned())
 }
 
 /// Fly `controller` with `plant` from state `x0` through `scenario`.
 ///
-/// Timing (DESIGN.md §2): at each communication point t the controller is
+/// Timing (docs/DESIGN.md §2): at each communication point t the controller is
 /// handed the plant outputs at t; it samples when its own clock is due (here:
 /// every multiple of `mission.sample_time`, the first at t = 0) and holds its
 /// command otherwise. The plant then advances over [t, t + h) with the
@@ -467,7 +468,7 @@ pub fn fly<C: FlightController>(plant: &Plant, x0: StateVector, controller: &mut
                 measurement,
                 ref_offset_ned: scenario.ref_offset(t),
             };
-            match controller.update(&input) {
+            match controller.sample(&input) {
                 Ok(out) => {
                     if let Some(notice) = out.notice {
                         trace.notices.push((t, notice));

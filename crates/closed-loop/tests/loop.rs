@@ -2,20 +2,39 @@
 
 use closed_loop::{fly, Ordering, Scenario, Wind};
 use flight_mission::{
-    Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, FlightController, MissionParams, Phase,
+    Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, MissionParams, ParamError, Phase,
+    SampledUnit,
 };
 use nalgebra::Vector3;
 use tailsitter_physics::{idx, Airframe, Plant};
 
 /// Holds a fixed command; the reference is wherever the aircraft is plus the offset.
-#[derive(Clone)]
+#[derive(Clone, PartialEq)]
 struct Hold {
     command: Command,
     samples: Vec<f64>,
 }
 
-impl FlightController for Hold {
-    fn update(&mut self, input: &ControllerInput) -> Result<ControllerOutput, ControlError> {
+impl SampledUnit for Hold {
+    type Config = Hold;
+    type Input = ControllerInput;
+    type Output = ControllerOutput;
+
+    fn build(config: &Hold) -> Result<Self, ParamError> {
+        Ok(config.clone())
+    }
+
+    fn sample_time(_: &Hold) -> f64 {
+        0.02
+    }
+
+    fn save(&self, _: &mut impl FnMut(f64)) {}
+
+    fn restore(&mut self, _: &mut impl FnMut() -> Option<f64>) -> Result<(), ControlError> {
+        Ok(())
+    }
+
+    fn sample(&mut self, input: &ControllerInput) -> Result<ControllerOutput, ControlError> {
         self.samples.push(input.t);
         // A command that encodes the sample index, to observe the master's ordering.
         let mut command = self.command;

@@ -1,13 +1,306 @@
-//! Glue shared by the controller FMUs (`fmu-lqr`, `fmu-tsd`) between the
-//! controller interface ([`flight_mission`]) and the FMI export layer
-//! ([`fmi2_export`]): the held output in FMU states and the controller's
-//! notices on the FMI logger. Knows neither controller.
+//! One FMU adapter for every sampled unit ([`flight_mission::SampledUnit`]): the
+//! controllers `fmu-lqr` and `fmu-tsd` today, the sensor model and the estimator
+//! tomorrow. Knows no unit: a crate binds its unit to its generated `Variables`
+//! by implementing [`Binding`] (four functions; controllers use
+//! [`flight_controller_binding!`]) and exports `SampledFmu<ItsBinding>`.
+//!
+//! What the adapter does for every unit (docs/DESIGN.md §2 timing, §7 units):
+//! - builds the unit from its parameters in `fmi2ExitInitializationMode`; an
+//!   invalid parameter is an FMI error whose message names it;
+//! - samples at the multiples of the unit's sample time ([`SampleClock`]),
+//!   the first at the start time, and holds the output in between;
+//! - rejects a non-finite Real input with an error naming it;
+//! - reports the output's notices as warnings on the FMI logger (a lasting
+//!   saturation once);
+//! - saves and restores FMU states in one layout: `u64` next sample index, the
+//!   held output ([`write_held`]), `u32` count and the unit's values
+//!   ([`SampledUnit::save`]).
 
-use flight_mission::{ControllerOutput, Notice};
-use fmi2_export::{Logger, StateError, StateReader, StateWriter};
+use std::marker::PhantomData;
+
+use flight_mission::{HeldOutput, Notice, SampleClock};
+use fmi2_export::{
+    Causality, FmuModel, Logger, ModelError, StateError, StateReader, StateWriter, ValueType, VariableStore,
+};
+
+/// Upper bound on the unit values an FMU state may claim (the LQR saves a few hundred).
+pub const MAX_SAVED_VALUES: usize = 4096;
+
+type Config<B> = <<B as Binding>::Unit as SampledUnit>::Config;
+type Input<B> = <<B as Binding>::Unit as SampledUnit>::Input;
+type Output<B> = <<B as Binding>::Unit as SampledUnit>::Output;
+
+/// How a sampled unit maps to the generated variables of its FMU.
+pub trait Binding: 'static {
+    /// The pure-Rust unit.
+    type Unit: SampledUnit;
+    /// The generated variable store of the FMU.
+    type Vars: VariableStore;
+    /// `modelIdentifier` of the FMU.
+    const MODEL_IDENTIFIER: &'static str;
+    /// GUID of the FMU.
+    const GUID: &'static str;
+    /// Name of the unit in messages, e.g. "LQR".
+    const NAME: &'static str;
+    /// The unit's configuration from the parameters.
+    fn config(vars: &Self::Vars) -> Config<Self>;
+    /// The unit's input at time `t` from the input variables (all finite: checked before).
+    fn input(vars: &Self::Vars, t: f64) -> Input<Self>;
+    /// Write an output to the output variables.
+    fn write_output(vars: &mut Self::Vars, output: &Output<Self>);
+}
+
+/// The binding of a [`flight_mission::FlightController`] to the generated
+/// `Variables` of a crate that includes `modelDescription/fragments/controller_interface.json`
+/// (groups `measurement`, `ref_offset`, `command`, `diagnostics`):
+/// `flight_controller_binding!(Lqr, LqrController, "LQR", |vars| config)` defines
+/// `pub struct Lqr` implementing [`Binding`] with `Variables`, `MODEL_IDENTIFIER`
+/// and `GUID` of the calling module.
+#[macro_export]
+macro_rules! flight_controller_binding {
+    ($binding:ident, $unit:ty, $name:literal, |$vars:ident| $config:expr) => {
+        /// The controller bound to this FMU's variables.
+        pub struct $binding;
+
+        impl $crate::Binding for $binding {
+            type Unit = $unit;
+            type Vars = Variables;
+            const MODEL_IDENTIFIER: &'static str = MODEL_IDENTIFIER;
+            const GUID: &'static str = GUID;
+            const NAME: &'static str = $name;
+
+            fn config($vars: &Variables) -> <$unit as $crate::SampledUnit>::Config {
+                $config
+            }
+
+            fn input(vars: &Variables, t: f64) -> $crate::flight_mission::ControllerInput {
+                $crate::flight_mission::ControllerInput {
+                    t,
+                    measurement: vars.measurement(),
+                    ref_offset_ned: vars.ref_offset(),
+                }
+            }
+
+            fn write_output(vars: &mut Variables, output: &$crate::flight_mission::ControllerOutput) {
+                vars.set_command(&output.command);
+                vars.set_diagnostics(&output.diagnostics);
+            }
+        }
+    };
+}
+
+#[doc(hidden)]
+pub use flight_mission;
+pub use flight_mission::SampledUnit;
+
+/// The FMU model of the unit of binding `B`.
+pub struct SampledFmu<B: Binding> {
+    /// The unit as freshly built, with the configuration it was built from
+    /// (rebuilt only when a parameter changed).
+    pristine: Option<(Config<B>, B::Unit)>,
+    unit: Option<B::Unit>,
+    clock: SampleClock,
+    held: Option<Output<B>>,
+    /// Unit state read from an FMU state before the unit existed.
+    pending: Option<Vec<f64>>,
+    /// The clock's period must be re-read from the parameters (after a state restore).
+    reclock: bool,
+    /// The previous sample reported a saturation: warn only when one starts.
+    saturated: bool,
+    binding: PhantomData<fn() -> B>,
+}
+
+impl<B: Binding> Clone for SampledFmu<B> {
+    fn clone(&self) -> Self {
+        Self {
+            pristine: self.pristine.clone(),
+            unit: self.unit.clone(),
+            clock: self.clock,
+            held: self.held,
+            pending: self.pending.clone(),
+            reclock: self.reclock,
+            saturated: self.saturated,
+            binding: PhantomData,
+        }
+    }
+}
+
+impl<B: Binding> SampledFmu<B> {
+    /// The unit in its initial state for the parameters in `vars`.
+    fn fresh(&mut self, config: Config<B>) -> Result<B::Unit, ModelError> {
+        if let Some((c, unit)) = &self.pristine {
+            if *c == config {
+                return Ok(unit.clone());
+            }
+        }
+        let unit =
+            B::Unit::build(&config).map_err(|e| ModelError::new(format!("{}: invalid parameter: {e}", B::NAME)))?;
+        self.pristine = Some((config, unit.clone()));
+        Ok(unit)
+    }
+
+    /// After a state restore: the clock's period from the restored parameters,
+    /// the unit rebuilt if the state was read before it existed.
+    fn ensure_unit(&mut self, vars: &B::Vars) -> Result<(), ModelError> {
+        if self.reclock {
+            let config = B::config(vars);
+            let next = self.clock.next_index();
+            self.clock = SampleClock::new(B::Unit::sample_time(&config), 0.0);
+            self.clock.set_next_index(next);
+            if let Some(saved) = self.pending.take() {
+                let mut unit = self.fresh(config)?;
+                let mut it = saved.into_iter();
+                unit.restore(&mut || it.next())
+                    .map_err(|e| ModelError::new(format!("restoring the FMU state: {e}")))?;
+                self.unit = Some(unit);
+            }
+            self.reclock = false;
+        }
+        Ok(())
+    }
+
+    /// One sample at `t`.
+    fn sample(&mut self, vars: &B::Vars, t: f64, log: &mut Logger<'_>) -> Result<(), ModelError> {
+        if let Some(name) = first_non_finite_input(vars) {
+            return Err(ModelError::new(format!("input '{name}' is not finite at t = {t} s")));
+        }
+        let unit = self
+            .unit
+            .as_mut()
+            .ok_or_else(|| ModelError::new(format!("{} not initialised", B::NAME)))?;
+        let out = unit
+            .sample(&B::input(vars, t))
+            .map_err(|e| ModelError::new(format!("{} at t = {t} s: {e}", B::NAME)))?;
+        self.saturated = log_notice(log, t, out.notice(), self.saturated);
+        self.held = Some(out);
+        Ok(())
+    }
+
+    fn write_outputs(&self, vars: &mut B::Vars) {
+        if let Some(out) = &self.held {
+            B::write_output(vars, out);
+        }
+    }
+}
+
+/// The name of the first Real input of `vars` that is not finite.
+pub fn first_non_finite_input<V: VariableStore>(vars: &V) -> Option<&'static str> {
+    V::VARIABLES
+        .iter()
+        .filter(|s| s.causality == Causality::Input && s.value_type == ValueType::Real)
+        .find(|s| !vars.get_real(s.value_reference).is_some_and(f64::is_finite))
+        .map(|s| s.name)
+}
+
+impl<B: Binding> FmuModel for SampledFmu<B> {
+    type Vars = B::Vars;
+    const MODEL_IDENTIFIER: &'static str = B::MODEL_IDENTIFIER;
+    const GUID: &'static str = B::GUID;
+
+    fn new(_vars: &B::Vars) -> Self {
+        Self {
+            pristine: None,
+            unit: None,
+            // Placeholder period: set from the parameters in `initialize` or after a restore.
+            clock: SampleClock::new(1.0, 0.0),
+            held: None,
+            pending: None,
+            reclock: true,
+            saturated: false,
+            binding: PhantomData,
+        }
+    }
+
+    fn initialize(&mut self, vars: &mut B::Vars, start_time: f64, log: &mut Logger<'_>) -> Result<(), ModelError> {
+        // Idempotent: a fresh unit and clock every time, then the sample at the start time.
+        let config = B::config(vars);
+        let sample_time = B::Unit::sample_time(&config);
+        self.unit = Some(self.fresh(config)?);
+        self.pending = None;
+        self.reclock = false;
+        self.clock = SampleClock::new(sample_time, start_time);
+        self.held = None;
+        self.saturated = false;
+        let due = self.clock.take(start_time);
+        debug_assert!(due);
+        self.sample(vars, start_time, log)?;
+        self.write_outputs(vars);
+        Ok(())
+    }
+
+    fn update_outputs(&mut self, vars: &mut B::Vars) -> Result<(), ModelError> {
+        self.ensure_unit(vars)?;
+        self.write_outputs(vars);
+        Ok(())
+    }
+
+    fn do_step(&mut self, vars: &mut B::Vars, t: f64, _h: f64, log: &mut Logger<'_>) -> Result<(), ModelError> {
+        self.ensure_unit(vars)?;
+        if self.clock.take(t) || self.held.is_none() {
+            self.sample(vars, t, log)?;
+        }
+        self.write_outputs(vars);
+        Ok(())
+    }
+
+    fn write_state(&self, w: &mut StateWriter) {
+        w.u64(self.clock.next_index());
+        write_held(w, &self.held);
+        match (&self.unit, &self.pending) {
+            (Some(unit), _) => {
+                w.u32(unit.saved_len() as u32);
+                unit.save(&mut |v| w.f64(v));
+            }
+            (None, Some(p)) => {
+                w.u32(p.len() as u32);
+                for v in p {
+                    w.f64(*v);
+                }
+            }
+            (None, None) => w.u32(0),
+        }
+    }
+
+    fn read_state(&mut self, r: &mut StateReader<'_>) -> Result<(), StateError> {
+        let next_index = r.u64()?;
+        let held = read_held(r)?;
+        let n = r.u32()? as usize;
+        // The count comes from the buffer: bound it before allocating.
+        if n > MAX_SAVED_VALUES {
+            return Err(StateError::invalid(format!(
+                "{} state claims {n} values (at most {MAX_SAVED_VALUES})",
+                B::NAME
+            )));
+        }
+        let mut saved = Vec::with_capacity(n);
+        for _ in 0..n {
+            saved.push(r.f64()?);
+        }
+        if n == 0 {
+            self.unit = None;
+            self.pending = None;
+        } else if let Some(unit) = self.unit.as_mut() {
+            let expected = unit.saved_len();
+            if n != expected {
+                return Err(StateError::invalid(format!(
+                    "{} state has {n} values, expected {expected}",
+                    B::NAME
+                )));
+            }
+            let mut it = saved.into_iter();
+            unit.restore(&mut || it.next()).map_err(|e| StateError::invalid(e.0))?;
+        } else {
+            self.pending = Some(saved);
+        }
+        self.clock.set_next_index(next_index);
+        self.held = held;
+        self.reclock = true;
+        Ok(())
+    }
+}
 
 /// Append the held output (or its absence) to an FMU state.
-pub fn write_held(w: &mut StateWriter, held: &Option<ControllerOutput>) {
+pub fn write_held<O: HeldOutput>(w: &mut StateWriter, held: &Option<O>) {
     w.bool(held.is_some());
     if let Some(out) = held {
         out.save(&mut |x| w.f64(x));
@@ -15,22 +308,23 @@ pub fn write_held(w: &mut StateWriter, held: &Option<ControllerOutput>) {
 }
 
 /// Read back what [`write_held`] wrote.
-pub fn read_held(r: &mut StateReader<'_>) -> Result<Option<ControllerOutput>, StateError> {
+pub fn read_held<O: HeldOutput>(r: &mut StateReader<'_>) -> Result<Option<O>, StateError> {
     if !r.bool()? {
         return Ok(None);
     }
-    let mut saved = [0.0; ControllerOutput::SAVED_LEN];
-    for x in saved.iter_mut() {
+    let mut saved = [0.0; 64];
+    assert!(O::SAVED_LEN <= saved.len(), "held outputs are small");
+    for x in saved[..O::SAVED_LEN].iter_mut() {
         *x = r.f64()?;
     }
-    let mut it = saved.into_iter();
-    ControllerOutput::restore(&mut || it.next())
+    let mut it = saved[..O::SAVED_LEN].iter().copied();
+    O::restore(&mut || it.next())
         .map(Some)
-        .ok_or_else(|| StateError::invalid("held controller output: phase out of range"))
+        .ok_or_else(|| StateError::invalid("held output: invalid value (e.g. phase out of range)"))
 }
 
-/// Log a controller's notice as a warning; `was_saturated` (the previous
-/// sample's saturation) keeps a lasting saturation to one message.
+/// Log a unit's notice as a warning; `was_saturated` (the previous sample's
+/// saturation) keeps a lasting saturation to one message.
 /// Returns whether this sample is saturated.
 pub fn log_notice(log: &mut Logger<'_>, t: f64, notice: Option<Notice>, was_saturated: bool) -> bool {
     match notice {
@@ -48,7 +342,7 @@ pub fn log_notice(log: &mut Logger<'_>, t: f64, notice: Option<Notice>, was_satu
 #[cfg(test)]
 mod tests {
     use super::*;
-    use flight_mission::{Command, Diagnostics, Phase};
+    use flight_mission::{Command, ControllerOutput, Diagnostics, Phase};
 
     #[test]
     fn held_output_round_trips_and_rejects_corruption() {
@@ -71,11 +365,14 @@ mod tests {
             write_held(&mut w, &held);
             let bytes = w.into_bytes();
             let mut r = StateReader::new(&bytes);
-            assert_eq!(read_held(&mut r).unwrap(), held);
+            assert_eq!(read_held::<ControllerOutput>(&mut r).unwrap(), held);
             r.finish().unwrap();
             // Every truncation is an error, never a panic.
             for n in 0..bytes.len() {
-                assert!(read_held(&mut StateReader::new(&bytes[..n])).is_err(), "{n}");
+                assert!(
+                    read_held::<ControllerOutput>(&mut StateReader::new(&bytes[..n])).is_err(),
+                    "{n}"
+                );
             }
         }
         let mut w = StateWriter::new();
@@ -85,7 +382,7 @@ mod tests {
         let mut bytes = w.into_bytes();
         let phase_at = bytes.len() - 8;
         bytes[phase_at..].copy_from_slice(&9.0f64.to_le_bytes());
-        assert!(read_held(&mut StateReader::new(&bytes)).is_err());
+        assert!(read_held::<ControllerOutput>(&mut StateReader::new(&bytes)).is_err());
     }
 
     #[test]

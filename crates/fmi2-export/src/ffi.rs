@@ -210,12 +210,22 @@ pub unsafe fn instantiate<M: FmuModel>(
         if name.is_empty() {
             return fail("instanceName is NULL or empty".into());
         }
-        if fmu_type != fmi2Type_fmi2CoSimulation {
-            return fail(format!(
-                "fmuType {fmu_type} not supported: {} is a Co-Simulation FMU only",
-                M::MODEL_IDENTIFIER
-            ));
-        }
+        let has_states = !M::Vars::CONTINUOUS_STATES.is_empty();
+        let model_exchange = match fmu_type {
+            t if t == fmi2Type_fmi2CoSimulation => false,
+            t if t == fmi2Type_fmi2ModelExchange && has_states => true,
+            t if t == fmi2Type_fmi2ModelExchange => {
+                return fail(format!(
+                    "fmuType fmi2ModelExchange not supported: {} is a Co-Simulation FMU only",
+                    M::MODEL_IDENTIFIER
+                ))
+            }
+            other => {
+                return fail(format!(
+                    "fmuType {other} is neither fmi2ModelExchange (0) nor fmi2CoSimulation (1)"
+                ))
+            }
+        };
         // SAFETY: NUL-terminated if non-NULL.
         let Some(guid) = (unsafe { c_str(guid) }) else {
             return fail("fmuGUID is NULL".into());
@@ -233,7 +243,10 @@ pub unsafe fn instantiate<M: FmuModel>(
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
         match catch_unwind(AssertUnwindSafe(|| Instance::<M>::new(sink, resources))) {
-            Ok(inst) => Box::into_raw(Box::new(inst)).cast(),
+            Ok(mut inst) => {
+                inst.machine.model_exchange = model_exchange;
+                Box::into_raw(Box::new(inst)).cast()
+            }
             Err(payload) => {
                 // The sink moved into the closure; build a fresh one for the report.
                 let sink = LogSink::new(callbacks.logger, callbacks.componentEnvironment, &name, true);
@@ -482,7 +495,13 @@ pub unsafe fn get_fmu_state<M: FmuModel>(c: fmi2Component, state: *mut fmi2FMUst
 pub unsafe fn set_fmu_state<M: FmuModel>(c: fmi2Component, state: fmi2FMUstate) -> fmi2Status {
     unsafe {
         call::<M>(c, "fmi2SetFMUstate", mask::ANY, |inst| {
-            inst.restore(snapshot::<M>(state)?);
+            let snap = snapshot::<M>(state)?;
+            if snap.machine.model_exchange != inst.machine.model_exchange {
+                return Err(Fmi2Error::error(
+                    "the FMU state belongs to an instance of the other interface (Model Exchange vs Co-Simulation)",
+                ));
+            }
+            inst.restore(snap);
             Ok(())
         })
     }
@@ -674,7 +693,126 @@ pub unsafe fn not_supported<M: FmuModel>(c: fmi2Component, function: &str, why: 
     }
 }
 
-/// A Model Exchange function: this layer exports Co-Simulation only.
-pub unsafe fn model_exchange_only<M: FmuModel>(c: fmi2Component, function: &str) -> fmi2Status {
-    unsafe { not_supported::<M>(c, function, "Co-Simulation only") }
+// ---------------------------------------------------------------- Model Exchange
+//
+// Legal only in the Model Exchange states (EventMode, ContinuousTimeMode, …), which a
+// Co-Simulation instance never reaches: there every call below fails with "illegal
+// call in state …", and a model without continuous states cannot be instantiated as
+// Model Exchange at all.
+
+pub unsafe fn enter_event_mode<M: FmuModel>(c: fmi2Component) -> fmi2Status {
+    unsafe {
+        call::<M>(c, "fmi2EnterEventMode", mask::ENTER_EVENT_MODE, |inst| {
+            inst.machine.state = FmiState::EventMode;
+            Ok(())
+        })
+    }
+}
+
+/// No discrete states, no time events: one iteration, nothing changes.
+pub unsafe fn new_discrete_states<M: FmuModel>(c: fmi2Component, info: *mut fmi2EventInfo) -> fmi2Status {
+    unsafe {
+        call::<M>(c, "fmi2NewDiscreteStates", mask::NEW_DISCRETE_STATES, |_| {
+            let info = out_ptr(info, "eventInfo")?;
+            info.newDiscreteStatesNeeded = fmi2False as fmi2Boolean;
+            info.terminateSimulation = fmi2False as fmi2Boolean;
+            info.nominalsOfContinuousStatesChanged = fmi2False as fmi2Boolean;
+            info.valuesOfContinuousStatesChanged = fmi2False as fmi2Boolean;
+            info.nextEventTimeDefined = fmi2False as fmi2Boolean;
+            info.nextEventTime = 0.0;
+            Ok(())
+        })
+    }
+}
+
+pub unsafe fn enter_continuous_time_mode<M: FmuModel>(c: fmi2Component) -> fmi2Status {
+    unsafe {
+        call::<M>(
+            c,
+            "fmi2EnterContinuousTimeMode",
+            mask::ENTER_CONTINUOUS_TIME_MODE,
+            |inst| {
+                inst.machine.state = FmiState::ContinuousTimeMode;
+                Ok(())
+            },
+        )
+    }
+}
+
+/// No step events: never asks for event mode or termination.
+pub unsafe fn completed_integrator_step<M: FmuModel>(
+    c: fmi2Component,
+    _no_set_fmu_state_prior_to_current_point: fmi2Boolean,
+    enter_event_mode: *mut fmi2Boolean,
+    terminate_simulation: *mut fmi2Boolean,
+) -> fmi2Status {
+    unsafe {
+        call::<M>(
+            c,
+            "fmi2CompletedIntegratorStep",
+            mask::COMPLETED_INTEGRATOR_STEP,
+            |_| {
+                let enter = out_ptr(enter_event_mode, "enterEventMode")?;
+                let terminate = out_ptr(terminate_simulation, "terminateSimulation")?;
+                *enter = fmi2False as fmi2Boolean;
+                *terminate = fmi2False as fmi2Boolean;
+                Ok(())
+            },
+        )
+    }
+}
+
+pub unsafe fn set_time<M: FmuModel>(c: fmi2Component, time: fmi2Real) -> fmi2Status {
+    unsafe { call::<M>(c, "fmi2SetTime", mask::SET_TIME, |inst| inst.set_time(time)) }
+}
+
+pub unsafe fn set_continuous_states<M: FmuModel>(c: fmi2Component, x: *const fmi2Real, nx: usize) -> fmi2Status {
+    unsafe {
+        call::<M>(c, "fmi2SetContinuousStates", mask::SET_CONTINUOUS_STATES, |inst| {
+            inst.set_continuous_states(slice(x, nx, "x")?)
+        })
+    }
+}
+
+pub unsafe fn get_derivatives<M: FmuModel>(c: fmi2Component, dx: *mut fmi2Real, nx: usize) -> fmi2Status {
+    unsafe {
+        call::<M>(c, "fmi2GetDerivatives", mask::GET_DERIVATIVES, |inst| {
+            inst.get_derivatives(slice_mut(dx, nx, "derivatives")?)
+        })
+    }
+}
+
+/// numberOfEventIndicators = 0: only `ni == 0` is valid.
+pub unsafe fn get_event_indicators<M: FmuModel>(c: fmi2Component, z: *mut fmi2Real, ni: usize) -> fmi2Status {
+    unsafe {
+        call::<M>(c, "fmi2GetEventIndicators", mask::GET_EVENT_INDICATORS, |_| {
+            slice_mut(z, ni, "eventIndicators")?;
+            if ni != 0 {
+                return Err(Fmi2Error::error(format!(
+                    "ni = {ni}, but the model has no event indicators"
+                )));
+            }
+            Ok(())
+        })
+    }
+}
+
+pub unsafe fn get_continuous_states<M: FmuModel>(c: fmi2Component, x: *mut fmi2Real, nx: usize) -> fmi2Status {
+    unsafe {
+        call::<M>(c, "fmi2GetContinuousStates", mask::GET_CONTINUOUS_STATES, |inst| {
+            inst.get_continuous_states(slice_mut(x, nx, "x")?)
+        })
+    }
+}
+
+pub unsafe fn get_nominals_of_continuous_states<M: FmuModel>(
+    c: fmi2Component,
+    x_nominal: *mut fmi2Real,
+    nx: usize,
+) -> fmi2Status {
+    unsafe {
+        call::<M>(c, "fmi2GetNominalsOfContinuousStates", mask::GET_NOMINALS, |inst| {
+            inst.get_nominals(slice_mut(x_nominal, nx, "x_nominal")?)
+        })
+    }
 }

@@ -9,7 +9,8 @@ use crate::variables::{Causality, ValueType, Variability, VariableSpec, Variable
 use std::ffi::CString;
 use std::fmt;
 
-/// FMI 2.0 Co-Simulation states (StartAndEnd is "no instance").
+/// FMI 2.0 states of both interfaces (StartAndEnd is "no instance"): Co-Simulation
+/// (StepComplete …) and Model Exchange (EventMode, ContinuousTimeMode).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[repr(u8)]
 pub enum FmiState {
@@ -20,6 +21,10 @@ pub enum FmiState {
     StepFailed = 5,
     StepCanceled = 6,
     Terminated = 7,
+    /// Model Exchange: event iteration (after initialization or fmi2EnterEventMode).
+    EventMode = 8,
+    /// Model Exchange: the importer's integrator sets time and states, reads derivatives.
+    ContinuousTimeMode = 9,
 }
 
 impl FmiState {
@@ -36,6 +41,8 @@ impl FmiState {
             5 => Self::StepFailed,
             6 => Self::StepCanceled,
             7 => Self::Terminated,
+            8 => Self::EventMode,
+            9 => Self::ContinuousTimeMode,
             _ => return None,
         })
     }
@@ -79,14 +86,43 @@ pub mod mask {
         StepFailed,
         StepCanceled,
         Terminated,
+        EventMode,
+        ContinuousTimeMode,
     ]);
     pub const INSTANTIATED: StateMask = StateMask::of(&[Instantiated]);
     pub const INITIALIZATION_MODE: StateMask = StateMask::of(&[InitializationMode]);
-    pub const SET: StateMask = StateMask::of(&[Instantiated, InitializationMode, StepComplete]);
-    pub const GET: StateMask = StateMask::of(&[InitializationMode, StepComplete, StepFailed, StepCanceled, Terminated]);
+    pub const SET: StateMask = StateMask::of(&[
+        Instantiated,
+        InitializationMode,
+        StepComplete,
+        EventMode,
+        ContinuousTimeMode,
+    ]);
+    pub const GET: StateMask = StateMask::of(&[
+        InitializationMode,
+        StepComplete,
+        StepFailed,
+        StepCanceled,
+        Terminated,
+        EventMode,
+        ContinuousTimeMode,
+    ]);
     pub const DO_STEP: StateMask = StateMask::of(&[StepComplete]);
     pub const CANCEL_STEP: StateMask = StateMask::of(&[StepInProgress]);
-    pub const TERMINATE: StateMask = StateMask::of(&[StepComplete, StepFailed]);
+    pub const TERMINATE: StateMask = StateMask::of(&[StepComplete, StepFailed, EventMode, ContinuousTimeMode]);
+    // Model Exchange (FMI 2.0 §3.2.3 state table).
+    pub const ENTER_EVENT_MODE: StateMask = StateMask::of(&[EventMode, ContinuousTimeMode]);
+    pub const NEW_DISCRETE_STATES: StateMask = StateMask::of(&[EventMode]);
+    pub const ENTER_CONTINUOUS_TIME_MODE: StateMask = StateMask::of(&[EventMode]);
+    pub const COMPLETED_INTEGRATOR_STEP: StateMask = StateMask::of(&[ContinuousTimeMode]);
+    pub const SET_TIME: StateMask = StateMask::of(&[EventMode, ContinuousTimeMode]);
+    pub const SET_CONTINUOUS_STATES: StateMask = StateMask::of(&[ContinuousTimeMode]);
+    pub const GET_DERIVATIVES: StateMask = StateMask::of(&[EventMode, ContinuousTimeMode, Terminated]);
+    pub const GET_EVENT_INDICATORS: StateMask =
+        StateMask::of(&[InitializationMode, EventMode, ContinuousTimeMode, Terminated]);
+    pub const GET_CONTINUOUS_STATES: StateMask =
+        StateMask::of(&[InitializationMode, EventMode, ContinuousTimeMode, Terminated]);
+    pub const GET_NOMINALS: StateMask = StateMask::of(&[Instantiated, EventMode, ContinuousTimeMode, Terminated]);
     pub const STATUS: StateMask = StateMask::of(&[StepComplete, StepInProgress, StepFailed, StepCanceled, Terminated]);
 }
 
@@ -140,6 +176,8 @@ pub struct Machine {
     pub initialized: bool,
     /// A value was set since outputs were last computed.
     pub dirty: bool,
+    /// Instantiated as Model Exchange (fmi2ModelExchange) rather than Co-Simulation.
+    pub model_exchange: bool,
 }
 
 impl Machine {
@@ -152,6 +190,7 @@ impl Machine {
             tolerance: None,
             initialized: false,
             dirty: true,
+            model_exchange: false,
         }
     }
 
@@ -165,6 +204,7 @@ impl Machine {
         w.f64(self.tolerance.unwrap_or(0.0));
         w.bool(self.initialized);
         w.bool(self.dirty);
+        w.bool(self.model_exchange);
     }
 
     fn read(r: &mut StateReader<'_>) -> Result<Self, StateError> {
@@ -191,9 +231,23 @@ impl Machine {
             tolerance: has_tol.then_some(tol),
             initialized: r.bool()?,
             dirty: r.bool()?,
+            model_exchange: r.bool()?,
         };
         if !(start_time.is_finite() && time.is_finite() && stop.is_finite() && tol.is_finite()) {
             return Err(StateError::invalid("non-finite time in FMU state"));
+        }
+        let me_state = matches!(m.state, EventMode | ContinuousTimeMode);
+        let cs_state = matches!(m.state, StepComplete | StepFailed | StepCanceled);
+        if (me_state && !m.model_exchange) || (cs_state && m.model_exchange) {
+            return Err(StateError::invalid(format!(
+                "state {} does not belong to a {} instance",
+                m.state,
+                if m.model_exchange {
+                    "Model Exchange"
+                } else {
+                    "Co-Simulation"
+                }
+            )));
         }
         Ok(m)
     }
@@ -309,7 +363,9 @@ impl<M: FmuModel> Instance<M> {
     pub fn reset(&mut self) {
         self.vars = M::Vars::with_start_values();
         self.model = M::new(&self.vars);
+        let model_exchange = self.machine.model_exchange;
         self.machine = Machine::fresh();
+        self.machine.model_exchange = model_exchange;
         self.strings.clear();
     }
 
@@ -348,7 +404,11 @@ impl<M: FmuModel> Instance<M> {
             .map_err(|e| Fmi2Error::error(format!("initialization failed: {e}")))?;
         self.machine.initialized = true;
         self.machine.dirty = false;
-        self.machine.state = StepComplete;
+        self.machine.state = if self.machine.model_exchange {
+            EventMode
+        } else {
+            StepComplete
+        };
         Ok(())
     }
 
@@ -434,7 +494,8 @@ impl<M: FmuModel> Instance<M> {
             (_, Variability::Constant) => false,
             (Causality::Input, _) => true,
             (Causality::Parameter, Variability::Fixed) => matches!(state, Instantiated | InitializationMode),
-            (Causality::Parameter, Variability::Tunable) => true,
+            // Model Exchange: tunable parameters change only at events (FMI 2.0 §3.2.3).
+            (Causality::Parameter, Variability::Tunable) => state != ContinuousTimeMode,
             (Causality::Parameter, _) => matches!(state, Instantiated | InitializationMode),
             _ => false,
         };
@@ -564,6 +625,86 @@ impl<M: FmuModel> Instance<M> {
         snap.machine = self.machine;
         snap.model.clone_from(&self.model);
         snap.vars.clone_from(&self.vars);
+    }
+
+    // ------------------------------------------------------------ Model Exchange
+
+    /// `Err` unless `n` is the number of continuous states.
+    fn check_nx(n: usize, what: &str) -> Fmi2Result {
+        let nx = M::Vars::CONTINUOUS_STATES.len();
+        if n != nx {
+            return Err(Fmi2Error::error(format!(
+                "{what} = {n}, but the model has {nx} continuous states"
+            )));
+        }
+        Ok(())
+    }
+
+    /// fmi2SetTime.
+    pub fn set_time(&mut self, t: f64) -> Fmi2Result {
+        if !t.is_finite() {
+            return Err(Fmi2Error::error(format!("time = {t} is not finite")));
+        }
+        self.machine.time = t;
+        self.machine.dirty = true;
+        Ok(())
+    }
+
+    /// fmi2SetContinuousStates: every value finite, then handed to the model.
+    pub fn set_continuous_states(&mut self, x: &[f64]) -> Fmi2Result {
+        Self::check_nx(x.len(), "nx")?;
+        for (value, cs) in x.iter().zip(M::Vars::CONTINUOUS_STATES) {
+            if !value.is_finite() {
+                let name = M::Vars::spec(cs.state).map_or("?", |s| s.name);
+                return Err(Fmi2Error::error(format!("state {name} = {value} is not finite")));
+            }
+        }
+        self.model
+            .set_continuous_states(&mut self.vars, x)
+            .map_err(|e| Fmi2Error::error(format!("setting the continuous states failed: {e}")))?;
+        self.machine.dirty = true;
+        Ok(())
+    }
+
+    /// Read the state (`derivative == false`) or derivative variable of every continuous state.
+    fn read_states(&mut self, out: &mut [f64], derivative: bool) -> Fmi2Result {
+        Self::check_nx(out.len(), "nx")?;
+        self.refresh()?;
+        for (slot, cs) in out.iter_mut().zip(M::Vars::CONTINUOUS_STATES) {
+            let vr = if derivative { cs.derivative } else { cs.state };
+            let value = self
+                .vars
+                .get_real(vr)
+                .ok_or_else(|| Fmi2Error::error(format!("value reference {vr} has no Real value")))?;
+            if !value.is_finite() {
+                let name = M::Vars::spec(vr).map_or("?", |s| s.name);
+                return Err(Fmi2Error::error(format!(
+                    "{name} = {value} at t = {} s is not finite",
+                    self.machine.time
+                )));
+            }
+            *slot = value;
+        }
+        Ok(())
+    }
+
+    /// fmi2GetContinuousStates.
+    pub fn get_continuous_states(&mut self, out: &mut [f64]) -> Fmi2Result {
+        self.read_states(out, false)
+    }
+
+    /// fmi2GetDerivatives.
+    pub fn get_derivatives(&mut self, out: &mut [f64]) -> Fmi2Result {
+        self.read_states(out, true)
+    }
+
+    /// fmi2GetNominalsOfContinuousStates (the `nominal` attributes; constant).
+    pub fn get_nominals(&self, out: &mut [f64]) -> Fmi2Result {
+        Self::check_nx(out.len(), "nx")?;
+        for (slot, cs) in out.iter_mut().zip(M::Vars::CONTINUOUS_STATES) {
+            *slot = cs.nominal;
+        }
+        Ok(())
     }
 
     pub fn restore(&mut self, snap: &Snapshot<M>) {

@@ -1,4 +1,5 @@
-//! Generic FMI 2.0 Co-Simulation export layer.
+//! Generic FMI 2.0 export layer: Co-Simulation, and Model Exchange for models
+//! with continuous states.
 //!
 //! A model implements [`FmuModel`] (its equations) on top of a generated
 //! [`VariableStore`] (its variables); `export_fmu!(MyModel);` then emits every
@@ -12,6 +13,7 @@ pub mod instance;
 pub mod logger;
 pub mod model;
 pub mod state;
+pub mod test_host;
 pub mod testing;
 pub mod variables;
 
@@ -22,7 +24,7 @@ pub use instance::{Fmi2Error, Fmi2Result, FmiState, Instance, Snapshot};
 pub use logger::{Level, LogSink, Logger};
 pub use model::{FmuModel, ModelError};
 pub use state::{StateError, StateReader, StateWriter};
-pub use variables::{Causality, ValueType, Variability, VariableSpec, VariableStore};
+pub use variables::{Causality, ContinuousState, ValueType, Variability, VariableSpec, VariableStore};
 
 /// Log categories of every FMU built on this layer (name, description), in
 /// the order of `<LogCategories>` in modelDescription.xml.
@@ -36,8 +38,8 @@ pub const LOG_CATEGORIES: &[(&str, &str)] = &[
 ];
 
 /// Export model type `$model` (implementing [`FmuModel`]) as an FMI 2.0
-/// Co-Simulation FMU: emits every FMI 2.0 function (Co-Simulation and the
-/// Model Exchange ones, which fail with "not supported") with its exact C
+/// Co-Simulation FMU, and also as Model Exchange when its variables declare
+/// continuous states: emits every FMI 2.0 function of both interfaces with its exact C
 /// signature, checked at compile time against the `fmi-sys` `…TYPE` aliases.
 /// Each body delegates to the generic function of [`ffi`].
 ///
@@ -148,36 +150,36 @@ macro_rules! export_fmu {
             fmi2GetStringStatus [fmi2GetStringStatusTYPE] (c: $crate::fmi_sys::fmi2::fmi2Component, s: $crate::fmi_sys::fmi2::fmi2StatusKind,
                 value: *mut $crate::fmi_sys::fmi2::fmi2String) -> $crate::fmi_sys::fmi2::fmi2Status
                 => $crate::ffi::get_string_status::<$model>(c, s, value);
-            // Model Exchange only.
+            // Model Exchange.
             fmi2EnterEventMode [fmi2EnterEventModeTYPE] (c: $crate::fmi_sys::fmi2::fmi2Component) -> $crate::fmi_sys::fmi2::fmi2Status
-                => $crate::ffi::model_exchange_only::<$model>(c, "fmi2EnterEventMode");
-            fmi2NewDiscreteStates [fmi2NewDiscreteStatesTYPE] (c: $crate::fmi_sys::fmi2::fmi2Component, _info: *mut $crate::fmi_sys::fmi2::fmi2EventInfo)
+                => $crate::ffi::enter_event_mode::<$model>(c);
+            fmi2NewDiscreteStates [fmi2NewDiscreteStatesTYPE] (c: $crate::fmi_sys::fmi2::fmi2Component, info: *mut $crate::fmi_sys::fmi2::fmi2EventInfo)
                 -> $crate::fmi_sys::fmi2::fmi2Status
-                => $crate::ffi::model_exchange_only::<$model>(c, "fmi2NewDiscreteStates");
+                => $crate::ffi::new_discrete_states::<$model>(c, info);
             fmi2EnterContinuousTimeMode [fmi2EnterContinuousTimeModeTYPE] (c: $crate::fmi_sys::fmi2::fmi2Component) -> $crate::fmi_sys::fmi2::fmi2Status
-                => $crate::ffi::model_exchange_only::<$model>(c, "fmi2EnterContinuousTimeMode");
-            fmi2CompletedIntegratorStep [fmi2CompletedIntegratorStepTYPE] (c: $crate::fmi_sys::fmi2::fmi2Component, _no_set_prior: $crate::fmi_sys::fmi2::fmi2Boolean,
-                _enter_event_mode: *mut $crate::fmi_sys::fmi2::fmi2Boolean,
-                _terminate: *mut $crate::fmi_sys::fmi2::fmi2Boolean) -> $crate::fmi_sys::fmi2::fmi2Status
-                => $crate::ffi::model_exchange_only::<$model>(c, "fmi2CompletedIntegratorStep");
-            fmi2SetTime [fmi2SetTimeTYPE] (c: $crate::fmi_sys::fmi2::fmi2Component, _time: $crate::fmi_sys::fmi2::fmi2Real)
+                => $crate::ffi::enter_continuous_time_mode::<$model>(c);
+            fmi2CompletedIntegratorStep [fmi2CompletedIntegratorStepTYPE] (c: $crate::fmi_sys::fmi2::fmi2Component, no_set_prior: $crate::fmi_sys::fmi2::fmi2Boolean,
+                enter_event_mode: *mut $crate::fmi_sys::fmi2::fmi2Boolean,
+                terminate: *mut $crate::fmi_sys::fmi2::fmi2Boolean) -> $crate::fmi_sys::fmi2::fmi2Status
+                => $crate::ffi::completed_integrator_step::<$model>(c, no_set_prior, enter_event_mode, terminate);
+            fmi2SetTime [fmi2SetTimeTYPE] (c: $crate::fmi_sys::fmi2::fmi2Component, time: $crate::fmi_sys::fmi2::fmi2Real)
                 -> $crate::fmi_sys::fmi2::fmi2Status
-                => $crate::ffi::model_exchange_only::<$model>(c, "fmi2SetTime");
-            fmi2SetContinuousStates [fmi2SetContinuousStatesTYPE] (c: $crate::fmi_sys::fmi2::fmi2Component, _x: *const $crate::fmi_sys::fmi2::fmi2Real, _nx: usize)
+                => $crate::ffi::set_time::<$model>(c, time);
+            fmi2SetContinuousStates [fmi2SetContinuousStatesTYPE] (c: $crate::fmi_sys::fmi2::fmi2Component, x: *const $crate::fmi_sys::fmi2::fmi2Real, nx: usize)
                 -> $crate::fmi_sys::fmi2::fmi2Status
-                => $crate::ffi::model_exchange_only::<$model>(c, "fmi2SetContinuousStates");
-            fmi2GetDerivatives [fmi2GetDerivativesTYPE] (c: $crate::fmi_sys::fmi2::fmi2Component, _dx: *mut $crate::fmi_sys::fmi2::fmi2Real, _nx: usize)
+                => $crate::ffi::set_continuous_states::<$model>(c, x, nx);
+            fmi2GetDerivatives [fmi2GetDerivativesTYPE] (c: $crate::fmi_sys::fmi2::fmi2Component, dx: *mut $crate::fmi_sys::fmi2::fmi2Real, nx: usize)
                 -> $crate::fmi_sys::fmi2::fmi2Status
-                => $crate::ffi::model_exchange_only::<$model>(c, "fmi2GetDerivatives");
-            fmi2GetEventIndicators [fmi2GetEventIndicatorsTYPE] (c: $crate::fmi_sys::fmi2::fmi2Component, _z: *mut $crate::fmi_sys::fmi2::fmi2Real, _ni: usize)
+                => $crate::ffi::get_derivatives::<$model>(c, dx, nx);
+            fmi2GetEventIndicators [fmi2GetEventIndicatorsTYPE] (c: $crate::fmi_sys::fmi2::fmi2Component, z: *mut $crate::fmi_sys::fmi2::fmi2Real, ni: usize)
                 -> $crate::fmi_sys::fmi2::fmi2Status
-                => $crate::ffi::model_exchange_only::<$model>(c, "fmi2GetEventIndicators");
-            fmi2GetContinuousStates [fmi2GetContinuousStatesTYPE] (c: $crate::fmi_sys::fmi2::fmi2Component, _x: *mut $crate::fmi_sys::fmi2::fmi2Real, _nx: usize)
+                => $crate::ffi::get_event_indicators::<$model>(c, z, ni);
+            fmi2GetContinuousStates [fmi2GetContinuousStatesTYPE] (c: $crate::fmi_sys::fmi2::fmi2Component, x: *mut $crate::fmi_sys::fmi2::fmi2Real, nx: usize)
                 -> $crate::fmi_sys::fmi2::fmi2Status
-                => $crate::ffi::model_exchange_only::<$model>(c, "fmi2GetContinuousStates");
+                => $crate::ffi::get_continuous_states::<$model>(c, x, nx);
             fmi2GetNominalsOfContinuousStates [fmi2GetNominalsOfContinuousStatesTYPE] (c: $crate::fmi_sys::fmi2::fmi2Component,
-                _x_nominal: *mut $crate::fmi_sys::fmi2::fmi2Real, _nx: usize) -> $crate::fmi_sys::fmi2::fmi2Status
-                => $crate::ffi::model_exchange_only::<$model>(c, "fmi2GetNominalsOfContinuousStates");
+                x_nominal: *mut $crate::fmi_sys::fmi2::fmi2Real, nx: usize) -> $crate::fmi_sys::fmi2::fmi2Status
+                => $crate::ffi::get_nominals_of_continuous_states::<$model>(c, x_nominal, nx);
         }
 
         /// FMI 2.0 `fmi2Instantiate` (see `fmi2_export::ffi::instantiate`).

@@ -1,4 +1,5 @@
-//! The trait a model implements to be exported as an FMI 2.0 Co-Simulation FMU.
+//! The trait a model implements to be exported as an FMI 2.0 Co-Simulation (and,
+//! with continuous states, Model Exchange) FMU.
 //! The export layer owns the state machine, argument checks, logging, FMU state
 //! and panic safety; a model only supplies its equations.
 
@@ -58,6 +59,17 @@ pub trait FmuModel: Clone + Send + 'static {
     /// on return, `vars` outputs hold values at `t + h`. Must not allocate on
     /// the success path.
     fn do_step(&mut self, vars: &mut Self::Vars, t: f64, h: f64, log: &mut Logger<'_>) -> Result<(), ModelError>;
+
+    /// Model Exchange (only for models whose `Vars::CONTINUOUS_STATES` is not empty):
+    /// take the continuous states `x` (finite, in the order of `CONTINUOUS_STATES`) as the
+    /// internal state. The export layer then calls [`Self::update_outputs`], which must
+    /// also write every derivative variable of `CONTINUOUS_STATES` (ẋ at the current
+    /// states and inputs). Default: an error (Co-Simulation-only model).
+    fn set_continuous_states(&mut self, _vars: &mut Self::Vars, _x: &[f64]) -> Result<(), ModelError> {
+        Err(ModelError::new(
+            "this model has no continuous states (Co-Simulation only)",
+        ))
+    }
 
     /// Append the complete internal state (everything `do_step` depends on
     /// besides `vars`) to an FMU-state buffer.

@@ -53,6 +53,15 @@ pub struct VariableSpec {
 
 /// The generated per-model value store: one named field per variable, holding
 /// the current value. Implemented by generated code only.
+/// One continuous state of a Model Exchange FMU: the value references of the state
+/// and of its derivative, and the state's nominal value (`nominal` attribute).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContinuousState {
+    pub state: u32,
+    pub derivative: u32,
+    pub nominal: f64,
+}
+
 pub trait VariableStore: Clone + Send + 'static {
     /// Every declared variable, in declaration order.
     const VARIABLES: &'static [VariableSpec];
@@ -80,6 +89,10 @@ pub trait VariableStore: Clone + Send + 'static {
     fn read_state(&mut self, r: &mut crate::state::StateReader<'_>) -> Result<(), crate::state::StateError>;
 
     /// The spec of a value reference, if declared.
+    /// Model Exchange: the continuous states, in the order of the continuous-state
+    /// vector (fmi2GetContinuousStates, fmi2GetDerivatives). Empty: Co-Simulation only.
+    const CONTINUOUS_STATES: &'static [ContinuousState] = &[];
+
     fn spec(value_reference: u32) -> Option<&'static VariableSpec> {
         Self::index_of(value_reference).map(|i| &Self::VARIABLES[i])
     }

@@ -20,7 +20,8 @@ pub mod trajectory;
 pub mod weights;
 
 use flight_mission::{
-    Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, FlightController, MissionParams, Notice,
+    Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, MissionParams, Notice, ParamError,
+    SampledUnit,
 };
 use nalgebra::{SMatrix, SVector, Vector3};
 use tailsitter_physics::Airframe;
@@ -32,10 +33,10 @@ use model::{ix, linearise, state_of, wrap_pi, EulerRep, I_POS, NA, NU, NX, U, X}
 use trajectory::{TrajPoint, Trajectory, TrajectoryMode, TrajectoryOptions};
 use weights::{load_set, WeightSchedule, Weights, DEFAULT_WEIGHTS_JSON};
 
-/// Smallest reference airspeed the (V, α, β) model for control supports \[m/s\].
+/// Smallest reference airspeed the (V, α, β) model for control supports (m/s).
 pub const MIN_AIRSPEED: f64 = 0.5;
 
-/// Bound on the magnitude of the wind estimate \[m/s\].
+/// Bound on the magnitude of the wind estimate (m/s).
 pub const MAX_WIND_ESTIMATE: f64 = 20.0;
 
 /// Size of the augmented ZOH exponential: states + integrator + inputs.
@@ -48,7 +49,7 @@ pub type Gain = SMatrix<f64, NU, NA>;
 /// parameter names).
 #[derive(Debug, Clone, PartialEq)]
 pub struct LqrParams {
-    /// T_l: period of relinearisation and gain computation \[s\] (§3.1.3, §3.2.4: 0.2 s).
+    /// T_l: period of relinearisation and gain computation (s) (§3.1.3, §3.2.4: 0.2 s).
     pub relinearisation_period: f64,
     /// 0 = exact steady-state DARE (structured doubling), 1 = the thesis's backward
     /// iteration over `riccati_horizon` steps (3.1.3–3.1.5).
@@ -59,13 +60,13 @@ pub struct LqrParams {
     pub r_scale: f64,
     /// Index of the weight set in the weights JSON (0 = thesis Table 3.4).
     pub weight_set: i32,
-    /// Time over which the weights blend from one phase's table to the next \[s\].
+    /// Time over which the weights blend from one phase's table to the next (s).
     pub weight_blend_time: f64,
-    /// Reference 3-2-1 pitch above which the 2-3-1 Euler set is used \[rad\].
+    /// Reference 3-2-1 pitch above which the 2-3-1 Euler set is used (rad).
     pub euler_switch_pitch: f64,
-    /// Limit of the airspeed-error integrator |∫ΔV dt| \[m\].
+    /// Limit of the airspeed-error integrator |∫ΔV dt| (m).
     pub integrator_limit: f64,
-    /// Leak λ of the airspeed integrator, ẋ_I = V − V_t − λ x_I \[1/s\]. Must be > 0: with
+    /// Leak λ of the airspeed integrator, ẋ_I = V − V_t − λ x_I (1/s). Must be > 0: with
     /// λ = 0 the integrator minus the along-track position is an uncontrollable mode at
     /// z = 1 (ẋ_I = ΔV = along-track Δṗ in straight flight) and no stabilising DARE
     /// solution exists.
@@ -74,9 +75,9 @@ pub struct LqrParams {
     /// steady-state position error in a steady wind or with a model mismatch); 0 = the
     /// thesis's structure, integral action on airspeed only (3.2.12–3.2.14).
     pub position_integral: i32,
-    /// Limit of each position-error integrator |∫Δp dt| \[m·s\].
+    /// Limit of each position-error integrator |∫Δp dt| (m·s).
     pub position_integrator_limit: f64,
-    /// Leak of the position integrators \[1/s\], ẋ_Ip = p − p_t − λ_p x_Ip. Not needed for
+    /// Leak of the position integrators (1/s), ẋ_Ip = p − p_t − λ_p x_Ip. Not needed for
     /// stabilisability (see `solve_gain`); > 0 trades the zero steady-state error for less
     /// integrator memory.
     pub position_integrator_leak: f64,
@@ -85,13 +86,13 @@ pub struct LqrParams {
     /// reference attitude, weighted by sin²θ_ref (full in vertical flight, none in level
     /// flight); 0 = the thesis's no-wind reference (V_t, α_t, β_t = 0).
     pub wind_compensation: i32,
-    /// Time constant of the wind estimate ŵ = low-pass(v_inertial − DCMᵀ v_air) \[s\].
+    /// Time constant of the wind estimate ŵ = low-pass(v_inertial − DCMᵀ v_air) (s).
     pub wind_filter_time: f64,
     /// Trajectory: 0 = thesis closed forms (3.3.3–3.3.4, 3.3.13–3.3.17), 1 = force balance.
     pub trajectory_mode: i32,
-    /// α_max of (3.3.4) \[rad\] (trajectory_mode 0 only).
+    /// α_max of (3.3.4) (rad) (trajectory_mode 0 only).
     pub alpha_max: f64,
-    /// Banked-turn radius ρ in the level segment \[m\] (3.3.18–3.3.21); 0 = straight, < 0 left.
+    /// Banked-turn radius ρ in the level segment (m) (3.3.18–3.3.21); 0 = straight, < 0 left.
     pub turn_radius: f64,
 }
 
@@ -139,9 +140,9 @@ pub struct LqrController {
     // ---- state ----
     origin: Option<Vector3<f64>>,
     integrator: f64,
-    /// ∫ΔN, ∫ΔE, ∫Δh \[m·s\].
+    /// ∫ΔN, ∫ΔE, ∫Δh (m·s).
     pos_integrator: Vector3<f64>,
-    /// Low-pass wind estimate, NED \[m/s\]; NaN before the first sample.
+    /// Low-pass wind estimate, NED (m/s); NaN before the first sample.
     wind: Vector3<f64>,
     gain: Gain,
     have_gain: bool,
@@ -151,15 +152,7 @@ pub struct LqrController {
 }
 
 /// Names of the commands, for [`Notice::Saturated`].
-const COMMAND_NAMES: [&str; NU] = [
-    "thrust_cmd",
-    "elevator_cmd",
-    "aileron_cmd",
-    "rudder_cmd",
-    "flap_collective_cmd",
-    "flap_differential_cmd",
-    "vertical_flap_cmd",
-];
+use tailsitter_physics::idx::INPUT_NAMES as COMMAND_NAMES;
 
 /// The result of one gain computation.
 #[derive(Debug, Clone, Copy)]
@@ -325,7 +318,7 @@ impl LqrController {
         self.params.position_integral != 0
     }
 
-    /// The position integrators ∫ΔN, ∫ΔE, ∫Δh \[m·s\] and the wind estimate (NED, m/s).
+    /// The position integrators ∫ΔN, ∫ΔE, ∫Δh (m·s) and the wind estimate (NED, m/s).
     pub fn integrator_states(&self) -> (f64, Vector3<f64>, Vector3<f64>) {
         (self.integrator, self.pos_integrator, self.wind)
     }
@@ -483,7 +476,7 @@ impl LqrController {
         }
     }
 
-    /// Append the controller's state (everything `update` depends on besides its
+    /// Append the controller's state (everything `sample` depends on besides its
     /// construction parameters) as f64s.
     pub fn save(&self, out: &mut impl FnMut(f64)) {
         let origin = self
@@ -552,8 +545,58 @@ impl LqrController {
     }
 }
 
-impl FlightController for LqrController {
-    fn update(&mut self, input: &ControllerInput) -> Result<ControllerOutput, ControlError> {
+/// Everything an [`LqrController`] is built from: the FMU's parameters.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LqrConfig {
+    /// The controller's own model of the airframe (may differ from the plant's).
+    pub airframe: Airframe,
+    pub mission: MissionParams,
+    pub params: LqrParams,
+    /// Weight tables in a JSON file (`weights_file`); empty: the built-in tables.
+    pub weights_file: String,
+}
+
+impl LqrConfig {
+    /// The nominal airframe, the given mission, default tuning and weights.
+    pub fn with_mission(mission: MissionParams) -> Self {
+        Self {
+            airframe: Airframe::default(),
+            mission,
+            params: LqrParams::default(),
+            weights_file: String::new(),
+        }
+    }
+}
+
+impl SampledUnit for LqrController {
+    type Config = LqrConfig;
+    type Input = ControllerInput;
+    type Output = ControllerOutput;
+
+    fn build(c: &LqrConfig) -> Result<Self, ParamError> {
+        if c.weights_file.is_empty() {
+            Self::new(c.airframe, c.mission, c.params.clone())
+        } else {
+            let json = std::fs::read_to_string(&c.weights_file)
+                .map_err(|e| ParamError(format!("weights_file {:?}: {e}", c.weights_file)))?;
+            Self::with_weights_json(c.airframe, c.mission, c.params.clone(), &json)
+        }
+        .map_err(|e| ParamError(e.0))
+    }
+
+    fn sample_time(c: &LqrConfig) -> f64 {
+        c.mission.sample_time
+    }
+
+    fn save(&self, out: &mut impl FnMut(f64)) {
+        Self::save(self, out)
+    }
+
+    fn restore(&mut self, next: &mut impl FnMut() -> Option<f64>) -> Result<(), ControlError> {
+        Self::restore(self, next)
+    }
+
+    fn sample(&mut self, input: &ControllerInput) -> Result<ControllerOutput, ControlError> {
         let m = &input.measurement;
         if let Some(name) = m.first_non_finite() {
             return Err(ControlError(format!("measurement {name} is not finite")));

@@ -3,7 +3,30 @@
 //! (structured doubling), the thesis's finite-horizon backward Riccati iteration
 //! (3.1.3–3.1.5), the LQR gain and a spectral-radius bound.
 
-use nalgebra::{SMatrix, SVector};
+use nalgebra::{ArrayStorage, SMatrix, SVector};
+
+/// Run `$body` (an expression calling `#[inline(always)]` code) compiled for AVX2 when the
+/// CPU has it, else for the baseline target. Both builds perform the same floating-point
+/// operations in the same order (no FMA contraction), so they give bit-identical results.
+macro_rules! simd_dispatch {
+    ($ret:ty, $body:expr) => {{
+        #[cfg(target_arch = "x86_64")]
+        {
+            #[target_feature(enable = "avx2")]
+            #[inline]
+            unsafe fn avx2<R, F: FnOnce() -> R>(f: F) -> R {
+                f()
+            }
+            if std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: the CPU supports AVX2 (checked just above), the only requirement
+                // of the `#[target_feature(enable = "avx2")]` function.
+                let r: $ret = unsafe { avx2(|| $body) };
+                return r;
+            }
+        }
+        $body
+    }};
+}
 
 /// Why a Riccati solve was rejected.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -37,6 +60,11 @@ impl RiccatiError {
 /// approximant: A is scaled by 2^-s so that ‖A/2^s‖₁ ≤ 1/2, where the [6/6] Padé
 /// error is below 1e-16 relative (Moler & Van Loan, "Nineteen dubious ways", method 3).
 pub fn expm<const N: usize>(a: &SMatrix<f64, N, N>) -> SMatrix<f64, N, N> {
+    simd_dispatch!(SMatrix<f64, N, N>, expm_impl(a))
+}
+
+#[inline(always)]
+fn expm_impl<const N: usize>(a: &SMatrix<f64, N, N>) -> SMatrix<f64, N, N> {
     // Padé coefficients c_k = (2q−k)! q! / ((2q)! k! (q−k)!), q = 6.
     const C: [f64; 7] = [
         1.0,
@@ -52,24 +80,48 @@ pub fn expm<const N: usize>(a: &SMatrix<f64, N, N>) -> SMatrix<f64, N, N> {
     if norm > 0.5 {
         s = (norm / 0.5).log2().ceil() as i32;
     }
-    let x = a * 2f64.powi(-s);
-    let id = SMatrix::<f64, N, N>::identity();
-    let x2 = x * x;
-    let x4 = x2 * x2;
-    let x6 = x4 * x2;
+    let scale = 2f64.powi(-s);
+    let mut x = a.data.0;
+    for col in x.iter_mut() {
+        for v in col.iter_mut() {
+            *v *= scale;
+        }
+    }
+    let x2 = dense::mul(&x, &x);
+    let x4 = dense::mul(&x2, &x2);
+    let x6 = dense::mul(&x4, &x2);
     // Even part U and odd part V: N = U + V, D = U − V.
-    let u = id * C[0] + x2 * C[2] + x4 * C[4] + x6 * C[6];
-    let v = x * (id * C[1] + x2 * C[3] + x4 * C[5]);
-    let num = u + v;
-    let den = u - v;
-    let mut e = match Lu::new(&den) {
-        Some(lu) => lu.solve(&num),
-        None => SMatrix::from_element(f64::NAN),
+    let mut u = [[0.0; N]; N];
+    let mut vi = [[0.0; N]; N];
+    for j in 0..N {
+        for i in 0..N {
+            u[j][i] = x2[j][i] * C[2] + x4[j][i] * C[4] + x6[j][i] * C[6];
+            vi[j][i] = x2[j][i] * C[3] + x4[j][i] * C[5];
+        }
+        u[j][j] += C[0];
+        vi[j][j] += C[1];
+    }
+    let v = dense::mul(&x, &vi);
+    let mut den = [[0.0; N]; N];
+    let mut num = [[0.0; N]; N];
+    for j in 0..N {
+        for i in 0..N {
+            num[j][i] = u[j][i] + v[j][i];
+            den[j][i] = u[j][i] - v[j][i];
+        }
+    }
+    // Row-major right-hand side: the rows of N are the columns of Nᵀ.
+    let mut y = dense::transpose(&num);
+    let mut none = [[0.0; 0]; N];
+    let mut e = if dense::lu_solve2(&mut den, &mut y, &mut none) {
+        dense::transpose(&y)
+    } else {
+        [[f64::NAN; N]; N]
     };
     for _ in 0..s {
-        e = e * e;
+        e = dense::mul(&e, &e);
     }
-    e
+    SMatrix::from_data(ArrayStorage(e))
 }
 
 /// Zero-order-hold discretisation (replacing the Euler approximation (3.2.10–3.2.11)):
@@ -190,8 +242,27 @@ fn all_finite<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> bool {
 ///
 /// `r_diag` is the diagonal of R (control weights are diagonal, (3.4.2)). After k
 /// doublings H_k equals the finite-horizon Riccati iterate of 2^k steps, so the
-/// solution is the N → ∞ limit of the thesis's backward iteration.
+/// solution is the N → ∞ limit of the thesis's backward iteration. The iteration stops
+/// when ‖H_{k+1} − H_k‖_F ≤ 1e-13 ‖H_{k+1}‖_F.
+///
+/// The iteration runs on [`dense`] kernels (column-major arrays, constant trip counts,
+/// no heap) compiled twice: for the baseline target and, selected at run time when the
+/// CPU has it, for AVX2. Both perform the same floating-point operations in the same
+/// order (no FMA contraction), so they return bit-identical results.
 pub fn dare_sda<const N: usize, const U: usize>(
+    phi: &SMatrix<f64, N, N>,
+    gamma: &SMatrix<f64, N, U>,
+    q: &SMatrix<f64, N, N>,
+    r_diag: &SVector<f64, U>,
+) -> Result<SMatrix<f64, N, N>, RiccatiError> {
+    simd_dispatch!(
+        Result<SMatrix<f64, N, N>, RiccatiError>,
+        dare_sda_impl(phi, gamma, q, r_diag)
+    )
+}
+
+#[inline(always)]
+fn dare_sda_impl<const N: usize, const U: usize>(
     phi: &SMatrix<f64, N, N>,
     gamma: &SMatrix<f64, N, U>,
     q: &SMatrix<f64, N, N>,
@@ -200,38 +271,261 @@ pub fn dare_sda<const N: usize, const U: usize>(
     if r_diag.iter().any(|r| r.is_nan() || *r <= 0.0) {
         return Err(RiccatiError::Singular("control weight R not positive definite"));
     }
-    let mut gr = *gamma;
-    for (j, mut col) in gr.column_iter_mut().enumerate() {
-        col /= r_diag[j];
+    // G₀ = Γ R⁻¹ Γᵀ.
+    let mut gr = gamma.data.0;
+    for (j, col) in gr.iter_mut().enumerate() {
+        let rj = r_diag[j];
+        for v in col.iter_mut() {
+            *v /= rj;
+        }
     }
-    let mut g = gr * gamma.transpose();
-    symmetrise(&mut g);
-    let mut a = *phi;
-    let mut h = *q;
-    let id = SMatrix::<f64, N, N>::identity();
+    let gt = dense::transpose(&gamma.data.0);
+    let mut g = dense::mul(&gr, &gt);
+    dense::symmetrise(&mut g);
+    let mut a = phi.data.0;
+    let mut h = q.data.0;
     for _ in 0..60 {
-        let w = id + g * h;
-        let lu = Lu::new(&w).ok_or(RiccatiError::Singular("I + G H singular in doubling"))?;
-        let x1 = lu.solve(&a);
-        let x2 = lu.solve(&g);
-        let h_new = h + a.transpose() * h * x1;
-        let g_new = g + a * x2 * a.transpose();
-        let a_new = a * x1;
-        let mut h_new = h_new;
-        symmetrise(&mut h_new);
-        g = g_new;
-        symmetrise(&mut g);
-        if !all_finite(&h_new) || !all_finite(&g) || !all_finite(&a_new) {
+        // W = I + G H; X₁ = W⁻¹ A, X₂ = W⁻¹ G.
+        let mut w = dense::mul(&g, &h);
+        for (i, col) in w.iter_mut().enumerate() {
+            col[i] += 1.0;
+        }
+        // Row-major right-hand sides: Aᵀ's columns are A's rows, G is symmetric.
+        let at = dense::transpose(&a);
+        let mut y1 = at;
+        let mut y2 = g;
+        if !dense::lu_solve2(&mut w, &mut y1, &mut y2) {
+            return Err(RiccatiError::Singular("I + G H singular in doubling"));
+        }
+        let x1 = dense::transpose(&y1);
+        let x2 = dense::transpose(&y2);
+        // H ← H + Aᵀ (H X₁), G ← G + (A X₂) Aᵀ, A ← A X₁.
+        let mut h_new = dense::mul_add(&h, &at, &dense::mul(&h, &x1));
+        dense::symmetrise(&mut h_new);
+        g = dense::mul_add(&g, &dense::mul(&a, &x2), &at);
+        dense::symmetrise(&mut g);
+        a = dense::mul(&a, &x1);
+        let change2 = dense::diff_norm2(&h_new, &h);
+        h = h_new;
+        let g_norm2 = dense::norm2(&g);
+        let h_norm2 = dense::norm2(&h);
+        let a_norm2 = dense::norm2(&a);
+        if !(h_norm2.is_finite() && g_norm2.is_finite() && a_norm2.is_finite()) {
             return Err(RiccatiError::NonFinite);
         }
-        let change = (h_new - h).norm();
-        h = h_new;
-        a = a_new;
-        if change <= 1e-13 * h.norm() {
-            return Ok(h);
+        // Stop when the last change is below 1e-13 relative, or when ‖A_{k+1}‖_F² ≤ 1e-13:
+        // 0 ≤ P − H_{k+1} ≤ A_{k+1}ᵀ P A_{k+1} (Lin & Xu 2006, Thm 3.1: P − H_k =
+        // A_kᵀ (P⁻¹ + G_k)⁻¹ A_k with G_k ≥ 0), so then ‖P − H_{k+1}‖₂ ≤ 1e-13 ‖P‖₂.
+        // The second test saves the last doubling, whose change is already ≈ 1e-19.
+        if change2.sqrt() <= 1e-13 * h_norm2.sqrt() || a_norm2 <= 1e-13 {
+            return Ok(SMatrix::from_data(ArrayStorage(h)));
         }
     }
     Err(RiccatiError::NotConverged)
+}
+
+/// Dense kernels on column-major arrays `[[f64; R]; C]` (nalgebra's static storage):
+/// constant trip counts and column-wise updates (no reductions in the inner loops) so
+/// that the compiler vectorises them for the target it compiles for. All
+/// `#[inline(always)]`, so that a `#[target_feature]` caller gets them compiled for its
+/// features.
+// Index loops over constant ranges are the point here (they vectorise); iterator
+// adaptors over partial ranges do not always.
+#[allow(clippy::needless_range_loop)]
+pub mod dense {
+    /// `A B`, two result columns at a time (each column of A loaded once per pair).
+    #[inline(always)]
+    pub fn mul<const R: usize, const K: usize, const C: usize>(a: &[[f64; R]; K], b: &[[f64; K]; C]) -> [[f64; R]; C] {
+        let mut c = [[0.0; R]; C];
+        let mut j = 0;
+        while j + 1 < C {
+            let (b0, b1) = (&b[j], &b[j + 1]);
+            let mut acc0 = [0.0; R];
+            let mut acc1 = [0.0; R];
+            for k in 0..K {
+                let (s0, s1) = (b0[k], b1[k]);
+                let ak = &a[k];
+                for i in 0..R {
+                    acc0[i] += ak[i] * s0;
+                    acc1[i] += ak[i] * s1;
+                }
+            }
+            c[j] = acc0;
+            c[j + 1] = acc1;
+            j += 2;
+        }
+        if j < C {
+            let mut acc = [0.0; R];
+            for (ak, &s) in a.iter().zip(b[j].iter()) {
+                for i in 0..R {
+                    acc[i] += ak[i] * s;
+                }
+            }
+            c[j] = acc;
+        }
+        c
+    }
+
+    /// `D + A B`.
+    #[inline(always)]
+    pub fn mul_add<const R: usize, const K: usize, const C: usize>(
+        d: &[[f64; R]; C],
+        a: &[[f64; R]; K],
+        b: &[[f64; K]; C],
+    ) -> [[f64; R]; C] {
+        let mut c = mul(a, b);
+        for (cj, dj) in c.iter_mut().zip(d.iter()) {
+            for i in 0..R {
+                cj[i] += dj[i];
+            }
+        }
+        c
+    }
+
+    /// `Aᵀ`.
+    #[inline(always)]
+    pub fn transpose<const R: usize, const C: usize>(a: &[[f64; R]; C]) -> [[f64; C]; R] {
+        let mut t = [[0.0; C]; R];
+        for (j, aj) in a.iter().enumerate() {
+            for (i, v) in aj.iter().enumerate() {
+                t[i][j] = *v;
+            }
+        }
+        t
+    }
+
+    /// `M ← s M`.
+    #[inline(always)]
+    pub fn scale<const R: usize, const C: usize>(m: &mut [[f64; R]; C], s: f64) {
+        for col in m.iter_mut() {
+            for v in col.iter_mut() {
+                *v *= s;
+            }
+        }
+    }
+
+    /// `(M + Mᵀ)/2` in place.
+    #[inline(always)]
+    pub fn symmetrise<const N: usize>(m: &mut [[f64; N]; N]) {
+        for j in 0..N {
+            for i in (j + 1)..N {
+                let v = 0.5 * (m[j][i] + m[i][j]);
+                m[j][i] = v;
+                m[i][j] = v;
+            }
+        }
+    }
+
+    /// Squared Frobenius norm.
+    #[inline(always)]
+    pub fn norm2<const R: usize, const C: usize>(a: &[[f64; R]; C]) -> f64 {
+        let mut acc = [0.0; R];
+        for aj in a {
+            for i in 0..R {
+                acc[i] += aj[i] * aj[i];
+            }
+        }
+        acc.iter().sum()
+    }
+
+    /// Squared Frobenius norm of `A − B`.
+    #[inline(always)]
+    pub fn diff_norm2<const R: usize, const C: usize>(a: &[[f64; R]; C], b: &[[f64; R]; C]) -> f64 {
+        let mut acc = [0.0; R];
+        for (aj, bj) in a.iter().zip(b.iter()) {
+            for i in 0..R {
+                let d = aj[i] - bj[i];
+                acc[i] += d * d;
+            }
+        }
+        acc.iter().sum()
+    }
+
+    /// Solve `W X₁ = B₁` and `W X₂ = B₂` in place by Gaussian elimination with partial
+    /// pivoting; `W` is overwritten. The right-hand sides are given and returned
+    /// row-major (`y[i]` = row i, i.e. the column-major arrays of B₁ᵀ, B₂ᵀ), so that every
+    /// elimination and substitution step is one whole-row update. `false` if a pivot is
+    /// zero or not finite.
+    #[inline(always)]
+    pub fn lu_solve2<const N: usize, const C1: usize, const C2: usize>(
+        w: &mut [[f64; N]; N],
+        y1: &mut [[f64; C1]; N],
+        y2: &mut [[f64; C2]; N],
+    ) -> bool {
+        for k in 0..N {
+            let mut piv = k;
+            let mut best = w[k][k].abs();
+            for i in (k + 1)..N {
+                let v = w[k][i].abs();
+                if v > best {
+                    best = v;
+                    piv = i;
+                }
+            }
+            if !(best > 0.0 && best.is_finite()) {
+                return false;
+            }
+            if piv != k {
+                for col in w.iter_mut() {
+                    col.swap(k, piv);
+                }
+                y1.swap(k, piv);
+                y2.swap(k, piv);
+            }
+            // Multipliers l_i = w_ik / w_kk below the pivot, zero elsewhere, so that the
+            // rank-1 update of W runs over whole columns (constant trip count).
+            let d = w[k][k];
+            let mut l = [0.0; N];
+            for i in (k + 1)..N {
+                l[i] = w[k][i] / d;
+            }
+            for col in w.iter_mut().skip(k + 1) {
+                let s = col[k];
+                for i in 0..N {
+                    col[i] -= l[i] * s;
+                }
+            }
+            // Local copies of the pivot rows: no aliasing with the rows updated.
+            let (r1, r2) = (y1[k], y2[k]);
+            for i in (k + 1)..N {
+                let li = l[i];
+                let row1 = &mut y1[i];
+                for j in 0..C1 {
+                    row1[j] -= li * r1[j];
+                }
+                let row2 = &mut y2[i];
+                for j in 0..C2 {
+                    row2[j] -= li * r2[j];
+                }
+            }
+        }
+        // Back substitution: row k /= u_kk, then subtract u_ik · row k from the rows above.
+        for k in (0..N).rev() {
+            let d = w[k][k];
+            let mut r1 = y1[k];
+            let mut r2 = y2[k];
+            for v in r1.iter_mut() {
+                *v /= d;
+            }
+            for v in r2.iter_mut() {
+                *v /= d;
+            }
+            y1[k] = r1;
+            y2[k] = r2;
+            for i in 0..k {
+                let u = w[k][i];
+                let row1 = &mut y1[i];
+                for j in 0..C1 {
+                    row1[j] -= u * r1[j];
+                }
+                let row2 = &mut y2[i];
+                for j in 0..C2 {
+                    row2[j] -= u * r2[j];
+                }
+            }
+        }
+        true
+    }
 }
 
 /// LQR gain `K = (R + Γᵀ P Γ)⁻¹ Γᵀ P Φ` ((3.1.5) with S = P).
@@ -335,26 +629,33 @@ pub fn riccati_backward<const N: usize, const U: usize>(
 /// κ the eigenvector condition number, so a value < 1 proves stability). Each square is
 /// normalised and the scale accumulated in logarithms, so nothing overflows.
 pub fn spectral_radius_bound<const N: usize>(m: &SMatrix<f64, N, N>) -> f64 {
-    let n0 = m.norm();
+    simd_dispatch!(f64, spectral_radius_bound_impl(m))
+}
+
+#[inline(always)]
+fn spectral_radius_bound_impl<const N: usize>(m: &SMatrix<f64, N, N>) -> f64 {
+    let n0 = dense::norm2(&m.data.0).sqrt();
     if !n0.is_finite() {
         return f64::INFINITY;
     }
     if n0 == 0.0 {
         return 0.0;
     }
-    let mut x = m / n0;
+    let mut x = m.data.0;
+    dense::scale(&mut x, 1.0 / n0);
     let mut log = n0.ln();
     let mut power = 1.0;
     for _ in 0..16 {
-        let y = x * x;
-        let n = y.norm();
+        let mut y = dense::mul(&x, &x);
+        let n = dense::norm2(&y).sqrt();
         if n == 0.0 {
             return 0.0;
         }
         if !n.is_finite() {
             return f64::INFINITY;
         }
-        x = y / n;
+        dense::scale(&mut y, 1.0 / n);
+        x = y;
         log = 2.0 * log + n.ln();
         power *= 2.0;
     }
@@ -461,6 +762,63 @@ mod tests {
             last = err;
         }
         assert!(last < 1e-8, "{last}");
+    }
+
+    /// A well-conditioned but unstructured test matrix (entries from a fixed sequence).
+    fn test_matrix<const R: usize, const C: usize>(seed: u64) -> SMatrix<f64, R, C> {
+        let mut state = seed;
+        SMatrix::from_fn(|_, _| {
+            // 64-bit LCG (Knuth's MMIX constants), mapped to [−1, 1).
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+        })
+    }
+
+    #[test]
+    fn dense_kernels_match_nalgebra() {
+        let a = test_matrix::<17, 13>(1);
+        let b = test_matrix::<13, 9>(2);
+        let c = SMatrix::<f64, 17, 9>::from_data(ArrayStorage(dense::mul(&a.data.0, &b.data.0)));
+        assert!((c - a * b).norm() < 1e-14 * (a.norm() * b.norm()));
+        let t = SMatrix::<f64, 13, 17>::from_data(ArrayStorage(dense::transpose(&a.data.0)));
+        assert_eq!(t, a.transpose());
+        // W X = B for a pivoting-demanding W (zero leading entry), two right-hand sides.
+        let mut w = test_matrix::<17, 17>(3) + SMatrix::<f64, 17, 17>::identity() * 0.5;
+        w[(0, 0)] = 0.0;
+        let b1 = test_matrix::<17, 5>(4);
+        let b2 = test_matrix::<17, 17>(5);
+        let mut wa = w.data.0;
+        let mut y1 = dense::transpose(&b1.data.0);
+        let mut y2 = dense::transpose(&b2.data.0);
+        assert!(dense::lu_solve2(&mut wa, &mut y1, &mut y2));
+        let x1 = SMatrix::<f64, 17, 5>::from_data(ArrayStorage(dense::transpose(&y1)));
+        let x2 = SMatrix::<f64, 17, 17>::from_data(ArrayStorage(dense::transpose(&y2)));
+        assert!((w * x1 - b1).norm() < 1e-12 * b1.norm(), "{}", (w * x1 - b1).norm());
+        assert!((w * x2 - b2).norm() < 1e-12 * b2.norm());
+        // A singular W is reported.
+        let mut s = w.data.0;
+        s[3] = s[5];
+        let (mut y1, mut y2) = (dense::transpose(&b1.data.0), dense::transpose(&b2.data.0));
+        assert!(!dense::lu_solve2(&mut s, &mut y1, &mut y2));
+    }
+
+    #[test]
+    fn simd_and_baseline_builds_agree_bitwise() {
+        // The dispatcher picks the AVX2 build on CPUs that have it; the `_impl` functions
+        // called directly are the baseline build. Same operations, same order: same bits.
+        let phi = test_matrix::<9, 9>(6) * 0.4 + SMatrix::<f64, 9, 9>::identity();
+        let gamma = test_matrix::<9, 3>(7);
+        let q = SMatrix::<f64, 9, 9>::from_diagonal(&SVector::<f64, 9>::from_fn(|i, _| 1.0 + i as f64));
+        let r = SVector::<f64, 3>::new(0.5, 2.0, 7.0);
+        let p = dare_sda(&phi, &gamma, &q, &r).unwrap();
+        assert_eq!(p, dare_sda_impl(&phi, &gamma, &q, &r).unwrap());
+        let k = lqr_gain(&phi, &gamma, &p, &r).unwrap();
+        assert!(dare_residual(&phi, &gamma, &q, &p, &k) < 1e-12);
+        assert_eq!(expm(&(phi * 0.3)), expm_impl(&(phi * 0.3)));
+        let cl = phi - gamma * k;
+        assert_eq!(spectral_radius_bound(&cl), spectral_radius_bound_impl(&cl));
     }
 
     #[test]

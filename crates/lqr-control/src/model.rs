@@ -7,7 +7,7 @@
 //!
 //! built on the same force model as the plant ([`Airframe::forces_moments`], §2.3) with
 //! the controller's own [`Airframe`], and rigid-body equations written here from first
-//! principles instead of the printed (2.4.6–2.4.29) (which carry typos, DESIGN.md §5):
+//! principles instead of the printed (2.4.6–2.4.29) (which carry typos, docs/DESIGN.md §5):
 //!
 //! * body velocity `v = V (cα cβ, sβ, sα cβ)` (inverse of (2.2.12–2.2.13), no wind);
 //! * `v̇ = F/m + DCM^BE (0, 0, g) − ω × v` ((2.2.19–2.2.21), gravity (2.3.14));
@@ -24,6 +24,7 @@
 //! as in the thesis). Linearisation (3.2.7–3.2.9) is by central differences.
 
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3, Vector4};
+use tailsitter_physics::numeric::central_differences;
 use tailsitter_physics::{
     dcm_earth_to_body, dcm_from_euler_231, euler_231_from_quat, euler_321_from_quat, Airframe, Surfaces,
 };
@@ -167,28 +168,21 @@ pub fn derivatives(af: &Airframe, rep: EulerRep, x: &X, u: &U) -> X {
 pub fn linearise(af: &Airframe, rep: EulerRep, x: &X, u: &U) -> (SMatrix<f64, NX, NX>, SMatrix<f64, NX, NU>) {
     let mut f = SMatrix::<f64, NX, NX>::zeros();
     let mut g = SMatrix::<f64, NX, NU>::zeros();
-    for j in 0..NX {
-        // Positions do not enter the dynamics: their columns are exactly zero.
-        if j == ix::N || j == ix::E || j == ix::H {
-            continue;
-        }
-        let h = 1e-6 * (1.0 + x[j].abs());
-        let mut xp = *x;
-        let mut xm = *x;
-        xp[j] += h;
-        xm[j] -= h;
-        let d = (derivatives(af, rep, &xp, u) - derivatives(af, rep, &xm, u)) / (2.0 * h);
-        f.set_column(j, &d);
-    }
-    for j in 0..NU {
-        let h = 1e-6 * (1.0 + u[j].abs());
-        let mut up = *u;
-        let mut um = *u;
-        up[j] += h;
-        um[j] -= h;
-        let d = (derivatives(af, rep, x, &up) - derivatives(af, rep, x, &um)) / (2.0 * h);
-        g.set_column(j, &d);
-    }
+    // Positions do not enter the dynamics: their columns are exactly zero.
+    central_differences(
+        x,
+        NX,
+        |j, v| (j != ix::N && j != ix::E && j != ix::H).then(|| 1e-6 * (1.0 + v.abs())),
+        |xp| derivatives(af, rep, xp, u),
+        |j, col| f.set_column(j, &col),
+    );
+    central_differences(
+        u,
+        NU,
+        |_, v| Some(1e-6 * (1.0 + v.abs())),
+        |up| derivatives(af, rep, x, up),
+        |j, col| g.set_column(j, &col),
+    );
     (f, g)
 }
 

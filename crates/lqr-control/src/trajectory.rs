@@ -40,9 +40,9 @@ use tailsitter_physics::{quat_from_euler_321, Airframe};
 
 use crate::model::{derivatives, ix, EulerRep, U, X};
 
-/// Table step \[s\].
+/// Table step (s).
 pub const TABLE_STEP: f64 = 0.01;
-/// Ramp time of the turn rate at the start and the end of the level segment \[s\].
+/// Ramp time of the turn rate at the start and the end of the level segment (s).
 pub const TURN_RAMP: f64 = 2.0;
 const FRAC_PI_2: f64 = core::f64::consts::FRAC_PI_2;
 const PI: f64 = core::f64::consts::PI;
@@ -60,9 +60,9 @@ pub enum TrajectoryMode {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TrajectoryOptions {
     pub mode: TrajectoryMode,
-    /// α_max of (3.3.4) \[rad\] (Thesis mode only).
+    /// α_max of (3.3.4) (rad) (Thesis mode only).
     pub alpha_max: f64,
-    /// Turn radius ρ \[m\] of the level segment (3.3.18–3.3.21); 0 = straight, < 0 left.
+    /// Turn radius ρ (m) of the level segment (3.3.18–3.3.21); 0 = straight, < 0 left.
     pub turn_radius: f64,
 }
 
@@ -79,21 +79,21 @@ impl Default for TrajectoryOptions {
 /// One reference point: state x_t and input u_t (positions relative to the start).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TrajPoint {
-    /// Mission time \[s\].
+    /// Mission time (s).
     pub t: f64,
-    /// Airspeed V \[m/s\].
+    /// Airspeed V (m/s).
     pub v: f64,
-    /// α \[rad\].
+    /// α (rad).
     pub alpha: f64,
-    /// Flight-path angle γ (wind-axis pitch) \[rad\].
+    /// Flight-path angle γ (wind-axis pitch) (rad).
     pub gamma: f64,
-    /// 3-2-1 Euler angles φ, θ, ψ \[rad\] (ψ not wrapped).
+    /// 3-2-1 Euler angles φ, θ, ψ (rad) (ψ not wrapped).
     pub euler_321: Vector3<f64>,
-    /// Body rates p, q, r \[rad/s\].
+    /// Body rates p, q, r (rad/s).
     pub rates: Vector3<f64>,
-    /// North, east, height relative to the start \[m\].
+    /// North, east, height relative to the start (m).
     pub pos_neh: Vector3<f64>,
-    /// Thrust state T \[N\].
+    /// Thrust state T (N).
     pub thrust: f64,
     /// Reference inputs u_t = [T_c δe δa δr δfc δfd δv].
     pub u: U,

@@ -30,7 +30,7 @@ pub struct MaxDeviations {
     pub e: f64,
     pub h: f64,
     pub thrust: f64,
-    /// Position integrators ∫ΔN, ∫ΔE, ∫Δh \[m·s\] (extension; absent = the default below).
+    /// Position integrators ∫ΔN, ∫ΔE, ∫Δh (m·s) (extension; absent = the default below).
     #[serde(default = "default_pos_int")]
     pub n_int: f64,
     #[serde(default = "default_pos_int")]
@@ -48,7 +48,7 @@ pub struct MaxDeviations {
     pub r_scale: f64,
 }
 
-/// Maximum deviation of a position integrator when a table does not give one \[m·s\].
+/// Maximum deviation of a position integrator when a table does not give one (m·s).
 pub const DEFAULT_POSITION_INTEGRAL_DEVIATION: f64 = 0.3;
 
 fn default_pos_int() -> f64 {
@@ -132,7 +132,7 @@ impl MaxDeviations {
 pub struct WeightSchedule {
     /// Vertical, Tran1, Level, Tran2.
     pub phases: [Weights; 4],
-    /// Blend time after a phase boundary \[s\].
+    /// Blend time after a phase boundary (s).
     pub blend_time: f64,
 }
 

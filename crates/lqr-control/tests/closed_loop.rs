@@ -222,57 +222,6 @@ fn banked_turn_in_level_flight() {
 }
 
 #[test]
-fn timing_per_update() {
-    let m = MissionParams::default();
-    let plant = Plant::new(Airframe::default());
-    let x0 = plant.trim_vertical_climb(m.v_vertical).unwrap().state;
-    let mut c = LqrController::new(Airframe::default(), m, LqrParams::default()).unwrap();
-    let trace = fly(&plant, x0, &mut c.clone(), &Scenario::mission(m));
-    // Replay the recorded inputs through a fresh controller, timing only `update`.
-    let t0 = std::time::Instant::now();
-    for smp in &trace.samples {
-        let input = flight_mission::ControllerInput {
-            t: smp.t,
-            measurement: smp.measurement,
-            ref_offset_ned: Vector3::zeros(),
-        };
-        std::hint::black_box(flight_mission::FlightController::update(&mut c, &input).unwrap());
-    }
-    let total = t0.elapsed().as_secs_f64();
-    let n = trace.samples.len() as f64;
-    // The sample path alone: no periodic relinearisation (only the Euler switches).
-    let mut c2 = LqrController::new(
-        Airframe::default(),
-        m,
-        LqrParams {
-            relinearisation_period: 1e6,
-            ..Default::default()
-        },
-    )
-    .unwrap();
-    let t1 = std::time::Instant::now();
-    for smp in &trace.samples {
-        let input = flight_mission::ControllerInput {
-            t: smp.t,
-            measurement: smp.measurement,
-            ref_offset_ned: Vector3::zeros(),
-        };
-        std::hint::black_box(flight_mission::FlightController::update(&mut c2, &input).unwrap());
-    }
-    println!(
-        "update without relinearisation: {:.1} µs ({} gain computations)",
-        t1.elapsed().as_secs_f64() / n * 1e6,
-        c2.stats().solves
-    );
-    println!(
-        "update: {:.1} µs mean over {} samples including {} gain computations (every 0.2 s)",
-        total / n * 1e6,
-        trace.samples.len(),
-        c.stats().solves
-    );
-}
-
-#[test]
 fn thesis_table_3_4_weights_fly_the_mission() {
     for ordering in [Ordering::GaussSeidel, Ordering::Jacobi] {
         let mut s = Scenario::mission(MissionParams::default());

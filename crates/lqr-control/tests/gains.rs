@@ -1,6 +1,6 @@
 //! Riccati solvers on the aircraft's own linearised, discretised model: the thesis's
 //! backward iteration converges to the steady-state DARE gain as N grows; the DARE
-//! solution satisfies its equation; timing of one relinearisation + gain computation.
+//! solution satisfies its equation (timing: `cargo bench -p lqr-control`).
 
 use flight_mission::MissionParams;
 use lqr_control::linalg::{dare_residual, dare_sda, lqr_gain, riccati_backward, spectral_radius_bound};
@@ -53,38 +53,4 @@ fn backward_iteration_converges_to_the_dare_gain() {
         println!();
         assert!(last < 1e-8, "t = {t}: {last}");
     }
-}
-
-#[test]
-fn timing_of_gain_computation() {
-    let (c, _, _, _) = setup(15.0);
-    let p = c.trajectory().at(15.0);
-    let x = p.state(EulerRep::E321);
-    let n = 200;
-    let t0 = std::time::Instant::now();
-    for _ in 0..n {
-        std::hint::black_box(
-            c.solve_gain(EulerRep::E321, std::hint::black_box(&x), &p.u, 15.0)
-                .unwrap(),
-        );
-    }
-    let dare = t0.elapsed().as_secs_f64() / n as f64 * 1e6;
-    let c2 = LqrController::new(
-        Airframe::default(),
-        MissionParams::default(),
-        LqrParams {
-            riccati_method: 1,
-            ..Default::default()
-        },
-    )
-    .unwrap();
-    let t0 = std::time::Instant::now();
-    for _ in 0..20 {
-        std::hint::black_box(
-            c2.solve_gain(EulerRep::E321, std::hint::black_box(&x), &p.u, 15.0)
-                .unwrap(),
-        );
-    }
-    let backward = t0.elapsed().as_secs_f64() / 20.0 * 1e6;
-    println!("relinearisation + ZOH + gain: DARE (doubling) {dare:.0} µs, backward iteration N=200 {backward:.0} µs");
 }

@@ -94,6 +94,11 @@ fn fly_on_estimates<C: FlightController>(c: &mut C, seed: u64, butterworth: bool
     let mut sensors = sensor_model::SensorModel::new(sensor_params).unwrap();
     let mut params = EstimatorParams::default();
     params.filter.enabled = butterworth;
+    if !butterworth {
+        // The sensors' σ's unfiltered (the defaults are those after their 8 Hz filter).
+        params.noise.sigma_mag = sensor_params.mag_std;
+        params.noise.sigma_pitot_dp = sensor_params.pitot_std;
+    }
     let mut ekf = Ekf::new(params).unwrap();
     let wind = Vector3::zeros();
     let m0 = sensors.start(&truth(&plant, &x, &trim.inputs, &wind), 0.0).unwrap();
@@ -123,7 +128,7 @@ fn fly_on_estimates<C: FlightController>(c: &mut C, seed: u64, butterworth: bool
             ref_offset_ned: Vector3::zeros(),
         };
         let out = c
-            .update(&input)
+            .sample(&input)
             .unwrap_or_else(|e| panic!("controller failed at t = {t}: {e}"));
         u = closed_loop::plant_inputs(&out.command);
         let pos = Vector3::new(x[idx::POS_N], x[idx::POS_E], x[idx::POS_D]);
@@ -171,7 +176,7 @@ fn lqr_flies_the_mission_on_the_estimates() {
 #[test]
 fn tsd_flies_the_mission_on_the_estimates() {
     let m = MissionParams::default();
-    let mut c = TsdController::new(TsdParams::default(), m, Airframe::default()).unwrap();
+    let mut c = TsdController::new(Airframe::default(), m, TsdParams::default()).unwrap();
     let f = fly_on_estimates(&mut c, 2, false);
     eprintln!(
         "TSD on estimates: max |true position − reference| {:.2} m ({:.2} m after 5 s), max position estimation error {:.2} m (≤ {:.2} × 3σ), max attitude error {:.2}°, rejected {}",
@@ -210,7 +215,7 @@ fn lqr_flies_the_mission_with_butterworth_filtered_sensors() {
 fn tsd_flies_the_mission_with_butterworth_filtered_sensors() {
     let m = MissionParams::default();
     for seed in [2, 3] {
-        let mut c = TsdController::new(TsdParams::default(), m, Airframe::default()).unwrap();
+        let mut c = TsdController::new(Airframe::default(), m, TsdParams::default()).unwrap();
         let f = fly_on_estimates(&mut c, seed, true);
         eprintln!(
             "TSD on estimates, 8 Hz Butterworth, seed {seed}: max |true position − reference| {:.2} m ({:.2} m after 5 s), max attitude error {:.2}°, rejected {}",

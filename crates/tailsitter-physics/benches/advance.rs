@@ -26,6 +26,33 @@ fn bench(c: &mut Criterion) {
             })
         });
     }
+    // Issue 13: hovering in a 5 m/s horizontal wind (free wing stalled, immersed part
+    // attached): the global model's post-stall path, against the thesis model.
+    let hover = plant.trim_vertical_climb(0.0).unwrap();
+    let gust = Vector3::new(5.0, 0.0, 0.0);
+    for model in [
+        tailsitter_physics::AeroModel::Thesis,
+        tailsitter_physics::AeroModel::Global,
+    ] {
+        let mut p = plant.clone();
+        p.aero.model = model;
+        c.bench_function(
+            &format!("advance_20ms_hover_wind_5_aero_model_{}", model.index()),
+            |b| {
+                b.iter(|| {
+                    let mut x = hover.state;
+                    p.advance(
+                        black_box(&mut x),
+                        black_box(&hover.inputs),
+                        black_box(&gust),
+                        black_box(0.02),
+                    )
+                    .unwrap();
+                    x
+                })
+            },
+        );
+    }
     let trim = plant.trim_level(25.0).unwrap();
     c.bench_function("derivatives", |b| {
         b.iter(|| plant.derivatives(black_box(&trim.state), black_box(&trim.inputs), black_box(&wind)))

@@ -31,7 +31,7 @@ fn main() {
         }
     }
     let t = plant.trim_level(25.0).unwrap();
-    let (a, _) = plant.linearize(&t.state, &t.inputs, &Vector3::zeros());
+    let (a, _) = plant.linearise(&t.state, &t.inputs, &Vector3::zeros());
     let long = [U, W, Q, Q2, Q4];
     let lat = [V, P, R, Q1, Q3];
     for (name, s) in [("long", long), ("lat", lat)] {

@@ -6,7 +6,7 @@
 //! * V̄ = |v_a|, α = atan2(w_a, u_a) (2.2.12), β = asin(v_a / V̄) (2.2.13); α = β = 0 when
 //!   V̄ < [`AIRSPEED_EPS`] so every output is finite in hover.
 //! * Induced velocity w from momentum theory (2.3.19–2.3.21), [`Airframe::induced_velocity`].
-//! * Slip-stream speed V_s = V̄ + 2w (far wake, DESIGN.md §4, (3.3.17)).
+//! * Slip-stream speed V_s = V̄ + 2w (far wake, docs/DESIGN.md §4, (3.3.17)).
 //! * Free-stream terms (wing/body: C_L0, C_Lα, C_Lq, C_D, C_Yβ, rate terms, C_m0, C_mα, C_mq,
 //!   C_lβ, C_nβ, and the **ailerons** C_{Y,l,n}δa) use q̄ = ½ρV̄² and the free-stream
 //!   wind axes (A.2.7, exact).
@@ -126,7 +126,11 @@ impl Airframe {
     /// V cos α) and `airspeed` = V̄ ≥ |V_x|. For pure axial flow this is (2.3.18),
     /// `T = 2ρA (V_0 + w) w`. Valid for any sign of `V_x` (the largest root is taken; in
     /// axial descent that is the branch with w > −V_x) and at V̄ = 0 (w = √(T/(2ρA))).
-    /// Returns 0 for T ≤ 0 or ρ = 0. Newton from an upper bound with a bisection safeguard.
+    /// Returns 0 for T ≤ 0 or ρ = 0. Halley's method (cubic convergence) from an upper
+    /// bound with a bisection safeguard: ≈ 3 iterations instead of Newton's ≈ 5. It stops
+    /// when a step is ≤ 1e-6 w: the error after it is then O(1e-18) w (cubic convergence),
+    /// so the result is the root to rounding (a bisection step never stops it early), or when
+    /// the bracket is below 1e-14 (1 + w).
     pub fn induced_velocity(&self, airspeed: f64, axial_airspeed: f64, thrust: f64) -> f64 {
         let denom = 2.0 * self.air_density * self.prop_disc_area;
         if thrust <= 0.0 || denom <= 0.0 || !thrust.is_finite() {
@@ -136,35 +140,50 @@ impl Airframe {
         let vx = axial_airspeed;
         let v2 = (airspeed * airspeed).max(vx * vx); // V̄² ≥ V_x² by construction
         let k2 = k * k;
-        let f = |w: f64| {
-            let w2 = w * w;
-            let val = w2 * (w2 + 2.0 * vx * w + v2) - k2;
-            let der = 4.0 * w2 * w + 6.0 * vx * w2 + 2.0 * v2 * w;
-            (val, der)
-        };
         // Start at the axial-flow root of w (w + V_x) = k, w_ax = (−V_x + √(V_x² + 4k))/2 (exact
         // when V̄ = |V_x|; hover √k). Since V'² = (w + V_x)² + (V̄² − V_x²) ≥ (w + V_x)² and
-        // w_ax + V_x ≥ 0, f(w_ax) ≥ 0: it is an upper bound of the root, Newton comes down.
+        // w_ax + V_x ≥ 0, f(w_ax) ≥ 0: it is an upper bound of the root.
         let mut lo = 0.0;
-        let mut hi = 0.5 * (-vx + (vx * vx + 4.0 * k).sqrt());
+        // (Written without cancellation for V_x > 0: (−V_x + √(V_x² + 4k))/2 = 2k/(V_x + √(…)).)
+        let root = (vx * vx + 4.0 * k).sqrt();
+        let mut hi = if vx > 0.0 {
+            2.0 * k / (vx + root)
+        } else {
+            0.5 * (root - vx)
+        };
+        if v2 == vx * vx {
+            // Purely axial flow (vertical flight): w_ax is the root, (2.3.18).
+            return hi;
+        }
         let mut w = hi;
         for _ in 0..100 {
-            let (val, der) = f(w);
+            // f = w²(w² + 2V_x w + V̄²) − k², f', f''.
+            let w2 = w * w;
+            let val = w2 * (w2 + 2.0 * vx * w + v2) - k2;
             if val == 0.0 {
                 break;
             }
+            let der = 4.0 * w2 * w + 6.0 * vx * w2 + 2.0 * v2 * w;
+            let der2 = 12.0 * w2 + 12.0 * vx * w + 2.0 * v2;
             if val > 0.0 {
                 hi = w;
             } else {
                 lo = w;
             }
-            let mut next = if der > 0.0 { w - val / der } else { f64::NAN };
-            if !(next >= lo && next <= hi) {
+            // Halley: w − 2 f f' / (2 f'² − f f'').
+            let den = 2.0 * der * der - val * der2;
+            let mut next = if der > 0.0 && den > 0.0 {
+                w - 2.0 * val * der / den
+            } else {
+                f64::NAN
+            };
+            let halley = next >= lo && next <= hi;
+            if !halley {
                 next = 0.5 * (lo + hi);
             }
             let step = (next - w).abs();
             w = next;
-            if step <= 1e-14 * (1.0 + w) || hi - lo <= 1e-14 * (1.0 + w) {
+            if (halley && step <= 1e-6 * w) || hi - lo <= 1e-14 * (1.0 + w) {
                 break;
             }
         }

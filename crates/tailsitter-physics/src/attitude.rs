@@ -113,6 +113,12 @@ pub fn quat_from_euler_321(phi: f64, theta: f64, psi: f64) -> Vector4<f64> {
     )
 }
 
+/// Pitch θ of the 3-2-1 Euler angles from DCM element C₁₃ = −sin θ (A.2.5): well
+/// defined at θ = ±90° (vertical flight), where φ and ψ are not.
+pub fn pitch_321(q: &Vector4<f64>) -> f64 {
+    (-dcm_earth_to_body(q)[(0, 2)]).clamp(-1.0, 1.0).asin()
+}
+
 /// 3-2-1 Euler angles `[φ, θ, ψ]` of a quaternion: φ = atan2(C₂₃, C₃₃), θ = −asin C₁₃,
 /// ψ = atan2(C₁₂, C₁₁) (1-based elements of `DCM^BE`). Singular (but finite) at θ = ±90°.
 pub fn euler_321_from_quat(q: &Vector4<f64>) -> Vector3<f64> {

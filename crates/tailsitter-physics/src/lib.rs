@@ -2,10 +2,10 @@
 //! *A Comparison of Control Systems for the Flight Transition of VTOL Unmanned Aerial
 //! Vehicles* (ch. 2, App. A, C, D).
 //!
-//! * [`Airframe`]: parameters (App. C, DESIGN.md §4) and the force/moment model
+//! * [`Airframe`]: parameters (App. C, docs/DESIGN.md §4) and the force/moment model
 //!   [`Airframe::forces_moments`] (§2.3) that controllers use for their own models.
 //! * [`Plant`]: the 20-state plant: derivatives, fixed-step RK4 [`Plant::advance`], outputs,
-//!   trims ([`Plant::trim_level`], [`Plant::trim_vertical_climb`]) and [`Plant::linearize`].
+//!   trims ([`Plant::trim_level`], [`Plant::trim_vertical_climb`]) and [`Plant::linearise`].
 //! * [`attitude`]: quaternion (A.2.8, scalar last), DCMs and Euler angles (3-2-1, 2-3-1).
 //!
 //! Frames: earth NED (treated as inertial), body (x forward/nose — up in hover — y right
@@ -18,15 +18,20 @@ pub mod aero;
 pub mod airframe;
 pub mod attitude;
 pub mod error;
+pub mod global_aero;
+pub mod ground;
+pub mod numeric;
 pub mod plant;
 
 pub use aero::{ForcesMoments, Surfaces, AIRSPEED_EPS};
 pub use airframe::{Airframe, Coefficients, InvalidParameter};
 pub use attitude::{
-    dcm_earth_to_body, dcm_from_euler_231, euler_231, euler_231_from_quat, euler_321_from_quat, quat_derivative,
-    quat_from_dcm, quat_from_euler_231, quat_from_euler_321,
+    dcm_earth_to_body, dcm_from_euler_231, euler_231, euler_231_from_quat, euler_321_from_quat, pitch_321,
+    quat_derivative, quat_from_dcm, quat_from_euler_231, quat_from_euler_321,
 };
 pub use error::PhysicsError;
+pub use global_aero::{AeroDiagnostics, AeroModel, AeroRegime, GlobalAero};
+pub use ground::{ContactState, Ground};
 pub use plant::{Envelope, Outputs, Plant, Trim, MAX_SUBSTEPS};
 
 use nalgebra::SVector;
@@ -125,14 +130,6 @@ pub mod idx {
         "flap_differential",
         "vertical_flap",
     ];
-    /// Input names (FMU input names), by index.
-    pub const INPUT_NAMES: [&str; super::N_INPUTS] = [
-        "thrust_cmd",
-        "elevator_cmd",
-        "aileron_cmd",
-        "rudder_cmd",
-        "flap_collective_cmd",
-        "flap_differential_cmd",
-        "vertical_flap_cmd",
-    ];
+    include!(concat!(env!("OUT_DIR"), "/input_names.rs"));
+    const _: () = assert!(INPUT_NAMES.len() == super::N_INPUTS);
 }

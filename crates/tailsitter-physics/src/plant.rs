@@ -1,12 +1,15 @@
 //! The 20-state plant: state derivatives (§2.2, §2.3, App. D.5), fixed-step RK4, outputs,
 //! trims and linearisation.
 
+use crate::numeric::central_differences;
 use nalgebra::{SMatrix, Vector3, Vector4};
 
 use crate::aero::{ForcesMoments, Surfaces};
 use crate::airframe::Airframe;
 use crate::attitude::{dcm_earth_to_body, euler_321_from_quat, quat_derivative, quat_from_euler_321};
 use crate::error::PhysicsError;
+use crate::global_aero::{AeroModel, AeroRegime, GlobalAero};
+use crate::ground::{ContactState, Ground};
 use crate::idx::{self, *};
 use crate::{InputVector, StateVector, N_INPUTS, N_STATES};
 
@@ -44,6 +47,12 @@ pub struct Plant {
     pub integration_step: f64,
     /// Envelope checked after every substep.
     pub envelope: Envelope,
+    /// Aerodynamic model selection and global-model parameters. [`Plant::new`] selects the
+    /// thesis's model ([`AeroModel::Thesis`], the controllers' design model); the FMU's
+    /// default (`aero_model` = 1) is the global model.
+    pub aero: GlobalAero,
+    /// Ground plane and contact points (default: [`Ground::none`]).
+    pub ground: Ground,
 }
 
 /// Outputs of the plant beyond the raw states.
@@ -65,6 +74,13 @@ pub struct Outputs {
     pub induced_velocity: f64,
     /// Slip-stream speed V̄ + 2w (m/s).
     pub slipstream_speed: f64,
+    /// Share of the wing in post-stall flow (global model's stall weights, reported for
+    /// either model) ∈ [0, 1]; 0 = the thesis's attached-flow model holds.
+    pub stall_fraction: f64,
+    /// Aerodynamic regime from `stall_fraction`.
+    pub aero_regime: AeroRegime,
+    /// Ground contact summary.
+    pub ground: ContactState,
 }
 
 /// A trimmed (steady) flight condition.
@@ -91,12 +107,18 @@ pub struct Trim {
 }
 
 impl Plant {
-    /// Plant with `integration_step` = 0.002 s and the default envelope.
+    /// Plant with `integration_step` = 0.002 s, the default envelope, the thesis's
+    /// aerodynamic model (set `aero.model` for the global one) and no ground.
     pub fn new(airframe: Airframe) -> Self {
         Self {
             airframe,
             integration_step: 0.002,
             envelope: Envelope::default(),
+            aero: GlobalAero {
+                model: AeroModel::Thesis,
+                ..GlobalAero::default()
+            },
+            ground: Ground::none(),
         }
     }
 
@@ -127,11 +149,17 @@ impl Plant {
         let v = Vector3::new(x[U], x[V], x[W]);
         let omega = Vector3::new(x[P], x[Q], x[R]);
         let v_air = v - c * wind_ned;
-        (
-            self.airframe
+        let fm = match self.aero.model {
+            AeroModel::Thesis => self
+                .airframe
                 .forces_moments(&v_air, &omega, x[THRUST], &Self::surfaces(x)),
-            c,
-        )
+            AeroModel::Global => {
+                self.aero
+                    .forces_moments(&self.airframe, &v_air, &omega, x[THRUST], &Self::surfaces(x))
+                    .0
+            }
+        };
+        (fm, c)
     }
 
     /// State derivatives ẋ = f(x, u, wind).
@@ -155,10 +183,11 @@ impl Plant {
         let q = Vector4::new(x[Q1], x[Q2], x[Q3], x[Q4]);
 
         let g_body = Vector3::new(c[(0, 2)], c[(1, 2)], c[(2, 2)]) * a.gravity;
-        let vdot = fm.force_body / a.mass + g_body - omega.cross(&v);
+        let (f_ground, m_ground) = self.ground.contact(a, x, &c);
+        let vdot = (fm.force_body + f_ground) / a.mass + g_body - omega.cross(&v);
         let i = Vector3::new(a.i_xx, a.i_yy, a.i_zz);
         let h = omega.component_mul(&i);
-        let wdot = (fm.moment_body - omega.cross(&h)).component_div(&i);
+        let wdot = (fm.moment_body + m_ground - omega.cross(&h)).component_div(&i);
         let qdot = quat_derivative(&q, &omega);
         let pdot = c.tr_mul(&v);
 
@@ -346,21 +375,27 @@ impl Plant {
     pub fn outputs(&self, x: &StateVector, _u: &InputVector, wind_ned: &Vector3<f64>) -> Outputs {
         let (fm, c) = self.eval(x, wind_ned);
         let q = Vector4::new(x[Q1], x[Q2], x[Q3], x[Q4]);
+        let v_air = Vector3::new(x[U], x[V], x[W]) - c * wind_ned;
+        let stall_fraction = self.aero.diagnostics(&self.airframe, &v_air, x[THRUST]).stall_fraction;
+        let (f_ground, _) = self.ground.contact(&self.airframe, x, &c);
         Outputs {
             vel_ned: c.tr_mul(&Vector3::new(x[U], x[V], x[W])),
             euler_321: euler_321_from_quat(&q),
             airspeed: fm.airspeed,
             alpha: fm.alpha,
             beta: fm.beta,
-            specific_force_body: fm.force_body / self.airframe.mass,
+            specific_force_body: (fm.force_body + f_ground) / self.airframe.mass,
             induced_velocity: fm.induced_velocity,
             slipstream_speed: fm.slipstream_speed,
+            stall_fraction,
+            aero_regime: AeroRegime::of(stall_fraction),
+            ground: self.ground.contact_state(&self.airframe, x),
         }
     }
 
     /// Jacobians (A, B) of [`Plant::derivatives`] at (x, u) by central differences
     /// (perturbation 1e-6·max(1, |value|)).
-    pub fn linearize(
+    pub fn linearise(
         &self,
         x: &StateVector,
         u: &InputVector,
@@ -368,24 +403,21 @@ impl Plant {
     ) -> (SMatrix<f64, N_STATES, N_STATES>, SMatrix<f64, N_STATES, N_INPUTS>) {
         let mut a = SMatrix::<f64, N_STATES, N_STATES>::zeros();
         let mut b = SMatrix::<f64, N_STATES, N_INPUTS>::zeros();
-        for j in 0..N_STATES {
-            let d = 1e-6 * x[j].abs().max(1.0);
-            let mut xp = *x;
-            let mut xm = *x;
-            xp[j] += d;
-            xm[j] -= d;
-            let col = (self.derivatives(&xp, u, wind_ned) - self.derivatives(&xm, u, wind_ned)) / (2.0 * d);
-            a.set_column(j, &col);
-        }
-        for j in 0..N_INPUTS {
-            let d = 1e-6 * u[j].abs().max(1.0);
-            let mut up = *u;
-            let mut um = *u;
-            up[j] += d;
-            um[j] -= d;
-            let col = (self.derivatives(x, &up, wind_ned) - self.derivatives(x, &um, wind_ned)) / (2.0 * d);
-            b.set_column(j, &col);
-        }
+        let step = |_, v: f64| Some(1e-6 * v.abs().max(1.0));
+        central_differences(
+            x,
+            N_STATES,
+            step,
+            |xp| self.derivatives(xp, u, wind_ned),
+            |j, col| a.set_column(j, &col),
+        );
+        central_differences(
+            u,
+            N_INPUTS,
+            step,
+            |up| self.derivatives(x, up, wind_ned),
+            |j, col| b.set_column(j, &col),
+        );
         (a, b)
     }
 
@@ -452,15 +484,13 @@ impl Plant {
                 break;
             }
             let mut jac = nalgebra::Matrix3::<f64>::zeros();
-            for j in 0..3 {
-                let d = 1e-6 * z[j].abs().max(1.0);
-                let mut zp = z;
-                let mut zm = z;
-                zp[j] += d;
-                zm[j] -= d;
-                let col = (self.trim_residual(v_ned, &zp) - self.trim_residual(v_ned, &zm)) / (2.0 * d);
-                jac.set_column(j, &col);
-            }
+            central_differences(
+                &z,
+                3,
+                |_, v| Some(1e-6 * v.abs().max(1.0)),
+                |zd| self.trim_residual(v_ned, zd),
+                |j, col| jac.set_column(j, &col),
+            );
             let Some(dz) = jac.lu().solve(&r) else {
                 return Err(PhysicsError::Trim(format!(
                     "singular trim Jacobian at θ = {}, δe = {}, T = {}",

@@ -4,7 +4,7 @@
 //!
 //! With `TSD_SCAN_WIND=1` it also hovers 35 s (vertical flight) in a constant 5 m/s wind
 //! from N, E, S, W, NE and flies the default mission in a 3 m/s crosswind (from the east),
-//! printing max / final position error [m].
+//! printing max / final position error (m).
 
 use closed_loop::{fly, MissionCheck, Ordering, Scenario, Wind};
 use flight_mission::MissionParams;
@@ -78,7 +78,7 @@ fn main() {
                 ..Default::default()
             };
             let x0 = plant.trim_vertical_climb(3.0).unwrap().state;
-            let mut ctl = TsdController::new(p, mission, Airframe::default()).unwrap();
+            let mut ctl = TsdController::new(Airframe::default(), mission, p).unwrap();
             let mut sc = Scenario::mission(mission);
             sc.ordering = ordering;
             let tr = fly(&plant, x0, &mut ctl, &sc);
@@ -115,7 +115,7 @@ fn wind_line(plant: &Plant, p: TsdParams, theta_trim: f64) -> String {
             ..Default::default()
         };
         let x0 = plant.trim_vertical_climb(3.0).unwrap().state;
-        let mut ctl = TsdController::new(p, mission, Airframe::default()).unwrap();
+        let mut ctl = TsdController::new(Airframe::default(), mission, p).unwrap();
         let mut sc = Scenario::mission(mission);
         sc.stop_time = 35.0;
         sc.wind = Wind::Constant(Vector3::new(5.0 * w[0], 5.0 * w[1], 0.0));
@@ -130,7 +130,7 @@ fn wind_line(plant: &Plant, p: TsdParams, theta_trim: f64) -> String {
     }
     let mission = MissionParams::default();
     let x0 = plant.trim_vertical_climb(3.0).unwrap().state;
-    let mut ctl = TsdController::new(p, mission, Airframe::default()).unwrap();
+    let mut ctl = TsdController::new(Airframe::default(), mission, p).unwrap();
     let mut sc = Scenario::mission(mission);
     sc.wind = Wind::Constant(Vector3::new(0.0, -3.0, 0.0));
     let tr = fly(plant, x0, &mut ctl, &sc);

@@ -2,10 +2,10 @@
 //!
 //! `cargo run --release -p tsd-control --example tsd_trace -- <case> [every_s]`
 //! with case one of `default`, `fast`, `jacobi`, `vstep-n`, `vstep-e`, `lstep-d`, `lstep-e`, `hover`
-//! (40 s of vertical flight); a constant wind with `TSD_WIND=n,e,d` [m/s, NED].
+//! (40 s of vertical flight); a constant wind with `TSD_WIND=n,e,d` (m/s, NED).
 
 use closed_loop::{measure, pitch, plant_inputs, Ordering, Scenario};
-use flight_mission::{ControllerInput, FlightController, MissionParams};
+use flight_mission::{ControllerInput, MissionParams, SampledUnit};
 use nalgebra::Vector3;
 use tailsitter_physics::{Airframe, InputVector, Plant};
 use tsd_control::TsdController;
@@ -79,7 +79,7 @@ fn main() {
         let t = k as f64 * h;
         let meas = measure(&plant, &x, &u, &wind);
         let out = ctl
-            .update(&ControllerInput {
+            .sample(&ControllerInput {
                 t,
                 measurement: meas,
                 ref_offset_ned: scenario.ref_offset(t),

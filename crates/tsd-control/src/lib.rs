@@ -29,7 +29,7 @@
 //! they are initialised at the first sample so the first command equals the measured
 //! actuator state (bumpless start from the plant's trim), wound back by back-calculation
 //! with the tracking gain (§4.2.1) when a command saturates, and only finite values are
-//! committed. `update` does not allocate (static nalgebra types only).
+//! committed. `sample` does not allocate (static nalgebra types only).
 //!
 //! Frames: earth NED, body (x nose, y right wing, z belly), wind axes (x along the air
 //! velocity, z in the plane of symmetry). Units SI, angles rad.
@@ -42,8 +42,8 @@ pub use params::TsdParams;
 pub use trajectory::{Reference, Trajectory};
 
 use flight_mission::{
-    Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, FlightController, MissionParams, Notice,
-    ParamError, Phase,
+    Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, MissionParams, Notice, ParamError, Phase,
+    SampledUnit,
 };
 use nalgebra::{Matrix3, Quaternion, RowVector3, UnitQuaternion, Vector3};
 use tailsitter_physics::Airframe;
@@ -54,15 +54,15 @@ pub const STATE_LEN: usize = 6;
 /// Internal signals of the last sample, for tests, plots and tuning.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Internals {
-    /// Guidance command Σ, NED [m/s²] (4.3.24).
+    /// Guidance command Σ, NED (m/s²) (4.3.24).
     pub sigma_cmd: Vector3<f64>,
-    /// Axial, lateral, normal specific-acceleration commands A_Wc, B_Wc, C_Wc [m/s²].
+    /// Axial, lateral, normal specific-acceleration commands A_Wc, B_Wc, C_Wc (m/s²).
     pub accel_cmd: Vector3<f64>,
-    /// Measured A_W, B_W, C_W [m/s²].
+    /// Measured A_W, B_W, C_W (m/s²).
     pub accel: Vector3<f64>,
     /// Commanded normal vector k^Wc, NED.
     pub normal_cmd: Vector3<f64>,
-    /// NVD error angle φ (4.3.5) [rad].
+    /// NVD error angle φ (4.3.5) (rad).
     pub roll_error: f64,
     /// Weight of the computed (vs prescribed) normal vector, 0..1.
     pub normal_weight: f64,
@@ -79,15 +79,15 @@ pub struct Internals {
 /// The flight condition the loops are scheduled on (measured).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FlightCondition {
-    /// Airspeed V̄ [m/s].
+    /// Airspeed V̄ (m/s).
     pub airspeed: f64,
-    /// Angle of attack α [rad] (derivatives interpolated in it).
+    /// Angle of attack α (rad) (derivatives interpolated in it).
     pub alpha: f64,
-    /// Thrust T [N].
+    /// Thrust T (N).
     pub thrust: f64,
-    /// Induced velocity w [m/s]: the slip-stream surfaces see V̄ + 2w.
+    /// Induced velocity w (m/s): the slip-stream surfaces see V̄ + 2w.
     pub induced_velocity: f64,
-    /// Air-velocity component along the body x axis, V̄ cos α cos β [m/s]: the variable of
+    /// Air-velocity component along the body x axis, V̄ cos α cos β (m/s): the variable of
     /// the low-speed frame blend κ ([`TsdController::frame_weight`]). Equal to V̄ when the
     /// air flows from the nose; in hover in a crosswind it stays at the climb rate.
     pub axial_airspeed: f64,
@@ -100,7 +100,7 @@ pub struct LoopDesign {
     pub schedule: f64,
     /// Weight κ of the wind axes vs the reference-path frame (low-speed frame).
     pub kappa: f64,
-    /// Airspeed used in the models, V̄ floored at `min_airspeed` [m/s].
+    /// Airspeed used in the models, V̄ floored at `min_airspeed` (m/s).
     pub v: f64,
     /// Mixing ratios (δfc/δe, δv/δr).
     pub mixing: (f64, f64),
@@ -114,7 +114,7 @@ pub struct LoopDesign {
     pub normal_poly: [f64; 3],
     /// Normal loop gains (K_C, K_Q, K_E).
     pub normal_gains: RowVector3<f64>,
-    /// Pitch damping a22 and mixed control effectiveness b2 of the normal loop [1/s, 1/s²].
+    /// Pitch damping a22 and mixed control effectiveness b2 of the normal loop (1/s, 1/s²).
     pub a22_n: f64,
     pub b2: f64,
     /// Roll model (a21, a22, a23, b21) (4.2.26).
@@ -136,8 +136,8 @@ pub struct LoopDesign {
     pub b32: f64,
 }
 
-/// Integrator state of the four inner loops: the thrust contribution [N] and, for the
-/// surface loops, the contribution to the control *acceleration* b·δ [rad/s²] (pitch, roll,
+/// Integrator state of the four inner loops: the thrust contribution (N) and, for the
+/// surface loops, the contribution to the control *acceleration* b·δ (rad/s²) (pitch, roll,
 /// yaw): the command is recovered as u_I/b with the current control effectiveness b, so
 /// a trim held by an integrator stays trimmed when the dynamic pressure over the surfaces
 /// changes (e.g. the slip-stream when thrust comes on) — integrators in the natural units
@@ -165,15 +165,7 @@ pub struct TsdController {
 }
 
 /// Names of the commands, bit order of the saturation mask.
-const COMMAND_NAMES: [&str; 7] = [
-    "thrust_cmd",
-    "elevator_cmd",
-    "aileron_cmd",
-    "rudder_cmd",
-    "flap_collective_cmd",
-    "flap_differential_cmd",
-    "vertical_flap_cmd",
-];
+use tailsitter_physics::idx::INPUT_NAMES as COMMAND_NAMES;
 
 #[inline]
 fn lerp(a: f64, b: f64, s: f64) -> f64 {
@@ -183,7 +175,7 @@ fn lerp(a: f64, b: f64, s: f64) -> f64 {
 impl TsdController {
     /// A controller for `mission` with tuning `params`, using `airframe` (its own model of
     /// the aircraft, not necessarily the plant's) for gains and feedback linearisation.
-    pub fn new(params: TsdParams, mission: MissionParams, airframe: Airframe) -> Result<Self, ParamError> {
+    pub fn new(airframe: Airframe, mission: MissionParams, params: TsdParams) -> Result<Self, ParamError> {
         params.validate()?;
         mission.validate()?;
         airframe
@@ -203,7 +195,7 @@ impl TsdController {
 
     /// The nominal airframe and Table 4.3 poles for `mission`.
     pub fn with_mission(mission: MissionParams) -> Result<Self, ParamError> {
-        Self::new(TsdParams::default(), mission, Airframe::default())
+        Self::new(Airframe::default(), mission, TsdParams::default())
     }
 
     /// Tuning parameters.
@@ -243,11 +235,11 @@ impl TsdController {
         out(self.saturated as f64);
     }
 
-    /// Restore what [`Self::save`] wrote; `None` (too few values) leaves `self` unchanged.
-    pub fn restore(&mut self, next: &mut impl FnMut() -> Option<f64>) -> Option<()> {
+    /// Restore what [`Self::save`] wrote; a truncated state is an error and leaves `self` unchanged.
+    pub fn restore(&mut self, next: &mut impl FnMut() -> Option<f64>) -> Result<(), ControlError> {
         let mut v = [0.0; STATE_LEN];
         for slot in v.iter_mut() {
-            *slot = next()?;
+            *slot = next().ok_or_else(|| ControlError("truncated TSD controller state".into()))?;
         }
         self.initialized = v[0] != 0.0;
         self.integrators = Integrators {
@@ -261,7 +253,7 @@ impl TsdController {
         } else {
             0
         };
-        Some(())
+        Ok(())
     }
 
     /// Mixing ratios (r_n, r_v): δfc = r_n·δm, δe = δm (4.2.12–4.2.13, Table 4.1) and
@@ -410,8 +402,48 @@ impl TsdController {
     }
 }
 
-impl FlightController for TsdController {
-    fn update(&mut self, input: &ControllerInput) -> Result<ControllerOutput, ControlError> {
+/// Everything a [`TsdController`] is built from: the FMU's parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TsdConfig {
+    /// The controller's own model of the airframe (may differ from the plant's).
+    pub airframe: Airframe,
+    pub mission: MissionParams,
+    pub params: TsdParams,
+}
+
+impl TsdConfig {
+    /// The nominal airframe, the given mission and the default tuning (Table 4.3 poles).
+    pub fn with_mission(mission: MissionParams) -> Self {
+        Self {
+            airframe: Airframe::default(),
+            mission,
+            params: TsdParams::default(),
+        }
+    }
+}
+
+impl SampledUnit for TsdController {
+    type Config = TsdConfig;
+    type Input = ControllerInput;
+    type Output = ControllerOutput;
+
+    fn build(c: &TsdConfig) -> Result<Self, ParamError> {
+        Self::new(c.airframe, c.mission, c.params)
+    }
+
+    fn sample_time(c: &TsdConfig) -> f64 {
+        c.mission.sample_time
+    }
+
+    fn save(&self, out: &mut impl FnMut(f64)) {
+        Self::save(self, out)
+    }
+
+    fn restore(&mut self, next: &mut impl FnMut() -> Option<f64>) -> Result<(), ControlError> {
+        Self::restore(self, next)
+    }
+
+    fn sample(&mut self, input: &ControllerInput) -> Result<ControllerOutput, ControlError> {
         let meas = &input.measurement;
         if let Some(name) = meas.first_non_finite() {
             return Err(Self::err(format!(
@@ -853,7 +885,7 @@ mod tests {
         assert_eq!(a.integrators, b.integrators);
         assert_eq!((a.initialized, a.saturated), (b.initialized, b.saturated));
         let mut empty = std::iter::empty();
-        assert!(b.restore(&mut || empty.next()).is_none());
+        assert!(b.restore(&mut || empty.next()).is_err());
     }
 
     #[test]
@@ -862,7 +894,7 @@ mod tests {
             normal_pole_re_level: 1.0,
             ..Default::default()
         };
-        let e = TsdController::new(p, MissionParams::default(), Airframe::default()).unwrap_err();
+        let e = TsdController::new(Airframe::default(), MissionParams::default(), p).unwrap_err();
         assert!(e.0.contains("normal_pole_re_level"), "{e}");
     }
 }

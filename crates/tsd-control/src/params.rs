@@ -10,85 +10,85 @@ use flight_mission::ParamError;
 /// "real" (a real pole) and "re ± i·im" (a complex pair).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TsdParams {
-    /// Axial specific acceleration, first pole, vertical flight [1/s].
+    /// Axial specific acceleration, first pole, vertical flight (1/s).
     pub axial_pole_1_vertical: f64,
-    /// Axial specific acceleration, second pole, vertical flight [1/s].
+    /// Axial specific acceleration, second pole, vertical flight (1/s).
     pub axial_pole_2_vertical: f64,
-    /// Axial specific acceleration, first pole, level flight [1/s].
+    /// Axial specific acceleration, first pole, level flight (1/s).
     pub axial_pole_1_level: f64,
-    /// Axial specific acceleration, second pole, level flight [1/s].
+    /// Axial specific acceleration, second pole, level flight (1/s).
     pub axial_pole_2_level: f64,
-    /// Roll rate pair, real part, vertical flight [1/s].
+    /// Roll rate pair, real part, vertical flight (1/s).
     pub roll_pole_re_vertical: f64,
-    /// Roll rate pair, imaginary part, vertical flight [1/s].
+    /// Roll rate pair, imaginary part, vertical flight (1/s).
     pub roll_pole_im_vertical: f64,
-    /// Roll rate pair, real part, level flight [1/s].
+    /// Roll rate pair, real part, level flight (1/s).
     pub roll_pole_re_level: f64,
-    /// Roll rate pair, imaginary part, level flight [1/s].
+    /// Roll rate pair, imaginary part, level flight (1/s).
     pub roll_pole_im_level: f64,
-    /// Normal specific acceleration, real pole, vertical flight [1/s].
+    /// Normal specific acceleration, real pole, vertical flight (1/s).
     pub normal_pole_real_vertical: f64,
-    /// Normal specific acceleration pair, real part, vertical flight [1/s].
+    /// Normal specific acceleration pair, real part, vertical flight (1/s).
     pub normal_pole_re_vertical: f64,
-    /// Normal specific acceleration pair, imaginary part, vertical flight [1/s].
+    /// Normal specific acceleration pair, imaginary part, vertical flight (1/s).
     pub normal_pole_im_vertical: f64,
-    /// Normal specific acceleration, real pole, level flight [1/s].
+    /// Normal specific acceleration, real pole, level flight (1/s).
     pub normal_pole_real_level: f64,
-    /// Normal specific acceleration pair, real part, level flight [1/s].
+    /// Normal specific acceleration pair, real part, level flight (1/s).
     pub normal_pole_re_level: f64,
-    /// Normal specific acceleration pair, imaginary part, level flight [1/s].
+    /// Normal specific acceleration pair, imaginary part, level flight (1/s).
     pub normal_pole_im_level: f64,
-    /// Directional (lateral specific acceleration), real pole, vertical flight [1/s].
+    /// Directional (lateral specific acceleration), real pole, vertical flight (1/s).
     pub directional_pole_real_vertical: f64,
-    /// Directional pair, real part, vertical flight [1/s].
+    /// Directional pair, real part, vertical flight (1/s).
     pub directional_pole_re_vertical: f64,
-    /// Directional pair, imaginary part, vertical flight [1/s].
+    /// Directional pair, imaginary part, vertical flight (1/s).
     pub directional_pole_im_vertical: f64,
-    /// Directional, real pole, level flight [1/s].
+    /// Directional, real pole, level flight (1/s).
     pub directional_pole_real_level: f64,
-    /// Directional pair, real part, level flight [1/s].
+    /// Directional pair, real part, level flight (1/s).
     pub directional_pole_re_level: f64,
-    /// Directional pair, imaginary part, level flight [1/s].
+    /// Directional pair, imaginary part, level flight (1/s).
     pub directional_pole_im_level: f64,
-    /// Normal-vector-direction pole, vertical flight [1/s].
+    /// Normal-vector-direction pole, vertical flight (1/s).
     pub nvd_pole_vertical: f64,
-    /// Normal-vector-direction pole, level flight [1/s].
+    /// Normal-vector-direction pole, level flight (1/s).
     pub nvd_pole_level: f64,
-    /// Guidance pair, real part, vertical flight [1/s].
+    /// Guidance pair, real part, vertical flight (1/s).
     pub guidance_pole_re_vertical: f64,
-    /// Guidance pair, imaginary part, vertical flight [1/s].
+    /// Guidance pair, imaginary part, vertical flight (1/s).
     pub guidance_pole_im_vertical: f64,
-    /// Guidance pair, real part, level flight [1/s].
+    /// Guidance pair, real part, level flight (1/s).
     pub guidance_pole_re_level: f64,
-    /// Guidance pair, imaginary part, level flight [1/s].
+    /// Guidance pair, imaginary part, level flight (1/s).
     pub guidance_pole_im_level: f64,
-    /// Integrator anti-windup tracking gain of every loop (§4.2.1: 50) [1/s].
+    /// Integrator anti-windup tracking gain of every loop (§4.2.1: 50) (1/s).
     pub antiwindup_gain: f64,
     /// Factor k of the elevator/collective-flap mixing r = −k·C_Lδe/C_Lδfc (4.2.12: 1.1).
     pub flap_mixing_factor: f64,
     /// Factor k of the rudder/vertical-flap mixing r = −k·C_Yδr/C_Yδv (Table 4.2: 1.1).
     pub vertical_flap_mixing_factor: f64,
-    /// Airspeed floor of the gain schedule: the loop models divide by V̄ [m/s].
+    /// Airspeed floor of the gain schedule: the loop models divide by V̄ (m/s).
     pub min_airspeed: f64,
     /// Time over which the commanded normal vector changes between the prescribed one
     /// (vertical flight, transitions) and the one from the guidance acceleration (level
-    /// flight, (4.3.27–4.3.30)) at the start and end of level flight [s].
+    /// flight, (4.3.27–4.3.30)) at the start and end of level flight (s).
     pub normal_vector_blend_time: f64,
     /// Below this normal part of the commanded acceleration the prescribed normal vector is
-    /// used even in level flight (§4.3.2.1) [m/s²].
+    /// used even in level flight (§4.3.2.1) (m/s²).
     pub min_normal_accel: f64,
     /// Below this axial airspeed V̄ cos α cos β the specific accelerations are resolved in
     /// the reference-path frame instead of the wind axes (the wind axes turn as fast as the
     /// body at low speed, (C_W + g₁)/V̄, and the time-scale separation fails; the axial
-    /// component keeps a hover crosswind out of the blend) [m/s].
+    /// component keeps a hover crosswind out of the blend) (m/s).
     pub wind_frame_speed_low: f64,
     /// Above this axial airspeed V̄ cos α cos β the wind axes are used, as in the thesis;
-    /// linear blend between [m/s].
+    /// linear blend between (m/s).
     pub wind_frame_speed_high: f64,
     /// Preview of the feed-forward specific acceleration: Σ^RE of (4.3.24) is taken from the
     /// trajectory this much ahead of the sample, compensating the lag of the inner loops
     /// (servo, thrust and the specific-acceleration poles) at the acceleration steps of the
-    /// unsmoothed trajectory (§4.3.3) [s].
+    /// unsmoothed trajectory (§4.3.3) (s).
     pub feedforward_lead: f64,
 }
 

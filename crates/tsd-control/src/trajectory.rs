@@ -29,15 +29,15 @@ use nalgebra::Vector3;
 pub struct Reference {
     /// Mission phase.
     pub phase: Phase,
-    /// Position, NED [m] (without the user offset).
+    /// Position, NED (m) (without the user offset).
     pub pos: Vector3<f64>,
-    /// Inertial velocity, NED [m/s].
+    /// Inertial velocity, NED (m/s).
     pub vel: Vector3<f64>,
-    /// Specific acceleration Σ^RE = a − g, NED [m/s²] (4.3.35–4.3.36).
+    /// Specific acceleration Σ^RE = a − g, NED (m/s²) (4.3.35–4.3.36).
     pub specific_accel: Vector3<f64>,
-    /// Reference airspeed V̄ [m/s] (4.3.31–4.3.32).
+    /// Reference airspeed V̄ (m/s) (4.3.31–4.3.32).
     pub airspeed: f64,
-    /// Flight-path angle γ [rad] (π/2 climbing vertically, 0 level).
+    /// Flight-path angle γ (rad) (π/2 climbing vertically, 0 level).
     pub gamma: f64,
 }
 
@@ -60,7 +60,7 @@ impl Reference {
 pub struct Trajectory {
     mission: MissionParams,
     gravity: f64,
-    /// Radii of the two quarter loops [m].
+    /// Radii of the two quarter loops (m).
     r1: f64,
     r2: f64,
     /// Start positions of phases 1..4 (NED).
@@ -93,7 +93,7 @@ impl Trajectory {
         (v_vertical + v_level) * duration / core::f64::consts::PI
     }
 
-    /// Radii (r1, r2) of the two quarter loops [m].
+    /// Radii (r1, r2) of the two quarter loops (m).
     pub fn radii(&self) -> (f64, f64) {
         (self.r1, self.r2)
     }

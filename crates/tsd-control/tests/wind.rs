@@ -17,7 +17,7 @@ use tsd_control::TsdController;
 
 const HOVER_STOP: f64 = 35.0;
 
-/// 35 s of vertical flight (t_vertical_1 = 40 s) in `wind` (NED air velocity [m/s]).
+/// 35 s of vertical flight (t_vertical_1 = 40 s) in `wind` (NED air velocity (m/s)).
 fn hover(wind: Wind) -> Trace {
     let plant = Plant::new(Airframe::default());
     let mission = MissionParams {

@@ -1526,7 +1526,7 @@ impl<'a> Fuzzer<'a> {
                 fmi2Type_fmi2ModelExchange,
                 guid.as_ptr(),
                 &*host.callbacks,
-                true,
+                fmu.n_states == 0,
                 "ME",
             ),
             4 => (
@@ -1564,7 +1564,8 @@ impl<'a> Fuzzer<'a> {
         };
         // SAFETY: strings NUL-terminated or NULL; callbacks valid or NULL; host outlives the instance.
         let comp = unsafe { ffi!(fmu.api, instantiate(n, ty, g, c"".as_ptr(), cb, 0, 1)) };
-        let valid = variant == 7;
+        // Model Exchange is valid exactly for the FMUs with continuous states.
+        let valid = variant == 7 || (variant == 3 && fmu.n_states > 0);
         self.count("fmi2Instantiate", label, if comp.is_null() { ERROR } else { OK });
         if comp.is_null() == valid {
             self.violation(fmu, format!("fmi2Instantiate ({label}) returned {comp:?}"));
@@ -1573,8 +1574,208 @@ impl<'a> Fuzzer<'a> {
             self.violation(fmu, format!("fmi2Instantiate ({label}) refused without logging"));
         }
         if !comp.is_null() {
+            if variant == 3 {
+                // SAFETY: a live Model Exchange component of this model; host outlives it.
+                unsafe { self.model_exchange_sequence(fmu, comp, &host) };
+            }
             // SAFETY: a live component of this model.
             unsafe { ffi!(fmu.api, free_instance(comp)) };
+        }
+    }
+
+    /// A random sequence of Model Exchange calls on a fresh ME instance, legal and
+    /// illegal, each checked against the ME state table (FMI 2.0 §3.2.3) and argument
+    /// rules (nx must equal the number of states, states finite, no event indicators).
+    ///
+    /// # Safety
+    /// `c` is a live Model Exchange component of `fmu`, logging into `host`.
+    unsafe fn model_exchange_sequence(&mut self, fmu: &Fmu, c: fmi2Component, host: &Host) {
+        #[derive(Clone, Copy, PartialEq, Debug)]
+        enum Me {
+            Instantiated,
+            InitializationMode,
+            EventMode,
+            ContinuousTimeMode,
+            Terminated,
+        }
+        let api = &fmu.api;
+        let n = fmu.n_states;
+        let mut st = Me::Instantiated;
+        let mut x = vec![0.0; n + 1];
+        let mut good_x: Option<Vec<f64>> = None;
+        let mut flag: fmi2Boolean = 0;
+        let mut flag2: fmi2Boolean = 0;
+        let mut info = fmi2EventInfo::default();
+        for _ in 0..self.rng.below(40) + 5 {
+            let from = host.len();
+            let op = self.rng.below(16);
+            let nx = *self.rng.pick(&[n, n, n, n.saturating_sub(1), n + 1, 0]);
+            let in_ = |states: &[Me]| states.contains(&st);
+            // SAFETY (every call below): live component, buffers of n + 1 ≥ nx elements.
+            let (name, expect, s, next) = unsafe {
+                match op {
+                    0 => {
+                        let ok = in_(&[Me::Instantiated]);
+                        (
+                            "fmi2SetupExperiment",
+                            ok,
+                            ffi!(api, setup_experiment(c, 0, 0.0, 0.0, 0, 0.0)),
+                            st,
+                        )
+                    }
+                    1 => {
+                        let ok = in_(&[Me::Instantiated]);
+                        let s = ffi!(api, enter_initialization_mode(c));
+                        (
+                            "fmi2EnterInitializationMode",
+                            ok,
+                            s,
+                            if ok { Me::InitializationMode } else { st },
+                        )
+                    }
+                    2 => {
+                        let ok = in_(&[Me::InitializationMode]);
+                        let s = ffi!(api, exit_initialization_mode(c));
+                        ("fmi2ExitInitializationMode", ok, s, if ok { Me::EventMode } else { st })
+                    }
+                    3 => {
+                        let ok = in_(&[Me::EventMode, Me::ContinuousTimeMode]);
+                        (
+                            "fmi2EnterEventMode",
+                            ok,
+                            ffi!(api, enter_event_mode(c)),
+                            if ok { Me::EventMode } else { st },
+                        )
+                    }
+                    4 => {
+                        let ok = in_(&[Me::EventMode]);
+                        (
+                            "fmi2NewDiscreteStates",
+                            ok,
+                            ffi!(api, new_discrete_states(c, &mut info)),
+                            st,
+                        )
+                    }
+                    5 => {
+                        let ok = in_(&[Me::EventMode]);
+                        let s = ffi!(api, enter_continuous_time_mode(c));
+                        (
+                            "fmi2EnterContinuousTimeMode",
+                            ok,
+                            s,
+                            if ok { Me::ContinuousTimeMode } else { st },
+                        )
+                    }
+                    6 => {
+                        let ok = in_(&[Me::ContinuousTimeMode]);
+                        let s = ffi!(api, completed_integrator_step(c, 1, &mut flag, &mut flag2));
+                        ("fmi2CompletedIntegratorStep", ok, s, st)
+                    }
+                    7 => {
+                        let t = *self.rng.pick(&[0.01, 0.5, f64::NAN, f64::INFINITY]);
+                        let ok = in_(&[Me::EventMode, Me::ContinuousTimeMode]) && t.is_finite();
+                        ("fmi2SetTime", ok, ffi!(api, set_time(c, t)), st)
+                    }
+                    8 => {
+                        // Perturb the last states read back, sometimes with a NaN.
+                        let mut v = good_x.clone().unwrap_or_else(|| vec![0.0; n]);
+                        for e in v.iter_mut() {
+                            *e *= 1.0 + 1e-3 * (self.rng.unit() - 0.5);
+                        }
+                        let nan = n > 0 && self.rng.chance(0.2);
+                        if nan {
+                            let k = self.rng.below(n);
+                            v[k] = f64::NAN;
+                        }
+                        v.push(0.0);
+                        let ok = in_(&[Me::ContinuousTimeMode]) && nx == n && !nan;
+                        let s = ffi!(api, set_continuous_states(c, v.as_ptr(), nx));
+                        ("fmi2SetContinuousStates", ok, s, st)
+                    }
+                    9 => {
+                        let ok = in_(&[Me::EventMode, Me::ContinuousTimeMode, Me::Terminated]) && nx == n;
+                        (
+                            "fmi2GetDerivatives",
+                            ok,
+                            ffi!(api, get_derivatives(c, x.as_mut_ptr(), nx)),
+                            st,
+                        )
+                    }
+                    10 => {
+                        let ok = in_(&[
+                            Me::InitializationMode,
+                            Me::EventMode,
+                            Me::ContinuousTimeMode,
+                            Me::Terminated,
+                        ]) && nx == n;
+                        let s = ffi!(api, get_continuous_states(c, x.as_mut_ptr(), nx));
+                        if s == OK {
+                            good_x = Some(x[..n].to_vec());
+                        }
+                        ("fmi2GetContinuousStates", ok, s, st)
+                    }
+                    11 => {
+                        let ok =
+                            in_(&[Me::Instantiated, Me::EventMode, Me::ContinuousTimeMode, Me::Terminated]) && nx == n;
+                        let s = ffi!(api, get_nominals_of_continuous_states(c, x.as_mut_ptr(), nx));
+                        if s == OK && x[..n].iter().any(|v| !(v.is_finite() && *v > 0.0)) {
+                            self.violation(fmu, format!("fmi2GetNominalsOfContinuousStates gave {:?}", &x[..n]));
+                        }
+                        ("fmi2GetNominalsOfContinuousStates", ok, s, st)
+                    }
+                    12 => {
+                        let ni = *self.rng.pick(&[0, 0, 1, 3]);
+                        let ok = in_(&[
+                            Me::InitializationMode,
+                            Me::EventMode,
+                            Me::ContinuousTimeMode,
+                            Me::Terminated,
+                        ]) && ni == 0;
+                        (
+                            "fmi2GetEventIndicators",
+                            ok,
+                            ffi!(api, get_event_indicators(c, x.as_mut_ptr(), ni)),
+                            st,
+                        )
+                    }
+                    13 => ("fmi2DoStep", false, ffi!(api, do_step(c, 0.0, 0.01, 1)), st),
+                    14 => {
+                        let ok = in_(&[Me::EventMode, Me::ContinuousTimeMode]);
+                        (
+                            "fmi2Terminate",
+                            ok,
+                            ffi!(api, terminate(c)),
+                            if ok { Me::Terminated } else { st },
+                        )
+                    }
+                    _ => {
+                        good_x = None;
+                        ("fmi2Reset", true, ffi!(api, reset(c)), Me::Instantiated)
+                    }
+                }
+            };
+            // A legal call may still fail in the model (e.g. a derivative not finite at a
+            // perturbed state): OK or Error then; an illegal one must be Error and logged.
+            let label = format!("ME {st:?}");
+            self.count(name, &label, s);
+            if !expect && s != ERROR {
+                self.violation(
+                    fmu,
+                    format!("{name} in ME state {st:?} (nx {nx}) returned {}", status_name(s)),
+                );
+            }
+            if expect && s != OK && s != ERROR {
+                self.violation(fmu, format!("{name} in ME state {st:?} returned {}", status_name(s)));
+            }
+            if s == ERROR && host.records()[from..].iter().all(|r| r.status != ERROR) {
+                self.violation(fmu, format!("{name} in ME state {st:?} failed without logging"));
+            }
+            if host.records()[from..].iter().any(|r| r.message.contains("panic")) {
+                self.violation(fmu, format!("{name} in ME state {st:?} panicked"));
+            }
+            if s == OK || op == 15 {
+                st = next;
+            }
         }
     }
 }

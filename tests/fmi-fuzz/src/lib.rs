@@ -21,9 +21,8 @@ pub mod fuzz;
 use fmi_sys::fmi2::*;
 use libloading::Library;
 use model_description::{Causality, VarType, Variability};
-use std::ffi::{c_char, c_void, CStr, CString};
+use std::ffi::CString;
 use std::path::PathBuf;
-use std::sync::Mutex;
 
 pub use fmi_sys::fmi2;
 /// The variable kinds of the model description, re-exported for the tests.
@@ -214,6 +213,8 @@ pub struct Fmu {
     pub guid: String,
     pub vars: Vec<Var>,
     pub default_step: f64,
+    /// Number of continuous states (> 0: the FMU also offers Model Exchange).
+    pub n_states: usize,
     pub api: Api,
 }
 
@@ -261,9 +262,10 @@ impl Fmu {
         let api = unsafe { Api::load(&path) }?;
         Ok(Self {
             id: id.to_string(),
-            guid: model.guid,
+            guid: model.guid.clone(),
             vars,
             default_step: model.default_experiment.step_size,
+            n_states: model.continuous_states().len(),
             api,
         })
     }
@@ -343,120 +345,7 @@ impl Fmu {
 
 // ------------------------------------------------------------------ host logger
 
-/// One logger call.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Record {
-    pub instance: String,
-    pub status: fmi2Status,
-    pub category: String,
-    pub message: String,
-    /// The format was `"%s"` and the environment our recorder.
-    pub well_formed: bool,
-}
-
-#[derive(Default)]
-pub struct Recorder(pub Mutex<Vec<Record>>);
-
-impl Recorder {
-    fn lock(&self) -> std::sync::MutexGuard<'_, Vec<Record>> {
-        self.0.lock().unwrap_or_else(|e| e.into_inner())
-    }
-}
-
-unsafe fn text(p: *const c_char) -> String {
-    if p.is_null() {
-        "(NULL)".into()
-    } else {
-        // SAFETY: non-NULL strings from the FMU are NUL-terminated.
-        unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
-    }
-}
-
-/// The recording logger. Never panics (a panic here would abort: it is called from C).
-unsafe extern "C" fn record_log(
-    env: fmi2ComponentEnvironment,
-    instance_name: fmi2String,
-    status: fmi2Status,
-    category: fmi2String,
-    format: fmi2String,
-    arg: *const c_char,
-) {
-    if env.is_null() {
-        return;
-    }
-    // SAFETY: env is the Recorder we registered; strings are NUL-terminated.
-    unsafe {
-        let rec = &*(env as *const Recorder);
-        let format = text(format);
-        let well_formed = format == "%s";
-        rec.lock().push(Record {
-            instance: text(instance_name),
-            status,
-            category: text(category),
-            message: if well_formed { text(arg) } else { format },
-            well_formed,
-        });
-    }
-}
-
-type SixArgs =
-    unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, fmi2Status, fmi2String, fmi2String, *const c_char);
-type Variadic = unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, fmi2Status, fmi2String, fmi2String, ...);
-
-/// A host: callbacks whose `componentEnvironment` is a boxed [`Recorder`].
-pub struct Host {
-    pub recorder: Box<Recorder>,
-    pub callbacks: Box<fmi2CallbackFunctions>,
-}
-
-impl Default for Host {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl Host {
-    pub fn new() -> Self {
-        let recorder = Box::new(Recorder::default());
-        // SAFETY: the export layer always calls logger(env, name, status, category, "%s", msg):
-        // on x86_64 System V / AArch64 Linux the one variadic `const char*` is passed like a
-        // sixth fixed argument.
-        let logger: fmi2CallbackLogger = Some(unsafe { std::mem::transmute::<SixArgs, Variadic>(record_log) });
-        let callbacks = Box::new(fmi2CallbackFunctions {
-            logger,
-            allocateMemory: None,
-            freeMemory: None,
-            stepFinished: None,
-            componentEnvironment: &*recorder as *const Recorder as *mut c_void,
-        });
-        Self { recorder, callbacks }
-    }
-
-    pub fn len(&self) -> usize {
-        self.recorder.lock().len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
-    pub fn records(&self) -> Vec<Record> {
-        self.recorder.lock().clone()
-    }
-
-    /// Records from index `from` on.
-    pub fn since(&self, from: usize) -> Vec<Record> {
-        self.recorder
-            .lock()
-            .get(from..)
-            .map(<[Record]>::to_vec)
-            .unwrap_or_default()
-    }
-
-    pub fn clear(&self) {
-        self.recorder.lock().clear();
-    }
-}
+pub use fmi2_export::test_host::{text, Host, Record, Recorder};
 
 // ------------------------------------------------------------------ instances
 

@@ -45,4 +45,17 @@ fn random_call_sequences_keep_every_invariant() {
     for must in must {
         assert!(report.coverage.contains_key(must), "{must} never exercised");
     }
+    // Model Exchange instances of the plant: the ME calls ran legally (some OK) in the
+    // ME states, and illegally elsewhere.
+    for must in [
+        "fmi2SetContinuousStates @ ME ContinuousTimeMode",
+        "fmi2GetDerivatives @ ME ContinuousTimeMode",
+        "fmi2EnterContinuousTimeMode @ ME EventMode",
+        "fmi2NewDiscreteStates @ ME EventMode",
+        "fmi2GetNominalsOfContinuousStates @ ME Instantiated",
+    ] {
+        let ok = report.coverage.get(must).map_or(0, |c| c[0]);
+        assert!(ok > 0, "{must}: never returned fmi2OK");
+    }
+    assert!(report.coverage.contains_key("fmi2SetContinuousStates @ ME EventMode"));
 }

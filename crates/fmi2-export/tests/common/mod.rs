@@ -1,21 +1,13 @@
-//! A toy model (first-order lag) with a hand-written `VariableStore`, and a
-//! recording host logger, shared by the integration tests.
-//!
-//! The FMI logger callback is C-variadic, and defining variadic functions is
-//! not stable Rust. The export layer always calls it as
-//! `logger(env, name, status, category, "%s", message)`, so the recorder is a
-//! plain 6-argument `extern "C"` function transmuted to the variadic pointer
-//! type: on x86_64 System V (and AArch64 Linux) a variadic call passes its
-//! first variadic pointer argument exactly like a 6th fixed argument.
+//! A toy model (first-order lag) with a hand-written `VariableStore`, shared by
+//! the integration tests, which record the FMI logger with
+//! [`fmi2_export::test_host::Host`].
 #![allow(dead_code)]
 
-use fmi2_export::fmi_sys::fmi2::*;
 use fmi2_export::{
     Causality, FmuModel, Logger, ModelError, StateError, StateReader, StateWriter, ValueType, Variability,
     VariableSpec, VariableStore,
 };
-use std::ffi::{c_char, c_void, CStr, CString};
-use std::sync::Mutex;
+use std::ffi::CString;
 
 pub mod vr {
     pub const U: u32 = 0;
@@ -370,85 +362,7 @@ impl FmuModel for Other {
 
 // ------------------------------------------------------------------ host side
 
-#[derive(Debug, Clone, PartialEq)]
-pub struct Record {
-    pub instance: String,
-    pub status: fmi2Status,
-    pub category: String,
-    pub message: String,
-}
-
-/// Per-host log; its address is the `componentEnvironment`.
-#[derive(Default)]
-pub struct Recorder(pub Mutex<Vec<Record>>);
-
-unsafe extern "C" fn record_log(
-    env: fmi2ComponentEnvironment,
-    instance_name: fmi2String,
-    status: fmi2Status,
-    category: fmi2String,
-    format: fmi2String,
-    arg: *const c_char,
-) {
-    let s = |p: *const c_char| unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned();
-    assert!(!env.is_null(), "componentEnvironment not passed back");
-    assert_eq!(s(format), "%s", "message must be passed as the argument of a %s format");
-    let rec = unsafe { &*(env as *const Recorder) };
-    rec.0.lock().unwrap().push(Record {
-        instance: s(instance_name),
-        status,
-        category: s(category),
-        message: s(arg),
-    });
-}
-
-type SixArgs =
-    unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, fmi2Status, fmi2String, fmi2String, *const c_char);
-
-/// A host: callbacks whose environment is a boxed [`Recorder`].
-pub struct Host {
-    pub recorder: Box<Recorder>,
-    pub callbacks: Box<fmi2CallbackFunctions>,
-}
-
-impl Host {
-    pub fn new() -> Self {
-        let recorder = Box::new(Recorder::default());
-        // SAFETY: see the module docs: the layer always passes exactly one
-        // variadic argument, a `const char*`.
-        let logger: fmi2CallbackLogger = Some(unsafe {
-            std::mem::transmute::<
-                SixArgs,
-                unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, fmi2Status, fmi2String, fmi2String, ...),
-            >(record_log)
-        });
-        let callbacks = Box::new(fmi2CallbackFunctions {
-            logger,
-            allocateMemory: None,
-            freeMemory: None,
-            stepFinished: None,
-            componentEnvironment: &*recorder as *const Recorder as *mut c_void,
-        });
-        Self { recorder, callbacks }
-    }
-
-    pub fn records(&self) -> Vec<Record> {
-        self.recorder.0.lock().unwrap().clone()
-    }
-
-    pub fn messages(&self) -> Vec<String> {
-        self.records().into_iter().map(|r| r.message).collect()
-    }
-
-    pub fn clear(&self) {
-        self.recorder.0.lock().unwrap().clear();
-    }
-
-    /// Whether some message contains every one of `parts`.
-    pub fn logged(&self, parts: &[&str]) -> bool {
-        self.messages().iter().any(|m| parts.iter().all(|p| m.contains(p)))
-    }
-}
+pub use fmi2_export::test_host::Host;
 
 pub fn cstring(s: &str) -> CString {
     CString::new(s).unwrap()

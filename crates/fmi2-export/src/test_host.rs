@@ -1,0 +1,150 @@
+//! A recording FMI host logger for tests of FMUs through their C ABI, shared by
+//! the export layer's tests and the fuzzer.
+//!
+//! The FMI logger callback is C-variadic, and defining variadic functions is not
+//! stable Rust. The export layer always calls it as
+//! `logger(env, name, status, category, "%s", message)`, so the recorder is a
+//! plain 6-argument `extern "C"` function transmuted to the variadic pointer type:
+//! on x86_64 System V (and AArch64 Linux) a variadic call passes its first
+//! variadic pointer argument exactly like a 6th fixed argument. Any other format
+//! is recorded as not [`Record::well_formed`].
+
+use crate::fmi_sys::fmi2::{
+    fmi2CallbackFunctions, fmi2CallbackLogger, fmi2ComponentEnvironment, fmi2Status, fmi2String,
+};
+use std::ffi::{c_char, c_void, CStr};
+use std::sync::Mutex;
+
+/// One logger call.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Record {
+    pub instance: String,
+    pub status: fmi2Status,
+    pub category: String,
+    pub message: String,
+    /// The format was `"%s"` and the environment our recorder.
+    pub well_formed: bool,
+}
+
+#[derive(Default)]
+pub struct Recorder(pub Mutex<Vec<Record>>);
+
+impl Recorder {
+    fn lock(&self) -> std::sync::MutexGuard<'_, Vec<Record>> {
+        self.0.lock().unwrap_or_else(|e| e.into_inner())
+    }
+}
+
+/// A C string from an FMU as a Rust string; `"(NULL)"` for a null pointer.
+///
+/// # Safety
+/// `p` is null or points to a NUL-terminated string.
+pub unsafe fn text(p: *const c_char) -> String {
+    if p.is_null() {
+        "(NULL)".into()
+    } else {
+        // SAFETY: non-NULL strings from the FMU are NUL-terminated.
+        unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
+    }
+}
+
+/// The recording logger. Never panics (a panic here would abort: it is called from C).
+unsafe extern "C" fn record_log(
+    env: fmi2ComponentEnvironment,
+    instance_name: fmi2String,
+    status: fmi2Status,
+    category: fmi2String,
+    format: fmi2String,
+    arg: *const c_char,
+) {
+    if env.is_null() {
+        return;
+    }
+    // SAFETY: env is the Recorder we registered; strings are NUL-terminated.
+    unsafe {
+        let rec = &*(env as *const Recorder);
+        let format = text(format);
+        let well_formed = format == "%s";
+        rec.lock().push(Record {
+            instance: text(instance_name),
+            status,
+            category: text(category),
+            message: if well_formed { text(arg) } else { format },
+            well_formed,
+        });
+    }
+}
+
+type SixArgs =
+    unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, fmi2Status, fmi2String, fmi2String, *const c_char);
+type Variadic = unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, fmi2Status, fmi2String, fmi2String, ...);
+
+/// A host: callbacks whose `componentEnvironment` is a boxed [`Recorder`].
+pub struct Host {
+    pub recorder: Box<Recorder>,
+    pub callbacks: Box<fmi2CallbackFunctions>,
+}
+
+impl Default for Host {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Host {
+    pub fn new() -> Self {
+        let recorder = Box::new(Recorder::default());
+        // SAFETY: the export layer always calls logger(env, name, status, category, "%s", msg):
+        // on x86_64 System V / AArch64 Linux the one variadic `const char*` is passed like a
+        // sixth fixed argument.
+        let logger: fmi2CallbackLogger = Some(unsafe { std::mem::transmute::<SixArgs, Variadic>(record_log) });
+        let callbacks = Box::new(fmi2CallbackFunctions {
+            logger,
+            allocateMemory: None,
+            freeMemory: None,
+            stepFinished: None,
+            componentEnvironment: &*recorder as *const Recorder as *mut c_void,
+        });
+        Self { recorder, callbacks }
+    }
+
+    pub fn len(&self) -> usize {
+        self.recorder.lock().len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    pub fn records(&self) -> Vec<Record> {
+        self.recorder.lock().clone()
+    }
+
+    /// Records from index `from` on.
+    pub fn since(&self, from: usize) -> Vec<Record> {
+        self.recorder
+            .lock()
+            .get(from..)
+            .map(<[Record]>::to_vec)
+            .unwrap_or_default()
+    }
+
+    pub fn clear(&self) {
+        self.recorder.lock().clear();
+    }
+
+    /// Every message; panics if a call did not use the `"%s"` format.
+    pub fn messages(&self) -> Vec<String> {
+        let records = self.records();
+        assert!(
+            records.iter().all(|r| r.well_formed),
+            "message not passed as the argument of a %s format: {records:?}"
+        );
+        records.into_iter().map(|r| r.message).collect()
+    }
+
+    /// Whether some message contains every one of `parts`.
+    pub fn logged(&self, parts: &[&str]) -> bool {
+        self.messages().iter().any(|m| parts.iter().all(|p| m.contains(p)))
+    }
+}

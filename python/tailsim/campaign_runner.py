@@ -1,0 +1,435 @@
+"""One campaign run, on whatever process executes it (a Dask worker or the caller).
+
+The process keeps the FMUs it was given (as bytes: no shared filesystem is
+assumed) extracted in a temp dir of its own, and one instance per FMU (per
+thread), reset (fmi2Reset) between runs. The stepping is the Gauss-Seidel
+sequence of `master.ClosedLoop.run` call for call (same FMI calls, same order,
+same values); it only records fewer signals and stops early on divergence or
+timeout. tests/test_campaign.py checks that a run equals ClosedLoop's exactly.
+
+Any failure of a run (an FMI error status, a Python exception) becomes a failed
+row; it never propagates, so one bad sample cannot crash a campaign.
+"""
+
+from __future__ import annotations
+
+import collections
+import ctypes
+import hashlib
+import json
+import math
+import os
+import pathlib
+import shutil
+import socket
+import tempfile
+import threading
+import time
+from typing import Any, Mapping
+
+import numpy as np
+
+from .campaign_sampling import CONFIGURATIONS, CampaignSpec, plant_parameters, wind_function
+from .master import Fmu
+
+FMU_NAMES = {"plant": "tailsitter_plant", "lqr": "tailsitter_lqr", "tsd": "tailsitter_tsd"}
+N_PHASES = 5
+#: Command limits of the saturation metric: thrust 0 / 150 N, surfaces ±25° (plant defaults).
+THRUST_LIMITS = (0.0, 150.0)
+DEFLECTION_LIMIT = math.radians(25.0)
+COMMANDS = [
+    "thrust_cmd",
+    "elevator_cmd",
+    "aileron_cmd",
+    "rudder_cmd",
+    "flap_collective_cmd",
+    "flap_differential_cmd",
+    "vertical_flap_cmd",
+]
+FAILURES = ("fmi_error", "divergence", "timeout", "exception")
+
+
+def digest(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()
+
+
+# --- the FMUs and instances this process holds --------------------------------------------
+
+_lock = threading.Lock()
+_fmus: dict[str, Fmu] = {}  # by sha256 of the .fmu bytes
+_dirs: list[str] = []
+_slaves: dict[tuple[int, str], "_Slave"] = {}  # (thread id, digest) -> instance
+
+
+_logs: dict[str, collections.deque] = {}  # instance name -> its last messages
+_callbacks = None
+_logger_fn = None
+
+
+def _shared_callbacks():
+    """One logger for the whole process, routing by instance name: fmpy's logger proxy
+    (which formats the variadic message) keeps a single Python target per process."""
+    global _callbacks
+    if _callbacks is None:
+        from fmpy.fmi2 import fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
+        from fmpy.logging import addLoggerProxy
+
+        def log(_env, instance, status, category, message):
+            name = instance.decode(errors="replace") if instance else ""
+            q = _logs.get(name)
+            if q is not None:
+                q.append(f"[{status}] {message.decode(errors='replace')}")
+
+        global _logger_fn
+        _logger_fn = fmi2CallbackLoggerTYPE(log)  # must outlive every instance
+        cb = fmi2CallbackFunctions()
+        cb.logger = _logger_fn
+        addLoggerProxy(ctypes.byref(cb))
+        _callbacks = cb
+    return _callbacks
+
+
+class _Slave:
+    """An fmpy instance (uniquely named) with the last messages the FMU logged for it."""
+
+    def __init__(self, fmu: Fmu, name: str):
+        self.name = f"{name}-{fmu.identifier}-{threading.get_ident()}"
+        self.messages: collections.deque[str] = collections.deque(maxlen=8)
+        _logs[self.name] = self.messages
+        self.fmu = fmu
+        self.slave = fmu.instantiate(self.name, _shared_callbacks())
+        self.used = False
+
+    def free(self) -> None:
+        try:
+            self.slave.freeInstance()
+        except Exception:  # noqa: BLE001 - already broken; drop it
+            pass
+        _logs.pop(self.name, None)
+
+
+def install_fmus(blobs: Mapping[str, bytes]) -> dict[str, str]:
+    """Extract FMUs given as bytes (once per content) into a temp dir of this process.
+    Returns {name: digest}."""
+    out = {}
+    with _lock:
+        for name, data in blobs.items():
+            d = digest(data)
+            out[name] = d
+            if d in _fmus:
+                continue
+            tmp = tempfile.mkdtemp(prefix=f"tailsim-campaign-{os.getpid()}-")
+            _dirs.append(tmp)
+            path = pathlib.Path(tmp) / f"{name}.fmu"
+            path.write_bytes(data)
+            _fmus[d] = Fmu(path, pathlib.Path(tmp) / "x")
+    return out
+
+
+def release_all() -> None:
+    """Free every instance and remove the extracted FMUs of this process."""
+    with _lock:
+        for s in _slaves.values():
+            s.free()
+        _slaves.clear()
+        _fmus.clear()
+        for d in _dirs:
+            shutil.rmtree(d, ignore_errors=True)
+        _dirs.clear()
+
+
+def instances() -> dict[str, int]:
+    """How many instances this process holds, by model identifier (for tests and monitoring)."""
+    out: dict[str, int] = {}
+    for s in _slaves.values():
+        out[s.fmu.identifier] = out.get(s.fmu.identifier, 0) + 1
+    return out
+
+
+def _instance(d: str, role: str) -> _Slave:
+    key = (threading.get_ident(), d)
+    s = _slaves.get(key)
+    if s is None:
+        if d not in _fmus:
+            raise RuntimeError(f"FMU {d[:12]} not installed on this worker (plugin missing?)")
+        s = _Slave(_fmus[d], role)
+        _slaves[key] = s
+    return s
+
+
+def _discard(d: str) -> None:
+    s = _slaves.pop((threading.get_ident(), d), None)
+    if s is not None:
+        s.free()
+
+
+# --- the closed loop ---------------------------------------------------------------------
+
+
+class Diverged(Exception):
+    pass
+
+
+class TimedOut(Exception):
+    pass
+
+
+def fly(
+    plant: Fmu,
+    p,
+    controller: Fmu,
+    c,
+    plant_params: Mapping[str, float],
+    controller_params: Mapping[str, float],
+    wind,
+    stop_time: float,
+    step_size: float,
+    divergence_m: float = math.inf,
+    deadline: float = math.inf,
+) -> tuple[dict[str, np.ndarray], str, str]:
+    """Fly instances `p`, `c` (freshly instantiated or reset) as ClosedLoop.run does
+    with ordering 'gauss-seidel' and a zero ref_offset.
+
+    Returns the recorded signals (up to where it stopped) — time, phase, pos_error,
+    ref_pos_d, pos_d, alpha and the seven commands, each as ClosedLoop records it —
+    and (failure, detail) with failure '' when it reached the stop time.
+    """
+    h = float(step_size)
+    n = int(round(float(stop_time) / h))
+    pv, cv = plant.variables, controller.variables
+    p_out = set(plant.names("output"))
+    p_in = set(plant.names("input"))
+    to_controller = [x for x in controller.names("input") if x in p_out]
+    to_plant = [x for x in controller.names("output") if x in p_in]
+    p_vr_out = [pv[x].valueReference for x in to_controller]
+    c_vr_in = [cv[x].valueReference for x in to_controller]
+    c_vr_out = [cv[x].valueReference for x in to_plant]
+    p_vr_in = [pv[x].valueReference for x in to_plant]
+    wind_vr = [pv[f"wind_{k}"].valueReference for k in "ned"]
+    offset_vr = [cv[f"ref_offset_{k}"].valueReference for k in "ned"]
+    rec_p = [pv["pos_d"].valueReference, pv["alpha"].valueReference]
+    rec_c = [cv["ref_pos_d"].valueReference, cv["pos_error"].valueReference]
+    phase_vr = [cv["phase"].valueReference]
+    cmd_idx = [to_plant.index(x) for x in COMMANDS]
+    zero = [0.0, 0.0, 0.0]
+
+    time_ = np.full(n + 1, np.nan)
+    phase = np.full(n + 1, -1, dtype=np.int64)
+    rec = np.full((n + 1, 4), np.nan)  # pos_d, alpha, ref_pos_d, pos_error
+    cmds = np.full((n + 1, len(COMMANDS)), np.nan)
+    failure, detail, k_end = "", "", -1
+
+    for s in (p, c):
+        s.setupExperiment(startTime=0.0)
+        s.enterInitializationMode()
+    plant.set(p, plant_params)
+    p.setReal(wind_vr, list(wind(0.0)))
+    p.exitInitializationMode()
+    controller.set(c, controller_params)
+    c.setReal(c_vr_in, p.getReal(p_vr_out))
+    c.setReal(offset_vr, zero)
+    c.exitInitializationMode()
+    try:
+        for k in range(n + 1):
+            t = k * h
+            w = wind(t)
+            y_p = p.getReal(p_vr_out)
+            if not math.isfinite(math.fsum(y_p)):
+                raise Diverged(f"non-finite plant output at t = {t:.2f} s")
+            c.setReal(c_vr_in, y_p)
+            c.setReal(offset_vr, zero)
+            p.setReal(wind_vr, list(w))
+            c.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+            u_c = c.getReal(c_vr_out)
+            p.setReal(p_vr_in, u_c)
+            time_[k] = t
+            rec[k, 0:2] = p.getReal(rec_p)
+            rec[k, 2:4] = c.getReal(rec_c)
+            phase[k] = c.getInteger(phase_vr)[0]
+            cmds[k] = [u_c[i] for i in cmd_idx]
+            k_end = k
+            e = rec[k, 3]
+            if not e <= divergence_m:
+                raise Diverged(f"position error {e:.1f} m > {divergence_m:g} m at t = {t:.2f} s")
+            if k % 50 == 0 and time.perf_counter() > deadline:
+                raise TimedOut(f"wall-time limit reached at t = {t:.2f} s")
+            if k < n:
+                p.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+    except Diverged as exc:
+        failure, detail = "divergence", str(exc)
+    except TimedOut as exc:
+        failure, detail = "timeout", str(exc)
+    except Exception as exc:  # noqa: BLE001 - an error status mid-flight: keep what was flown
+        from fmpy.fmi1 import FMICallException
+
+        if not isinstance(exc, FMICallException):
+            raise
+        failure, detail = "fmi_error", f"{exc} at t = {k * h:.2f} s"
+    for s in (p, c):
+        if failure:
+            try:  # after a divergence the instances are discarded anyway
+                s.terminate()
+            except Exception:  # noqa: BLE001
+                pass
+        else:
+            s.terminate()
+    m = slice(0, k_end + 1)
+    signals = {
+        "time": time_[m],
+        "phase": phase[m],
+        "pos_d": rec[m, 0],
+        "alpha": rec[m, 1],
+        "ref_pos_d": rec[m, 2],
+        "pos_error": rec[m, 3],
+    }
+    for i, name in enumerate(COMMANDS):
+        signals[name] = cmds[m, i]
+    return signals, failure, detail
+
+
+# --- metrics of one run -------------------------------------------------------------------
+
+
+def metric_columns() -> list[str]:
+    cols = []
+    for k in range(N_PHASES):
+        cols += [f"max_err_p{k}", f"rms_err_p{k}"]
+    return cols + [
+        "max_err",
+        "rms_err",
+        "alt_loss_t1",
+        "alt_loss_t2",
+        "max_alpha_deg",
+        "sat_frac",
+        "sat_frac_thrust",
+        "t_end",
+        "last_phase",
+    ]
+
+
+def run_metrics(sig: Mapping[str, np.ndarray]) -> dict[str, float]:
+    """Metrics of the recorded part of a run (NaN where a phase was not reached).
+
+    max/RMS of the controller's pos_error per phase (phase output 0..4) and over the
+    run; altitude loss in transition 1 and 2 = largest height below the reference
+    (pos_d − ref_pos_d, ≥ 0) in phase 1 / 3; max α over phases 1–3 (α is not
+    meaningful in the near-hover vertical phases); saturation = fraction of samples
+    with any command at its limit (thrust ≤ 0 or ≥ 150 N, a surface at ±25°).
+    """
+    out: dict[str, float] = {}
+    err, phase = sig["pos_error"], sig["phase"]
+    nan = float("nan")
+    for k in range(N_PHASES):
+        e = err[phase == k]
+        out[f"max_err_p{k}"] = float(e.max()) if e.size else nan
+        out[f"rms_err_p{k}"] = float(math.sqrt(np.mean(e**2))) if e.size else nan
+    out["max_err"] = float(err.max()) if err.size else nan
+    out["rms_err"] = float(math.sqrt(np.mean(err**2))) if err.size else nan
+    below = sig["pos_d"] - sig["ref_pos_d"]
+    for name, k in (("alt_loss_t1", 1), ("alt_loss_t2", 3)):
+        b = below[phase == k]
+        out[name] = float(max(b.max(), 0.0)) if b.size else nan
+    a = sig["alpha"][(phase >= 1) & (phase <= 3)]
+    out["max_alpha_deg"] = float(np.degrees(a.max())) if a.size else nan
+    thrust = sig["thrust_cmd"]
+    sat_thrust = (thrust <= THRUST_LIMITS[0]) | (thrust >= THRUST_LIMITS[1] * (1 - 1e-9))
+    sat = sat_thrust.copy()
+    for name in COMMANDS[1:]:
+        sat |= np.abs(sig[name]) >= DEFLECTION_LIMIT * (1 - 1e-9)
+    out["sat_frac"] = float(sat.mean()) if sat.size else nan
+    out["sat_frac_thrust"] = float(sat_thrust.mean()) if sat.size else nan
+    out["t_end"] = float(sig["time"][-1]) if sig["time"].size else nan
+    out["last_phase"] = float(phase.max()) if phase.size else nan
+    return out
+
+
+def _worker_name() -> str:
+    try:
+        from distributed import get_worker
+
+        return get_worker().address
+    except Exception:  # noqa: BLE001 - not on a Dask worker
+        return f"{socket.gethostname()}:{os.getpid()}"
+
+
+def run_job(job: Mapping[str, Any], spec_json: Mapping[str, Any], digests: Mapping[str, str]) -> dict[str, Any]:
+    """Fly one run; always returns its row (failed runs included)."""
+    spec = CampaignSpec.from_json(spec_json)
+    t0, c0 = time.perf_counter(), time.thread_time()
+    row: dict[str, Any] = dict(job)
+    row.update({k: float("nan") for k in metric_columns()})
+    row.update(completed=False, failure="", detail="", worker=_worker_name())
+    pd_, cd_ = digests["plant"], digests[job["controller"]]
+    plant_ok = ctrl_ok = False
+    try:
+        ps, cs = _instance(pd_, "plant"), _instance(cd_, "controller")
+        for s in (ps, cs):
+            if s.used:
+                s.slave.reset()  # fmi2Reset: back to the instantiated state, then set parameters
+            s.used = True
+            s.messages.clear()
+        plant, ctrl = ps.fmu, cs.fmu
+        nominal = {n: v.start for n, v in plant.variables.items() if v.causality == "parameter"}
+        pp = plant_parameters(job, {k: float(v) for k, v in nominal.items() if k in _scaled_names()})
+        pp["aero_model"] = spec.aero_model
+        pp.update(json.loads(job.get("overrides") or "{}"))
+        cp = dict(spec.mission)
+        cp.update(CONFIGURATIONS[job["configuration"]][job["controller"]])
+        sig, failure, detail = fly(
+            plant,
+            ps.slave,
+            ctrl,
+            cs.slave,
+            pp,
+            cp,
+            wind_function(job),
+            spec.stop_time,
+            spec.step_size,
+            spec.divergence_m,
+            t0 + spec.timeout_s,
+        )
+        row.update(run_metrics(sig))
+        if failure == "fmi_error":
+            logs = _error_logs(pd_, cd_)
+            if any("left its envelope" in m for m in logs):
+                failure = "divergence"  # the plant's own tumble check (an error status by design)
+            detail = " | ".join([detail, *logs])
+        row.update(completed=not failure, failure=failure, detail=detail)
+        plant_ok = ctrl_ok = not failure
+    except Exception as exc:  # noqa: BLE001 - a failed run is a result, not a crash
+        from fmpy.fmi1 import FMICallException
+
+        kind = "fmi_error" if isinstance(exc, FMICallException) else "exception"
+        logs = _error_logs(pd_, cd_)
+        row.update(completed=False, failure=kind, detail=" | ".join([f"{type(exc).__name__}: {exc}", *logs]))
+    finally:
+        # An instance that went through a failure is not trusted again: free it.
+        if not plant_ok:
+            _discard(pd_)
+        if not ctrl_ok:
+            _discard(cd_)
+    row["wall_time_s"] = time.perf_counter() - t0
+    row["cpu_time_s"] = time.thread_time() - c0  # CPU time of this run's thread (load-independent cost)
+    return row
+
+
+def _error_logs(*digests: str) -> list[str]:
+    """The error/fatal messages the FMUs logged for this thread's instances in this run."""
+    logs = []
+    for d in digests:
+        s = _slaves.get((threading.get_ident(), d))
+        if s is not None:
+            logs += [m for m in s.messages if m.startswith("[3]") or m.startswith("[4]")]
+    return logs
+
+
+def _scaled_names() -> set[str]:
+    from .campaign_sampling import TABLE_5_1
+
+    return {n for p in TABLE_5_1 for n in p.plant_params}
+
+
+def load_fmu_bytes(dist: str | pathlib.Path, controllers) -> dict[str, bytes]:
+    dist = pathlib.Path(dist)
+    names = ["plant", *controllers]
+    return {n: (dist / f"{FMU_NAMES[n]}.fmu").read_bytes() for n in names}

@@ -1,0 +1,263 @@
+"""The sample space of the Monte-Carlo campaign (issue 15, part 3).
+
+A *sample* is one draw of everything random: the 25 uncertain parameters of the
+thesis's Table 5.1 (each scaled by an independent log-uniform factor within
+[1/τ, τ], τ = 1.5 for the aerodynamic derivatives and 1.1 for the mass and the
+inertias, as in the thesis's sweep (5.1.1)), a steady horizontal wind, a 1 − cos
+gust of random direction, amplitude and timing, and a sensor-noise seed (for the
+avionics state source, once it exists).
+
+A *run* is one sample flown on one point of the configuration axes:
+controller × configuration × state source. Every run of a sample sees the same
+draw, so controllers are compared on paired samples.
+
+Sample i is drawn from its own generator, seeded with (seed, i), so any subset of
+a campaign is reproducible on its own and a campaign can grow.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from dataclasses import dataclass, field
+from typing import Any, Mapping
+
+import numpy as np
+
+# Thesis Table 5.1: (column name, symbol, plant-FMU parameters, uncertainty class).
+# The plant interpolates each stability/control derivative between α = 0 and
+# α = alpha_1 (5.9°): both table points (_a0, _a1) are scaled by the same factor.
+_AERO = [
+    ("C_La", "C_Lα", "c_L_alpha"),
+    ("C_Lq", "C_Lq", "c_L_q"),
+    ("C_Lde", "C_Lδe", "c_L_de"),
+    ("C_Yb", "C_Yβ", "c_Y_beta"),
+    ("C_Yp", "C_Yp", "c_Y_p"),
+    ("C_Yr", "C_Yr", "c_Y_r"),
+    ("C_Yda", "C_Yδa", "c_Y_da"),
+    ("C_Ydr", "C_Yδr", "c_Y_dr"),
+    ("C_lb", "C_lβ", "c_l_beta"),
+    ("C_lp", "C_lp", "c_l_p"),
+    ("C_lr", "C_lr", "c_l_r"),
+    ("C_lda", "C_lδa", "c_l_da"),
+    ("C_ldr", "C_lδr", "c_l_dr"),
+    ("C_ma", "C_mα", "c_m_alpha"),
+    ("C_mq", "C_mq", "c_m_q"),
+    ("C_mde", "C_mδe", "c_m_de"),
+    ("C_nb", "C_nβ", "c_n_beta"),
+    ("C_np", "C_np", "c_n_p"),
+    ("C_nr", "C_nr", "c_n_r"),
+    ("C_nda", "C_nδa", "c_n_da"),
+    ("C_ndr", "C_nδr", "c_n_dr"),
+]
+_MASS = [("m", "m", "mass"), ("I_x", "I_x", "i_xx"), ("I_y", "I_y", "i_yy"), ("I_z", "I_z", "i_zz")]
+
+
+@dataclass(frozen=True)
+class Uncertain:
+    """One Table 5.1 parameter."""
+
+    name: str  # column-safe name (sample column `k_<name>`)
+    symbol: str  # thesis symbol
+    plant_params: tuple[str, ...]  # plant-FMU parameters scaled by the same factor
+    kind: str  # "aero" (τ_aero) or "mass" (τ_mass)
+
+
+TABLE_5_1: tuple[Uncertain, ...] = tuple(
+    [Uncertain(n, s, (f"{p}_a0", f"{p}_a1"), "aero") for n, s, p in _AERO]
+    + [Uncertain(n, s, (p,), "mass") for n, s, p in _MASS]
+)
+assert len(TABLE_5_1) == 25
+
+#: Configuration axes: the values that exist now; the others are named so the
+#: schema has room for them (issue 15: 'thesis' configurations, 'avionics' state).
+CONTROLLERS = ("lqr", "tsd")
+CONFIGURATIONS = {"tuned": {"lqr": {}, "tsd": {}}}  # controller-parameter overrides per configuration
+PLANNED_CONFIGURATIONS = ("thesis",)
+STATE_SOURCES = ("perfect",)
+PLANNED_STATE_SOURCES = ("avionics",)
+
+#: Missions (controller parameters; identical for both controllers) and their stop times (s).
+MISSIONS: dict[str, dict[str, float]] = {
+    # The controllers' defaults: 5 s climb, T1 = 5 s, 10 s level, T2 = 10 s, 5 s vertical.
+    "default": {"t_vertical_1": 5.0, "t_transition_1": 5.0, "t_level": 10.0, "t_transition_2": 10.0, "t_vertical_2": 5.0},
+    # A short mission for tests and smoke runs (all five phases in 11 s).
+    "short": {"t_vertical_1": 1.0, "t_transition_1": 3.0, "t_level": 2.0, "t_transition_2": 4.0, "t_vertical_2": 1.0},
+}
+
+
+def mission_stop_time(mission: Mapping[str, float]) -> float:
+    return float(sum(mission[k] for k in ("t_vertical_1", "t_transition_1", "t_level", "t_transition_2", "t_vertical_2")))
+
+
+@dataclass(frozen=True)
+class CampaignSpec:
+    """Everything that fixes a campaign's runs (the FMUs aside: they are hashed)."""
+
+    seed: int = 0
+    n_samples: int = 64
+    controllers: tuple[str, ...] = CONTROLLERS
+    configurations: tuple[str, ...] = ("tuned",)
+    state_sources: tuple[str, ...] = ("perfect",)
+    tau_aero: float = 1.5
+    tau_mass: float = 1.1
+    #: Largest steady horizontal wind speed (m/s); heading uniform.
+    wind_max: float = 5.0
+    #: Largest 1 − cos gust amplitude (m/s); direction uniform on the sphere.
+    gust_max: float = 5.0
+    #: Range of the gust duration (s).
+    gust_duration: tuple[float, float] = (1.0, 3.0)
+    mission_name: str = "default"
+    mission: Mapping[str, float] = field(default_factory=lambda: dict(MISSIONS["default"]))
+    step_size: float = 0.02
+    #: A run is stopped as diverged once the controller's pos_error exceeds this (m).
+    divergence_m: float = 50.0
+    #: A run is stopped as timed out after this wall time (s).
+    timeout_s: float = 300.0
+    #: Extra plant-parameter values for some samples {sample_id: {name: value}}:
+    #: what-if studies and fault injection (an invalid value makes a failed run).
+    overrides: Mapping[int, Mapping[str, float]] = field(default_factory=dict)
+    #: The plant's `aero_model` for every run: 1 = global (post-stall, the FMU's default),
+    #: 0 = the thesis's linear derivatives at every angle.
+    aero_model: int = 1
+
+    def __post_init__(self):
+        for c in self.controllers:
+            if c not in CONTROLLERS:
+                raise ValueError(f"unknown controller {c!r} (one of {CONTROLLERS})")
+        for c in self.configurations:
+            if c not in CONFIGURATIONS:
+                why = "not implemented yet" if c in PLANNED_CONFIGURATIONS else "unknown"
+                raise ValueError(f"configuration {c!r}: {why} (available: {tuple(CONFIGURATIONS)})")
+        for s in self.state_sources:
+            if s not in STATE_SOURCES:
+                why = "not implemented yet" if s in PLANNED_STATE_SOURCES else "unknown"
+                raise ValueError(f"state source {s!r}: {why} (available: {STATE_SOURCES})")
+        if self.aero_model not in (0, 1):
+            raise ValueError(f"aero_model = {self.aero_model!r}: expected 0 (thesis) or 1 (global)")
+        if not (self.tau_aero >= 1.0 and self.tau_mass >= 1.0):
+            raise ValueError("tau_aero and tau_mass must be ≥ 1")
+
+    @property
+    def stop_time(self) -> float:
+        return mission_stop_time(self.mission)
+
+    def to_json(self) -> dict[str, Any]:
+        d = dataclasses.asdict(self)
+        d["overrides"] = {str(k): dict(v) for k, v in self.overrides.items()}
+        d["mission"] = dict(self.mission)
+        return d
+
+    @classmethod
+    def from_json(cls, d: Mapping[str, Any]) -> "CampaignSpec":
+        d = dict(d)
+        for k in ("controllers", "configurations", "state_sources", "gust_duration"):
+            d[k] = tuple(d[k])
+        d["overrides"] = {int(k): dict(v) for k, v in d.get("overrides", {}).items()}
+        return cls(**d)
+
+    def identity(self) -> dict[str, Any]:
+        """What must not change when a campaign is resumed or grown (n_samples may)."""
+        d = self.to_json()
+        d.pop("n_samples")
+        return d
+
+    def tau(self, u: Uncertain) -> float:
+        return self.tau_aero if u.kind == "aero" else self.tau_mass
+
+
+def sample_generator(seed: int, i: int) -> np.random.Generator:
+    """The generator of sample i: its own stream, derived from (seed, i) only."""
+    return np.random.default_rng(np.random.SeedSequence(entropy=seed, spawn_key=(i,)))
+
+
+def draw_sample(spec: CampaignSpec, i: int) -> dict[str, Any]:
+    """Sample i as a flat dict (the sample columns of the results).
+
+    Draw order (fixed, so that adding configuration axes never changes a draw):
+    25 log-uniform exponents, steady wind (speed, heading), gust (amplitude,
+    direction, duration, start), noise seed.
+    """
+    rng = sample_generator(spec.seed, i)
+    s: dict[str, Any] = {"sample_id": int(i)}
+    # Log-uniform on [1/τ, τ]: k = τ^u with u ~ U(−1, 1) (thesis (5.1.1) spans the same range).
+    u = rng.uniform(-1.0, 1.0, size=len(TABLE_5_1))
+    for p, ui in zip(TABLE_5_1, u):
+        s[f"k_{p.name}"] = float(spec.tau(p) ** ui)
+    speed = rng.uniform(0.0, spec.wind_max)
+    heading = rng.uniform(0.0, 2.0 * math.pi)
+    s["wind_steady_n"] = float(speed * math.cos(heading))
+    s["wind_steady_e"] = float(speed * math.sin(heading))
+    amp = rng.uniform(0.0, spec.gust_max)
+    d = rng.normal(size=3)
+    d /= np.linalg.norm(d)
+    dur = rng.uniform(*spec.gust_duration)
+    start = rng.uniform(0.0, max(spec.stop_time - dur, 0.0))
+    s["gust_n"], s["gust_e"], s["gust_d"] = (float(x) for x in amp * d)
+    s["gust_start"] = float(start)
+    s["gust_duration"] = float(dur)
+    s["noise_seed"] = int(rng.integers(0, 2**31 - 1))
+    return s
+
+
+def sample_columns() -> list[str]:
+    return (
+        ["sample_id"]
+        + [f"k_{p.name}" for p in TABLE_5_1]
+        + ["wind_steady_n", "wind_steady_e", "gust_n", "gust_e", "gust_d", "gust_start", "gust_duration", "noise_seed"]
+    )
+
+
+def plant_parameters(sample: Mapping[str, Any], nominal: Mapping[str, float]) -> dict[str, float]:
+    """The plant-parameter values of a sample: every Table 5.1 parameter's
+    nominal value (from the plant's modelDescription) times its factor."""
+    out = {}
+    for p in TABLE_5_1:
+        k = sample[f"k_{p.name}"]
+        for name in p.plant_params:
+            out[name] = float(nominal[name]) * k
+    return out
+
+
+def wind_function(sample: Mapping[str, Any]):
+    """Wind (n, e, d) (m/s) of a sample: steady horizontal wind plus the 1 − cos gust
+    amplitude·(1 − cos(2π(t − t_start)/duration))/2 inside the gust."""
+    wn, we = sample["wind_steady_n"], sample["wind_steady_e"]
+    gn, ge, gd = sample["gust_n"], sample["gust_e"], sample["gust_d"]
+    t0, dur = sample["gust_start"], sample["gust_duration"]
+    two_pi = 2.0 * math.pi
+
+    def wind(t: float) -> tuple[float, float, float]:
+        s = (t - t0) / dur
+        if 0.0 <= s <= 1.0:
+            k = 0.5 * (1.0 - math.cos(two_pi * s))
+            return (wn + gn * k, we + ge * k, gd * k)
+        return (wn, we, 0.0)
+
+    return wind
+
+
+def run_key(sample_id: int, controller: str, configuration: str, state_source: str) -> str:
+    return f"{sample_id}/{controller}/{configuration}/{state_source}"
+
+
+def jobs(spec: CampaignSpec, sample_ids=None) -> list[dict[str, Any]]:
+    """Every run of the campaign: sample × controller × configuration × state source."""
+    out = []
+    for i in range(spec.n_samples) if sample_ids is None else sample_ids:
+        s = draw_sample(spec, i)
+        for c in spec.controllers:
+            for cfg in spec.configurations:
+                for src in spec.state_sources:
+                    out.append(
+                        {
+                            "key": run_key(i, c, cfg, src),
+                            "controller": c,
+                            "configuration": cfg,
+                            "state_source": src,
+                            "overrides": json.dumps(dict(spec.overrides.get(i, {})), sort_keys=True),
+                            **s,
+                        }
+                    )
+    return out
