@@ -19,6 +19,9 @@ from tailsim.avionics import AvionicsLoop, fly_with_avionics, format_phase_error
 from tailsim.master import pos_error
 from tailsim.metrics import mission_check
 
+# The thesis's aerodynamics (aero_model 0), as tests/test_closed_loop.py: the controllers'
+# design model (the plant's default global model stalls the wing in places).
+PLANT = {"aero_model": 0}
 MISSION = ["t_vertical_1", "t_transition_1", "t_level", "t_transition_2", "t_vertical_2", "v_level"]
 CONTROLLERS = ["tailsitter_lqr", "tailsitter_tsd"]
 
@@ -64,17 +67,17 @@ def check(result, fmus, controller, theta_trim):
 
 @pytest.mark.parametrize("controller", CONTROLLERS)
 def test_default_mission_with_avionics_gauss_seidel(fmus, controller, level_trim_theta):
-    r = fly_with_avionics(fmus, controller)
+    r = fly_with_avionics(fmus, controller, plant_params=PLANT)
     check(r, fmus, controller, level_trim_theta)
 
 
 def test_lqr_default_mission_with_avionics_jacobi(fmus, level_trim_theta):
-    r = fly_with_avionics(fmus, "tailsitter_lqr", ordering="jacobi", ekf_params={"measurement_latency": 0.02})
+    r = fly_with_avionics(fmus, "tailsitter_lqr", ordering="jacobi", ekf_params={"measurement_latency": 0.02}, plant_params=PLANT)
     check(r, fmus, "tailsitter_lqr", level_trim_theta)
 
 
 def test_lqr_plant_and_sensors_at_5_ms(fmus, level_trim_theta):
-    r = fly_with_avionics(fmus, "tailsitter_lqr", plant_step=0.005)
+    r = fly_with_avionics(fmus, "tailsitter_lqr", plant_step=0.005, plant_params=PLANT)
     check(r, fmus, "tailsitter_lqr", level_trim_theta)
 
 
@@ -85,7 +88,7 @@ def test_lqr_plant_and_sensors_at_5_ms(fmus, level_trim_theta):
     "Butterworth too); see python/tailsim/avionics.py",
 )
 def test_tsd_default_mission_with_avionics_jacobi(fmus, level_trim_theta):
-    r = fly_with_avionics(fmus, "tailsitter_tsd", ordering="jacobi", ekf_params={"measurement_latency": 0.02})
+    r = fly_with_avionics(fmus, "tailsitter_tsd", ordering="jacobi", ekf_params={"measurement_latency": 0.02}, plant_params=PLANT)
     check(r, fmus, "tailsitter_tsd", level_trim_theta)
 
 
@@ -95,7 +98,7 @@ def test_tsd_default_mission_with_avionics_jacobi(fmus, level_trim_theta):
     "(limit cycle of its fast loops on the filtered IMU); see python/tailsim/avionics.py",
 )
 def test_tsd_plant_and_sensors_at_5_ms(fmus, level_trim_theta):
-    r = fly_with_avionics(fmus, "tailsitter_tsd", plant_step=0.005)
+    r = fly_with_avionics(fmus, "tailsitter_tsd", plant_step=0.005, plant_params=PLANT)
     check(r, fmus, "tailsitter_tsd", level_trim_theta)
 
 
@@ -129,7 +132,7 @@ def test_wiring_by_name_and_shared_parameters(fmus):
 
 def test_estimation_errors_are_against_the_truth(fmus):
     """A short hover: the recorded errors are the estimate minus the plant's outputs."""
-    r = fly_with_avionics(fmus, "tailsitter_lqr", stop_time=1.0)
+    r = fly_with_avionics(fmus, "tailsitter_lqr", stop_time=1.0, plant_params=PLANT)
     d = np.sqrt(sum((r[f"est_pos_{a}"] - r[f"pos_{a}"]) ** 2 for a in "ned"))
     assert np.allclose(r["err_pos"], d)
     assert np.allclose(r["err_airspeed"], r["est_airspeed"] - r["airspeed"])
