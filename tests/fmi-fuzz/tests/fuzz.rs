@@ -45,8 +45,11 @@ fn random_call_sequences_keep_every_invariant() {
     for must in must {
         assert!(report.coverage.contains_key(must), "{must} never exercised");
     }
-    // Model Exchange instances of the plant: the ME calls ran legally (some OK) in the
-    // ME states, and illegally elsewhere.
+    // Model Exchange instances of the plant (the only ME model): the ME calls ran legally
+    // (some OK) in the ME states, and illegally elsewhere.
+    if !required_models().iter().any(|m| m == "tailsitter_plant") {
+        return;
+    }
     for must in [
         "fmi2SetContinuousStates @ ME ContinuousTimeMode",
         "fmi2GetDerivatives @ ME ContinuousTimeMode",
