@@ -5,7 +5,7 @@
 #
 #   scripts/hardening.sh [FUZZ_SECONDS]        default 600
 #
-# Environment: TAILSITTER_FMUS=a,b narrows the FMUs (default: all three);
+# Environment: TAILSITTER_FMUS=a,b narrows the FMUs (default: all five, fmi-fuzz ALL_MODELS);
 # HARDENING_SKIP_DIST=1 skips `cargo xtask dist`; FUZZ_SEED sets the fuzz seed;
 # VALGRIND_CYCLES (default 5) cycles per FMU under valgrind; RSS_CYCLES (default 100000)
 # light and RSS_FULL_CYCLES (default 5000; ~40 ms each for the LQR FMU) full cycles.

@@ -39,6 +39,10 @@ pub fn params_from(v: &Variables) -> EstimatorParams {
     n.sigma_gyro = v.sigma_gyro;
     n.sigma_mag = v.sigma_mag;
     n.sigma_pitot = v.sigma_pitot;
+    n.sigma_pitot_dp = v.sigma_pitot_dp;
+    p.filter.enabled = v.filter_enabled;
+    p.filter.bandwidth = v.filter_bandwidth;
+    p.filter.latency = v.measurement_latency;
     n.imu_period = v.imu_period;
     let q = &mut p.process;
     q.accel_model = v.accel_model_noise;
@@ -50,7 +54,7 @@ pub fn params_from(v: &Variables) -> EstimatorParams {
     e.ref_latitude = v.ref_latitude;
     e.ref_longitude = v.ref_longitude;
     e.ref_height = v.ref_height;
-    e.mag_total = v.mag_total;
+    e.mag_field_total = v.mag_field_total;
     e.mag_declination = v.mag_declination;
     e.mag_inclination = v.mag_inclination;
     e.gravity = v.gravity;

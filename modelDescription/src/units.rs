@@ -16,6 +16,10 @@ pub struct Unit {
     pub m: i32,
     pub s: i32,
     pub rad: i32,
+    /// Ampere exponent.
+    pub a: i32,
+    /// `BaseUnit` factor: value in SI base units = factor × value (1 for SI units).
+    pub factor: f64,
     pub display_units: &'static [DisplayUnit],
 }
 
@@ -35,6 +39,8 @@ const fn unit(name: &'static str, kg: i32, m: i32, s: i32, rad: i32) -> Unit {
         m,
         s,
         rad,
+        a: 0,
+        factor: 1.0,
         display_units: &[],
     }
 }
@@ -61,6 +67,8 @@ pub const UNITS: &[Unit] = &[
         m: 0,
         s: 0,
         rad: 1,
+        a: 0,
+        factor: 1.0,
         display_units: &[DEG],
     },
     Unit {
@@ -69,7 +77,22 @@ pub const UNITS: &[Unit] = &[
         m: 0,
         s: -1,
         rad: 1,
+        a: 0,
+        factor: 1.0,
         display_units: &[DEG_PER_S],
+    },
+    // Pressure: the pitot's differential pressure.
+    unit("Pa", 1, -1, -2, 0),
+    // Magnetic flux density, CGS: 1 Gauss = 1e-4 T = 1e-4 kg·A⁻¹·s⁻² (`factor` 1e-4 to SI).
+    Unit {
+        name: "Gauss",
+        kg: 1,
+        m: 0,
+        s: -2,
+        rad: 0,
+        a: -1,
+        factor: 1e-4,
+        display_units: &[],
     },
 ];
 

@@ -118,10 +118,13 @@ fn unit_definitions(w: &mut W, model: &Model) -> Result<()> {
                 .with_attribute(("name", u.name))
                 .write_inner_content(|w| {
                     let mut base = w.create_element("BaseUnit");
-                    for (name, exp) in [("kg", u.kg), ("m", u.m), ("s", u.s), ("rad", u.rad)] {
+                    for (name, exp) in [("kg", u.kg), ("m", u.m), ("s", u.s), ("A", u.a), ("rad", u.rad)] {
                         if exp != 0 {
                             base = base.with_attribute((name, exp.to_string().as_str()));
                         }
+                    }
+                    if u.factor != 1.0 {
+                        base = base.with_attribute(("factor", fmt_f64(u.factor).as_str()));
                     }
                     base.write_empty()?;
                     for d in u.display_units {

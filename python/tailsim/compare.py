@@ -149,6 +149,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--fast-t2", type=float, default=4.0, help="T2 of the fast mission [s]")
     ap.add_argument("--no-steps", action="store_true", help="skip the position-step tests")
     ap.add_argument("--jacobi", action="store_true", help="use a Jacobi master instead of Gauss-Seidel")
+    ap.add_argument("--no-avionics", action="store_true", help="skip the missions with avionics in the loop")
     args = ap.parse_args(argv)
 
     from tqdm import tqdm
@@ -273,6 +274,18 @@ def main(argv: list[str] | None = None) -> int:
             md.append(f"| {label} | " + " | ".join(vals) + " |")
     if failures:
         md += ["", "## Failed runs", ""] + [f"- {k[2].upper()} {k[1]} ({k[0]}): {v}" for k, v in failures.items()]
+    if not args.no_avionics:
+        from .avionics import avionics_section
+
+        md += avionics_section(
+            dist,
+            keys,
+            {m: {**mission_params(defaults, t1, t2), "v_level": defaults["v_level"]} for m, (t1, t2) in missions.items()},
+            {(m, k): r for m, runs in mission_runs.items() for k, r in runs.items()},
+            theta_trim,
+            ordering=ordering,
+            out=out,
+        )
     md += ["", "## Plots", ""]
     for title, p in plots:
         md += [f"### {title}", "", f"![{title}]({p.name})", ""]

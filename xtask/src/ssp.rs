@@ -134,6 +134,14 @@ pub fn write_all(dir: &Path) -> Result<Vec<PathBuf>, String> {
     if written.is_empty() {
         return Err(format!("no controller FMU in {}", dir.display()));
     }
+    let has = |id: &str| dir.join(format!("{id}.fmu")).exists();
+    if has(SENSORS) && has(ESTIMATOR) {
+        for id in CONTROLLERS.iter().filter(|id| has(id)) {
+            let path = write_avionics_ssp(dir, id)?;
+            println!("wrote {}", path.display());
+            written.push(path);
+        }
+    }
     Ok(written)
 }
 
@@ -410,17 +418,167 @@ pub fn system_description(plant: &FmuInfo, controller: &FmuInfo) -> Result<Strin
             ("initial_speed", "Real", real(v_vertical)),
         ],
     )?;
-    let mut units: Vec<&Unit> = Vec::new();
-    for u in plant.units.iter().chain(&controller.units) {
-        if !units.iter().any(|known| known.name == u.name) {
-            units.push(u);
-        }
-    }
     let name = format!("{}_closed_loop", controller.model_identifier);
     let description = format!(
         "Tail-sitter closed loop: {} flying {} (docs/DESIGN.md section 2 port wiring by name, section 3 mission).",
         controller.model_identifier, plant.model_identifier
     );
+    write_ssd(
+        &name,
+        &description,
+        &[
+            ("controller", controller, controller_inputs, controller_parameters),
+            ("plant", plant, plant_inputs, plant_parameters),
+        ],
+        &links,
+    )
+}
+
+/// The estimator and sensors of the avionics systems `dist/<controller>_avionics.ssp`.
+pub const SENSORS: &str = "tailsitter_sensors";
+pub const ESTIMATOR: &str = "tailsitter_ekf";
+
+/// Connections by name from `from` outputs to `to` inputs (same type).
+fn links_between(
+    from: &FmuInfo,
+    from_id: &'static str,
+    to: &FmuInfo,
+    to_id: &'static str,
+) -> Result<Vec<Connection>, String> {
+    let mut out = Vec::new();
+    for output in from.with("output") {
+        if let Some(input) = to.port(&output.name).filter(|p| p.causality == "input") {
+            if input.kind != output.kind {
+                return Err(format!(
+                    "{}: {} output is {}, {} input is {}",
+                    output.name, from.model_identifier, output.kind, to.model_identifier, input.kind
+                ));
+            }
+            out.push(Connection {
+                start: from_id,
+                end: to_id,
+                name: output.name.clone(),
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// SystemStructure.ssd of avionics in the loop: plant → sensors → estimator → controller →
+/// plant and controller → estimator (the commands), every connection explicit and by name.
+/// The sensors and the estimator keep their (equal) defaults of the shared parameters.
+pub fn avionics_system_description(
+    plant: &FmuInfo,
+    sensors: &FmuInfo,
+    ekf: &FmuInfo,
+    controller: &FmuInfo,
+) -> Result<String, String> {
+    let mut links = links_between(plant, "plant", sensors, "sensors")?;
+    links.extend(links_between(sensors, "sensors", ekf, "estimator")?);
+    links.extend(links_between(ekf, "estimator", controller, "controller")?);
+    links.extend(links_between(controller, "controller", plant, "plant")?);
+    links.extend(links_between(controller, "controller", ekf, "estimator")?);
+    for (fmu, id) in [(plant, "plant"), (ekf, "estimator")] {
+        let undriven: Vec<_> = fmu
+            .with("input")
+            .filter(|p| p.name.ends_with("_cmd") && !links.iter().any(|c| c.end == id && c.name == p.name))
+            .map(|p| p.name.as_str())
+            .collect();
+        if !undriven.is_empty() {
+            return Err(format!(
+                "{} does not drive {id} inputs {undriven:?}",
+                controller.model_identifier
+            ));
+        }
+    }
+    let undriven: Vec<_> = ekf
+        .with("input")
+        .filter(|p| !p.name.ends_with("_cmd") && !links.iter().any(|c| c.end == "estimator" && c.name == p.name))
+        .map(|p| p.name.as_str())
+        .collect();
+    if !undriven.is_empty() {
+        return Err(format!(
+            "{} does not drive estimator inputs {undriven:?}",
+            sensors.model_identifier
+        ));
+    }
+    let inputs_of =
+        |end: &str| -> Vec<&str> { links.iter().filter(|c| c.end == end).map(|c| c.name.as_str()).collect() };
+    let mission: Vec<_> = MISSION.iter().map(|(n, v)| (*n, "Real", real(*v))).collect();
+    let controller_parameters = bindings(controller, &mission)?;
+    let plant_parameters = bindings(
+        plant,
+        &[
+            ("initial_condition", "Integer", "0".to_string()),
+            ("initial_speed", "Real", real(mission_default("v_vertical"))),
+        ],
+    )?;
+    // SSP importers (fmpy, libcosim) are Jacobi masters: the estimator fuses the sensors'
+    // outputs of the previous step, one `sample_time` old (its `measurement_latency`).
+    let estimator_parameters = if ekf.port("measurement_latency").is_some() {
+        bindings(
+            ekf,
+            &[("measurement_latency", "Real", real(mission_default("sample_time")))],
+        )?
+    } else {
+        Vec::new()
+    };
+    let name = format!("{}_avionics", controller.model_identifier);
+    let description = format!(
+        "Tail-sitter with avionics in the loop: {} flying {} on the estimates of {} from {} (port wiring by name).",
+        controller.model_identifier, plant.model_identifier, ekf.model_identifier, sensors.model_identifier
+    );
+    write_ssd(
+        &name,
+        &description,
+        &[
+            ("controller", controller, inputs_of("controller"), controller_parameters),
+            ("estimator", ekf, inputs_of("estimator"), estimator_parameters),
+            ("sensors", sensors, inputs_of("sensors"), Vec::new()),
+            ("plant", plant, inputs_of("plant"), plant_parameters),
+        ],
+        &links,
+    )
+}
+
+/// Write `<dir>/<controller>_avionics.ssp` (plant, sensors, estimator, controller).
+pub fn write_avionics_ssp(dir: &Path, controller_id: &str) -> Result<PathBuf, String> {
+    let read = |id: &str| {
+        let p = dir.join(format!("{id}.fmu"));
+        std::fs::read(&p).map_err(|e| format!("{}: {e}", p.display()))
+    };
+    let bytes = [read(PLANT)?, read(SENSORS)?, read(ESTIMATOR)?, read(controller_id)?];
+    let infos = bytes.iter().map(|b| fmu_info(b)).collect::<Result<Vec<_>, _>>()?;
+    let ssd = avionics_system_description(&infos[0], &infos[1], &infos[2], &infos[3])?;
+    let path = dir.join(format!("{controller_id}_avionics.ssp"));
+    let file = std::fs::File::create(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut zip = zip::ZipWriter::new(file);
+    let deflated = zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
+    let stored = zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Stored);
+    zip.start_file("SystemStructure.ssd", deflated)
+        .map_err(|e| e.to_string())?;
+    zip.write_all(ssd.as_bytes()).map_err(|e| e.to_string())?;
+    for (info, b) in infos.iter().zip(&bytes) {
+        let name = resource(&info.model_identifier);
+        zip.start_file(name.as_str(), stored)
+            .map_err(|e| format!("{name}: {e}"))?;
+        zip.write_all(b).map_err(|e| format!("{name}: {e}"))?;
+    }
+    zip.finish().map_err(|e| e.to_string())?;
+    Ok(path)
+}
+
+/// One element of a system: its name, FMU, connected inputs and parameter bindings.
+type Element<'a> = (&'a str, &'a FmuInfo, Vec<&'a str>, Vec<(&'static str, String, String)>);
+
+/// SystemStructure.ssd of `elements` wired by `links`, with the default mission experiment.
+fn write_ssd(name: &str, description: &str, elements: &[Element], links: &[Connection]) -> Result<String, String> {
+    let mut units: Vec<&Unit> = Vec::new();
+    for u in elements.iter().flat_map(|e| e.1.units.iter()) {
+        if !units.iter().any(|known| known.name == u.name) {
+            units.push(u);
+        }
+    }
     let mut w = Writer::new_with_indent(Vec::new(), b' ', 2);
     let io = |e: std::io::Error| e.to_string();
     w.write_event(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None)))
@@ -432,7 +590,7 @@ pub fn system_description(plant: &FmuInfo, controller: &FmuInfo) -> Result<Strin
             ("xmlns:ssv", NS_SSV),
             ("xmlns:osp", NS_OSP),
             ("version", "1.0"),
-            ("name", name.as_str()),
+            ("name", name),
             (
                 "generationTool",
                 concat!("tailsitter xtask ", env!("CARGO_PKG_VERSION")),
@@ -440,14 +598,16 @@ pub fn system_description(plant: &FmuInfo, controller: &FmuInfo) -> Result<Strin
         ])
         .write_inner_content(|w| {
             w.create_element("ssd:System")
-                .with_attributes([("name", name.as_str()), ("description", description.as_str())])
+                .with_attributes([("name", name), ("description", description)])
                 .write_inner_content(|w| {
                     w.create_element("ssd:Elements").write_inner_content(|w| {
-                        component(w, "controller", controller, &controller_inputs, &controller_parameters)?;
-                        component(w, "plant", plant, &plant_inputs, &plant_parameters)
+                        for (name, fmu, inputs, parameters) in elements {
+                            component(w, name, fmu, inputs, parameters)?;
+                        }
+                        Ok(())
                     })?;
                     w.create_element("ssd:Connections").write_inner_content(|w| {
-                        for c in &links {
+                        for c in links {
                             w.create_element("ssd:Connection")
                                 .with_attributes([
                                     ("startElement", c.start),
@@ -577,6 +737,53 @@ mod tests {
         assert!(ssd.contains(r#"<ssv:Integer value="0"/>"#));
         assert!(ssd.contains(r#"<osp:FixedStepAlgorithm baseStepSize="0.02"/>"#));
         assert!(ssd.contains(r#"stopTime="35.0""#));
+    }
+
+    fn avionics() -> (FmuInfo, FmuInfo, FmuInfo) {
+        let sensors = FmuInfo {
+            model_identifier: SENSORS.into(),
+            ports: vec![port("pos_d", "input", "Real"), port("gps_height", "output", "Real")],
+            units: vec![],
+        };
+        let ekf = FmuInfo {
+            model_identifier: ESTIMATOR.into(),
+            ports: vec![
+                port("gps_height", "input", "Real"),
+                port("thrust_cmd", "input", "Real"),
+                port("pos_d", "output", "Real"),
+            ],
+            units: vec![],
+        };
+        let mut controller = controller();
+        controller.ports.retain(|p| p.name != "phase");
+        (sensors, ekf, controller)
+    }
+
+    #[test]
+    fn avionics_system_wires_the_chain_by_name() {
+        let (sensors, ekf, controller) = avionics();
+        let ssd = avionics_system_description(&plant(), &sensors, &ekf, &controller).unwrap();
+        for (from, to, name) in [
+            ("plant", "sensors", "pos_d"),
+            ("sensors", "estimator", "gps_height"),
+            ("estimator", "controller", "pos_d"),
+            ("controller", "plant", "thrust_cmd"),
+            ("controller", "estimator", "thrust_cmd"),
+        ] {
+            let c = format!(
+                r#"<ssd:Connection startElement="{from}" startConnector="{name}" endElement="{to}" endConnector="{name}"/>"#
+            );
+            assert!(ssd.contains(&c), "{c} missing");
+        }
+        assert!(!ssd.contains(r#"startElement="plant" startConnector="pos_d" endElement="controller""#));
+    }
+
+    #[test]
+    fn avionics_system_refuses_an_undriven_estimator_input() {
+        let (sensors, mut ekf, controller) = avionics();
+        ekf.ports.push(port("mag_x", "input", "Real"));
+        let e = avionics_system_description(&plant(), &sensors, &ekf, &controller).unwrap_err();
+        assert!(e.contains("mag_x"), "{e}");
     }
 
     #[test]

@@ -17,9 +17,16 @@ pub struct SensorNoise {
     pub sigma_accel: f64,
     /// Rate-gyro σ per axis and sample (rad/s) (Table D.1: 27.925e-3 rad/s).
     pub sigma_gyro: f64,
-    /// Magnetometer σ per axis (Gauss) (Table D.1: 0.02 Gauss).
+    /// Magnetometer σ per axis (Gauss): Table D.1's 0.02 Gauss before the sensors' 8 Hz
+    /// Butterworth × its noise gain at 50 Hz (0.5764, the sensors' `mag_noise_gain`).
     pub sigma_mag: f64,
-    /// Pitot airspeed σ (m/s) (not in Table D.1; 0.5 m/s, see the crate README).
+    /// σ of the pitot's differential pressure as the estimator sees it (Pa): the sensors'
+    /// `pitot_std` 1 Pa × `pitot_noise_gain` 0.5764. With Δp = ½ρ₀u|u| the airspeed σ is
+    /// σ_Δp/(ρ₀|u|) (ρ₀ = 1.225 kg/m³, the sensors' indication density).
+    pub sigma_pitot_dp: f64,
+    /// Pitot model-error σ (m/s), added in quadrature: the reading lags the body-x airspeed
+    /// by the filter's delay (≈ 28 ms: 0.14 m/s at 5 m/s²) and the air density may differ
+    /// from ρ₀.
     pub sigma_pitot: f64,
     /// Period of the IMU samples (s): converts the per-sample σ to a noise density (20 ms).
     pub imu_period: f64,
@@ -33,8 +40,9 @@ impl Default for SensorNoise {
             sigma_gps_vel: 0.5,
             sigma_accel: 0.1414,
             sigma_gyro: 27.925e-3,
-            sigma_mag: 0.02,
-            sigma_pitot: 0.5,
+            sigma_mag: 0.02 * 0.5764,
+            sigma_pitot_dp: 0.5764,
+            sigma_pitot: 0.2,
             imu_period: 0.02,
         }
     }
@@ -77,11 +85,13 @@ pub struct Earth {
     pub ref_longitude: f64,
     /// Height of the NED origin above the WGS-84 ellipsoid (m) (default 0).
     pub ref_height: f64,
-    /// Total magnetic field intensity (Gauss) (≈ 0.26 Gauss near Stellenbosch).
-    pub mag_total: f64,
-    /// Magnetic declination, east of true north positive (rad) (≈ −25°).
+    /// Total magnetic field intensity (Gauss): WMM2025 at the reference point, epoch 2025.0,
+    /// 25 132 nT = 0.2513 Gauss (as the sensor model's `mag_field_total`).
+    pub mag_field_total: f64,
+    /// Magnetic declination, east of true north positive (rad): WMM2025 −26.61°.
     pub mag_declination: f64,
-    /// Magnetic inclination, below the horizontal positive (rad) (≈ −65°: field points up).
+    /// Magnetic inclination, below the horizontal positive (rad): WMM2025 −64.73° (the field
+    /// points up).
     pub mag_inclination: f64,
     /// Gravitational acceleration (m/s²), as the plant's `gravity` (9.81).
     pub gravity: f64,
@@ -93,11 +103,22 @@ impl Default for Earth {
             ref_latitude: (-33.93f64).to_radians(),
             ref_longitude: 18.86f64.to_radians(),
             ref_height: 0.0,
-            mag_total: 0.26,
-            mag_declination: (-25.0f64).to_radians(),
-            mag_inclination: (-65.0f64).to_radians(),
+            mag_field_total: 0.2513,
+            mag_declination: (-26.61f64).to_radians(),
+            mag_inclination: (-64.73f64).to_radians(),
             gravity: 9.81,
         }
+    }
+}
+
+impl SensorNoise {
+    /// σ of a pitot reading `airspeed` (m/s): σ_Δp/(ρ₀ max(|u|, `min_airspeed`)) and the
+    /// model error in quadrature. Δp = ½ρ₀u|u| ⇒ du/dΔp = 1/(ρ₀|u|).
+    pub fn pitot_sigma(&self, airspeed: f64, min_airspeed: f64) -> f64 {
+        /// Density of the sensors' indicated airspeed (kg/m³) (ISA sea level).
+        const RHO_0: f64 = 1.225;
+        let u = airspeed.abs().max(min_airspeed).max(1e-3);
+        ((self.sigma_pitot_dp / (RHO_0 * u)).powi(2) + self.sigma_pitot.powi(2)).sqrt()
     }
 }
 
@@ -106,7 +127,7 @@ impl Earth {
     pub fn mag_ned(&self) -> Vector3<f64> {
         let (si, ci) = self.mag_inclination.sin_cos();
         let (sd, cd) = self.mag_declination.sin_cos();
-        self.mag_total * Vector3::new(ci * cd, ci * sd, si)
+        self.mag_field_total * Vector3::new(ci * cd, ci * sd, si)
     }
 }
 
@@ -153,10 +174,52 @@ impl Default for Tuning {
     }
 }
 
+/// The avionics' analogue low-pass filter on the IMU, magnetometer and pitot channels
+/// (thesis App. D.3: second-order Butterworth), as the sensor model's `filter_enabled`,
+/// `filter_bandwidth`. The estimator compensates its group delay (see [`AnalogFilter::delay`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AnalogFilter {
+    /// The sensors' channels are filtered (–).
+    pub enabled: bool,
+    /// −3 dB frequency f_c of the Butterworth (Hz) (8 Hz).
+    pub bandwidth: f64,
+    /// Transport delay of the measurement inputs (s) (0): the age of the latest sample at
+    /// the communication point beyond the filter's delay, e.g. one communication step when
+    /// a Jacobi master gives the estimator the sensors' outputs of the previous step.
+    pub latency: f64,
+}
+
+impl Default for AnalogFilter {
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            bandwidth: 8.0,
+            latency: 0.0,
+        }
+    }
+}
+
+impl AnalogFilter {
+    /// Low-frequency group delay of the second-order Butterworth (s):
+    /// H(s) = Ω²/(s² + √2Ωs + Ω²) has phase −atan(√2Ωω/(Ω² − ω²)) ≈ −√2 ω/Ω for ω ≪ Ω, so
+    /// τ = √2/Ω = √2/(2π f_c) (28.1 ms at 8 Hz; 0 when the filter is off), plus the
+    /// transport `latency`.
+    pub fn delay(&self) -> f64 {
+        let filter = if self.enabled {
+            std::f64::consts::SQRT_2 / (2.0 * std::f64::consts::PI * self.bandwidth)
+        } else {
+            0.0
+        };
+        filter + self.latency
+    }
+}
+
 /// Everything the estimator needs besides the measurements.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct EstimatorParams {
     pub noise: SensorNoise,
+    /// The sensors' analogue filter (compensated).
+    pub filter: AnalogFilter,
     pub process: ProcessNoise,
     pub earth: Earth,
     pub tuning: Tuning,
@@ -176,8 +239,9 @@ impl EstimatorParams {
             ("sigma_gyro", self.noise.sigma_gyro),
             ("sigma_mag", self.noise.sigma_mag),
             ("sigma_pitot", self.noise.sigma_pitot),
+            ("sigma_pitot_dp", self.noise.sigma_pitot_dp),
             ("imu_period", self.noise.imu_period),
-            ("mag_total", self.earth.mag_total),
+            ("mag_field_total", self.earth.mag_field_total),
             ("gravity", self.earth.gravity),
             ("init_std_wind", self.tuning.init_std_wind),
             ("init_std_gyro_bias", self.tuning.init_std_gyro_bias),
@@ -204,6 +268,18 @@ impl EstimatorParams {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(format!("{name} = {v} must be finite and >= 0"));
             }
+        }
+        if !(self.filter.bandwidth.is_finite() && self.filter.bandwidth > 0.0) {
+            return Err(format!(
+                "filter_bandwidth = {} Hz must be finite and > 0",
+                self.filter.bandwidth
+            ));
+        }
+        if !(self.filter.latency.is_finite() && (0.0..=1.0).contains(&self.filter.latency)) {
+            return Err(format!(
+                "measurement_latency = {} s must be within [0, 1] s",
+                self.filter.latency
+            ));
         }
         let e = &self.earth;
         if !e.ref_latitude.is_finite() || e.ref_latitude.abs() > 1.5 {

@@ -87,7 +87,7 @@ fn report(label: &str, nees: &[[f64; 3]]) -> [(f64, f64); 3] {
 /// exercised in level flight below.)
 #[test]
 fn nees_inside_chi_square_bounds_over_the_mission() {
-    let nees = averaged_nees(mission_truth, &EstimatorParams::default(), false);
+    let nees = averaged_nees(mission_truth, &unfiltered_params(), false);
     let stats = report("mission", &nees);
     for (j, (inside, mean)) in stats.iter().enumerate() {
         assert!(
@@ -104,7 +104,7 @@ fn nees_inside_chi_square_bounds_over_the_mission() {
 /// Trimmed level flight at 25 m/s in a constant wind drawn from the filter's wind prior.
 #[test]
 fn nees_inside_chi_square_bounds_in_level_flight() {
-    let nees = averaged_nees(|w| level_truth(30.0, w), &EstimatorParams::default(), true);
+    let nees = averaged_nees(|w| level_truth(30.0, w), &unfiltered_params(), true);
     let stats = report("level", &nees);
     for (j, (inside, mean)) in stats.iter().enumerate() {
         assert!(

@@ -6,7 +6,7 @@ mod common;
 
 use common::*;
 use nalgebra::Vector3;
-use state_estimator::{geodesy, Ekf, EstimatorParams, Reason, Sensor};
+use state_estimator::{geodesy, Ekf, Reason, Sensor};
 use tailsitter_physics::idx;
 
 fn assert_finite(ekf: &Ekf, k: usize) {
@@ -37,7 +37,7 @@ fn assert_finite(ekf: &Ekf, k: usize) {
 #[test]
 fn gps_dropout_of_10_s_in_level_flight_is_dead_reckoned_inside_3_sigma() {
     let truth = level_truth(50.0, Vector3::new(2.0, -1.0, 0.0));
-    let params = EstimatorParams::default();
+    let params = unfiltered_params();
     let (t_off, t_on) = (20.0, 30.0);
     for seed in 0..10 {
         let mut std_at_loss = 0.0;
@@ -94,7 +94,7 @@ fn gps_dropout_of_10_s_in_level_flight_is_dead_reckoned_inside_3_sigma() {
 #[test]
 fn gps_spikes_are_rejected_and_counted_never_fused() {
     let truth = level_truth(30.0, Vector3::zeros());
-    let params = EstimatorParams::default();
+    let params = unfiltered_params();
     let (mn, me) = geodesy::LocalFrame::metres_per_radian(params.earth.ref_latitude, 0.0);
     let mut spiked = 0;
     let mut seen = Vec::new();
@@ -144,7 +144,7 @@ fn gps_spikes_are_rejected_and_counted_never_fused() {
 #[test]
 fn non_finite_and_out_of_range_values_are_rejected_not_propagated() {
     let truth = level_truth(20.0, Vector3::zeros());
-    let params = EstimatorParams::default();
+    let params = unfiltered_params();
     // (step, what, expected sensor)
     type Fault = (usize, fn(&mut state_estimator::Measurements), Sensor);
     let faults: [Fault; 10] = [
@@ -197,7 +197,7 @@ fn non_finite_and_out_of_range_values_are_rejected_not_propagated() {
 #[test]
 fn restarted_gps_receiver_counter_going_back_is_accepted_as_new_fixes() {
     let truth = level_truth(20.0, Vector3::zeros());
-    let params = EstimatorParams::default();
+    let params = unfiltered_params();
     let mut restart = None;
     let mut fused_after = 0;
     let ekf = run_filter(
@@ -233,7 +233,7 @@ fn restarted_gps_receiver_counter_going_back_is_accepted_as_new_fixes() {
 #[test]
 fn persistent_gps_jump_resets_the_position_after_repeated_rejections() {
     let truth = level_truth(20.0, Vector3::zeros());
-    let params = EstimatorParams::default();
+    let params = unfiltered_params();
     let (mn, _) = geodesy::LocalFrame::metres_per_radian(params.earth.ref_latitude, 0.0);
     let mut reset_at = None;
     let ekf = run_filter(
@@ -263,7 +263,7 @@ fn persistent_gps_jump_resets_the_position_after_repeated_rejections() {
 #[test]
 fn initialisation_without_gps_then_a_fix_far_away() {
     let truth = level_truth(20.0, Vector3::zeros());
-    let params = EstimatorParams::default();
+    let params = unfiltered_params();
     let mut resets = 0;
     let ekf = run_filter(
         &truth,
@@ -292,7 +292,7 @@ fn initialisation_without_gps_then_a_fix_far_away() {
 #[test]
 fn reinitialisation_mid_run_restarts_cleanly() {
     let truth = level_truth(20.0, Vector3::zeros());
-    let params = EstimatorParams::default();
+    let params = unfiltered_params();
     let mut ekf = Ekf::new(params.clone()).unwrap();
     let mut sim = SensorSim::new(&params, 21);
     let m = sim.measure(&ekf, &truth, 0);
@@ -316,7 +316,7 @@ fn reinitialisation_mid_run_restarts_cleanly() {
 #[test]
 fn motor_servo_and_air_data_outputs_follow_the_plant() {
     let truth = mission_truth(Vector3::zeros());
-    let params = EstimatorParams::default();
+    let params = unfiltered_params();
     let mut worst = [0.0f64; 6];
     run_filter(
         &truth,
@@ -373,7 +373,7 @@ fn hover_gives_finite_air_data() {
     };
     let ekf = run_filter(
         &truth,
-        &EstimatorParams::default(),
+        &unfiltered_params(),
         2,
         |_, _, _| {},
         |k, ekf, _| {

@@ -31,7 +31,19 @@ pub mod model_description_types {
 }
 
 /// Every FMU of the workspace.
-pub const ALL_MODELS: [&str; 3] = ["tailsitter_plant", "tailsitter_lqr", "tailsitter_tsd"];
+pub const ALL_MODELS: [&str; 5] = [
+    "tailsitter_plant",
+    "tailsitter_lqr",
+    "tailsitter_tsd",
+    "tailsitter_sensors",
+    "tailsitter_ekf",
+];
+
+/// The models whose `fmi2DoStep` random inputs make fail (the plant leaves its flight
+/// envelope): a fuzz run over at least one of them must reach `StepFailed`. The estimator
+/// never fails a step (it rejects a bad measurement and keeps estimating), the sensor
+/// model only on an impossible quaternion.
+pub const STEP_CAN_FAIL: [&str; 1] = ["tailsitter_plant"];
 
 pub const OK: fmi2Status = fmi2Status_fmi2OK;
 pub const WARNING: fmi2Status = fmi2Status_fmi2Warning;
@@ -58,7 +70,7 @@ pub fn workspace_root() -> PathBuf {
         .expect("workspace root")
 }
 
-/// The models under test: `TAILSITTER_FMUS` (comma-separated) or all three.
+/// The models under test: `TAILSITTER_FMUS` (comma-separated) or all of [`ALL_MODELS`].
 pub fn required_models() -> Vec<String> {
     match std::env::var("TAILSITTER_FMUS") {
         Ok(list) if !list.trim().is_empty() => list.split(',').map(|s| s.trim().to_string()).collect(),

@@ -2,7 +2,7 @@
 //! libcosim rows are tests/test_interop.py): every packaged FMU in `dist/`
 //! loads through rust-fmi's importer, instantiates, initialises, steps over
 //! its default experiment, reads every Real, and gets/sets/serializes its FMU
-//! state with bit-identical continuation. All three FMUs are required;
+//! state with bit-identical continuation. All five FMUs are required;
 //! `TAILSITTER_FMUS=a,b` narrows the set while some are not built yet.
 
 use fmi::fmi2::import::Fmi2Import;
@@ -14,9 +14,15 @@ use std::path::PathBuf;
 fn required() -> Vec<String> {
     match std::env::var("TAILSITTER_FMUS") {
         Ok(list) if !list.trim().is_empty() => list.split(',').map(|s| s.trim().to_string()).collect(),
-        _ => ["tailsitter_plant", "tailsitter_lqr", "tailsitter_tsd"]
-            .map(String::from)
-            .to_vec(),
+        _ => [
+            "tailsitter_plant",
+            "tailsitter_lqr",
+            "tailsitter_tsd",
+            "tailsitter_sensors",
+            "tailsitter_ekf",
+        ]
+        .map(String::from)
+        .to_vec(),
     }
 }
 

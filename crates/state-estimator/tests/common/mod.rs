@@ -174,7 +174,10 @@ impl SensorSim {
             accel: y.specific_force_body + self.accel_bias + self.rng.normal3(n.sigma_accel),
             gyro: Vector3::new(x[idx::P], x[idx::Q], x[idx::R]) + self.gyro_bias + self.rng.normal3(n.sigma_gyro),
             mag: c * self.params.earth.mag_ned() + self.rng.normal3(n.sigma_mag),
-            pitot: (c * (y.vel_ned - wind)).x + n.sigma_pitot * self.rng.normal(),
+            pitot: {
+                let u = (c * (y.vel_ned - wind)).x;
+                u + n.pitot_sigma(u, self.params.tuning.pitot_min_airspeed) * self.rng.normal()
+            },
             gps_valid: self.gps_on,
             ..Default::default()
         };
@@ -256,4 +259,16 @@ pub fn run_filter(
         observe(k + 1, &ekf, &rep);
     }
     ekf
+}
+
+/// The parameters for the synthesised sensors of these tests: white noise per step of
+/// Table D.1's σ (magnetometer 0.02 Gauss unfiltered), pitot white 0.5 m/s, no analogue
+/// filter (its compensation would differentiate white noise).
+pub fn unfiltered_params() -> EstimatorParams {
+    let mut p = EstimatorParams::default();
+    p.filter.enabled = false;
+    p.noise.sigma_mag = 0.02;
+    p.noise.sigma_pitot = 0.5;
+    p.noise.sigma_pitot_dp = 1e-6;
+    p
 }

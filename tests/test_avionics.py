@@ -1,0 +1,142 @@
+"""Avionics in the loop (issue 14): plant → tailsitter_sensors → tailsitter_ekf →
+controller → plant under fmpy (tailsim.avionics). Both controllers fly the
+default mission on the estimator's outputs; the true position error per phase
+and the estimation errors per phase are printed (pytest -s).
+
+The position error includes the estimation error, which starts at the first
+GPS fix's (σ 4 m per axis, Table D.1): the first vertical phase is bounded by
+that (8 m), the later phases, once the GPS has been averaged, by 5 m.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from tailsim.avionics import AvionicsLoop, fly_with_avionics, format_phase_errors, phase_errors
+from tailsim.master import pos_error
+from tailsim.metrics import mission_check
+
+# The thesis's aerodynamics (aero_model 0), as tests/test_closed_loop.py: the controllers'
+# design model (the plant's default global model stalls the wing in places).
+PLANT = {"aero_model": 0}
+MISSION = ["t_vertical_1", "t_transition_1", "t_level", "t_transition_2", "t_vertical_2", "v_level"]
+CONTROLLERS = ["tailsitter_lqr", "tailsitter_tsd"]
+
+
+@pytest.fixture(scope="module")
+def level_trim_theta(fmus):
+    plant = fmus["tailsitter_plant"]
+    s = plant.instantiate("trim")
+    s.setupExperiment(startTime=0.0)
+    s.enterInitializationMode()
+    plant.set(s, {"initial_condition": 1, "initial_speed": fmus["tailsitter_lqr"].start("v_level")})
+    s.exitInitializationMode()
+    (theta,) = s.getReal([plant.variables["theta"].valueReference])
+    s.terminate()
+    s.freeInstance()
+    return theta
+
+
+def check(result, fmus, controller, theta_trim):
+    print("\n" + format_phase_errors(result))
+    mc = mission_check(result, fmus[controller].starts(MISSION), theta_trim)
+    # Completion, level airspeed within 1 m/s, level pitch, back vertical at the end
+    # (modelDescription/fragments/mission_criteria.json) on the TRUE state.
+    assert mc.passed(), mc.failures()
+    assert result["phase"][-1] == 4
+    pe = phase_errors(result)
+    assert [p.phase for p in pe] == ["vertical 1", "transition 1", "level", "transition 2", "vertical 2"]
+    # First vertical phase: the first GPS fix's error (σ 4 m per axis) is flown out.
+    assert pe[0].max_position_error < 8.0, pe[0]
+    for p in pe[1:]:
+        assert p.max_position_error < 5.0, p
+    # Estimation errors: position within the GPS's averaging, attitude and airspeed
+    # tight in forward flight; α, β weakly observable in vertical flight (reported only).
+    level = pe[2]
+    assert level.rms["err_pos"] < 3.0 and level.rms["err_vel"] < 0.5
+    assert math.degrees(level.rms["err_att"]) < 2.0
+    assert level.rms["err_airspeed"] < 0.5
+    assert math.degrees(level.rms["err_alpha"]) < 2.0 and math.degrees(level.rms["err_beta"]) < 2.0
+    for p in pe:
+        assert math.degrees(p.max["err_att"]) < 10.0, p
+    return pe
+
+
+@pytest.mark.parametrize("controller", CONTROLLERS)
+def test_default_mission_with_avionics_gauss_seidel(fmus, controller, level_trim_theta):
+    r = fly_with_avionics(fmus, controller, plant_params=PLANT)
+    check(r, fmus, controller, level_trim_theta)
+
+
+def test_lqr_default_mission_with_avionics_jacobi(fmus, level_trim_theta):
+    r = fly_with_avionics(fmus, "tailsitter_lqr", ordering="jacobi", ekf_params={"measurement_latency": 0.02}, plant_params=PLANT)
+    check(r, fmus, "tailsitter_lqr", level_trim_theta)
+
+
+def test_lqr_plant_and_sensors_at_5_ms(fmus, level_trim_theta):
+    r = fly_with_avionics(fmus, "tailsitter_lqr", plant_step=0.005, plant_params=PLANT)
+    check(r, fmus, "tailsitter_lqr", level_trim_theta)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="known limit: TSD's normal-acceleration/pitch loop (≈ 4.5 Hz) has no margin for "
+    "the extra communication step of Jacobi on sensors→estimator (fails without the "
+    "Butterworth too); see python/tailsim/avionics.py",
+)
+def test_tsd_default_mission_with_avionics_jacobi(fmus, level_trim_theta):
+    r = fly_with_avionics(fmus, "tailsitter_tsd", ordering="jacobi", ekf_params={"measurement_latency": 0.02}, plant_params=PLANT)
+    check(r, fmus, "tailsitter_tsd", level_trim_theta)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="known limit: TSD with plant+sensors at 5 ms loses 19 m in level flight "
+    "(limit cycle of its fast loops on the filtered IMU); see python/tailsim/avionics.py",
+)
+def test_tsd_plant_and_sensors_at_5_ms(fmus, level_trim_theta):
+    r = fly_with_avionics(fmus, "tailsitter_tsd", plant_step=0.005, plant_params=PLANT)
+    check(r, fmus, "tailsitter_tsd", level_trim_theta)
+
+
+def test_wiring_by_name_and_shared_parameters(fmus):
+    loop = AvionicsLoop(
+        fmus["tailsitter_plant"],
+        fmus["tailsitter_sensors"],
+        fmus["tailsitter_ekf"],
+        fmus["tailsitter_lqr"],
+        sensors_params={"mag_declination": -0.4, "seed": 7},
+    )
+    # The sensors' Earth field reaches the estimator; the seed is the sensors' own.
+    assert loop.ekf_params == {"mag_declination": -0.4}
+    # The two FMUs declare the shared parameters with the same defaults.
+    s, e = fmus["tailsitter_sensors"], fmus["tailsitter_ekf"]
+    for name in ["ref_latitude", "ref_longitude", "ref_height", "mag_field_total", "mag_declination",
+                 "mag_inclination", "filter_bandwidth"]:
+        assert s.start(name) == pytest.approx(e.start(name), rel=1e-12), name
+        assert s.variables[name].unit == e.variables[name].unit, name
+    for name in ["mag_x", "mag_y", "mag_z"]:
+        assert s.variables[name].unit == e.variables[name].unit == "Gauss"
+    # The estimator's magnetometer σ is the sensors' σ through their 8 Hz filter at 50 Hz.
+    assert e.start("sigma_mag") == pytest.approx(s.start("mag_std") * 0.5764)
+    bad = AvionicsLoop(
+        fmus["tailsitter_plant"], fmus["tailsitter_sensors"], fmus["tailsitter_ekf"], fmus["tailsitter_lqr"],
+        plant_step=0.003,
+    )
+    with pytest.raises(ValueError, match="plant_step"):
+        bad.run(stop_time=0.1)
+
+
+def test_estimation_errors_are_against_the_truth(fmus):
+    """A short hover: the recorded errors are the estimate minus the plant's outputs."""
+    r = fly_with_avionics(fmus, "tailsitter_lqr", stop_time=1.0, plant_params=PLANT)
+    d = np.sqrt(sum((r[f"est_pos_{a}"] - r[f"pos_{a}"]) ** 2 for a in "ned"))
+    assert np.allclose(r["err_pos"], d)
+    assert np.allclose(r["err_airspeed"], r["est_airspeed"] - r["airspeed"])
+    # The estimate at t = 0 is the first GPS fix: within 5σ (Table D.1: 4 m per axis).
+    assert 0.0 < r["err_pos"][0] < 5 * 4.0 * math.sqrt(3)
+    assert np.all(r["err_att"] < math.radians(10.0))
+    assert pos_error(r).max() < 20.0
