@@ -6,33 +6,13 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use fmi2_export::ffi;
 use fmi2_export::fmi_sys::fmi2::*;
-use std::ffi::{c_char, c_void, CString};
+use std::ffi::CString;
 use std::hint::black_box;
 use tailsitter_plant::{vr, PlantModel, GUID};
 
-/// No-op host logger. Our layer always calls `logger(env, name, status, category, "%s", msg)`:
-/// a 6-argument function receives those arguments like the variadic type on x86_64 SysV.
-unsafe extern "C" fn quiet(
-    _env: fmi2ComponentEnvironment,
-    _name: fmi2String,
-    _status: fmi2Status,
-    _category: fmi2String,
-    _format: fmi2String,
-    _message: *const c_char,
-) {
-}
-
 fn bench(c: &mut Criterion) {
-    let logger: fmi2CallbackLogger =
-        // SAFETY: see `quiet`; the layer never passes more than one variadic argument.
-        Some(unsafe { std::mem::transmute::<*const c_void, unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, fmi2Status, fmi2String, fmi2String, ...)>(quiet as *const c_void) });
-    let callbacks = fmi2CallbackFunctions {
-        logger,
-        allocateMemory: None,
-        freeMemory: None,
-        stepFinished: None,
-        componentEnvironment: std::ptr::null_mut(),
-    };
+    // The layer's shared test host (a recording logger; doStep logs nothing here).
+    let host = fmi2_export::test_host::Host::new();
     let name = CString::new("bench").unwrap();
     let guid = CString::new(GUID).unwrap();
     for (label, initial_condition, speed) in [("level_25", 1, 25.0), ("vertical_3", 0, 3.0)] {
@@ -43,7 +23,7 @@ fn bench(c: &mut Criterion) {
                 fmi2Type_fmi2CoSimulation,
                 guid.as_ptr(),
                 std::ptr::null(),
-                &callbacks,
+                &*host.callbacks,
                 0,
                 0,
             )
