@@ -8,7 +8,18 @@ sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(ROOT / "python"))
 
 from fmu_util import Unpacked  # noqa: E402
-from tailsim import Fmu  # noqa: E402
+from tailsim import Fmu, fmilog  # noqa: E402
+
+
+@pytest.fixture(autouse=True)
+def _fmpy_logger_target():
+    """fmpy's native logger proxy calls one process-global Python logger, the one registered
+    last; `fmpy.simulate_fmu` and a test's `LogRecorder` register loggers that die with them.
+    Point the proxy back at the process logger around every test (tailsim.fmilog), so no test
+    inherits a dangling target (that segfaulted inside fmi2DoStep once a freed one was called)."""
+    fmilog.rearm()
+    yield
+    fmilog.rearm()
 
 
 @pytest.fixture(scope="session")

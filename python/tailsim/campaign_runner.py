@@ -14,7 +14,6 @@ row; it never propagates, so one bad sample cannot crash a campaign.
 from __future__ import annotations
 
 import collections
-import ctypes
 import hashlib
 import json
 import math
@@ -30,6 +29,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from .campaign_sampling import CONFIGURATIONS, CampaignSpec, plant_parameters, wind_function
+from . import fmilog
 from .master import Fmu
 
 FMU_NAMES = {"plant": "tailsitter_plant", "lqr": "tailsitter_lqr", "tsd": "tailsitter_tsd"}
@@ -61,43 +61,15 @@ _dirs: list[str] = []
 _slaves: dict[tuple[int, str], "_Slave"] = {}  # (thread id, digest) -> instance
 
 
-_logs: dict[str, collections.deque] = {}  # instance name -> its last messages
-_callbacks = None
-_logger_fn = None
-
-
-def _shared_callbacks():
-    """One logger for the whole process, routing by instance name: fmpy's logger proxy
-    (which formats the variadic message) keeps a single Python target per process."""
-    global _callbacks
-    if _callbacks is None:
-        from fmpy.fmi2 import fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
-        from fmpy.logging import addLoggerProxy
-
-        def log(_env, instance, status, category, message):
-            name = instance.decode(errors="replace") if instance else ""
-            q = _logs.get(name)
-            if q is not None:
-                q.append(f"[{status}] {message.decode(errors='replace')}")
-
-        global _logger_fn
-        _logger_fn = fmi2CallbackLoggerTYPE(log)  # must outlive every instance
-        cb = fmi2CallbackFunctions()
-        cb.logger = _logger_fn
-        addLoggerProxy(ctypes.byref(cb))
-        _callbacks = cb
-    return _callbacks
-
-
 class _Slave:
     """An fmpy instance (uniquely named) with the last messages the FMU logged for it."""
 
     def __init__(self, fmu: Fmu, name: str):
         self.name = f"{name}-{fmu.identifier}-{threading.get_ident()}"
         self.messages: collections.deque[str] = collections.deque(maxlen=8)
-        _logs[self.name] = self.messages
+        fmilog.route(self.name, lambda status, _category, message: self.messages.append(f"[{status}] {message}"))
         self.fmu = fmu
-        self.slave = fmu.instantiate(self.name, _shared_callbacks())
+        self.slave = fmu.instantiate(self.name)
         self.used = False
 
     def free(self) -> None:
@@ -105,7 +77,7 @@ class _Slave:
             self.slave.freeInstance()
         except Exception:  # noqa: BLE001 - already broken; drop it
             pass
-        _logs.pop(self.name, None)
+        fmilog.unroute(self.name)
 
 
 def install_fmus(blobs: Mapping[str, bytes]) -> dict[str, str]:

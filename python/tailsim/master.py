@@ -21,6 +21,8 @@ import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
+from . import fmilog
+
 Vector3 = tuple[float, float, float]
 TimeFunction = Callable[[float], Vector3]
 
@@ -88,7 +90,9 @@ class Fmu:
         slave = FMU2Slave(
             guid=self.md.guid, unzipDirectory=self.dir, modelIdentifier=self.identifier, instanceName=name
         )
-        slave.instantiate(callbacks=callbacks)
+        # fmilog's callbacks, not fmpy's defaults: fmpy's logger proxy may point at a logger
+        # some earlier fmpy call freed (see fmilog).
+        slave.instantiate(callbacks=fmilog.callbacks() if callbacks is None else callbacks)
         return slave
 
     def set(self, slave: FMU2Slave, values: Mapping[str, float | int | bool]) -> None:
