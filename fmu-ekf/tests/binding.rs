@@ -104,7 +104,7 @@ fn ports_are_named_like_the_plant_sensor_and_controller_ports() {
 fn parameter_defaults_are_the_libraries() {
     // The declared defaults build exactly the library's default parameters.
     let v = Variables::with_start_values();
-    let p = tailsitter_ekf::params_from(&v);
+    let p = <tailsitter_ekf::EkfBinding as controller_fmu::Binding>::config(&v).unwrap();
     let d = EstimatorParams::default();
     assert_eq!(p.noise, d.noise);
     assert_eq!(p.process, d.process);

@@ -1,6 +1,6 @@
 //! `tailsitter_lqr`: the gain-scheduled LQR controller of thesis chapter 3
 //! ([`lqr_control::LqrController`]) bound to the generic FMI 2.0 Co-Simulation export
-//! layer through the one adapter of every sampled unit ([`controller_fmu::SampledFmu`]).
+//! layer through the one adapter of every co-simulation unit ([`controller_fmu::UnitFmu`]).
 //! Only the parameters live here; the variables are declared in
 //! `modelDescription/tailsitter_lqr.json`, the ports in its controller-interface
 //! fragment, and timing, state and messages in `controller-fmu` (docs/DESIGN.md §2).
@@ -24,6 +24,6 @@ controller_fmu::flight_controller_binding!(Lqr, LqrController, "LQR", |vars| Lqr
 });
 
 /// One controller instance.
-pub type LqrModel = controller_fmu::SampledFmu<Lqr>;
+pub type LqrModel = controller_fmu::UnitFmu<Lqr>;
 
 fmi2_export::export_fmu!(LqrModel);

@@ -157,7 +157,8 @@ fn fmu_state_round_trip_continues_bit_identically() {
 
 #[test]
 fn declared_start_values_are_the_model_defaults() {
-    let p = tailsitter_sensors::params_from(&Variables::with_start_values()).unwrap();
+    let p = <tailsitter_sensors::SensorsBinding as controller_fmu::Binding>::config(&Variables::with_start_values())
+        .unwrap();
     let d = sensor_model::Params::default();
     // Angles are declared in rad from the same degrees: equal to the last bits or nearly.
     for (a, b) in [

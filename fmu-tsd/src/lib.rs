@@ -1,6 +1,6 @@
 //! `tailsitter_tsd`: the time-scale-decoupled controller of thesis chapter 4
 //! ([`tsd_control::TsdController`]) bound to the generic FMI 2.0 Co-Simulation export
-//! layer through the one adapter of every sampled unit ([`controller_fmu::SampledFmu`]).
+//! layer through the one adapter of every co-simulation unit ([`controller_fmu::UnitFmu`]).
 //! Only the parameters live here; the variables are declared in
 //! `modelDescription/tailsitter_tsd.json`, the ports in its controller-interface
 //! fragment, and timing, state and messages in `controller-fmu` (docs/DESIGN.md §2).
@@ -23,7 +23,7 @@ controller_fmu::flight_controller_binding!(Tsd, TsdController, "TSD", |vars| Tsd
 });
 
 /// One controller instance.
-pub type TsdModel = controller_fmu::SampledFmu<Tsd>;
+pub type TsdModel = controller_fmu::UnitFmu<Tsd>;
 
 fmi2_export::export_fmu!(TsdModel);
 

@@ -166,7 +166,9 @@ pub struct VariableDecl {
     pub group: Option<String>,
     /// Where the variable sits in its group's struct: `field`, `field[i]` (an
     /// element of a vector or array field) or `[i]` (the group's type is itself a
-    /// vector). Default: the field named like the variable.
+    /// vector); in a group built on its type's `Default` (see [`DeclFile::groups`])
+    /// also a nested field `sub.field` or `sub.field[i]`. Default: the field named
+    /// like the variable.
     #[serde(default)]
     pub field: Option<String>,
     /// Model Exchange: this variable is the time derivative of the named continuous
@@ -185,9 +187,10 @@ impl VariableDecl {
     /// into the field name (empty for the whole value) and the element index.
     pub fn group_field(&self) -> Result<(&str, Option<usize>), DeclError> {
         let path = self.field.as_deref().unwrap_or(&self.name);
+        let field_path = |top: &str| top.split('.').all(is_rust_identifier);
         match path.split_once('[') {
-            None if is_rust_identifier(path) => Ok((path, None)),
-            Some((top, rest)) if top.is_empty() || is_rust_identifier(top) => rest
+            None if field_path(path) => Ok((path, None)),
+            Some((top, rest)) if top.is_empty() || field_path(top) => rest
                 .strip_suffix(']')
                 .and_then(|i| i.parse().ok())
                 .map(|i| (top, Some(i)))
@@ -223,6 +226,10 @@ pub struct DeclFile {
     /// or inputs of that group, or `Variables::set_<group>(&<path>)` writing its
     /// outputs, so the struct and the declaration cannot drift without a compile
     /// error (a field missing from the declaration does not compile).
+    /// A path followed by [`FROM_DEFAULT`] (`"state_estimator::EstimatorParams { ..Default::default() }"`)
+    /// builds the value from the type's `Default` and assigns the declared fields,
+    /// which may then be nested (`noise.sigma_gps_vel`): for types with fields
+    /// that are not ports or parameters.
     #[serde(default)]
     pub groups: BTreeMap<String, String>,
     /// Other declaration files (relative paths) whose variables are inserted first.
@@ -308,6 +315,18 @@ impl Model {
     /// Whether the FMU also offers Model Exchange: it declares continuous states.
     pub fn model_exchange(&self) -> bool {
         self.variables.iter().any(|v| v.decl.derivative_of.is_some())
+    }
+}
+
+/// Suffix of a group's type path in [`DeclFile::groups`]: the value starts from the
+/// type's `Default` and only the declared fields are assigned.
+pub const FROM_DEFAULT: &str = " { ..Default::default() }";
+
+/// A group's Rust type and whether it is built on the type's `Default` ([`FROM_DEFAULT`]).
+pub fn group_type(path: &str) -> (&str, bool) {
+    match path.strip_suffix(FROM_DEFAULT) {
+        Some(ty) => (ty, true),
+        None => (path, false),
     }
 }
 
@@ -598,21 +617,31 @@ fn check(model: &Model) -> Result<(), DeclError> {
             if !model.groups.contains_key(g) {
                 return err(format!("variable '{n}': group '{g}' not declared in \"groups\""));
             }
-            if !matches!(d.causality, Causality::Parameter | Causality::Input | Causality::Output) {
+            if !matches!(
+                d.causality,
+                Causality::Parameter | Causality::CalculatedParameter | Causality::Input | Causality::Output
+            ) {
                 return err(format!(
                     "variable '{n}': a {} cannot belong to a group",
                     d.causality.as_str()
                 ));
             }
-            d.group_field()?;
-            let writes = d.causality == Causality::Output;
+            let written = |c: Causality| matches!(c, Causality::Output | Causality::CalculatedParameter);
+            let writes = written(d.causality);
+            let (top, _) = d.group_field()?;
+            if top.contains('.') && !group_type(&model.groups[g]).1 && !writes {
+                return err(format!(
+                    "variable '{n}': a nested field needs a group built on its type's Default (\"{}{FROM_DEFAULT}\")",
+                    model.groups[g]
+                ));
+            }
             if model
                 .variables
                 .iter()
-                .any(|o| o.decl.group.as_ref() == Some(g) && (o.decl.causality == Causality::Output) != writes)
+                .any(|o| o.decl.group.as_ref() == Some(g) && written(o.decl.causality) != writes)
             {
                 return err(format!(
-                    "group '{g}' mixes outputs with parameters or inputs (variable '{n}')"
+                    "group '{g}' mixes outputs or calculated parameters with parameters or inputs (variable '{n}')"
                 ));
             }
         } else if d.field.is_some() {

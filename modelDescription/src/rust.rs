@@ -52,8 +52,11 @@ fn group_accessor(model: &Model, group: &str, path: &str) -> String {
             (top, index, v.name())
         })
         .collect();
+    let (ty, from_default) = crate::group_type(path);
+    let path = ty;
     let causality = members[0].decl.causality;
-    if matches!(causality, Causality::Output | Causality::Input) {
+    let written = matches!(causality, Causality::Output | Causality::CalculatedParameter);
+    if written || causality == Causality::Input {
         let _ = writeln!(
             s,
             "    /// Set the variables of group `{group}` from a `{path}`.\n    #[allow(dead_code)]\n    pub fn set_{group}(&mut self, value: &{path}) {{"
@@ -65,7 +68,7 @@ fn group_accessor(model: &Model, group: &str, path: &str) -> String {
         }
         s.push_str("    }\n");
     }
-    if causality != Causality::Output {
+    if !written {
         let _ = writeln!(
             s,
             "    /// The `{path}` built from the variables of group `{group}`.\n    #[allow(dead_code)]\n    pub fn {group}(&self) -> {path} {{"
@@ -94,7 +97,15 @@ fn group_accessor(model: &Model, group: &str, path: &str) -> String {
             let list: Vec<String> = elements.iter().map(|(_, n)| format!("self.{n}")).collect();
             format!("[{}].into()", list.join(", "))
         };
-        if tops == [""] {
+        if from_default {
+            let _ = writeln!(s, "        let mut value = <{path}>::default();");
+            for (top, index, name) in &fields {
+                let sep = if top.is_empty() { "" } else { "." };
+                let element = index.map(|i| format!("[{i}]")).unwrap_or_default();
+                let _ = writeln!(s, "        value{sep}{top}{element} = self.{name};");
+            }
+            let _ = writeln!(s, "        value");
+        } else if tops == [""] {
             let _ = writeln!(s, "        let value: {path} = {};\n        value", value_of(""));
         } else {
             let _ = writeln!(s, "        {path} {{");

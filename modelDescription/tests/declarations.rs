@@ -261,3 +261,20 @@ fn connected_ports_map_to_the_same_field() {
         assert_eq!(connected, 40, "{id}");
     }
 }
+
+/// A nested field (`sub.field`) is only possible in a group built on its type's
+/// `Default`; such a group's constructor assigns the declared fields into it.
+#[test]
+fn nested_fields_need_a_group_built_on_default() {
+    let with = |ty: &str, field: &str| {
+        format!(
+            r#"{{"modelIdentifier":"m","defaultExperiment":{{"startTime":0,"stopTime":1,"stepSize":0.1}},"groups":{{"g":"{ty}"}},"variables":[{{"name":"a","causality":"parameter","start":1.0,"group":"g","field":"{field}","description":"d"}}]}}"#
+        )
+    };
+    let e = load_text(&with("T", "x.y")).unwrap_err();
+    assert!(e.contains("nested field"), "{e}");
+    let m = load_text(&with("T { ..Default::default() }", "x.y[2]")).unwrap();
+    let rust = model_description::rust::variables_module(&m, "m.xml");
+    assert!(rust.contains("let mut value = <T>::default();"), "{rust}");
+    assert!(rust.contains("value.x.y[2] = self.a;"), "{rust}");
+}

@@ -13,7 +13,7 @@ use nalgebra::{Vector3, Vector4};
 use std::fmt;
 
 mod unit;
-pub use unit::{HeldOutput, SampledUnit};
+pub use unit::{HeldOutput, Sampled, SampledUnit, SteppedUnit, UnitLog};
 
 /// Mission parameters (docs/DESIGN.md §3), the same names and defaults in both controllers.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -413,6 +413,11 @@ impl SampleClock {
         } else {
             0
         }
+    }
+
+    /// The sample period (s).
+    pub fn sample_time(&self) -> f64 {
+        self.sample_time
     }
 
     /// Time of the next due sample.
