@@ -7,22 +7,22 @@ use flight_mission::{Measurement, MissionParams};
 use fmi2_export::{FmuModel, Logger, StateReader, StateWriter, VariableStore};
 use lqr_control::{LqrController, LqrParams};
 use tailsitter_lqr::{LqrModel, Variables};
+use tailsitter_physics::idx::INPUT_NAMES;
 use tailsitter_physics::{Airframe, InputVector, Plant, StateVector};
 
 fn set_inputs(v: &mut Variables, m: &Measurement) {
     v.set_measurement(m);
 }
 
+/// The command outputs as the plant's input vector (the names generated from the plant's `command` group).
 fn commands(v: &Variables) -> InputVector {
-    InputVector::from([
-        v.thrust_cmd,
-        v.elevator_cmd,
-        v.aileron_cmd,
-        v.rudder_cmd,
-        v.flap_collective_cmd,
-        v.flap_differential_cmd,
-        v.vertical_flap_cmd,
-    ])
+    InputVector::from_fn(|i, _| {
+        let spec = Variables::VARIABLES
+            .iter()
+            .find(|s| s.name == INPUT_NAMES[i])
+            .expect("the controller outputs every plant command");
+        v.get_real(spec.value_reference).expect("a Real")
+    })
 }
 
 /// Fly the mission through the binding with communication step `h`; returns the

@@ -242,6 +242,23 @@ pub struct DeclFile {
     /// after this file's own variables, so their value references follow the others.
     #[serde(default)]
     pub import_groups: Vec<GroupImport>,
+    /// Port groups declared once on the other side of a connection: every variable of
+    /// this file named like a variable of one of these groups there takes the same
+    /// group and field (and the group its type). The plant's outputs read by the
+    /// controllers and its command inputs take their mapping from the controller
+    /// interface this way, so wiring by name carries each value into the same field.
+    #[serde(default)]
+    pub connect_groups: Vec<GroupLink>,
+}
+
+/// The groups of another declaration whose ports this file's variables connect to.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, rename_all = "camelCase")]
+pub struct GroupLink {
+    /// Declaration file (relative path), e.g. `fragments/controller_interface.json`.
+    pub file: String,
+    /// Its groups whose mapping applies here, e.g. `measurement`.
+    pub groups: Vec<String>,
 }
 
 /// Import of every parameter of one group of another declaration file, with the
@@ -429,7 +446,45 @@ fn collect(
             }
         }
     }
+    let own = out.len();
     out.extend(file.variables.iter().cloned());
+    for link in &file.connect_groups {
+        let src = read_decl(&dir.join(&link.file), sources)?;
+        let mut src_groups = BTreeMap::new();
+        let mut src_decls = Vec::new();
+        collect(dir, &src, sources, &mut src_groups, &mut src_decls, depth + 1)?;
+        for g in &link.groups {
+            let ty = src_groups
+                .get(g)
+                .cloned()
+                .ok_or_else(|| DeclError(format!("connectGroups: {} declares no group '{g}'", link.file)))?;
+            if let Some(old) = groups.insert(g.clone(), ty.clone()) {
+                if old != ty {
+                    return err(format!("group '{g}' declared as both {old} and {ty}"));
+                }
+            }
+            let mut linked = 0;
+            for port in src_decls.iter().filter(|d| d.group.as_ref() == Some(g)) {
+                if let Some(v) = out[own..].iter_mut().find(|v| v.name == port.name) {
+                    if v.group.is_some() || v.field.is_some() {
+                        return err(format!(
+                            "variable '{}': its group comes from {} (connectGroups): declare none",
+                            v.name, link.file
+                        ));
+                    }
+                    v.group = Some(g.clone());
+                    v.field = port.field.clone();
+                    linked += 1;
+                }
+            }
+            if linked == 0 {
+                return err(format!(
+                    "connectGroups: no variable connects to group '{g}' of {}",
+                    link.file
+                ));
+            }
+        }
+    }
     for import in &file.import_groups {
         let src = read_decl(&dir.join(&import.file), sources)?;
         let mut src_groups = BTreeMap::new();

@@ -217,20 +217,14 @@ fn malformed_declarations_are_rejected() {
     }
 }
 
-/// The port ↔ struct-field mapping is declared on both sides of a connection (plant
-/// outputs, controller inputs; controller outputs, plant inputs): the same name must
-/// sit in the same group and field on both sides, or the wiring by name would carry
-/// a value into another field.
+/// The plant takes the port ↔ struct-field mapping of its measurement outputs and
+/// command inputs from the controller interface (`connectGroups`), so both sides
+/// of a connection share one declaration. Every controller port of those groups
+/// must then be a plant port of the opposite causality: wiring by name connects
+/// them all (30 measurements read, 7 commands driven) plus phi, theta, psi.
 #[test]
-fn connected_ports_map_to_the_same_field() {
+fn controller_ports_connect_to_plant_ports() {
     let plant = load(&dir(), "tailsitter_plant", "0").unwrap();
-    let mapping = |v: &model_description::Variable| {
-        (
-            v.decl.group.clone(),
-            v.decl.group_field().unwrap().0.to_string(),
-            v.decl.group_field().unwrap().1,
-        )
-    };
     for id in ["tailsitter_lqr", "tailsitter_tsd"] {
         let controller = load(&dir(), id, "0").unwrap();
         let mut connected = 0;
@@ -239,27 +233,54 @@ fn connected_ports_map_to_the_same_field() {
             .iter()
             .filter(|v| matches!(v.decl.causality, Causality::Input | Causality::Output))
         {
-            let Some(p) = plant.variables.iter().find(|p| p.name() == c.name()) else {
-                continue;
-            };
-            assert_ne!(p.decl.causality, c.decl.causality, "{id}.{}", c.name());
-            // Groups that both sides use (the Measurement and the Command structs).
-            let shared =
-                |v: &model_description::Variable| matches!(v.decl.group.as_deref(), Some("measurement" | "command"));
-            if shared(p) || shared(c) {
+            let p = plant.variables.iter().find(|p| p.name() == c.name());
+            if matches!(c.decl.group.as_deref(), Some("measurement" | "command")) {
+                let p = p.unwrap_or_else(|| panic!("{id}.{} has no plant port", c.name()));
                 assert_eq!(
-                    mapping(p),
-                    mapping(c),
-                    "{id}.{} and tailsitter_plant.{}",
-                    c.name(),
-                    p.name()
+                    (&p.decl.group, &p.decl.field),
+                    (&c.decl.group, &c.decl.field),
+                    "{id}.{}",
+                    c.name()
                 );
             }
-            connected += 1;
+            if let Some(p) = p {
+                assert_ne!(p.decl.causality, c.decl.causality, "{id}.{}", c.name());
+                connected += 1;
+            }
         }
-        // 33 plant outputs read, 7 commands driven.
         assert_eq!(connected, 40, "{id}");
     }
+    // A variable that declares its own group where the mapping is connected is an error.
+    let dir = std::env::temp_dir().join(format!("decl-connect-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let port = |g: &str| format!(r#"{{"name":"a","causality":"input","start":0.0,{g}"description":"d"}}"#);
+    std::fs::write(
+        dir.join("other.json"),
+        format!(
+            r#"{{"groups":{{"g":"T"}},"variables":[{}]}}"#,
+            port(r#""group":"g","field":"x","#)
+        ),
+    )
+    .unwrap();
+    let model = |g: &str| {
+        format!(
+            r#"{{"modelIdentifier":"m","defaultExperiment":{{"startTime":0,"stopTime":1,"stepSize":0.1}},"connectGroups":[{{"file":"other.json","groups":["g"]}}],"groups":{{"g":"T"}},"variables":[{}]}}"#,
+            port(g)
+        )
+    };
+    std::fs::write(dir.join("m.json"), model("")).unwrap();
+    let m = load(&dir, "m", "0").unwrap();
+    assert_eq!(
+        (
+            m.variables[0].decl.group.as_deref(),
+            m.variables[0].decl.field.as_deref()
+        ),
+        (Some("g"), Some("x"))
+    );
+    std::fs::write(dir.join("m.json"), model(r#""group":"g","#)).unwrap();
+    let e = load(&dir, "m", "0").unwrap_err().to_string();
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(e.contains("connectGroups"), "{e}");
 }
 
 /// A nested field (`sub.field`) is only possible in a group built on its type's
