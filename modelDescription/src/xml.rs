@@ -9,21 +9,32 @@ use crate::{fmt_f64, units, Causality, Model, Start, VarType, Variable, AUTHOR, 
 use quick_xml::events::{BytesDecl, Event};
 use quick_xml::Writer;
 use std::collections::BTreeSet;
-use std::io::{Cursor, Result};
+use std::io::Result;
+
+/// The quick-xml writer of every XML file the project writes.
+pub type XmlWriter = Writer<Vec<u8>>;
+
+/// An XML document as the project writes them (modelDescription.xml, the SSP's
+/// SystemStructure.ssd): UTF-8 declaration, elements from `body` indented by two
+/// spaces, a final newline; no timestamp, so equal input gives equal bytes.
+pub fn document(body: impl FnOnce(&mut XmlWriter) -> Result<()>) -> Result<String> {
+    let mut w = Writer::new_with_indent(Vec::new(), b' ', 2);
+    w.write_event(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None)))?;
+    body(&mut w)?;
+    let mut text =
+        String::from_utf8(w.into_inner()).map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))?;
+    text.push('\n');
+    Ok(text)
+}
 
 /// The complete modelDescription.xml of `model`.
 pub fn model_description(model: &Model) -> String {
-    let mut w = Writer::new_with_indent(Cursor::new(Vec::new()), b' ', 2);
-    write_all(&mut w, model).expect("writing XML into memory cannot fail");
-    let mut text = String::from_utf8(w.into_inner().into_inner()).expect("quick-xml writes UTF-8");
-    text.push('\n');
-    text
+    document(|w| write_all(w, model)).expect("writing XML into memory cannot fail")
 }
 
-type W = Writer<Cursor<Vec<u8>>>;
+type W = XmlWriter;
 
 fn write_all(w: &mut W, model: &Model) -> Result<()> {
-    w.write_event(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None)))?;
     let n_events = "0";
     w.create_element("fmiModelDescription")
         .with_attributes([

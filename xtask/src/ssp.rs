@@ -23,8 +23,9 @@
 //!   element on every connector; namespace declarations sit on the root element only (libcosim would
 //!   read an `xmlns` attribute on an element it iterates as a child).
 
-use quick_xml::events::{BytesDecl, BytesStart, Event};
-use quick_xml::Writer;
+// Rust's shortest round-trip representation, as in modelDescription.xml; a valid xs:double.
+use model_description::fmt_f64 as real;
+use quick_xml::events::{BytesStart, Event};
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 use std::sync::LazyLock;
@@ -303,13 +304,8 @@ pub fn connections(plant: &FmuInfo, controller: &FmuInfo) -> Result<Vec<Connecti
     Ok(out)
 }
 
-type Xml = Writer<Vec<u8>>;
+type Xml = model_description::xml::XmlWriter;
 type XmlResult = std::io::Result<()>;
-
-fn real(value: f64) -> String {
-    // Rust's shortest round-trip representation; always a valid xs:double.
-    format!("{value:?}")
-}
 
 /// The connectors of one component: every output (recorded by tools that record connectors), and
 /// the inputs a connection drives.
@@ -579,88 +575,87 @@ fn write_ssd(name: &str, description: &str, elements: &[Element], links: &[Conne
             units.push(u);
         }
     }
-    let mut w = Writer::new_with_indent(Vec::new(), b' ', 2);
-    let io = |e: std::io::Error| e.to_string();
-    w.write_event(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None)))
-        .map_err(io)?;
-    w.create_element("ssd:SystemStructureDescription")
-        .with_attributes([
-            ("xmlns:ssd", NS_SSD),
-            ("xmlns:ssc", NS_SSC),
-            ("xmlns:ssv", NS_SSV),
-            ("xmlns:osp", NS_OSP),
-            ("version", "1.0"),
-            ("name", name),
-            (
-                "generationTool",
-                concat!("tailsitter xtask ", env!("CARGO_PKG_VERSION")),
-            ),
-        ])
-        .write_inner_content(|w| {
-            w.create_element("ssd:System")
-                .with_attributes([("name", name), ("description", description)])
-                .write_inner_content(|w| {
-                    w.create_element("ssd:Elements").write_inner_content(|w| {
-                        for (name, fmu, inputs, parameters) in elements {
-                            component(w, name, fmu, inputs, parameters)?;
-                        }
-                        Ok(())
-                    })?;
-                    w.create_element("ssd:Connections").write_inner_content(|w| {
-                        for c in links {
-                            w.create_element("ssd:Connection")
-                                .with_attributes([
-                                    ("startElement", c.start),
-                                    ("startConnector", c.name.as_str()),
-                                    ("endElement", c.end),
-                                    ("endConnector", c.name.as_str()),
-                                ])
-                                .write_empty()?;
-                        }
-                        Ok(())
-                    })?;
-                    Ok(())
-                })?;
-            if !units.is_empty() {
-                w.create_element("ssd:Units").write_inner_content(|w| {
-                    for u in &units {
-                        w.create_element("ssc:Unit")
-                            .with_attribute(("name", u.name.as_str()))
-                            .write_inner_content(|w| {
-                                w.create_element("ssc:BaseUnit")
-                                    .with_attributes(u.base.iter().map(|(k, v)| (k.as_str(), v.as_str())))
+    model_description::xml::document(|w| {
+        w.create_element("ssd:SystemStructureDescription")
+            .with_attributes([
+                ("xmlns:ssd", NS_SSD),
+                ("xmlns:ssc", NS_SSC),
+                ("xmlns:ssv", NS_SSV),
+                ("xmlns:osp", NS_OSP),
+                ("version", "1.0"),
+                ("name", name),
+                (
+                    "generationTool",
+                    concat!("tailsitter xtask ", env!("CARGO_PKG_VERSION")),
+                ),
+            ])
+            .write_inner_content(|w| {
+                w.create_element("ssd:System")
+                    .with_attributes([("name", name), ("description", description)])
+                    .write_inner_content(|w| {
+                        w.create_element("ssd:Elements").write_inner_content(|w| {
+                            for (name, fmu, inputs, parameters) in elements {
+                                component(w, name, fmu, inputs, parameters)?;
+                            }
+                            Ok(())
+                        })?;
+                        w.create_element("ssd:Connections").write_inner_content(|w| {
+                            for c in links {
+                                w.create_element("ssd:Connection")
+                                    .with_attributes([
+                                        ("startElement", c.start),
+                                        ("startConnector", c.name.as_str()),
+                                        ("endElement", c.end),
+                                        ("endConnector", c.name.as_str()),
+                                    ])
                                     .write_empty()?;
-                                Ok(())
-                            })?;
-                    }
-                    Ok(())
-                })?;
-            }
-            w.create_element("ssd:DefaultExperiment")
-                .with_attributes([("startTime", "0.0"), ("stopTime", real(stop_time()).as_str())])
-                .write_inner_content(|w| {
-                    w.create_element("ssd:Annotations").write_inner_content(|w| {
-                        w.create_element("ssc:Annotation")
-                            .with_attribute(("type", "com.opensimulationplatform"))
-                            .write_inner_content(|w| {
-                                w.create_element("osp:Algorithm").write_inner_content(|w| {
-                                    w.create_element("osp:FixedStepAlgorithm")
-                                        .with_attribute(("baseStepSize", real(mission_default("sample_time")).as_str()))
+                            }
+                            Ok(())
+                        })?;
+                        Ok(())
+                    })?;
+                if !units.is_empty() {
+                    w.create_element("ssd:Units").write_inner_content(|w| {
+                        for u in &units {
+                            w.create_element("ssc:Unit")
+                                .with_attribute(("name", u.name.as_str()))
+                                .write_inner_content(|w| {
+                                    w.create_element("ssc:BaseUnit")
+                                        .with_attributes(u.base.iter().map(|(k, v)| (k.as_str(), v.as_str())))
                                         .write_empty()?;
                                     Ok(())
                                 })?;
-                                Ok(())
-                            })?;
+                        }
                         Ok(())
                     })?;
-                    Ok(())
-                })?;
-            Ok(())
-        })
-        .map_err(io)?;
-    let mut text = String::from_utf8(w.into_inner()).map_err(|e| e.to_string())?;
-    text.push('\n');
-    Ok(text)
+                }
+                w.create_element("ssd:DefaultExperiment")
+                    .with_attributes([("startTime", "0.0"), ("stopTime", real(stop_time()).as_str())])
+                    .write_inner_content(|w| {
+                        w.create_element("ssd:Annotations").write_inner_content(|w| {
+                            w.create_element("ssc:Annotation")
+                                .with_attribute(("type", "com.opensimulationplatform"))
+                                .write_inner_content(|w| {
+                                    w.create_element("osp:Algorithm").write_inner_content(|w| {
+                                        w.create_element("osp:FixedStepAlgorithm")
+                                            .with_attribute((
+                                                "baseStepSize",
+                                                real(mission_default("sample_time")).as_str(),
+                                            ))
+                                            .write_empty()?;
+                                        Ok(())
+                                    })?;
+                                    Ok(())
+                                })?;
+                            Ok(())
+                        })?;
+                        Ok(())
+                    })?;
+                Ok(())
+            })?;
+        Ok(())
+    })
+    .map_err(|e| e.to_string())
 }
 
 #[cfg(test)]
