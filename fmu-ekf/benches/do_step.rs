@@ -6,35 +6,16 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use fmi2_export::ffi;
 use fmi2_export::fmi_sys::fmi2::*;
-use std::ffi::CString;
 use std::hint::black_box;
-use tailsitter_ekf::{vr, EkfModel, GUID};
+use tailsitter_ekf::{vr, EkfModel};
 
 fn bench(c: &mut Criterion) {
     // The layer's shared test host (a recording logger; doStep logs nothing here).
     let host = fmi2_export::test_host::Host::new();
-    let name = CString::new("bench").unwrap();
-    let guid = CString::new(GUID).unwrap();
-    // SAFETY: valid, NUL-terminated strings and callbacks that outlive the instance.
-    let inst = unsafe {
-        ffi::instantiate::<EkfModel>(
-            name.as_ptr(),
-            fmi2Type_fmi2CoSimulation,
-            guid.as_ptr(),
-            std::ptr::null(),
-            &*host.callbacks,
-            0,
-            0,
-        )
-    };
-    assert!(!inst.is_null());
-    // SAFETY: live instance.
+    // SAFETY: the host outlives the instance, freed below.
+    let inst = unsafe { host.initializing::<EkfModel>("bench") };
+    // SAFETY: live instance in Initialization Mode.
     unsafe {
-        assert_eq!(
-            ffi::setup_experiment::<EkfModel>(inst, 0, 0.0, 0.0, 0, 0.0),
-            fmi2Status_fmi2OK
-        );
-        assert_eq!(ffi::enter_initialization_mode::<EkfModel>(inst), fmi2Status_fmi2OK);
         assert_eq!(ffi::exit_initialization_mode::<EkfModel>(inst), fmi2Status_fmi2OK);
     }
     let mut t = 0.0;

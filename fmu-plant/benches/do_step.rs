@@ -6,35 +6,17 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use fmi2_export::ffi;
 use fmi2_export::fmi_sys::fmi2::*;
-use std::ffi::CString;
 use std::hint::black_box;
-use tailsitter_plant::{vr, PlantModel, GUID};
+use tailsitter_plant::{vr, PlantModel};
 
 fn bench(c: &mut Criterion) {
     // The layer's shared test host (a recording logger; doStep logs nothing here).
     let host = fmi2_export::test_host::Host::new();
-    let name = CString::new("bench").unwrap();
-    let guid = CString::new(GUID).unwrap();
     for (label, initial_condition, speed) in [("level_25", 1, 25.0), ("vertical_3", 0, 3.0)] {
-        // SAFETY: valid, NUL-terminated strings and callbacks that outlive the instance.
-        let inst = unsafe {
-            ffi::instantiate::<PlantModel>(
-                name.as_ptr(),
-                fmi2Type_fmi2CoSimulation,
-                guid.as_ptr(),
-                std::ptr::null(),
-                &*host.callbacks,
-                0,
-                0,
-            )
-        };
-        assert!(!inst.is_null());
+        // SAFETY: the host outlives the instance, freed below.
+        let inst = unsafe { host.initializing::<PlantModel>("bench") };
+        // SAFETY: live instance in Initialization Mode.
         unsafe {
-            assert_eq!(
-                ffi::setup_experiment::<PlantModel>(inst, 0, 0.0, 0.0, 0, 0.0),
-                fmi2Status_fmi2OK
-            );
-            assert_eq!(ffi::enter_initialization_mode::<PlantModel>(inst), fmi2Status_fmi2OK);
             let ic = [initial_condition];
             assert_eq!(
                 ffi::set_integer::<PlantModel>(inst, &vr::initial_condition, 1, ic.as_ptr()),

@@ -6,35 +6,17 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use fmi2_export::ffi;
 use fmi2_export::fmi_sys::fmi2::*;
-use std::ffi::CString;
 use std::hint::black_box;
-use tailsitter_sensors::{vr, SensorsModel, GUID};
+use tailsitter_sensors::{vr, SensorsModel};
 
 fn bench(c: &mut Criterion) {
     // The layer's shared test host (a recording logger; doStep logs nothing here).
     let host = fmi2_export::test_host::Host::new();
-    let name = CString::new("bench").unwrap();
-    let guid = CString::new(GUID).unwrap();
     for (label, imu_rate) in [("default_rates", 200.0), ("imu_1kHz", 1000.0)] {
-        // SAFETY: valid, NUL-terminated strings and callbacks that outlive the instance.
-        let inst = unsafe {
-            ffi::instantiate::<SensorsModel>(
-                name.as_ptr(),
-                fmi2Type_fmi2CoSimulation,
-                guid.as_ptr(),
-                std::ptr::null(),
-                &*host.callbacks,
-                0,
-                0,
-            )
-        };
-        assert!(!inst.is_null());
+        // SAFETY: the host outlives the instance, freed below.
+        let inst = unsafe { host.initializing::<SensorsModel>("bench") };
+        // SAFETY: live instance in Initialization Mode.
         unsafe {
-            assert_eq!(
-                ffi::setup_experiment::<SensorsModel>(inst, 0, 0.0, 0.0, 0, 0.0),
-                fmi2Status_fmi2OK
-            );
-            assert_eq!(ffi::enter_initialization_mode::<SensorsModel>(inst), fmi2Status_fmi2OK);
             let rates = [imu_rate, imu_rate];
             let rate_vrs = [vr::accel_rate, vr::gyro_rate];
             assert_eq!(

@@ -10,9 +10,11 @@
 //! is recorded as not [`Record::well_formed`].
 
 use crate::fmi_sys::fmi2::{
-    fmi2CallbackFunctions, fmi2CallbackLogger, fmi2ComponentEnvironment, fmi2Status, fmi2String,
+    fmi2CallbackFunctions, fmi2CallbackLogger, fmi2Component, fmi2ComponentEnvironment, fmi2Status, fmi2Status_fmi2OK,
+    fmi2String, fmi2Type_fmi2CoSimulation,
 };
-use std::ffi::{c_char, c_void, CStr};
+use crate::{ffi, FmuModel};
+use std::ffi::{c_char, c_void, CStr, CString};
 use std::sync::Mutex;
 
 /// One logger call.
@@ -141,6 +143,37 @@ impl Host {
             "message not passed as the argument of a %s format: {records:?}"
         );
         records.into_iter().map(|r| r.message).collect()
+    }
+
+    /// A Co-Simulation instance of `M` (instance name `name`) set up for t = 0 and in
+    /// Initialization Mode: the caller sets its parameters, then calls
+    /// `ffi::exit_initialization_mode`. Panics if a call fails.
+    ///
+    /// # Safety
+    /// `self` must outlive the instance, which the caller frees with `ffi::free_instance`.
+    pub unsafe fn initializing<M: FmuModel>(&self, name: &str) -> fmi2Component {
+        let name = CString::new(name).expect("no NUL in the instance name");
+        let guid = CString::new(M::GUID).expect("no NUL in the GUID");
+        // SAFETY: NUL-terminated strings that live over the call; callbacks in `self`,
+        // which outlives the instance (the caller's contract).
+        let inst = unsafe {
+            ffi::instantiate::<M>(
+                name.as_ptr(),
+                fmi2Type_fmi2CoSimulation,
+                guid.as_ptr(),
+                std::ptr::null(),
+                &*self.callbacks,
+                0,
+                0,
+            )
+        };
+        assert!(!inst.is_null(), "fmi2Instantiate failed: {:?}", self.records());
+        // SAFETY: a live instance just created.
+        unsafe {
+            assert_eq!(ffi::setup_experiment::<M>(inst, 0, 0.0, 0.0, 0, 0.0), fmi2Status_fmi2OK);
+            assert_eq!(ffi::enter_initialization_mode::<M>(inst), fmi2Status_fmi2OK);
+        }
+        inst
     }
 
     /// Whether some message contains every one of `parts`.
