@@ -269,27 +269,8 @@ pub struct Connection {
 /// Connections by name (docs/DESIGN.md §2): plant outputs → controller inputs, controller outputs →
 /// plant inputs. Errors if types differ or a plant command input (`*_cmd`) is left undriven.
 pub fn connections(plant: &FmuInfo, controller: &FmuInfo) -> Result<Vec<Connection>, String> {
-    let mut out = Vec::new();
-    for (from, from_id, to, to_id) in [
-        (plant, "plant", controller, "controller"),
-        (controller, "controller", plant, "plant"),
-    ] {
-        for output in from.with("output") {
-            if let Some(input) = to.port(&output.name).filter(|p| p.causality == "input") {
-                if input.kind != output.kind {
-                    return Err(format!(
-                        "{}: {} output is {}, {} input is {}",
-                        output.name, from.model_identifier, output.kind, to.model_identifier, input.kind
-                    ));
-                }
-                out.push(Connection {
-                    start: from_id,
-                    end: to_id,
-                    name: output.name.clone(),
-                });
-            }
-        }
-    }
+    let mut out = links_between(plant, "plant", controller, "controller")?;
+    out.extend(links_between(controller, "controller", plant, "plant")?);
     let undriven: Vec<_> = plant
         .with("input")
         .filter(|p| p.name.ends_with("_cmd") && !out.iter().any(|c| c.end == "plant" && c.name == p.name))
