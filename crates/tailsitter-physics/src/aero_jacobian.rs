@@ -157,9 +157,9 @@ impl Airframe {
             ($($f:ident),*) => { Coefficients { $($f: (hi.$f - lo.$f) * k),* } };
         }
         slope!(
-            c_L_alpha, c_m_alpha, c_Y_beta, c_l_beta, c_n_beta, c_Y_p, c_l_p, c_n_p, c_L_q, c_m_q, c_Y_r, c_l_r,
-            c_n_r, c_L_de, c_m_de, c_Y_da, c_l_da, c_n_da, c_Y_dr, c_l_dr, c_n_dr, c_L_dfc, c_m_dfc, c_l_dfd,
-            c_n_dfd, c_Y_dv, c_l_dv, c_n_dv
+            c_L_alpha, c_m_alpha, c_Y_beta, c_l_beta, c_n_beta, c_Y_p, c_l_p, c_n_p, c_L_q, c_m_q, c_Y_r, c_l_r, c_n_r,
+            c_L_de, c_m_de, c_Y_da, c_l_da, c_n_da, c_Y_dr, c_l_dr, c_n_dr, c_L_dfc, c_m_dfc, c_l_dfd, c_n_dfd, c_Y_dv,
+            c_l_dv, c_n_dv
         )
     }
 
@@ -296,7 +296,9 @@ impl Airframe {
         let ws = Axes::of(&v_wake)?;
         // ∂v_wake/∂(args) = [I 0] + 2 e_x ∇w.
         let mut j_wake = Jac3::zeros();
-        j_wake.fixed_view_mut::<3, 3>(0, arg::VELOCITY).copy_from(&Matrix3::identity());
+        j_wake
+            .fixed_view_mut::<3, 3>(0, arg::VELOCITY)
+            .copy_from(&Matrix3::identity());
         for k in 0..N_FM_ARGS {
             j_wake[(0, k)] += 2.0 * g_wi[k];
         }
@@ -313,12 +315,20 @@ impl Airframe {
         let (lift_s, g_lift_s) = slip(&[(c.c_L_de, cs.c_L_de, de), (c.c_L_dfc, cs.c_L_dfc, dfc)], 1.0);
         let (side_s, g_side_s) = slip(&[(c.c_Y_dr, cs.c_Y_dr, dr), (c.c_Y_dv, cs.c_Y_dv, dv)], 1.0);
         let (l_s, g_l_s) = slip(
-            &[(c.c_l_dr, cs.c_l_dr, dr), (c.c_l_dfd, cs.c_l_dfd, dfd), (c.c_l_dv, cs.c_l_dv, dv)],
+            &[
+                (c.c_l_dr, cs.c_l_dr, dr),
+                (c.c_l_dfd, cs.c_l_dfd, dfd),
+                (c.c_l_dv, cs.c_l_dv, dv),
+            ],
             b,
         );
         let (m_s, g_m_s) = slip(&[(c.c_m_de, cs.c_m_de, de), (c.c_m_dfc, cs.c_m_dfc, dfc)], cbar);
         let (n_s, g_n_s) = slip(
-            &[(c.c_n_dr, cs.c_n_dr, dr), (c.c_n_dfd, cs.c_n_dfd, dfd), (c.c_n_dv, cs.c_n_dv, dv)],
+            &[
+                (c.c_n_dr, cs.c_n_dr, dr),
+                (c.c_n_dfd, cs.c_n_dfd, dfd),
+                (c.c_n_dv, cs.c_n_dv, dv),
+            ],
             b,
         );
 
@@ -382,9 +392,13 @@ mod tests {
         let a = Airframe::default();
         let cases: [[f64; N_FM_ARGS]; 6] = [
             [24.79, 0.0, 3.22, 0.0, 0.0, 0.0, 9.28, -0.105, 0.0, 0.0, 0.0, 0.0, 0.0],
-            [12.0, 1.5, 5.0, 0.3, -0.4, 0.2, 40.0, 0.1, -0.05, 0.08, 0.03, -0.02, 0.04],
+            [
+                12.0, 1.5, 5.0, 0.3, -0.4, 0.2, 40.0, 0.1, -0.05, 0.08, 0.03, -0.02, 0.04,
+            ],
             [3.0, -1.0, 0.4, -0.5, 0.6, 0.7, 88.0, -0.2, 0.1, -0.1, 0.15, 0.05, -0.1],
-            [-6.0, 2.0, 1.0, 0.1, 0.2, -0.3, 20.0, 0.05, 0.02, 0.01, -0.03, 0.04, 0.02],
+            [
+                -6.0, 2.0, 1.0, 0.1, 0.2, -0.3, 20.0, 0.05, 0.02, 0.01, -0.03, 0.04, 0.02,
+            ],
             [-2.0, 0.3, -0.5, 0.0, 0.1, 0.0, 60.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
             [30.0, -3.0, -2.0, 1.0, 0.5, -0.5, 2.0, 0.2, 0.2, 0.2, 0.2, 0.2, 0.2],
         ];
@@ -420,8 +434,12 @@ mod tests {
     fn not_differentiable_without_airspeed() {
         let a = Airframe::default();
         let s = Surfaces::default();
-        assert!(a.forces_moments_jacobian(&Vector3::zeros(), &Vector3::zeros(), 80.0, &s).is_none());
-        assert!(a.forces_moments_jacobian(&Vector3::new(0.0, 2.0, 0.0), &Vector3::zeros(), 0.0, &s).is_none());
+        assert!(a
+            .forces_moments_jacobian(&Vector3::zeros(), &Vector3::zeros(), 80.0, &s)
+            .is_none());
+        assert!(a
+            .forces_moments_jacobian(&Vector3::new(0.0, 2.0, 0.0), &Vector3::zeros(), 0.0, &s)
+            .is_none());
     }
 
     #[test]
