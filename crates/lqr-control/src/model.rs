@@ -290,8 +290,8 @@ pub fn linearise_analytic(
         .copy_from(&(jf_v / m - w.cross_matrix() * jv));
     da.fixed_columns_mut::<3>(ix::P)
         .copy_from(&(jf.fixed_columns::<3>(arg::RATES) / m + vb.cross_matrix()));
-    for k in 0..3 {
-        da.set_column(ix::PHI + k, &(dc[k].column(2) * af.gravity));
+    for (k, dck) in dc.iter().enumerate() {
+        da.set_column(ix::PHI + k, &(dck.column(2) * af.gravity));
     }
     da.set_column(ix::T, &(jf.column(arg::THRUST) / m));
     for k in 0..6 {
@@ -356,8 +356,8 @@ pub fn linearise_analytic(
     // (Ṅ, Ė, −ḣ) = DCMᵀ v.
     let mut dpos = SMatrix::<f64, 3, NX>::zeros();
     dpos.fixed_columns_mut::<3>(ix::V).copy_from(&(c.transpose() * jv));
-    for k in 0..3 {
-        dpos.set_column(ix::PHI + k, &(dc[k].transpose() * vb));
+    for (k, dck) in dc.iter().enumerate() {
+        dpos.set_column(ix::PHI + k, &(dck.transpose() * vb));
     }
     f.set_row(ix::N, &dpos.row(0));
     f.set_row(ix::E, &dpos.row(1));

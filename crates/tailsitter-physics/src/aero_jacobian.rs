@@ -148,7 +148,7 @@ impl Airframe {
     /// constant slope of the straight line inside ±`alpha_interp_limit`, 0 outside.
     pub fn coefficient_slopes(&self, alpha: f64) -> Coefficients {
         let lim = self.alpha_interp_limit;
-        if !(alpha.abs() < lim) {
+        if alpha.abs() >= lim || alpha.is_nan() {
             return Coefficients::default();
         }
         let (hi, lo) = (self.coefficients(lim), self.coefficients(-lim));
