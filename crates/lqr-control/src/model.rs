@@ -21,7 +21,8 @@
 //! * thrust lag (2.3.16)/(2.4.28) with τ_T: `Ṫ = (T_c − T)/τ_T`.
 //!
 //! The surfaces are taken as direct inputs (the servo lag of App. D.5 is not modelled,
-//! as in the thesis). Linearisation (3.2.7–3.2.9) is by central differences.
+//! as in the thesis). Linearisation (3.2.7–3.2.9) is analytic ([`linearise_analytic`]),
+//! with central differences ([`linearise_central`]) as the fallback.
 
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3, Vector4};
 use tailsitter_physics::numeric::central_differences;
