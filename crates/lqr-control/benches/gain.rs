@@ -10,7 +10,7 @@ use closed_loop::{fly, Scenario};
 use criterion::{criterion_group, criterion_main, Criterion};
 use flight_mission::MissionParams;
 use lqr_control::linalg::{dare_sda, lqr_gain};
-use lqr_control::model::{EulerRep, NA};
+use lqr_control::model::{linearise_analytic, linearise_central, EulerRep, NA};
 use lqr_control::{LqrController, LqrParams};
 use nalgebra::SMatrix;
 use std::hint::black_box;
@@ -38,6 +38,14 @@ fn gain(c: &mut Criterion) {
         });
         c.bench_function(&format!("relinearisation_t{t}"), |b| {
             b.iter(|| ctl.solve_gain(rep, black_box(&x), &p.u, t).unwrap())
+        });
+        // The model's Jacobians alone: analytic (the default) against central differences.
+        let af = Airframe::default();
+        c.bench_function(&format!("jacobians_analytic_t{t}"), |b| {
+            b.iter(|| linearise_analytic(&af, rep, black_box(&x), &p.u).unwrap())
+        });
+        c.bench_function(&format!("jacobians_central_t{t}"), |b| {
+            b.iter(|| linearise_central(&af, rep, black_box(&x), &p.u))
         });
     }
 }

@@ -2,7 +2,7 @@
 //! pure Rust, independent of FMI.
 //!
 //! * [`model`]: the full-state Euler model for control (§2.4, candidate 2 of §3.2.3) on the
-//!   physics crate's force model, linearised numerically (3.2.7–3.2.9).
+//!   physics crate's force model, linearised analytically (3.2.7–3.2.9).
 //! * [`linalg`]: zero-order-hold discretisation (replacing (3.2.10–3.2.11)), the steady-state
 //!   DARE by structured doubling, the thesis's N-step backward iteration (3.1.3–3.1.5).
 //! * [`trajectory`]: the reference trajectory of §3.3.

@@ -1,12 +1,13 @@
 //! CPU time of `Plant::advance` over one 20 ms communication step (the work of the plant
-//! FMU's fmi2DoStep) in trimmed level flight at 25 m/s and vertical climb at 3 m/s: median
+//! FMU's fmi2DoStep) in trimmed level flight at 25 m/s, vertical climb at 3 m/s and hover in
+//! a 5 m/s wind, with the thesis's and the global aerodynamic model (`aero_model` 0 / 1): median
 //! over `batches` batches of the thread's CPU time per call (robust on a loaded machine).
 //!
 //! `cargo run --release -p tailsitter-physics --example advance_benchmark -- [batches=15]`
 
 use nalgebra::Vector3;
 use std::hint::black_box;
-use tailsitter_physics::{Airframe, Plant};
+use tailsitter_physics::{AeroModel, Airframe, Plant};
 
 fn thread_cpu_time() -> f64 {
     let mut ts = libc::timespec { tv_sec: 0, tv_nsec: 0 };
@@ -17,11 +18,22 @@ fn thread_cpu_time() -> f64 {
 
 fn main() {
     let batches: usize = std::env::args().nth(1).and_then(|a| a.parse().ok()).unwrap_or(15);
-    let plant = Plant::new(Airframe::default());
-    let wind = Vector3::zeros();
-    for (name, trim) in [
-        ("level 25 m/s", plant.trim_level(25.0).unwrap()),
-        ("vertical 3 m/s", plant.trim_vertical_climb(3.0).unwrap()),
+    let thesis = Plant::new(Airframe::default());
+    let mut global = thesis.clone();
+    global.aero.model = AeroModel::Global;
+    let calm = Vector3::zeros();
+    let level = thesis.trim_level(25.0).unwrap();
+    let vertical = thesis.trim_vertical_climb(3.0).unwrap();
+    let hover = thesis.trim_vertical_climb(0.0).unwrap();
+    // Hover in a 5 m/s horizontal wind: the global model's post-stall path.
+    let gust = Vector3::new(5.0, 0.0, 0.0);
+    for (name, plant, trim, wind) in [
+        ("level 25 m/s, thesis aero", &thesis, level, calm),
+        ("vertical 3 m/s, thesis aero", &thesis, vertical, calm),
+        ("level 25 m/s, global aero", &global, level, calm),
+        ("vertical 3 m/s, global aero", &global, vertical, calm),
+        ("hover, 5 m/s wind, thesis aero", &thesis, hover, gust),
+        ("hover, 5 m/s wind, global aero", &global, hover, gust),
     ] {
         let reps = 2000;
         let mut per_call = Vec::new();

@@ -485,7 +485,9 @@ impl GlobalAero {
         } else {
             (Flow::axes_of(v_wake), 0.0)
         };
-        let eta = Self::immersed_fraction(a);
+        // η only weighs stalled shares: not needed (and its square root not taken) at σ = 0,
+        // where the stall fraction σ((1 − η) + η σ_s) is 0 for any η ∈ [0, 1].
+        let eta = if sigma > 0.0 { Self::immersed_fraction(a) } else { 0.0 };
 
         // Attached share of the free stream: the thesis's static (2.3.6–2.3.13) and rate
         // (2.3.5) terms. Stalled share: the plate (post_stall, damped by its point

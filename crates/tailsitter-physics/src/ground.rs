@@ -167,7 +167,12 @@ impl Ground {
     pub fn contact(&self, a: &Airframe, x: &StateVector, c: &Matrix3<f64>) -> (Vector3<f64>, Vector3<f64>) {
         let mut force = Vector3::zeros();
         let mut moment = Vector3::zeros();
-        if x[POS_D] + self.reach(a) <= self.height || x[POS_D].is_nan() {
+        // Cheap test first (no square root): gear_length + max(half span, half height) bounds
+        // the gear's reach, so this returns only where the exact test below returns too.
+        let bound = (self.gear_length + self.gear_half_span.max(self.gear_half_height))
+            .max(self.nose_length)
+            .max(0.5 * a.wing_span);
+        if x[POS_D] + bound <= self.height || x[POS_D] + self.reach(a) <= self.height || x[POS_D].is_nan() {
             return (force, moment);
         }
         let pos = Vector3::new(x[POS_N], x[POS_E], x[POS_D]);

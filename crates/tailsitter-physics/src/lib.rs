@@ -15,6 +15,7 @@
 #![allow(non_snake_case)]
 
 pub mod aero;
+pub mod aero_jacobian;
 pub mod airframe;
 pub mod attitude;
 pub mod error;
@@ -24,6 +25,7 @@ pub mod numeric;
 pub mod plant;
 
 pub use aero::{ForcesMoments, Surfaces, AIRSPEED_EPS};
+pub use aero_jacobian::{FmJacobian, N_FM_ARGS};
 pub use airframe::{Airframe, Coefficients, InvalidParameter};
 pub use attitude::{
     dcm_earth_to_body, dcm_from_euler_231, euler_231, euler_231_from_quat, euler_321_from_quat, pitch_321,

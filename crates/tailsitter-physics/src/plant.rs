@@ -336,9 +336,13 @@ impl Plant {
                 unit: "m/s",
             });
         }
-        let q = Vector4::new(s[Q1], s[Q2], s[Q3], s[Q4]);
-        let v_air = Vector3::new(s[U], s[V], s[W]) - dcm_earth_to_body(&q) * wind_ned;
-        let airspeed = v_air.norm();
+        // In still air the airspeed is the speed (v − DCM·0 = v exactly): no DCM needed.
+        let airspeed = if *wind_ned == Vector3::zeros() {
+            speed
+        } else {
+            let q = Vector4::new(s[Q1], s[Q2], s[Q3], s[Q4]);
+            (Vector3::new(s[U], s[V], s[W]) - dcm_earth_to_body(&q) * wind_ned).norm()
+        };
         if airspeed > e.max_speed {
             return Err(PhysicsError::Envelope {
                 quantity: "airspeed",
