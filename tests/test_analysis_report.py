@@ -1,7 +1,8 @@
 """The analysis report is rendered by Python from the data the Rust campaign
 writes. `tests/data/analysis/` holds the output of a tiny campaign
 (`cargo run --release -p analysis -- all --n 2 --params Cmde --max-gust 2`,
-report.json + CSV; `aero_models.json` + CSV of `-- aero --out tests/data/analysis`); the Rust test `tiny_campaign_tables_come_from_runs_and_are_cached`
+report.json + CSV; `aero_models.json` + CSV of
+`-- aero --max-gust 2 --out tests/data/analysis`); the Rust test `tiny_campaign_tables_come_from_runs_and_are_cached`
 checks that a campaign still writes report.json with the same structure."""
 
 from __future__ import annotations
@@ -109,6 +110,13 @@ def test_aero_models_section_shows_both_models_side_by_side(rendered):
         assert cells[6] == f"{t['max_alt_dev_m']:.2f} / {g['max_alt_dev_m']:.2f}"
         lost = t["passed"] and not g["passed"]
         assert cells[8].startswith("LOST with the global model") == lost
+    # Gust sweep on both models: 3 phases × 3 axes, thesis / global per controller.
+    i = lines.index("### Gust sweep on both models")
+    gust = [line for line in lines[i:] if line.startswith("| ") and not line.startswith("| phase")]
+    assert len(gust) == 9
+    g = {(r["phase"], r["axis"], r["controller"], r["aero_model"]): r["largest_survived"] for r in a["gusts"]["rows"]}
+    first = [c.strip() for c in gust[0].strip("|").split("|")]
+    assert first[2] == f"{g[first[0], first[1], 'LQR', 0]:.0f} / {g[first[0], first[1], 'LQR', 1]:.0f}"
     # Coefficient curves: both models over 0…180°, identical in attached flow.
     c = a["coefficients"]
     assert c["alpha_deg"][0] == 0 and c["alpha_deg"][-1] == 180

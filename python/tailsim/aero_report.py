@@ -172,6 +172,7 @@ def section(d: dict) -> list[str]:
                 f"| {_pair(t['max_stall_fraction'], g['max_stall_fraction'], 2)} "
                 f"| {verdict(t, g, c['alpha_attached_deg'], 15.0)} |"
             )
+    out += gust_table(a, d.get("controllers") or sorted({r["controller"] for r in a["rows"]}))
     lost = [
         f"{r['controller']} — {desc[r['case']]}"
         for r in a["rows"]
@@ -184,6 +185,49 @@ def section(d: dict) -> list[str]:
         f"Coefficient curves (`aero_coefficients.csv`, plot `aero_coefficients.png`): both models at "
         f"{shortest(c['airspeed_m_s'])} m/s, β = 0, no thrust, no rotation, surfaces neutral; C_m about the CG.",
     ]
+    return out
+
+
+def gust_table(a: dict, controllers: list[str]) -> list[str]:
+    """The analysis's gust sweep flown on both models: largest survived amplitude."""
+    g = a.get("gusts")
+    if not g or not g["rows"]:
+        return []
+    amps = g["amplitudes"]
+    out = [
+        "",
+        "### Gust sweep on both models",
+        "",
+        f"The gust sweep of the analysis (1−cos, {shortest(g['duration_s'])} s, along one NED axis, default "
+        f"mission, amplitudes {shortest(amps[0])}…{shortest(amps[-1])} m/s) flown on both models with the same "
+        "ground: largest amplitude A such that every amplitude ≤ A passes the mission criteria without touching "
+        "the ground. Cells: thesis / global.",
+        "",
+    ]
+    header, rule = "| phase | axis |", "|---|---|"
+    for k in controllers:
+        header += f" {k} (m/s) |"
+        rule += "---|"
+    out += [header + " changed |", rule + "---|"]
+    by = {(r["phase"], r["axis"], r["controller"], r["aero_model"]): r for r in g["rows"]}
+    cases: list[tuple[str, str]] = []
+    for r in g["rows"]:
+        if (r["phase"], r["axis"]) not in cases:
+            cases.append((r["phase"], r["axis"]))
+    for ph, axis in cases:
+        line = f"| {ph} | {axis} |"
+        changes = []
+        for k in controllers:
+            t, gl = by.get((ph, axis, k, 0)), by.get((ph, axis, k, 1))
+            if t is None or gl is None:
+                line += " – |"
+                continue
+            line += f" {t['largest_survived']:.0f} / {gl['largest_survived']:.0f} |"
+            if gl["largest_survived"] < t["largest_survived"]:
+                changes.append(f"{k} lower with the global model")
+            elif gl["largest_survived"] > t["largest_survived"]:
+                changes.append(f"{k} higher with the global model")
+        out.append(line + f" {'; '.join(changes) if changes else 'same'} |")
     return out
 
 

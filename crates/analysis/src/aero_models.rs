@@ -1,8 +1,8 @@
 //! Beyond the thesis (issue 13): the thesis's linear aerodynamics (`aero_model` = 0) and the
 //! global model (`aero_model` = 1, the FMU's default) side by side. Both controllers, untuned,
 //! fly the same cases on a plant with each model (and the FMU's default ground, 10 m below
-//! the start): the default and the fast mission and hover wind steps; plus the force and
-//! moment coefficients of both models over α = 0…180°. Data only: `aero_models.json` and
+//! the start): the default and the fast mission, hover wind steps and the analysis's gust
+//! sweep; plus the force and moment coefficients of both models over α = 0…180°. Data only: `aero_models.json` and
 //! two CSV files; `python -m tailsim.analysis_report` renders them (`tailsim.aero_report`).
 
 use std::fmt::Write as _;
@@ -17,6 +17,7 @@ use serde_json::json;
 use tailsitter_physics::{AeroModel, Airframe, GlobalAero, Ground, Plant, Surfaces};
 
 use crate::controllers::Kind;
+use crate::robust::{gust_scenario, largest_survived, GustPhase, AXES, GUST_DURATION};
 
 /// Airspeed of the coefficient curves (m/s) (any: both models are quasi-steady, and the
 /// thrust-free curves do not depend on it).
@@ -124,11 +125,16 @@ fn plant(model: AeroModel) -> Plant {
 
 /// Fly one case with one controller on one model.
 pub fn fly_case(case: &Case, kind: Kind, model: AeroModel) -> AeroRow {
+    let is_mission = case.id == "default" || case.id == "fast";
+    fly_scenario(case.id, &case.scenario, kind, model, is_mission)
+}
+
+/// Fly `sc` with one controller on one model; `is_mission`: also judge the mission criteria.
+fn fly_scenario(id: &str, sc: &Scenario, kind: Kind, model: AeroModel, is_mission: bool) -> AeroRow {
     let p = plant(model);
-    let sc = &case.scenario;
     let m = &sc.mission;
     let mut row = AeroRow {
-        case: case.id.into(),
+        case: id.into(),
         controller: kind.name().into(),
         aero_model: model.index(),
         completed: false,
@@ -163,7 +169,6 @@ pub fn fly_case(case: &Case, kind: Kind, model: AeroModel) -> AeroRow {
         }
         row.ground_contact |= y.ground.points > 0;
     }
-    let is_mission = case.id == "default" || case.id == "fast";
     row.completed = trace.completed() && !row.ground_contact;
     row.passed = row.completed && (!is_mission || MissionCheck::of(&trace, m, theta).passed());
     row.failure = trace.failure.clone().or_else(|| {
@@ -176,6 +181,63 @@ pub fn fly_case(case: &Case, kind: Kind, model: AeroModel) -> AeroRow {
     row.max_alt_dev_m = alt;
     row.max_stall_fraction = stall;
     row
+}
+
+/// Largest survived gust of one phase, axis, controller and model.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct GustRow {
+    /// "vertical" / "transition" / "level".
+    pub phase: String,
+    /// "n" / "e" / "d".
+    pub axis: String,
+    /// "LQR" / "TSD".
+    pub controller: String,
+    /// 0 thesis, 1 global.
+    pub aero_model: i32,
+    /// Largest amplitude A such that every amplitude ≤ A passes the mission criteria, no
+    /// ground contact (m/s) (0: the smallest fails).
+    pub largest_survived: f64,
+    /// Largest stall fraction over the flights up to and including the first failure.
+    pub max_stall_fraction: f64,
+}
+
+/// The analysis's gust sweep ([`crate::robust`]: 1−cos gusts along each NED axis in the
+/// vertical phase, the first transition and level flight, default mission) flown on both
+/// models.
+pub fn gust_rows(mission: &MissionParams, amplitudes: &[f64]) -> Vec<GustRow> {
+    let mut jobs = Vec::new();
+    for phase in GustPhase::ALL {
+        for axis in 0..3 {
+            for kind in Kind::ALL {
+                for model in [AeroModel::Thesis, AeroModel::Global] {
+                    jobs.push((phase, axis, kind, model));
+                }
+            }
+        }
+    }
+    jobs.par_iter()
+        .map(|&(phase, axis, kind, model)| {
+            let mut passed = Vec::new();
+            let mut stall = 0.0f64;
+            for &amp in amplitudes {
+                let sc = gust_scenario(mission, phase, axis, amp);
+                let r = fly_scenario("gust", &sc, kind, model, true);
+                stall = stall.max(r.max_stall_fraction);
+                passed.push(r.passed);
+                if !r.passed {
+                    break;
+                }
+            }
+            GustRow {
+                phase: phase.name().into(),
+                axis: AXES[axis].into(),
+                controller: kind.name().into(),
+                aero_model: model.index(),
+                largest_survived: largest_survived(&amplitudes[..passed.len()], &passed),
+                max_stall_fraction: stall,
+            }
+        })
+        .collect()
 }
 
 /// Lift, drag and pitching-moment coefficients (wind axes, about the CG, no thrust, no
@@ -198,9 +260,10 @@ pub fn coefficients(a: &Airframe, g: &GlobalAero, model: AeroModel, alpha: f64) 
     ]
 }
 
-/// Fly every case with both controllers on both models (in parallel) and write
-/// `aero_models.json`, `aero_models.csv` and `aero_coefficients.csv` into `out`.
-pub fn run(out: &Path, mission: &MissionParams) -> std::io::Result<Vec<AeroRow>> {
+/// Fly every case and the gust sweep (`gust_amplitudes`, ascending; empty = none) with both
+/// controllers on both models (in parallel) and write `aero_models.json`, `aero_models.csv`,
+/// `aero_gusts.csv` and `aero_coefficients.csv` into `out`.
+pub fn run(out: &Path, mission: &MissionParams, gust_amplitudes: &[f64]) -> std::io::Result<Vec<AeroRow>> {
     std::fs::create_dir_all(out)?;
     let cases = cases(mission);
     let mut jobs = Vec::new();
@@ -258,8 +321,20 @@ pub fn run(out: &Path, mission: &MissionParams) -> std::io::Result<Vec<AeroRow>>
     }
     std::fs::write(out.join("aero_coefficients.csv"), curves)?;
 
+    let gusts = gust_rows(mission, gust_amplitudes);
+    let mut gcsv = String::from("phase,axis,controller,aero_model,largest_survived,max_stall_fraction\n");
+    for g in &gusts {
+        let _ = writeln!(
+            gcsv,
+            "{},{},{},{},{},{}",
+            g.phase, g.axis, g.controller, g.aero_model, g.largest_survived, g.max_stall_fraction
+        );
+    }
+    std::fs::write(out.join("aero_gusts.csv"), gcsv)?;
+
     let report = json!({
         "ground_height_m": Ground::default().height,
+        "gusts": {"duration_s": GUST_DURATION, "amplitudes": gust_amplitudes, "rows": gusts},
         "coefficients": {
             "airspeed_m_s": CURVE_AIRSPEED,
             "alpha_deg": alphas,

@@ -79,7 +79,8 @@ fn main() {
     if robustness || aero_only {
         // Thesis (aero_model 0) against global (1) aerodynamics: analysis::aero_models.
         let start = std::time::Instant::now();
-        match analysis::aero_models::run(&c.out, &flight_mission::MissionParams::default()) {
+        let amplitudes: Vec<f64> = (1..=c.max_gust.max(1)).map(f64::from).collect();
+        match analysis::aero_models::run(&c.out, &flight_mission::MissionParams::default(), &amplitudes) {
             Ok(rows) => eprintln!(
                 "wrote {}/aero_models.json: {} flights in {:.1} s",
                 c.out.display(),

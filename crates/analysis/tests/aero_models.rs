@@ -65,7 +65,7 @@ fn attached_runs_are_identical_on_both_models() {
 fn writes_the_data_the_renderer_reads() {
     let dir = std::env::temp_dir().join(format!("aero-models-test-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    let rows = run(&dir, &MissionParams::default()).unwrap();
+    let rows = run(&dir, &MissionParams::default(), &[1.0, 2.0]).unwrap();
     assert_eq!(rows.len(), cases(&MissionParams::default()).len() * 2 * 2);
     for r in &rows {
         assert!((0.0..=1.0).contains(&r.max_stall_fraction), "{r:?}");
@@ -85,14 +85,18 @@ fn writes_the_data_the_renderer_reads() {
     let fixture = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/analysis/aero_models.json");
     let fixture: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(fixture).unwrap()).unwrap();
     let keys = |v: &serde_json::Value| v.as_object().unwrap().keys().cloned().collect::<Vec<_>>();
-    for path in ["", "/coefficients", "/rows/0", "/cases/0"] {
+    for path in ["", "/coefficients", "/rows/0", "/cases/0", "/gusts", "/gusts/rows/0"] {
         assert_eq!(
             keys(written.pointer(path).unwrap()),
             keys(fixture.pointer(path).unwrap()),
             "{path}: refresh tests/data/analysis (cargo run --release -p analysis -- aero --out tests/data/analysis)"
         );
     }
-    for f in ["aero_models.csv", "aero_coefficients.csv"] {
+    // 3 phases × 3 axes × 2 controllers × 2 models; with the thesis's model the default
+    // mission survives 1 m/s gusts everywhere (the analysis's gust sweep on it, report.json).
+    let gusts = written["gusts"]["rows"].as_array().unwrap();
+    assert_eq!(gusts.len(), 36);
+    for f in ["aero_models.csv", "aero_coefficients.csv", "aero_gusts.csv"] {
         let text = std::fs::read_to_string(dir.join(f)).unwrap();
         assert!(text.lines().count() > rows.len().min(24), "{f}");
     }
