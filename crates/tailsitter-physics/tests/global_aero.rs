@@ -615,3 +615,51 @@ fn default_reversed_lift_maximum_is_a_finite_wing_value() {
     assert_eq!(g.reverse_attached_weight(&v_air(v, 0.3, 0.0)), 0.0);
     assert_eq!(g.reverse_attached_weight(&v_air(v, core::f64::consts::PI, 0.0)), 1.0);
 }
+
+/// The reversed-flow seams (α = ±(180° − δ_a), ±(180° − δ_s); β = β_a, β_s at 170°) with no
+/// rotation and no thrust, so every part of the wing sees the free-stream δ and the seam lies
+/// exactly at the tested angle: one-sided slopes of every force and moment component agree.
+#[test]
+fn reversed_flow_seams_are_c1() {
+    let a = Airframe::default();
+    let g = GlobalAero::default();
+    let pi = core::f64::consts::PI;
+    let h = 1e-7;
+    let zero = Vector3::zeros();
+    let s0 = Surfaces::default();
+    let eval = |al: f64, be: f64| {
+        let fm = g.forces_moments(&a, &v_air(20.0, al, be), &zero, 0.0, &s0).0;
+        [
+            fm.force_body.x,
+            fm.force_body.y,
+            fm.force_body.z,
+            fm.moment_body.x,
+            fm.moment_body.y,
+            fm.moment_body.z,
+        ]
+    };
+    let check = |al: f64, be: f64, d_al: f64, d_be: f64| {
+        let f0 = eval(al, be);
+        let fp = eval(al + d_al * h, be + d_be * h);
+        let fm = eval(al - d_al * h, be - d_be * h);
+        for k in 0..6 {
+            let right = (fp[k] - f0[k]) / h;
+            let left = (f0[k] - fm[k]) / h;
+            assert!(
+                (right - left).abs() <= 1e-3 * (1.0 + right.abs().max(left.abs())),
+                "component {k} at α {al} β {be}: {left} vs {right}"
+            );
+        }
+    };
+    for al in [
+        pi - g.alpha_reverse_attached,
+        pi - g.alpha_reverse_stalled,
+        -(pi - g.alpha_reverse_attached),
+        -(pi - g.alpha_reverse_stalled),
+    ] {
+        check(al, 0.05, 1.0, 0.0);
+    }
+    for be in [g.beta_attached, g.beta_stalled, -g.beta_attached] {
+        check(170f64.to_radians(), be, 0.0, 1.0);
+    }
+}
