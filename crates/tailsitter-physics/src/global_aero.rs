@@ -194,8 +194,8 @@ pub struct GlobalAero {
     /// |α| up to which the flow is attached: the thesis's model exactly (rad) (10°).
     pub alpha_attached: f64,
     /// |α| from which the flow is fully separated (rad) (25°). With α_a = 10° this puts the
-    /// model's C_Lmax at 0.99 (α = 16°), within 5 % of 0.945 = 0.9 × the section maximum c_l,max = 1.05 of a thick
-    /// symmetric section (NACA 0015 at Re 7·10⁵, Sheldahl & Klimas 1981), the usual
+    /// model's C_Lmax at 0.99 (α = 16°), within 5 % of 0.945 = 0.9 × the section maximum
+    /// c_l,max = 1.05 of a thick symmetric section (NACA 0015 at Re 7·10⁵, Sheldahl & Klimas 1981), the usual
     /// finite-wing estimate for an unswept wing (Raymer, Aircraft Design, §12.4).
     pub alpha_stalled: f64,
     /// |β| up to which the thesis's lateral model holds (rad) (15°).
