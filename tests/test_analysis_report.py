@@ -112,11 +112,18 @@ def test_aero_models_section_shows_both_models_side_by_side(rendered):
         assert cells[8].startswith("LOST with the global model") == lost
     # Gust sweep on both models: 3 phases × 3 axes, thesis / global per controller.
     i = lines.index("### Gust sweep on both models")
-    gust = [line for line in lines[i:] if line.startswith("| ") and not line.startswith("| phase")]
+    j = lines.index("### Parameter end points on both models")
+    gust = [line for line in lines[i:j] if line.startswith("| ") and not line.startswith("| phase")]
     assert len(gust) == 9
     g = {(r["phase"], r["axis"], r["controller"], r["aero_model"]): r["largest_survived"] for r in a["gusts"]["rows"]}
     first = [c.strip() for c in gust[0].strip("|").split("|")]
     assert first[2] == f"{g[first[0], first[1], 'LQR', 0]:.0f} / {g[first[0], first[1], 'LQR', 1]:.0f}"
+    # Parameter end points: one row per parameter of Table 5.1, ÷τ and ×τ per controller.
+    i = lines.index("### Parameter end points on both models")
+    scaled = [line for line in lines[i:] if line.startswith("| ") and not line.startswith("| parameter")]
+    assert len(scaled) == len({r["param"] for r in a["scaled"]}) == 25
+    r = next(r for r in a["scaled"] if r["param"] == "CLa" and r["controller"] == "LQR" and r["factor"] < 1)
+    assert scaled[0].startswith(f"| {r['name']} | {r['max_pos_error_m']:.2f}{'' if r['passed'] else ' ✗'} / ")
     # Coefficient curves: both models over 0…180°, identical in attached flow.
     c = a["coefficients"]
     assert c["alpha_deg"][0] == 0 and c["alpha_deg"][-1] == 180

@@ -172,7 +172,9 @@ def section(d: dict) -> list[str]:
                 f"| {_pair(t['max_stall_fraction'], g['max_stall_fraction'], 2)} "
                 f"| {verdict(t, g, c['alpha_attached_deg'], 15.0)} |"
             )
-    out += gust_table(a, d.get("controllers") or sorted({r["controller"] for r in a["rows"]}))
+    ctls = d.get("controllers") or sorted({r["controller"] for r in a["rows"]})
+    out += gust_table(a, ctls)
+    out += scaled_table(a, ctls)
     lost = [
         f"{r['controller']} — {desc[r['case']]}"
         for r in a["rows"]
@@ -228,6 +230,47 @@ def gust_table(a: dict, controllers: list[str]) -> list[str]:
             elif gl["largest_survived"] > t["largest_survived"]:
                 changes.append(f"{k} higher with the global model")
         out.append(line + f" {'; '.join(changes) if changes else 'same'} |")
+    return out
+
+
+def scaled_table(a: dict, controllers: list[str]) -> list[str]:
+    """The parameter sweep's end points (÷τ, ×τ) flown on both models."""
+    rows = a.get("scaled") or []
+    if not rows:
+        return []
+
+    def cell(r: dict) -> str:
+        return f"{fmt_or_dash(_num(r['max_pos_error_m']), 2)}{'' if r['passed'] else ' ✗'}"
+
+    by = {(r["param"], r["controller"], r["aero_model"], r["factor"] > 1): r for r in rows}
+    params: list[tuple[str, str]] = []
+    for r in rows:
+        if (r["param"], r["name"]) not in params:
+            params.append((r["param"], r["name"]))
+    passes = {m: sum(r["passed"] for r in rows if r["aero_model"] == m) for m in (0, 1)}
+    total = {m: sum(1 for r in rows if r["aero_model"] == m) for m in (0, 1)}
+    out = [
+        "",
+        "### Parameter end points on both models",
+        "",
+        "The default mission on a plant with one parameter of Table 5.1 scaled to an end of the thesis's range "
+        "(÷τ / ×τ; τ = 1.5 aerodynamic, 1.1 mass and inertia), controllers designed on the nominal airframe. Cells: "
+        "largest position error (m), thesis / global; ✗ = mission criteria missed or ground touched. Passes: "
+        f"thesis {passes[0]}/{total[0]}, global {passes[1]}/{total[1]}.",
+        "",
+    ]
+    header, rule = "| parameter |", "|---|"
+    for k in controllers:
+        header += f" {k} ÷τ | {k} ×τ |"
+        rule += "---|---|"
+    out += [header, rule]
+    for pid, name in params:
+        line = f"| {name} |"
+        for k in controllers:
+            for up in (False, True):
+                t, g = by.get((pid, k, 0, up)), by.get((pid, k, 1, up))
+                line += f" {cell(t)} / {cell(g)} |" if t and g else " – |"
+        out.append(line)
     return out
 
 

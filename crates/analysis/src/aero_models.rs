@@ -1,8 +1,8 @@
 //! Beyond the thesis (issue 13): the thesis's linear aerodynamics (`aero_model` = 0) and the
 //! global model (`aero_model` = 1, the FMU's default) side by side. Both controllers, untuned,
 //! fly the same cases on a plant with each model (and the FMU's default ground, 10 m below
-//! the start): the default and the fast mission, hover wind steps and the analysis's gust
-//! sweep; plus the force and moment coefficients of both models over α = 0…180°. Data only: `aero_models.json` and
+//! the start): the default and the fast mission, hover wind steps, the analysis's gust
+//! sweep and the end points (÷τ, ×τ) of its parameter sweep; plus the force and moment coefficients of both models over α = 0…180°. Data only: `aero_models.json` and
 //! two CSV files; `python -m tailsim.analysis_report` renders them (`tailsim.aero_report`).
 
 use std::fmt::Write as _;
@@ -116,8 +116,8 @@ pub struct AeroRow {
     pub ground_contact: bool,
 }
 
-fn plant(model: AeroModel) -> Plant {
-    let mut p = Plant::new(Airframe::default());
+fn plant(airframe: &Airframe, model: AeroModel) -> Plant {
+    let mut p = Plant::new(*airframe);
     p.aero.model = model;
     p.ground = Ground::default();
     p
@@ -126,12 +126,21 @@ fn plant(model: AeroModel) -> Plant {
 /// Fly one case with one controller on one model.
 pub fn fly_case(case: &Case, kind: Kind, model: AeroModel) -> AeroRow {
     let is_mission = case.id == "default" || case.id == "fast";
-    fly_scenario(case.id, &case.scenario, kind, model, is_mission)
+    fly_scenario(case.id, &case.scenario, kind, model, is_mission, &Airframe::default())
 }
 
-/// Fly `sc` with one controller on one model; `is_mission`: also judge the mission criteria.
-fn fly_scenario(id: &str, sc: &Scenario, kind: Kind, model: AeroModel, is_mission: bool) -> AeroRow {
-    let p = plant(model);
+/// Fly `sc` with one controller (designed on the nominal airframe) on one model of a plant
+/// with `airframe`; `is_mission`: also judge the mission criteria.
+fn fly_scenario(
+    id: &str,
+    sc: &Scenario,
+    kind: Kind,
+    model: AeroModel,
+    is_mission: bool,
+    airframe: &Airframe,
+) -> AeroRow {
+    let p = plant(airframe, model);
+    let nominal = plant(&Airframe::default(), model);
     let m = &sc.mission;
     let mut row = AeroRow {
         case: id.into(),
@@ -148,7 +157,12 @@ fn fly_scenario(id: &str, sc: &Scenario, kind: Kind, model: AeroModel, is_missio
         first_stall_s: None,
         ground_contact: false,
     };
-    let (x0, theta) = match (p.trim_vertical_climb(m.v_vertical), p.trim_level(m.v_level)) {
+    // A modified plant that cannot trim starts from the nominal trim (as crate::robust).
+    let climb = p
+        .trim_vertical_climb(m.v_vertical)
+        .or_else(|_| nominal.trim_vertical_climb(m.v_vertical));
+    let level = p.trim_level(m.v_level).or_else(|_| nominal.trim_level(m.v_level));
+    let (x0, theta) = match (climb, level) {
         (Ok(x0), Ok(level)) => (x0.state, level.theta),
         _ => {
             row.failure = Some("no trim".into());
@@ -221,7 +235,7 @@ pub fn gust_rows(mission: &MissionParams, amplitudes: &[f64]) -> Vec<GustRow> {
             let mut stall = 0.0f64;
             for &amp in amplitudes {
                 let sc = gust_scenario(mission, phase, axis, amp);
-                let r = fly_scenario("gust", &sc, kind, model, true);
+                let r = fly_scenario("gust", &sc, kind, model, true, &Airframe::default());
                 stall = stall.max(r.max_stall_fraction);
                 passed.push(r.passed);
                 if !r.passed {
@@ -235,6 +249,60 @@ pub fn gust_rows(mission: &MissionParams, amplitudes: &[f64]) -> Vec<GustRow> {
                 aero_model: model.index(),
                 largest_survived: largest_survived(&amplitudes[..passed.len()], &passed),
                 max_stall_fraction: stall,
+            }
+        })
+        .collect()
+}
+
+/// The default mission on a plant with one parameter of Table 5.1 scaled to an end of the
+/// thesis's range (÷τ or ×τ), one controller, one model.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct ScaledRow {
+    /// Parameter id (`CLa`, …, `Iz`).
+    pub param: String,
+    /// Its symbol.
+    pub name: String,
+    /// Scale factor (1/τ or τ).
+    pub factor: f64,
+    /// "LQR" / "TSD".
+    pub controller: String,
+    /// 0 thesis, 1 global.
+    pub aero_model: i32,
+    /// Mission criteria met, no ground contact.
+    pub passed: bool,
+    /// Largest position error (m).
+    pub max_pos_error_m: f64,
+    /// Largest stall fraction.
+    pub max_stall_fraction: f64,
+}
+
+/// The robustness sweep's end points on both models: every parameter of Table 5.1 at ÷τ and
+/// ×τ (τ = 1.5 aerodynamic, 1.1 mass and inertia), default mission.
+pub fn scaled_rows(mission: &MissionParams) -> Vec<ScaledRow> {
+    let nominal = Airframe::default();
+    let mut jobs = Vec::new();
+    for p in crate::sensitivity::params() {
+        for factor in [1.0 / p.tau(), p.tau()] {
+            for kind in Kind::ALL {
+                for model in [AeroModel::Thesis, AeroModel::Global] {
+                    jobs.push((p, factor, kind, model));
+                }
+            }
+        }
+    }
+    jobs.par_iter()
+        .map(|(p, factor, kind, model)| {
+            let af = p.scaled(&nominal, *factor);
+            let r = fly_scenario(p.id, &Scenario::mission(*mission), *kind, *model, true, &af);
+            ScaledRow {
+                param: p.id.into(),
+                name: p.name.into(),
+                factor: *factor,
+                controller: kind.name().into(),
+                aero_model: model.index(),
+                passed: r.passed,
+                max_pos_error_m: r.max_pos_error_m,
+                max_stall_fraction: r.max_stall_fraction,
             }
         })
         .collect()
@@ -261,8 +329,9 @@ pub fn coefficients(a: &Airframe, g: &GlobalAero, model: AeroModel, alpha: f64) 
 }
 
 /// Fly every case and the gust sweep (`gust_amplitudes`, ascending; empty = none) with both
-/// controllers on both models (in parallel) and write `aero_models.json`, `aero_models.csv`,
-/// `aero_gusts.csv` and `aero_coefficients.csv` into `out`.
+/// controllers on both models (in parallel), and the parameter end points ([`scaled_rows`]),
+/// and write `aero_models.json`, `aero_models.csv`, `aero_gusts.csv`, `aero_scaled.csv` and
+/// `aero_coefficients.csv` into `out`.
 pub fn run(out: &Path, mission: &MissionParams, gust_amplitudes: &[f64]) -> std::io::Result<Vec<AeroRow>> {
     std::fs::create_dir_all(out)?;
     let cases = cases(mission);
@@ -332,8 +401,20 @@ pub fn run(out: &Path, mission: &MissionParams, gust_amplitudes: &[f64]) -> std:
     }
     std::fs::write(out.join("aero_gusts.csv"), gcsv)?;
 
+    let scaled = scaled_rows(mission);
+    let mut scsv = String::from("param,factor,controller,aero_model,passed,max_pos_error_m,max_stall_fraction\n");
+    for r in &scaled {
+        let _ = writeln!(
+            scsv,
+            "{},{},{},{},{},{},{}",
+            r.param, r.factor, r.controller, r.aero_model, r.passed, r.max_pos_error_m, r.max_stall_fraction
+        );
+    }
+    std::fs::write(out.join("aero_scaled.csv"), scsv)?;
+
     let report = json!({
         "ground_height_m": Ground::default().height,
+        "scaled": scaled,
         "gusts": {"duration_s": GUST_DURATION, "amplitudes": gust_amplitudes, "rows": gusts},
         "coefficients": {
             "airspeed_m_s": CURVE_AIRSPEED,

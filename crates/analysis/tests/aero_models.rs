@@ -85,7 +85,15 @@ fn writes_the_data_the_renderer_reads() {
     let fixture = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/analysis/aero_models.json");
     let fixture: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(fixture).unwrap()).unwrap();
     let keys = |v: &serde_json::Value| v.as_object().unwrap().keys().cloned().collect::<Vec<_>>();
-    for path in ["", "/coefficients", "/rows/0", "/cases/0", "/gusts", "/gusts/rows/0"] {
+    for path in [
+        "",
+        "/coefficients",
+        "/rows/0",
+        "/cases/0",
+        "/gusts",
+        "/gusts/rows/0",
+        "/scaled/0",
+    ] {
         assert_eq!(
             keys(written.pointer(path).unwrap()),
             keys(fixture.pointer(path).unwrap()),
@@ -96,7 +104,14 @@ fn writes_the_data_the_renderer_reads() {
     // mission survives 1 m/s gusts everywhere (the analysis's gust sweep on it, report.json).
     let gusts = written["gusts"]["rows"].as_array().unwrap();
     assert_eq!(gusts.len(), 36);
-    for f in ["aero_models.csv", "aero_coefficients.csv", "aero_gusts.csv"] {
+    // 25 parameters × 2 ends × 2 controllers × 2 models.
+    assert_eq!(written["scaled"].as_array().unwrap().len(), 200);
+    for f in [
+        "aero_models.csv",
+        "aero_coefficients.csv",
+        "aero_gusts.csv",
+        "aero_scaled.csv",
+    ] {
         let text = std::fs::read_to_string(dir.join(f)).unwrap();
         assert!(text.lines().count() > rows.len().min(24), "{f}");
     }
