@@ -6,7 +6,10 @@ which `cargo run --release -p analysis -- all|aero --out DIR` writes.
     cargo run --release -p analysis -- aero --out out/analysis
     PYTHONPATH=python .venv/bin/python -m tailsim.analysis_report out/analysis
 
-Writes `aero_models.md` (via `tailsim.analysis_report`) and the plots
+Tables: the flight cases (default and fast mission, hover wind steps), the
+analysis's gust sweep and the end points of its parameter sweep, each with the
+thesis / global values side by side and what changed. Writes `aero_models.md`
+(via `tailsim.analysis_report`) and the plots
 `aero_coefficients.png` (C_L, C_D, C_m of both models over α = 0…180°) and
 `aero_flights.png` (largest position error of every flight).
 """
