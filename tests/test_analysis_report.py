@@ -1,7 +1,8 @@
 """The analysis report is rendered by Python from the data the Rust campaign
 writes. `tests/data/analysis/` holds the output of a tiny campaign
 (`cargo run --release -p analysis -- all --n 2 --params Cmde --max-gust 2`,
-report.json + CSV); the Rust test `tiny_campaign_tables_come_from_runs_and_are_cached`
+report.json + CSV; `aero_models.json` + CSV of
+`-- aero --max-gust 2 --out tests/data/analysis`); the Rust test `tiny_campaign_tables_come_from_runs_and_are_cached`
 checks that a campaign still writes report.json with the same structure."""
 
 from __future__ import annotations
@@ -42,6 +43,7 @@ def test_every_section_and_file_is_written(rendered):
         "## Nonlinear robustness (beyond the thesis)",
         "### Wider sweep: τ^3 (0.30 … 1.00 aerodynamic, 0.751 … 1.000 m and I)",
         "## Gust sweep (beyond the thesis)",
+        "## Thesis (linear) against global aerodynamics (beyond the thesis, issue 13)",
     ]:
         assert heading in text.splitlines(), heading
     for name in analysis_report.SECTIONS:
@@ -81,9 +83,68 @@ def test_tables_hold_the_data(rendered):
 
 def test_every_plot_is_drawn_and_embedded(rendered):
     folder, d = rendered
-    expected = {"open_loop_modes", "table_5_1", "robustness", "gusts"}
+    expected = {"open_loop_modes", "table_5_1", "robustness", "gusts", "aero_coefficients", "aero_flights"}
     expected |= {f"closed_loop_poles_{c}" for c in d["conditions"]}
     expected |= {f"loci_{k}_{c}_{kind}" for k in d["controllers"] for c in d["conditions"] for kind in ("pitch", "all")}
     assert {p.stem for p in folder.glob("*.png")} == expected
     html = (folder / "report.html").read_text()
     assert html.count("data:image/png;base64,") == len(expected)
+
+
+def test_aero_models_section_shows_both_models_side_by_side(rendered):
+    """Every case × controller has one row with the thesis (0) and global (1) values side by
+    side, and the verdict names the direction of the change."""
+    folder, _ = rendered
+    a = json.loads((DATA / "aero_models.json").read_text())
+    lines = lines_of(folder, "aero_models.md")
+    desc = {c["id"]: c["description"] for c in a["cases"]}
+    by = {(r["case"], r["controller"], r["aero_model"]): r for r in a["rows"]}
+    assert len(a["rows"]) == 2 * 2 * len(a["cases"])
+    for case, ctl, _ in [k for k in by if k[2] == 0]:
+        t, g = by[case, ctl, 0], by[case, ctl, 1]
+        row = [line for line in lines if line.startswith(f"| {desc[case]} | {ctl} |")]
+        assert len(row) == 1, (case, ctl)
+        cells = [c.strip() for c in row[0].strip("|").split("|")]
+        assert cells[3] == f"{t['max_alpha_deg']:.1f} / {g['max_alpha_deg']:.1f}"
+        assert cells[5] == f"{t['max_pos_error_m']:.2f} / {g['max_pos_error_m']:.2f}"
+        assert cells[6] == f"{t['max_alt_dev_m']:.2f} / {g['max_alt_dev_m']:.2f}"
+        lost = t["passed"] and not g["passed"]
+        assert cells[8].startswith("LOST with the global model") == lost
+    # Gust sweep on both models: 3 phases × 3 axes, thesis / global per controller.
+    i = lines.index("### Gust sweep on both models")
+    j = lines.index("### Parameter end points on both models")
+    gust = [line for line in lines[i:j] if line.startswith("| ") and not line.startswith("| phase")]
+    assert len(gust) == 9
+    g = {(r["phase"], r["axis"], r["controller"], r["aero_model"]): r["largest_survived"] for r in a["gusts"]["rows"]}
+    first = [c.strip() for c in gust[0].strip("|").split("|")]
+    assert first[2] == f"{g[first[0], first[1], 'LQR', 0]:.0f} / {g[first[0], first[1], 'LQR', 1]:.0f}"
+    # Parameter end points: one row per parameter of Table 5.1, ÷τ and ×τ per controller.
+    i = lines.index("### Parameter end points on both models")
+    scaled = [line for line in lines[i:] if line.startswith("| ") and not line.startswith("| parameter")]
+    assert len(scaled) == len({r["param"] for r in a["scaled"]}) == 25
+    r = next(r for r in a["scaled"] if r["param"] == "CLa" and r["controller"] == "LQR" and r["factor"] < 1)
+    assert scaled[0].startswith(f"| {r['name']} | {r['max_pos_error_m']:.2f}{'' if r['passed'] else ' ✗'} / ")
+    # Coefficient curves: both models over 0…180°, identical in attached flow.
+    c = a["coefficients"]
+    assert c["alpha_deg"][0] == 0 and c["alpha_deg"][-1] == 180
+    for al, t, g in zip(c["alpha_deg"], c["thesis"]["c_L"], c["global"]["c_L"]):
+        if al <= c["alpha_attached_deg"]:
+            assert abs(t - g) < 1e-12
+
+
+def test_aero_verdicts():
+    """The verdict logic on hand-made rows (independent of any run)."""
+    from tailsim.aero_report import verdict
+
+    def row(passed, alpha, err, alt, stall, beta=0.0, failure=None):
+        return {"passed": passed, "max_alpha_deg": alpha, "max_beta_deg": beta, "max_pos_error_m": err,
+                "max_alt_dev_m": alt, "max_stall_fraction": stall, "failure": failure}
+
+    assert verdict(row(True, 8, 0.5, 0.3, 0.0), row(True, 8, 0.5, 0.3, 0.0)) == "unchanged: attached flow throughout"
+    v = verdict(row(True, 22, 0.4, 0.2, 0.5), row(False, 170, 80, 79, 1.0, failure="touched the ground"))
+    assert v.startswith("LOST with the global model (touched the ground)")
+    assert "α up to 22°" in v and "tumbles" in v and "mostly height (79.0 of 80.0 m)" in v
+    assert verdict(row(False, 170, 90, 80, 1.0), row(True, 5, 1, 1, 0.5)).startswith("saved by the global model")
+    assert verdict(row(False, 170, 90, 80, 1.0), row(False, 170, 90, 80, 1.0)) == "lost with both models"
+    v = verdict(row(True, 22, 0.4, 0.2, 0.5), row(True, 52, 12.9, 12.7, 1.0))
+    assert v.startswith("passes with both; worse with the global model (error +12.50 m, max α +30.0°")

@@ -70,6 +70,8 @@ impl PlantModel {
             beta_attached: vars.beta_attached,
             beta_stalled: vars.beta_stalled,
             c_D_90: vars.c_D_90,
+            // Reversed-flow band: not FMU parameters (the physics crate's defaults).
+            ..GlobalAero::default()
         };
         aero.validate()
             .map_err(|e| ModelError::new(format!("invalid aerodynamic parameter: {e}")))?;

@@ -7,8 +7,8 @@ The campaign (`crates/analysis`) writes data only: `report.json` (every table
 as structured data) and the CSV files of every table and figure. This module
 renders them: `report.md` (everything) and one Markdown file per section
 (`open_loop_modes.md`, `closed_loop_poles.md`, `table_5_1.md`,
-`robustness.md`, `gusts.md`), `report.html` and the plots
-(`tailsim.analysis_plots`). `tailsim.compare` includes the same sections in
+`robustness.md`, `gusts.md`, `aero_models.md`), `report.html` and the plots
+(`tailsim.analysis_plots`, `tailsim.aero_report`). `tailsim.compare` includes the same sections in
 the comparison report.
 """
 
@@ -18,6 +18,7 @@ import argparse
 import json
 import pathlib
 
+from . import aero_report
 from .report import fmt_or_dash, fmt_pole, markdown_to_html, shortest
 
 OPEN_LOOP_NOTES = (
@@ -42,8 +43,10 @@ SENSITIVITY_NOTES = (
 
 
 def load(folder: str | pathlib.Path) -> dict:
-    """`report.json` of an analysis output folder."""
-    return json.loads((pathlib.Path(folder) / "report.json").read_text())
+    """`report.json` of an analysis output folder, with `aero_models.json` (if written)
+    under the key `aero_models`."""
+    d = json.loads((pathlib.Path(folder) / "report.json").read_text())
+    return aero_report.load_into(d, folder)
 
 
 def _rows(header: str, rule: str, lines: list[str]) -> list[str]:
@@ -277,6 +280,7 @@ SECTIONS = {
     "table_5_1.md": table_5_1,
     "robustness.md": robustness,
     "gusts.md": gusts,
+    "aero_models.md": aero_report.section,
 }
 
 
@@ -312,6 +316,7 @@ def write(folder: str | pathlib.Path, with_plots: bool = True) -> pathlib.Path:
         from . import analysis_plots
 
         analysis_plots.main(folder)
+        aero_report.plot(folder)
     md = markdown(d)
     pngs = plots(folder)
     if pngs:

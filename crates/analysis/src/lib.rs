@@ -6,6 +6,7 @@
 //!
 //! See README.md for the command that regenerates everything.
 
+pub mod aero_models;
 pub mod cache;
 pub mod campaign;
 pub mod closed;

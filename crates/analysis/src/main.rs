@@ -60,17 +60,41 @@ enum Cmd {
     Linear(Common),
     /// Modes, poles, and the nonlinear robustness and gust sweeps (Table 5.1 included).
     Nonlinear(Common),
+    /// Only the thesis-vs-global aerodynamic model comparison (aero_models.json), which
+    /// `all` and `nonlinear` also write.
+    Aero(Common),
 }
 
 fn main() {
     let cli = Cli::parse();
-    let (c, robustness, gusts) = match cli.command {
-        Cmd::All(c) => (c, true, true),
-        Cmd::Linear(c) => (c, false, false),
-        Cmd::Nonlinear(c) => (c, true, true),
+    let (c, robustness, gusts, aero_only) = match cli.command {
+        Cmd::All(c) => (c, true, true, false),
+        Cmd::Linear(c) => (c, false, false, false),
+        Cmd::Nonlinear(c) => (c, true, true, false),
+        Cmd::Aero(c) => (c, false, false, true),
     };
     if let Some(t) = c.threads {
         let _ = rayon::ThreadPoolBuilder::new().num_threads(t).build_global();
+    }
+    if robustness || aero_only {
+        // Thesis (aero_model 0) against global (1) aerodynamics: analysis::aero_models.
+        let start = std::time::Instant::now();
+        let amplitudes: Vec<f64> = (1..=c.max_gust.max(1)).map(f64::from).collect();
+        match analysis::aero_models::run(&c.out, &flight_mission::MissionParams::default(), &amplitudes) {
+            Ok(rows) => eprintln!(
+                "wrote {}/aero_models.json: {} flights in {:.1} s",
+                c.out.display(),
+                rows.len(),
+                start.elapsed().as_secs_f64()
+            ),
+            Err(e) => {
+                eprintln!("aerodynamic model comparison failed: {e}");
+                std::process::exit(1);
+            }
+        }
+        if aero_only {
+            return;
+        }
     }
     let mut cfg = Config::full(c.out);
     cfg.n = c.n.max(2);

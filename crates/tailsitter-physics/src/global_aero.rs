@@ -29,18 +29,41 @@
 //! F = q̄S (−C_D0 s_x, −C_D0 s_y + C_Yn, −C_N)          skin friction along the plate + normal forces
 //! ```
 //!
-//! The normal-force shape is the empirical flat-plate fit used in wind-turbine post-stall
-//! models (attributed to Lindenburg, ECN-C--03-025, 2003); at α = 90° it is C_D90, at 45°
-//! 0.815 C_D90 (flat plate: C_L = C_N cos α peaks near 45°, C_D = C_N sin α rises to C_D90
-//! broadside). C_D90 defaults to Viterna & Corrigan's (1982) finite-wing value
-//! 1.11 + 0.018 A = 1.187 for A = 4.29. It is the φ-theory structure of Lustosa, Defaÿ &
+//! The normal-force shape s_n/(0.56 + 0.44 |s_n|) is an empirical flat-plate fit of the
+//! wind-turbine post-stall literature, where it is usually attributed to Lindenburg (ECN).
+//! That attribution could not be confirmed in a primary source, so the shape stands here on
+//! its own agreement with measured data: Sheldahl & Klimas's NACA 0015 table
+//! (`tests/data/sheldahl_klimas_naca0015.csv`) gives C_N = C_l cos α + C_d sin α = 0.835 C_N(90°)
+//! at 45° and 0.57 C_N(90°) at 30°; the fit gives 0.812 and 0.641, and the lift and drag it
+//! implies are checked over 0–180° in `tests/global_aero.rs`. At α = 90° it is C_D90 (flat
+//! plate: C_L = C_N cos α peaks near 45°, C_D = C_N sin α rises to C_D90 broadside).
+//! C_D90 defaults to Viterna & Corrigan's (1982) finite-wing value 1.11 + 0.018 A = 1.187 for
+//! A = 4.29 (the formula as implemented in NREL's AirfoilPrep.py, `Polar.extrapolate`,
+//! wisdem.github.io/AirfoilPreppy). It is the φ-theory structure of Lustosa, Defaÿ &
 //! Moschetta (JGCD 42(2), 2019) — force = −½ρS‖v‖Φ v, singularity-free on the sphere —
 //! with the plate's normal coefficient made non-linear to follow measured post-stall data.
-//! Checked against Sheldahl & Klimas (SAND80-2114, 1981) in `tests/global_aero.rs`.
 //! C_Y90 = C_D90 |C_Yβ| / C_Lα (α = 0 columns): the side surfaces' broadside force scales
 //! with their share of the lift slope (no new parameter). Unlike the Gazebo/PX4
 //! `LiftDragPlugin` (a straight post-stall line from α_stall, C⁰ at the seam and
 //! unbounded past 90°) every coefficient here is bounded and C¹.
+//!
+//! **Reversed flow (tail first).** Near α = ±180° the wing is a symmetric section flown
+//! backwards: the sharp trailing edge leads. Thin-airfoil theory gives the same lift slope
+//! whichever edge leads, but a sharp leading edge carries no suction, so the force stays
+//! normal to the chord (C_N = C_Lα s_n, C_L = C_N cos δ, C_D = C_N sin δ + skin friction) and
+//! the flow separates early from the sharp edge. With the incidence δ = atan2(|w|, −u) of
+//! the flow on the reversed chord, each half wing's normal coefficient is
+//!
+//! ```text
+//! C_N/s_n = plate + r (C_Lα − plate),   r = (1 − S(δ; δ_a, δ_s)) (1 − S(|β|; β_a, β_s))
+//! ```
+//!
+//! (C_Lα the thesis's α = 0 slope: the reversed wing has the same planform), acting at the
+//! reversed quarter chord (x_cp below, s_x = −1). Defaults δ_a = 7°, δ_s = 22° from Sheldahl &
+//! Klimas's NACA 0015 data, which are linear to 175°, peak at 170° (c_l = −0.85, c_d = 0.14)
+//! and rejoin the plate curve by 165°; checked against those data in `tests/global_aero.rs`
+//! (section: |ΔC_l| ≤ 0.15 over 165–180°, slope within 20 %, C_d within 0.015). r is C¹: S
+//! is flat at δ = 0 (the |w| kink) and r = 0 for u ≥ 0 and near u = w = 0 (|β| → 90°).
 //!
 //! **Post-stall moments.** The plate's normal force acts at
 //! x_cp = x_np − (c̄/4)(1 − s_x) ahead of the CG, with x_np = c̄ C_mα/C_Lα the neutral point of
@@ -87,6 +110,11 @@
 //! coefficient stays below max(C_Lα α_s, C_D90, …) ≈ 1.5 of its own dynamic pressure.
 //! Limits: quasi-steady (no dynamic stall or hysteresis), no jet-height correction of the
 //! immersed strip (an upper estimate of the slip-stream lift), no asymmetric stall (spin).
+//! References: R.E. Sheldahl & P.C. Klimas, SAND80-2114, Sandia, 1981 (OSTI 6548367);
+//! L.A. Viterna & R.D. Corrigan, "Fixed pitch rotor performance of large horizontal axis wind
+//! turbines", NASA Lewis Research Center, 1982; L.R. Lustosa, F. Defaÿ & J.-M. Moschetta, "Global
+//! singularity-free aerodynamic model for algorithmic flight control of tail sitters",
+//! J. Guidance, Control, and Dynamics 42(2), 2019.
 
 use nalgebra::Vector3;
 
@@ -166,8 +194,8 @@ pub struct GlobalAero {
     /// |α| up to which the flow is attached: the thesis's model exactly (rad) (10°).
     pub alpha_attached: f64,
     /// |α| from which the flow is fully separated (rad) (25°). With α_a = 10° this puts the
-    /// model's C_Lmax ≈ 0.94 near α ≈ 15°: 0.9 × the section maximum c_l,max = 1.05 of a thick
-    /// symmetric section (NACA 0015 at Re 7·10⁵, Sheldahl & Klimas 1981), the usual
+    /// model's C_Lmax at 0.99 (α = 16°), within 5 % of 0.945 = 0.9 × the section maximum
+    /// c_l,max = 1.05 of a thick symmetric section (NACA 0015 at Re 7·10⁵, Sheldahl & Klimas 1981), the usual
     /// finite-wing estimate for an unswept wing (Raymer, Aircraft Design, §12.4).
     pub alpha_stalled: f64,
     /// |β| up to which the thesis's lateral model holds (rad) (15°).
@@ -177,6 +205,18 @@ pub struct GlobalAero {
     /// Broadside (α = 90°) normal-force coefficient C_D90 of the wing (Viterna & Corrigan
     /// 1982: 1.11 + 0.018 A = 1.187 for A = 4.29).
     pub c_D_90: f64,
+    /// Reversed flow (tail first): incidence δ = angle between the flow and the −x axis in
+    /// the wing's x–z plane up to which the reversed wing is attached (rad) (7°). Not an FMU
+    /// parameter (the FMU uses the default).
+    pub alpha_reverse_attached: f64,
+    /// Reversed flow: incidence δ from which the reversed wing is fully separated (rad)
+    /// (22°). The reversed NACA 0015 section of Sheldahl & Klimas (1981) is linear to 175°,
+    /// peaks at 170° (c_l = 0.85) and is back on the flat-plate curve at 165° (section band
+    /// 5°–15°); scaled to the wing as the forward band (section 7°–17° → wing 10°–25°,
+    /// geometric α × c_lα/C_Lα ≈ 1.45) this gives 7°–22°, and the wing's reversed
+    /// C_Lmax ≈ 0.9 × 0.85 (the forward finite-wing rule, `alpha_stalled`). Not an FMU
+    /// parameter.
+    pub alpha_reverse_stalled: f64,
 }
 
 impl Default for GlobalAero {
@@ -188,6 +228,8 @@ impl Default for GlobalAero {
             beta_attached: 15f64.to_radians(),
             beta_stalled: 30f64.to_radians(),
             c_D_90: 1.11 + 0.018 * 4.29,
+            alpha_reverse_attached: 7f64.to_radians(),
+            alpha_reverse_stalled: 22f64.to_radians(),
         }
     }
 }
@@ -293,7 +335,8 @@ impl Flow {
 type Wrench = (Vector3<f64>, Vector3<f64>);
 
 impl GlobalAero {
-    /// Every parameter finite; 0 ≤ α_a < α_s ≤ 90°, 0 ≤ β_a < β_s ≤ 90°, C_D90 > 0.
+    /// Every parameter finite; 0 ≤ α_a < α_s ≤ 90°, 0 ≤ β_a < β_s ≤ 90°, C_D90 > 0,
+    /// 0 ≤ δ_a < δ_s < 90° (reversed flow).
     pub fn validate(&self) -> Result<(), InvalidParameter> {
         let bad = |name, value, requirement| {
             Err(InvalidParameter {
@@ -309,6 +352,8 @@ impl GlobalAero {
             ("beta_attached", self.beta_attached),
             ("beta_stalled", self.beta_stalled),
             ("c_D_90", self.c_D_90),
+            ("alpha_reverse_attached", self.alpha_reverse_attached),
+            ("alpha_reverse_stalled", self.alpha_reverse_stalled),
         ] {
             if !value.is_finite() {
                 return bad(name, value, "finite");
@@ -328,6 +373,16 @@ impl GlobalAero {
         }
         if self.c_D_90 <= 0.0 {
             return bad("c_D_90", self.c_D_90, "positive");
+        }
+        if self.alpha_reverse_attached < 0.0 {
+            return bad("alpha_reverse_attached", self.alpha_reverse_attached, ">= 0");
+        }
+        if !(self.alpha_reverse_stalled > self.alpha_reverse_attached && self.alpha_reverse_stalled < half_pi) {
+            return bad(
+                "alpha_reverse_stalled",
+                self.alpha_reverse_stalled,
+                "> alpha_reverse_attached and < pi/2",
+            );
         }
         Ok(())
     }
@@ -401,6 +456,29 @@ impl GlobalAero {
         y.copysign(alpha)
     }
 
+    /// Weight r ∈ [0, 1] of the attached reversed-flow normal force for a local air velocity
+    /// v (module docs, "Reversed flow"): r = (1 − S(δ; δ_a, δ_s)) (1 − S(|β|; β_a, β_s)) with
+    /// δ = atan2(|w|, −u) the incidence of the flow on the reversed chord. 0 whenever u ≥ 0
+    /// (δ ≥ 90° > δ_s) and near u = w = 0, where the β factor vanishes; C¹ everywhere (S is
+    /// flat at δ = 0, where |w| has its kink, and at |β| = 0).
+    #[inline]
+    pub fn reverse_attached_weight(&self, v: &Vector3<f64>) -> f64 {
+        if v.x >= 0.0 {
+            return 0.0;
+        }
+        let vn = v.norm();
+        if vn < AIRSPEED_EPS {
+            return 0.0;
+        }
+        let delta = v.z.abs().atan2(-v.x);
+        if delta >= self.alpha_reverse_stalled {
+            return 0.0;
+        }
+        let beta = (v.y / vn).clamp(-1.0, 1.0).asin();
+        (1.0 - smoothstep(delta, self.alpha_reverse_attached, self.alpha_reverse_stalled))
+            * (1.0 - smoothstep(beta.abs(), self.beta_attached, self.beta_stalled))
+    }
+
     /// Post-stall flat-plate force and moment (module docs) for the local air velocity
     /// `v_cg` at the CG of one wing part (free stream, or free stream + slip-stream) and the
     /// body rates: each half wing (area S/2) at r = (x_cp, ±b/4, 0) and the side surfaces at
@@ -427,7 +505,10 @@ impl GlobalAero {
             let k = half_rho * 0.5 * a.wing_area * v.norm();
             let vn = v.norm();
             let sn = if vn < AIRSPEED_EPS { 0.0 } else { v.z / vn };
-            let cn_over_sn = self.c_D_90 / (0.56 + 0.44 * sn.abs());
+            let plate = self.c_D_90 / (0.56 + 0.44 * sn.abs());
+            // Tail first at small incidence the reversed wing is attached: C_N = C_Lα s_n.
+            let w_rev = self.reverse_attached_weight(&v);
+            let cn_over_sn = plate + w_rev * (a.c_L_alpha_a0.max(0.0) - plate);
             let f = Vector3::new(-k * a.c_D0 * v.x, -k * a.c_D0 * v.y, -k * cn_over_sn * v.z);
             force += f;
             moment += r.cross(&f);
