@@ -15,7 +15,16 @@ import pytest
 from tailsim import campaign_runner as R
 from tailsim.campaign import Store, deterministic, local_cluster, run_campaign
 from tailsim.campaign_report import bootstrap_mean_ci, spearman, wilson_interval, write_report
-from tailsim.campaign_sampling import MISSIONS, TABLE_5_1, CampaignSpec, draw_sample, jobs, plant_parameters, wind_function
+from tailsim.campaign_sampling import (
+    MISSIONS,
+    TABLE_5_1,
+    CampaignSpec,
+    draw_sample,
+    jobs,
+    plant_parameters,
+    sample_columns,
+    wind_function,
+)
 from tailsim.master import ClosedLoop
 
 from conftest import ROOT
@@ -90,11 +99,25 @@ def test_samples_are_reproducible_subsets_and_log_uniform():
     assert w(t_peak) == pytest.approx((s["wind_steady_n"] + s["gust_n"], s["wind_steady_e"] + s["gust_e"], s["gust_d"]))
 
 
-def test_not_yet_existing_axes_are_refused_clearly():
-    with pytest.raises(ValueError, match="not implemented yet"):
-        CampaignSpec(configurations=("thesis",))
-    with pytest.raises(ValueError, match="not implemented yet"):
-        CampaignSpec(state_sources=("avionics",))
+def test_unknown_axes_are_refused_clearly():
+    with pytest.raises(ValueError, match="unknown configuration 'printed'"):
+        CampaignSpec(configurations=("printed",))
+    with pytest.raises(ValueError, match="unknown state source 'gps'"):
+        CampaignSpec(state_sources=("gps",))
+    with pytest.raises(ValueError, match="distinct"):
+        CampaignSpec(configurations=("tuned", "tuned"))
+
+
+def test_axes_multiply_runs_without_changing_the_draws():
+    one = short_spec(n_samples=2)
+    four = short_spec(n_samples=2, configurations=("tuned", "thesis"), state_sources=("perfect", "avionics"))
+    a, b = jobs(one), jobs(four)
+    assert len(a) == 2 * 2 and len(b) == 2 * 2 * 2 * 2
+    assert len({j["key"] for j in b}) == len(b)
+    for j in b:  # every run of a sample sees the sample's draw, whatever its axes
+        ref = next(x for x in a if x["sample_id"] == j["sample_id"])
+        assert {k: j[k] for k in sample_columns()} == {k: ref[k] for k in sample_columns()}
+        assert j["key"] == f"{j['sample_id']}/{j['controller']}/{j['configuration']}/{j['state_source']}"
 
 
 # --- statistics ---------------------------------------------------------------------------
@@ -151,6 +174,65 @@ def test_reset_and_reuse_run_equals_closed_loop(fmus):
     for k, v in ref_metrics.items():
         assert row[k] == v or (math.isnan(v) and math.isnan(row[k])), k
     assert row["t_end"] == pytest.approx(spec.stop_time) and row["last_phase"] == 4
+
+
+def test_thesis_configuration_run_equals_closed_loop_with_configuration_1(fmus):
+    """The `thesis` axis sets the controller's `configuration` = 1 and nothing else."""
+    spec = short_spec(configurations=("thesis",))
+    dig = R.install_fmus(R.load_fmu_bytes(DIST, ["lqr", "tsd"]))
+    plant = fmus["tailsitter_plant"]
+    nominal = {n: float(v.start) for n, v in plant.variables.items() if v.causality == "parameter" and v.type == "Real"}
+    for j in jobs(spec, [1]):
+        assert j["configuration"] == "thesis"
+        pp = plant_parameters(j, nominal)
+        pp["aero_model"] = spec.aero_model
+        ctrl = fmus[f"tailsitter_{j['controller']}"]
+        ref = ClosedLoop(plant, ctrl, pp, {**spec.mission, "configuration": 1}).run(
+            stop_time=spec.stop_time, step_size=spec.step_size, wind=wind_function(j)
+        )
+        tuned = ClosedLoop(plant, ctrl, pp, dict(spec.mission)).run(
+            stop_time=spec.stop_time, step_size=spec.step_size, wind=wind_function(j)
+        )
+        row = R.run_job(j, spec.to_json(), dig)
+        want = R.run_metrics({k: ref[k] for k in ("time", "phase", "pos_d", "alpha", "ref_pos_d", "pos_error", *R.COMMANDS)})
+        for k, v in want.items():
+            assert row[k] == v or (math.isnan(v) and math.isnan(row[k])), (j["key"], k)
+        # and the configuration changes the flight (the parameter reached the controller)
+        assert abs(row["rms_err"] - math.sqrt(np.mean(tuned["pos_error"] ** 2))) > 1e-3, j["key"]
+
+
+def test_avionics_run_equals_the_avionics_loop_with_the_sample_seed(fmus):
+    """The `avionics` axis flies tailsim.avionics' chain with the sensors' seed = the sample's
+    noise_seed; errors are the TRUE position against the reference."""
+    from tailsim.avionics import AvionicsLoop
+    from tailsim.master import pos_error
+
+    spec = short_spec(state_sources=("avionics",), controllers=("lqr",))
+    dig = R.install_fmus(R.load_fmu_bytes(DIST, ["lqr"], ["avionics"]))
+    assert {"sensors", "ekf"} <= set(dig)
+    j = jobs(spec, [2])[0]
+    row = R.run_job(j, spec.to_json(), dig)
+    assert row["completed"], row["detail"]
+    plant = fmus["tailsitter_plant"]
+    nominal = {n: float(v.start) for n, v in plant.variables.items() if v.causality == "parameter" and v.type == "Real"}
+    pp = plant_parameters(j, nominal)
+    pp["aero_model"] = spec.aero_model
+    sensors, ekf = fmus["tailsitter_sensors"], fmus["tailsitter_ekf"]
+
+    def metrics(seed):
+        r = AvionicsLoop(plant, sensors, ekf, fmus["tailsitter_lqr"], plant_params=pp, sensors_params={"seed": seed},
+                         controller_params=dict(spec.mission)).run(
+            stop_time=spec.stop_time, step_size=spec.step_size, wind=wind_function(j))
+        sig = {k: r[k] for k in ("time", "phase", "pos_d", "alpha", "ref_pos_d", *R.COMMANDS)}
+        sig["phase"] = sig["phase"].astype(np.int64)
+        sig["pos_error"] = pos_error(r)
+        return R.run_metrics(sig)
+
+    want = metrics(j["noise_seed"])
+    for k, v in want.items():
+        assert row[k] == v or (math.isnan(v) and math.isnan(row[k])), k
+    other = metrics(j["noise_seed"] + 1)  # the seed reaches the sensors: other noise, other flight
+    assert abs(other["rms_err"] - row["rms_err"]) > 1e-6
 
 
 # --- the Dask campaign --------------------------------------------------------------------

@@ -207,7 +207,7 @@ def run_campaign(
     """
     out = pathlib.Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    blobs = load_fmu_bytes(dist, spec.controllers)
+    blobs = load_fmu_bytes(dist, spec.controllers, spec.state_sources)
     digests = {n: digest(b) for n, b in blobs.items()}
     _check_campaign_file(out, spec, digests, replace)
     store = Store(out)
