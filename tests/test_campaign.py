@@ -379,6 +379,36 @@ def test_tumble_mid_flight_is_a_divergence_and_the_next_run_is_clean(serial, tmp
         assert clean["completed"] and clean["max_err"] == ref[f"1/{c}/tuned/perfect"]["max_err"]
 
 
+def test_native_campaign_flies_identical_jobs_to_the_same_rows(serial, tmp_path):
+    """The native Rust loop (`analysis campaign-jobs`) on the campaign's jobs: the same
+    outcome for every run (an invalid parameter, a tumble) and the same metrics, to the
+    summation order of the RMS values (campaign_native.TOLERANCE), both configurations."""
+    from tailsim.campaign_native import TOLERANCE, compare, run_native
+
+    faults = {1: {"c_m_q_a0": 30.0, "c_m_q_a1": 30.0}, 3: {"mass": -1.0}}  # a tumble, an invalid value
+    spec = short_spec(n_samples=N + 1, configurations=("tuned", "thesis"), overrides=faults)
+    fmpy_rows = run_campaign(spec, tmp_path / "fmpy", DIST, serial=True, progress=False).to_pylist()
+    # The release binary when one was built (fast); else the debug one (same numbers, slower).
+    profile = "release" if (ROOT / "target" / "release" / "analysis").exists() else "debug"
+    native, _ = run_native(spec, DIST, threads=1, workdir=tmp_path / "native", profile=profile)
+    assert len(native) == len(fmpy_rows) == (N + 1) * 2 * 2
+    cmp = compare(fmpy_rows, native)
+    assert cmp["runs"] == len(native) and not cmp["outcome_differs"], cmp["outcome_differs"]
+    assert not cmp["beyond_tolerance"], cmp["beyond_tolerance"]
+    outcome = {r["key"]: (r["completed"], r["failure"]) for r in native}
+    for c in ("lqr", "tsd"):
+        for cfg in ("tuned", "thesis"):
+            assert outcome[f"1/{c}/{cfg}/perfect"] == (False, "divergence")
+            assert outcome[f"3/{c}/{cfg}/perfect"] == (False, "fmi_error")
+            assert outcome[f"0/{c}/{cfg}/perfect"][0]
+    # the tuned rows are those of the fixture's campaign (a different overrides map, same samples)
+    ref = {r["key"]: r for r in serial.to_pylist()}
+    for r in native:
+        if r["key"] in ref and r["key"].split("/")[0] in ("0", "2"):
+            assert r["max_err"] == ref[r["key"]]["max_err"]
+            assert abs(r["rms_err"] - ref[r["key"]]["rms_err"]) <= TOLERANCE
+
+
 def test_resume_refuses_a_different_campaign_unless_replace(serial, tmp_path):
     other = {"spec": short_spec(tau_aero=2.0).to_json(), "fmus": {}}
     (tmp_path / "campaign.json").write_text(json.dumps(other))
