@@ -4,6 +4,7 @@ ClosedLoop, and the Dask campaign on a 2-worker LocalCluster on 127.0.0.1
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import os
@@ -447,6 +448,37 @@ def test_resume_refuses_a_different_campaign_unless_replace(serial, tmp_path):
     assert Store(tmp_path).done_keys() == {"0/lqr/tuned/perfect"}  # nothing discarded
     table = run_campaign(short_spec(), tmp_path, DIST, serial=True, progress=False, replace=True)
     assert deterministic(table).equals(deterministic(serial))  # the other campaign's run is gone
+
+
+def test_comparison_section_is_the_paired_result(serial, tmp_path):
+    """tailsim.campaign_section (the comparison report's first section): Wilson intervals and
+    paired TSD − LQR differences of the campaign's rows; campaigns of other samples refused."""
+    import pyarrow.parquet as pq
+
+    from tailsim import campaign_section as S
+
+    for name, spec in (("a", short_spec()), ("b", dataclasses.replace(short_spec(), seed=8))):
+        (tmp_path / name).mkdir()
+        pq.write_table(serial, tmp_path / name / "results.parquet")
+        (tmp_path / name / "campaign.json").write_text(json.dumps({"spec": spec.to_json(), "fmus": {}}))
+    s = S.summarize([tmp_path / "a"])
+    rows = serial.to_pylist()
+    for c in ("lqr", "tsd"):
+        r = s["arms"][f"{c}/tuned/perfect"]
+        k = sum(x["completed"] for x in rows if x["controller"] == c)
+        assert (r["runs"], r["completed"]) == (N, k) and r["wilson95"] == list(wilson_interval(k, N))
+    p = s["paired"]["tuned/perfect"]
+    by = {(x["sample_id"], x["controller"]): x for x in rows}
+    d = [by[(i, "tsd")]["rms_err"] - by[(i, "lqr")]["rms_err"] for i in range(N)]
+    assert p["completion"]["n"] == N and p["rms_err"]["n"] == N
+    assert p["rms_err"]["mean"] == pytest.approx(np.mean(d), rel=1e-12)
+    assert p["rms_err"]["ci95"][0] <= p["rms_err"]["mean"] <= p["rms_err"]["ci95"][1]
+    with pytest.raises(SystemExit, match="seed"):
+        S.summarize([tmp_path / "a", tmp_path / "b"])
+    (tmp_path / "out").mkdir()
+    (tmp_path / "a").rename(tmp_path / "out" / "campaign")
+    text = "\n".join(S.report_section(tmp_path / "out"))
+    assert "## Comparison: paired Monte-Carlo" in text and "tuned/perfect | RMS position error (m) | 3 |" in text
 
 
 def test_report(serial, tmp_path):
