@@ -173,7 +173,7 @@ pub fn run(job: &Job) -> Row {
             // The fmpy runner stops after the first point whose pos_error exceeds the limit.
             if let Some(k) = samples
                 .iter()
-                .position(|s| !(s.diagnostics.pos_error <= job.divergence_m))
+                .position(|s| s.diagnostics.pos_error.is_nan() || s.diagnostics.pos_error > job.divergence_m)
             {
                 let s = &samples[k];
                 if k + 1 < samples.len() || failure.is_empty() {
@@ -192,7 +192,7 @@ pub fn run(job: &Job) -> Row {
         completed: failure.is_empty(),
         failure,
         detail,
-        metrics: plant.map_or_else(|| metrics_of_nothing(), |p| metrics(&p, &samples)),
+        metrics: plant.map_or_else(metrics_of_nothing, |p| metrics(&p, &samples)),
         cpu_time_s: cpu_time() - c0,
         wall_time_s: t0.elapsed().as_secs_f64(),
     }
