@@ -22,7 +22,8 @@ if [ "$analysis" = 1 ]; then
     cargo run --release --locked -p analysis -- all --out out/analysis
     PYTHONPATH=python .venv/bin/python -m tailsim.analysis_report out/analysis
 fi
-echo "== flying the missions"
-PYTHONPATH=python .venv/bin/python -m tailsim.compare --out out "${runner_args[@]+"${runner_args[@]}"}"
+# Before the missions: the comparison report's first section is the paired Monte-Carlo result.
 echo "== Monte-Carlo campaign (out/campaign; the full run: docs/CAMPAIGN.md)"
 PYTHONPATH=python .venv/bin/python -m tailsim.campaign --samples 16 --seed 1 --out out/campaign --replace --no-progress
+echo "== flying the missions"
+PYTHONPATH=python .venv/bin/python -m tailsim.compare --out out "${runner_args[@]+"${runner_args[@]}"}"

@@ -4,6 +4,7 @@ ClosedLoop, and the Dask campaign on a 2-worker LocalCluster on 127.0.0.1
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import os
@@ -15,7 +16,16 @@ import pytest
 from tailsim import campaign_runner as R
 from tailsim.campaign import Store, deterministic, local_cluster, run_campaign
 from tailsim.campaign_report import bootstrap_mean_ci, spearman, wilson_interval, write_report
-from tailsim.campaign_sampling import MISSIONS, TABLE_5_1, CampaignSpec, draw_sample, jobs, plant_parameters, wind_function
+from tailsim.campaign_sampling import (
+    MISSIONS,
+    TABLE_5_1,
+    CampaignSpec,
+    draw_sample,
+    jobs,
+    plant_parameters,
+    sample_columns,
+    wind_function,
+)
 from tailsim.master import ClosedLoop
 
 from conftest import ROOT
@@ -90,11 +100,25 @@ def test_samples_are_reproducible_subsets_and_log_uniform():
     assert w(t_peak) == pytest.approx((s["wind_steady_n"] + s["gust_n"], s["wind_steady_e"] + s["gust_e"], s["gust_d"]))
 
 
-def test_not_yet_existing_axes_are_refused_clearly():
-    with pytest.raises(ValueError, match="not implemented yet"):
-        CampaignSpec(configurations=("thesis",))
-    with pytest.raises(ValueError, match="not implemented yet"):
-        CampaignSpec(state_sources=("avionics",))
+def test_unknown_axes_are_refused_clearly():
+    with pytest.raises(ValueError, match="unknown configuration 'printed'"):
+        CampaignSpec(configurations=("printed",))
+    with pytest.raises(ValueError, match="unknown state source 'gps'"):
+        CampaignSpec(state_sources=("gps",))
+    with pytest.raises(ValueError, match="distinct"):
+        CampaignSpec(configurations=("tuned", "tuned"))
+
+
+def test_axes_multiply_runs_without_changing_the_draws():
+    one = short_spec(n_samples=2)
+    four = short_spec(n_samples=2, configurations=("tuned", "thesis"), state_sources=("perfect", "avionics"))
+    a, b = jobs(one), jobs(four)
+    assert len(a) == 2 * 2 and len(b) == 2 * 2 * 2 * 2
+    assert len({j["key"] for j in b}) == len(b)
+    for j in b:  # every run of a sample sees the sample's draw, whatever its axes
+        ref = next(x for x in a if x["sample_id"] == j["sample_id"])
+        assert {k: j[k] for k in sample_columns()} == {k: ref[k] for k in sample_columns()}
+        assert j["key"] == f"{j['sample_id']}/{j['controller']}/{j['configuration']}/{j['state_source']}"
 
 
 # --- statistics ---------------------------------------------------------------------------
@@ -151,6 +175,65 @@ def test_reset_and_reuse_run_equals_closed_loop(fmus):
     for k, v in ref_metrics.items():
         assert row[k] == v or (math.isnan(v) and math.isnan(row[k])), k
     assert row["t_end"] == pytest.approx(spec.stop_time) and row["last_phase"] == 4
+
+
+def test_thesis_configuration_run_equals_closed_loop_with_configuration_1(fmus):
+    """The `thesis` axis sets the controller's `configuration` = 1 and nothing else."""
+    spec = short_spec(configurations=("thesis",))
+    dig = R.install_fmus(R.load_fmu_bytes(DIST, ["lqr", "tsd"]))
+    plant = fmus["tailsitter_plant"]
+    nominal = {n: float(v.start) for n, v in plant.variables.items() if v.causality == "parameter" and v.type == "Real"}
+    for j in jobs(spec, [1]):
+        assert j["configuration"] == "thesis"
+        pp = plant_parameters(j, nominal)
+        pp["aero_model"] = spec.aero_model
+        ctrl = fmus[f"tailsitter_{j['controller']}"]
+        ref = ClosedLoop(plant, ctrl, pp, {**spec.mission, "configuration": 1}).run(
+            stop_time=spec.stop_time, step_size=spec.step_size, wind=wind_function(j)
+        )
+        tuned = ClosedLoop(plant, ctrl, pp, dict(spec.mission)).run(
+            stop_time=spec.stop_time, step_size=spec.step_size, wind=wind_function(j)
+        )
+        row = R.run_job(j, spec.to_json(), dig)
+        want = R.run_metrics({k: ref[k] for k in ("time", "phase", "pos_d", "alpha", "ref_pos_d", "pos_error", *R.COMMANDS)})
+        for k, v in want.items():
+            assert row[k] == v or (math.isnan(v) and math.isnan(row[k])), (j["key"], k)
+        # and the configuration changes the flight (the parameter reached the controller)
+        assert abs(row["rms_err"] - math.sqrt(np.mean(tuned["pos_error"] ** 2))) > 1e-3, j["key"]
+
+
+def test_avionics_run_equals_the_avionics_loop_with_the_sample_seed(fmus):
+    """The `avionics` axis flies tailsim.avionics' chain with the sensors' seed = the sample's
+    noise_seed; errors are the TRUE position against the reference."""
+    from tailsim.avionics import AvionicsLoop
+    from tailsim.master import pos_error
+
+    spec = short_spec(state_sources=("avionics",), controllers=("lqr",))
+    dig = R.install_fmus(R.load_fmu_bytes(DIST, ["lqr"], ["avionics"]))
+    assert {"sensors", "ekf"} <= set(dig)
+    j = jobs(spec, [2])[0]
+    row = R.run_job(j, spec.to_json(), dig)
+    assert row["completed"], row["detail"]
+    plant = fmus["tailsitter_plant"]
+    nominal = {n: float(v.start) for n, v in plant.variables.items() if v.causality == "parameter" and v.type == "Real"}
+    pp = plant_parameters(j, nominal)
+    pp["aero_model"] = spec.aero_model
+    sensors, ekf = fmus["tailsitter_sensors"], fmus["tailsitter_ekf"]
+
+    def metrics(seed):
+        r = AvionicsLoop(plant, sensors, ekf, fmus["tailsitter_lqr"], plant_params=pp, sensors_params={"seed": seed},
+                         controller_params=dict(spec.mission)).run(
+            stop_time=spec.stop_time, step_size=spec.step_size, wind=wind_function(j))
+        sig = {k: r[k] for k in ("time", "phase", "pos_d", "alpha", "ref_pos_d", *R.COMMANDS)}
+        sig["phase"] = sig["phase"].astype(np.int64)
+        sig["pos_error"] = pos_error(r)
+        return R.run_metrics(sig)
+
+    want = metrics(j["noise_seed"])
+    for k, v in want.items():
+        assert row[k] == v or (math.isnan(v) and math.isnan(row[k])), k
+    other = metrics(j["noise_seed"] + 1)  # the seed reaches the sensors: other noise, other flight
+    assert abs(other["rms_err"] - row["rms_err"]) > 1e-6
 
 
 # --- the Dask campaign --------------------------------------------------------------------
@@ -251,22 +334,51 @@ def test_interrupted_campaign_resumes_to_the_same_content(client, serial, tmp_pa
 
 
 def test_killed_worker_loses_no_sample(client, serial, tmp_path):
-    killed = []
+    """A worker process dies mid-campaign (runs are recorded after its death): every run
+    is still recorded, equal to the serial run's, and the nanny replaces the process.
+
+    Robust under load: the killed process is identified by its pid, not its address (the
+    restarted worker may get the same port), and the replacement is awaited by polling
+    until the scheduler lists two workers none of which is the killed process — the
+    scheduler may still list the dead worker for a while after the campaign ended (it
+    notices a closed connection asynchronously), so `wait_for_workers(2)` alone could
+    return at once with the dead worker counted."""
+    import time
+
+    killed, after = [], []
 
     def kill_one(row, c):
-        if not killed:
-            busy = [w for w, tasks in c.processing().items() if tasks] or list(c.scheduler_info()["workers"])
-            killed.append(busy[0])
-            try:
-                c.run(os._exit, 1, workers=[busy[0]])  # the worker process dies mid-campaign
-            except Exception:  # noqa: BLE001 - its connection closes instead of answering
-                pass
+        if killed:
+            after.append(row["key"])
+            return
+        busy = [w for w, tasks in c.processing().items() if tasks] or list(c.scheduler_info()["workers"])
+        victim = busy[0]
+        pid = c.run(os.getpid, workers=[victim])[victim]
+        killed.append((victim, pid))
+        try:
+            c.run(os._exit, 1, workers=[victim])  # the worker process dies mid-campaign
+        except Exception:  # noqa: BLE001 - its connection closes instead of answering
+            pass
 
     table = run_campaign(short_spec(), tmp_path, DIST, client=client, progress=False, on_row=kill_one)
-    assert killed
+    assert killed and after  # killed after the first row, with runs still to record
     assert deterministic(table).equals(deterministic(serial))
-    client.wait_for_workers(2, timeout=60)  # the nanny restarted it (with the FMU plugin)
-    assert killed[0] not in client.scheduler_info()["workers"]
+    _, pid = killed[0]
+    deadline, pids = time.monotonic() + 120, None
+    while time.monotonic() < deadline:
+        if len(client.scheduler_info()["workers"]) == 2:
+            try:
+                pids = set(client.run(os.getpid).values())
+            except Exception:  # noqa: BLE001 - a worker listed but already gone
+                pids = None
+            if pids is not None and len(pids) == 2 and pid not in pids:
+                break
+        time.sleep(0.2)
+    assert pids is not None and len(pids) == 2 and pid not in pids, pids  # restarted (with the FMU plugin)
+    # the replacement got the FMUs from the plugin
+    wanted = {R.digest(b) for b in R.load_fmu_bytes(DIST, ["lqr", "tsd"]).values()}
+    held = client.run(lambda: sorted(R._fmus))
+    assert all(wanted <= set(v) for v in held.values()), held
 
 
 def test_failing_sample_is_a_recorded_failure(client, serial, tmp_path):
@@ -297,6 +409,36 @@ def test_tumble_mid_flight_is_a_divergence_and_the_next_run_is_clean(serial, tmp
         assert clean["completed"] and clean["max_err"] == ref[f"1/{c}/tuned/perfect"]["max_err"]
 
 
+def test_native_campaign_flies_identical_jobs_to_the_same_rows(serial, tmp_path):
+    """The native Rust loop (`analysis campaign-jobs`) on the campaign's jobs: the same
+    outcome for every run (an invalid parameter, a tumble) and the same metrics, to the
+    summation order of the RMS values (campaign_native.TOLERANCE), both configurations."""
+    from tailsim.campaign_native import TOLERANCE, compare, run_native
+
+    faults = {1: {"c_m_q_a0": 30.0, "c_m_q_a1": 30.0}, 3: {"mass": -1.0}}  # a tumble, an invalid value
+    spec = short_spec(n_samples=N + 1, configurations=("tuned", "thesis"), overrides=faults)
+    fmpy_rows = run_campaign(spec, tmp_path / "fmpy", DIST, serial=True, progress=False).to_pylist()
+    # The release binary when one was built (fast); else the debug one (same numbers, slower).
+    profile = "release" if (ROOT / "target" / "release" / "analysis").exists() else "debug"
+    native, _ = run_native(spec, DIST, threads=1, workdir=tmp_path / "native", profile=profile)
+    assert len(native) == len(fmpy_rows) == (N + 1) * 2 * 2
+    cmp = compare(fmpy_rows, native)
+    assert cmp["runs"] == len(native) and not cmp["outcome_differs"], cmp["outcome_differs"]
+    assert not cmp["beyond_tolerance"], cmp["beyond_tolerance"]
+    outcome = {r["key"]: (r["completed"], r["failure"]) for r in native}
+    for c in ("lqr", "tsd"):
+        for cfg in ("tuned", "thesis"):
+            assert outcome[f"1/{c}/{cfg}/perfect"] == (False, "divergence")
+            assert outcome[f"3/{c}/{cfg}/perfect"] == (False, "fmi_error")
+            assert outcome[f"0/{c}/{cfg}/perfect"][0]
+    # the tuned rows are those of the fixture's campaign (a different overrides map, same samples)
+    ref = {r["key"]: r for r in serial.to_pylist()}
+    for r in native:
+        if r["key"] in ref and r["key"].split("/")[0] in ("0", "2"):
+            assert r["max_err"] == ref[r["key"]]["max_err"]
+            assert abs(r["rms_err"] - ref[r["key"]]["rms_err"]) <= TOLERANCE
+
+
 def test_resume_refuses_a_different_campaign_unless_replace(serial, tmp_path):
     other = {"spec": short_spec(tau_aero=2.0).to_json(), "fmus": {}}
     (tmp_path / "campaign.json").write_text(json.dumps(other))
@@ -306,6 +448,37 @@ def test_resume_refuses_a_different_campaign_unless_replace(serial, tmp_path):
     assert Store(tmp_path).done_keys() == {"0/lqr/tuned/perfect"}  # nothing discarded
     table = run_campaign(short_spec(), tmp_path, DIST, serial=True, progress=False, replace=True)
     assert deterministic(table).equals(deterministic(serial))  # the other campaign's run is gone
+
+
+def test_comparison_section_is_the_paired_result(serial, tmp_path):
+    """tailsim.campaign_section (the comparison report's first section): Wilson intervals and
+    paired TSD − LQR differences of the campaign's rows; campaigns of other samples refused."""
+    import pyarrow.parquet as pq
+
+    from tailsim import campaign_section as S
+
+    for name, spec in (("a", short_spec()), ("b", dataclasses.replace(short_spec(), seed=8))):
+        (tmp_path / name).mkdir()
+        pq.write_table(serial, tmp_path / name / "results.parquet")
+        (tmp_path / name / "campaign.json").write_text(json.dumps({"spec": spec.to_json(), "fmus": {}}))
+    s = S.summarize([tmp_path / "a"])
+    rows = serial.to_pylist()
+    for c in ("lqr", "tsd"):
+        r = s["arms"][f"{c}/tuned/perfect"]
+        k = sum(x["completed"] for x in rows if x["controller"] == c)
+        assert (r["runs"], r["completed"]) == (N, k) and r["wilson95"] == list(wilson_interval(k, N))
+    p = s["paired"]["tuned/perfect"]
+    by = {(x["sample_id"], x["controller"]): x for x in rows}
+    d = [by[(i, "tsd")]["rms_err"] - by[(i, "lqr")]["rms_err"] for i in range(N)]
+    assert p["completion"]["n"] == N and p["rms_err"]["n"] == N
+    assert p["rms_err"]["mean"] == pytest.approx(np.mean(d), rel=1e-12)
+    assert p["rms_err"]["ci95"][0] <= p["rms_err"]["mean"] <= p["rms_err"]["ci95"][1]
+    with pytest.raises(SystemExit, match="seed"):
+        S.summarize([tmp_path / "a", tmp_path / "b"])
+    (tmp_path / "out").mkdir()
+    (tmp_path / "a").rename(tmp_path / "out" / "campaign")
+    text = "\n".join(S.report_section(tmp_path / "out"))
+    assert "## Comparison: paired Monte-Carlo" in text and "tuned/perfect | RMS position error (m) | 3 |" in text
 
 
 def test_report(serial, tmp_path):

@@ -131,13 +131,9 @@ def test_ssd_binds_the_mission_and_default_experiment(controller):
 
     ssd = read_ssd(str(ssp_path(controller)))
     comps = {c.name: c for c in ssd.system.elements}
-    bound = {
-        p.name: float(p.value)
-        for b in comps["controller"].parameterBindings
-        for ps in b.parameterValues
-        for p in ps.parameters
-    }
-    assert bound == MISSION
+    sets = {ps.name: ps for b in comps["controller"].parameterBindings for ps in b.parameterValues}
+    assert set(sets) == {"mission", "design_model"}
+    assert {p.name: float(p.value) for p in sets["mission"].parameters} == MISSION
     plant = {
         p.name: p.value for b in comps["plant"].parameterBindings for ps in b.parameterValues for p in ps.parameters
     }
@@ -148,6 +144,37 @@ def test_ssd_binds_the_mission_and_default_experiment(controller):
     osp = "ssd:Annotations/ssc:Annotation[@type='com.opensimulationplatform']"
     algo = exp.find(f"{osp}/osp:Algorithm/osp:FixedStepAlgorithm", NS)
     assert float(algo.get("baseStepSize")) == 0.02
+
+
+@pytest.mark.parametrize("controller", CONTROLLERS)
+def test_design_model_is_bound_to_the_plants_declared_airframe(controller):
+    """The controller's design model (its `design_airframe` parameters, the plant's names) is
+    bound in the set `design_model` to the plant FMU's declared start values — every one of
+    them — and is not connected to the plant's parameters: a parameter set that changes the
+    plant's airframe leaves the controller designing on the nominal aircraft (the honest
+    default: a controller never knows the aircraft it flies) unless it changes
+    `design_model` too."""
+    from fmpy.ssp.ssd import read_ssd
+
+    ssd = read_ssd(str(ssp_path(controller)))
+    comps = {c.name: c for c in ssd.system.elements}
+    sets = {ps.name: ps for b in comps["controller"].parameterBindings for ps in b.parameterValues}
+    design = {p.name: float(p.value) for p in sets["design_model"].parameters}
+    with zipfile.ZipFile(ssp_path(controller)) as z:
+        plant_md = model_description(z.read("resources/tailsitter_plant.fmu"))
+        ctrl_md = model_description(z.read(f"resources/{controller}.fmu"))
+    ctrl_params = {v.get("name") for v in ctrl_md.iterfind("ModelVariables/ScalarVariable") if v.get("causality") == "parameter"}
+    airframe = {
+        v.get("name"): float(v.find("Real").get("start"))
+        for v in plant_md.iterfind("ModelVariables/ScalarVariable")
+        if v.get("causality") == "parameter" and v.get("name") in ctrl_params and v.find("Real") is not None
+    }
+    assert len(design) >= 70 and design["mass"] == 9.0
+    assert design == airframe  # every design parameter = the plant's declared value
+    # ... and the plant's airframe is not bound by the SSD (nothing ties the two together)
+    plant_bound = {p.name for b in comps["plant"].parameterBindings for ps in b.parameterValues for p in ps.parameters}
+    assert not plant_bound & set(design)
+    assert not [c for c in ssd.system.connections if c.startConnector in design or c.endConnector in design]
 
 
 def test_swapping_the_controller_swaps_one_component():

@@ -436,6 +436,15 @@ pub fn group_defaults(decls: &[VariableDecl], group: &str, type_name: &str, sour
         for d in &members {
             let _ = writeln!(w, "            ({:?}, self.{}),", d.name, field_of(d));
         }
+        let _ = writeln!(w, "        ]\n    }}\n");
+        let _ = writeln!(
+            w,
+            "    /// Every field, mutably, with its parameter name, in declaration order (set by name).\n    pub fn named_values_mut(&mut self) -> [(&'static str, &mut f64); {}] {{\n        [",
+            members.len()
+        );
+        for d in &members {
+            let _ = writeln!(w, "            ({:?}, &mut self.{}),", d.name, field_of(d));
+        }
         let _ = writeln!(w, "        ]\n    }}\n}}");
     }
     s

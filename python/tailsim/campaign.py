@@ -207,7 +207,7 @@ def run_campaign(
     """
     out = pathlib.Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    blobs = load_fmu_bytes(dist, spec.controllers)
+    blobs = load_fmu_bytes(dist, spec.controllers, spec.state_sources)
     digests = {n: digest(b) for n, b in blobs.items()}
     _check_campaign_file(out, spec, digests, replace)
     store = Store(out)
@@ -273,10 +273,19 @@ def run_campaign(
                 pure=False,
             )
             try:
-                for fut in as_completed(futures):
-                    if fut.status != "finished":  # lost more often than allowed: left for a resume
+                pending = as_completed(futures)
+                requeued: dict[str, int] = {}
+                for fut in pending:
+                    if fut.status in ("pending", "lost") and requeued.get(fut.key, 0) < 10:
+                        # Finished, then its result was lost with its worker before it was
+                        # gathered: the scheduler computes it again; wait for that.
+                        requeued[fut.key] = requeued.get(fut.key, 0) + 1
+                        pending.add(fut)
+                        continue
+                    if fut.status != "finished":  # failed more often than allowed: left for a resume
                         missing += 1
-                        print(f"run {fut.key} not recorded: {fut.exception()!r}", file=sys.stderr)
+                        exc = fut.exception() if fut.status == "error" else fut.status
+                        print(f"run {fut.key} not recorded: {exc!r}", file=sys.stderr)
                         continue
                     row = fut.result()
                     fut.release()

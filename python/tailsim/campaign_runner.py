@@ -32,7 +32,15 @@ from .campaign_sampling import CONFIGURATIONS, CampaignSpec, plant_parameters, w
 from . import fmilog
 from .master import Fmu
 
-FMU_NAMES = {"plant": "tailsitter_plant", "lqr": "tailsitter_lqr", "tsd": "tailsitter_tsd"}
+FMU_NAMES = {
+    "plant": "tailsitter_plant",
+    "lqr": "tailsitter_lqr",
+    "tsd": "tailsitter_tsd",
+    "sensors": "tailsitter_sensors",
+    "ekf": "tailsitter_ekf",
+}
+#: The FMUs a state source needs beside the plant and the controllers.
+STATE_SOURCE_FMUS = {"perfect": (), "avionics": ("sensors", "ekf")}
 N_PHASES = 5
 #: Command limits of the saturation metric: thrust 0 / 150 N, surfaces ±25° (plant defaults).
 THRUST_LIMITS = (0.0, 150.0)
@@ -334,19 +342,26 @@ def run_job(job: Mapping[str, Any], spec_json: Mapping[str, Any], digests: Mappi
     pd_, cd_ = digests["plant"], digests[job["controller"]]
     plant_ok = ctrl_ok = False
     try:
-        ps, cs = _instance(pd_, "plant"), _instance(cd_, "controller")
-        for s in (ps, cs):
-            if s.used:
-                s.slave.reset()  # fmi2Reset: back to the instantiated state, then set parameters
-            s.used = True
-            s.messages.clear()
-        plant, ctrl = ps.fmu, cs.fmu
+        if pd_ not in _fmus:
+            raise RuntimeError(f"FMU {pd_[:12]} not installed on this worker (plugin missing?)")
+        plant = _fmus[pd_]
         nominal = {n: v.start for n, v in plant.variables.items() if v.causality == "parameter"}
         pp = plant_parameters(job, {k: float(v) for k, v in nominal.items() if k in _scaled_names()})
         pp["aero_model"] = spec.aero_model
         pp.update(json.loads(job.get("overrides") or "{}"))
         cp = dict(spec.mission)
         cp.update(CONFIGURATIONS[job["configuration"]][job["controller"]])
+        if job["state_source"] == "avionics":
+            plant_ok = ctrl_ok = True  # the avionics loop instantiates its own four units
+            row.update(_run_avionics(job, spec, digests, pp, cp))
+            return row
+        ps, cs = _instance(pd_, "plant"), _instance(cd_, "controller")
+        for s in (ps, cs):
+            if s.used:
+                s.slave.reset()  # fmi2Reset: back to the instantiated state, then set parameters
+            s.used = True
+            s.messages.clear()
+        ctrl = cs.fmu
         sig, failure, detail = fly(
             plant,
             ps.slave,
@@ -380,9 +395,70 @@ def run_job(job: Mapping[str, Any], spec_json: Mapping[str, Any], digests: Mappi
             _discard(pd_)
         if not ctrl_ok:
             _discard(cd_)
-    row["wall_time_s"] = time.perf_counter() - t0
-    row["cpu_time_s"] = time.thread_time() - c0  # CPU time of this run's thread (load-independent cost)
+        row["wall_time_s"] = time.perf_counter() - t0
+        row["cpu_time_s"] = time.thread_time() - c0  # CPU time of this run's thread (load-independent cost)
     return row
+
+
+def _run_avionics(
+    job: Mapping[str, Any], spec: CampaignSpec, digests: Mapping[str, str], pp: Mapping[str, float], cp: Mapping[str, Any]
+) -> dict[str, Any]:
+    """Metrics and outcome of one run with avionics in the loop (`tailsim.avionics.AvionicsLoop`,
+    Gauss-Seidel, fresh instances): the sensors seeded with the sample's `noise_seed`. Position
+    error, altitude loss and α are the TRUE ones (plant outputs against the controller's
+    reference), not the controller's view of its estimate. A run whose true position error
+    exceeds `divergence_m` is a divergence, its metrics taken up to that point; an FMI error
+    (the plant's envelope check included) ends the run with NaN metrics (the loop keeps no
+    partial record)."""
+    from .avionics import AvionicsLoop
+    from .master import pos_error
+
+    fmus = {}
+    for role in ("plant", "sensors", "ekf", job["controller"]):
+        d = digests.get(role)
+        if d is None or d not in _fmus:
+            raise RuntimeError(f"FMU '{role}' not installed on this worker (campaign without the avionics axis?)")
+        fmus[role] = _fmus[d]
+    messages: collections.deque[str] = collections.deque(maxlen=8)
+    names = ("plant", "sensors", "ekf", "controller")  # AvionicsLoop's instance names
+    for n in names:
+        fmilog.route(n, lambda status, _c, message: messages.append(f"[{status}] {message}"))
+    try:
+        loop = AvionicsLoop(
+            fmus["plant"],
+            fmus["sensors"],
+            fmus["ekf"],
+            fmus[job["controller"]],
+            plant_params=pp,
+            sensors_params={"seed": int(job["noise_seed"])},
+            controller_params=cp,
+        )
+        try:
+            r = loop.run(stop_time=spec.stop_time, step_size=spec.step_size, wind=wind_function(job))
+        except Exception as exc:  # noqa: BLE001 - an error status mid-flight
+            from fmpy.fmi1 import FMICallException
+
+            if not isinstance(exc, FMICallException):
+                raise
+            logs = [m for m in messages if m.startswith("[3]") or m.startswith("[4]")]
+            failure = "divergence" if any("left its envelope" in m for m in logs) else "fmi_error"
+            return {"completed": False, "failure": failure, "detail": " | ".join([str(exc), *logs])}
+    finally:
+        for n in names:
+            fmilog.unroute(n)
+    sig = {k: r[k] for k in ("time", "phase", "pos_d", "alpha", "ref_pos_d", *COMMANDS)}
+    sig["phase"] = sig["phase"].astype(np.int64)
+    sig["pos_error"] = pos_error(r)  # the truth against the reference
+    failure = detail = ""
+    over = np.nonzero(~(sig["pos_error"] <= spec.divergence_m))[0]
+    if over.size:
+        k = int(over[0])
+        failure = "divergence"
+        detail = f"true position error {sig['pos_error'][k]:.1f} m > {spec.divergence_m:g} m at t = {sig['time'][k]:.2f} s"
+        sig = {n: v[: k + 1] for n, v in sig.items()}
+    out: dict[str, Any] = run_metrics(sig)
+    out.update(completed=not failure, failure=failure, detail=detail)
+    return out
 
 
 def _error_logs(*digests: str) -> list[str]:
@@ -401,7 +477,8 @@ def _scaled_names() -> set[str]:
     return {n for p in TABLE_5_1 for n in p.plant_params}
 
 
-def load_fmu_bytes(dist: str | pathlib.Path, controllers) -> dict[str, bytes]:
+def load_fmu_bytes(dist: str | pathlib.Path, controllers, state_sources=("perfect",)) -> dict[str, bytes]:
+    """The .fmu files a campaign needs: the plant, its controllers, and the FMUs of its state sources."""
     dist = pathlib.Path(dist)
-    names = ["plant", *controllers]
+    names = ["plant", *controllers, *[n for s in state_sources for n in STATE_SOURCE_FMUS[s]]]
     return {n: (dist / f"{FMU_NAMES[n]}.fmu").read_bytes() for n in names}

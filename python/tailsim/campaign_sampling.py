@@ -5,7 +5,7 @@ thesis's Table 5.1 (each scaled by an independent log-uniform factor within
 [1/τ, τ], τ = 1.5 for the aerodynamic derivatives and 1.1 for the mass and the
 inertias, as in the thesis's sweep (5.1.1)), a steady horizontal wind, a 1 − cos
 gust of random direction, amplitude and timing, and a sensor-noise seed (for the
-avionics state source, once it exists).
+avionics state source: the sensors' `seed`).
 
 A *run* is one sample flown on one point of the configuration axes:
 controller × configuration × state source. Every run of a sample sees the same
@@ -70,13 +70,20 @@ TABLE_5_1: tuple[Uncertain, ...] = tuple(
 )
 assert len(TABLE_5_1) == 25
 
-#: Configuration axes: the values that exist now; the others are named so the
-#: schema has room for them (issue 15: 'thesis' configurations, 'avionics' state).
+#: Configuration axes (issue 15). A configuration is the controller parameters it sets
+#: (the controller FMUs' `configuration`: 0 = tuned, the default; 1 = the thesis's
+#: configuration as printed, see the parameter's description). A state source is what the
+#: controller flies on: `perfect` = the plant's outputs; `avionics` = the estimate of
+#: `tailsitter_ekf` fed by `tailsitter_sensors` (tailsim.avionics, Gauss-Seidel), the
+#: sensors seeded with the sample's `noise_seed`.
 CONTROLLERS = ("lqr", "tsd")
-CONFIGURATIONS = {"tuned": {"lqr": {}, "tsd": {}}}  # controller-parameter overrides per configuration
-PLANNED_CONFIGURATIONS = ("thesis",)
-STATE_SOURCES = ("perfect",)
-PLANNED_STATE_SOURCES = ("avionics",)
+CONFIGURATIONS: dict[str, dict[str, dict[str, int]]] = {
+    "tuned": {"lqr": {}, "tsd": {}},
+    "thesis": {"lqr": {"configuration": 1}, "tsd": {"configuration": 1}},
+}
+#: The controller FMUs' `configuration` value of each configuration (the native campaign's input).
+CONFIGURATION_INDEX = {"tuned": 0, "thesis": 1}
+STATE_SOURCES = ("perfect", "avionics")
 
 #: Missions (controller parameters; identical for both controllers) and their stop times (s).
 MISSIONS: dict[str, dict[str, float]] = {
@@ -128,12 +135,14 @@ class CampaignSpec:
                 raise ValueError(f"unknown controller {c!r} (one of {CONTROLLERS})")
         for c in self.configurations:
             if c not in CONFIGURATIONS:
-                why = "not implemented yet" if c in PLANNED_CONFIGURATIONS else "unknown"
-                raise ValueError(f"configuration {c!r}: {why} (available: {tuple(CONFIGURATIONS)})")
+                raise ValueError(f"unknown configuration {c!r} (available: {tuple(CONFIGURATIONS)})")
         for s in self.state_sources:
             if s not in STATE_SOURCES:
-                why = "not implemented yet" if s in PLANNED_STATE_SOURCES else "unknown"
-                raise ValueError(f"state source {s!r}: {why} (available: {STATE_SOURCES})")
+                raise ValueError(f"unknown state source {s!r} (available: {STATE_SOURCES})")
+        for name, axis in (("controllers", self.controllers), ("configurations", self.configurations),
+                           ("state_sources", self.state_sources)):
+            if not axis or len(set(axis)) != len(axis):
+                raise ValueError(f"{name} = {axis!r}: expected distinct values, at least one")
         if self.aero_model not in (0, 1):
             raise ValueError(f"aero_model = {self.aero_model!r}: expected 0 (thesis) or 1 (global)")
         if not (self.tau_aero >= 1.0 and self.tau_mass >= 1.0):
@@ -197,6 +206,7 @@ def draw_sample(spec: CampaignSpec, i: int) -> dict[str, Any]:
     s["gust_n"], s["gust_e"], s["gust_d"] = (float(x) for x in amp * d)
     s["gust_start"] = float(start)
     s["gust_duration"] = float(dur)
+    # The sensors' `seed` of the avionics runs (all runs of a sample share it: paired noise).
     s["noise_seed"] = int(rng.integers(0, 2**31 - 1))
     return s
 

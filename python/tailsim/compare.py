@@ -15,7 +15,7 @@ import time
 
 import numpy as np
 
-from . import analysis_report
+from . import analysis_report, campaign_section
 from .master import ClosedLoop, Fmu, RunResult, pos_error, step
 from .metrics import CRITERIA, PHASES, mission_metrics, phase_starts, step_settling
 from .report import fmt, markdown_to_html
@@ -260,6 +260,7 @@ def main(argv: list[str] | None = None) -> int:
     md = ["# Tail-sitter controller comparison", ""]
     md.append(f"Master: fmpy, {ordering}; plant `tailsitter_plant`; controllers: {', '.join(NAMES[k] for k in keys)}. "
               f"Level-trim pitch of the plant at {defaults['v_level']:g} m/s: {math.degrees(theta_trim):.2f}°. Wall time {time.time() - t_start:.0f} s.")
+    md += campaign_section.report_section(out)  # the comparison: paired Monte-Carlo (issue 15)
     md += ["", "## Missions (thesis ch. 6 comparison)", ""]
     md.append("| " + " | ".join(header) + " |")
     md.append("|" + "---|" * len(header))

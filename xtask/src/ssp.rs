@@ -59,6 +59,31 @@ fn mission_default(name: &str) -> f64 {
         .unwrap_or_else(|| panic!("mission parameter {name} not declared"))
 }
 
+/// The plant's airframe parameters (group `airframe` of `modelDescription/tailsitter_plant.json`)
+/// with their declared values: the controllers' design model (`design_airframe`, the same names),
+/// bound on the controller component as the parameter set `design_model`.
+///
+/// **The honest default**: the design model is the *declared nominal* airframe, bound as values
+/// of its own, not connected to the plant's parameters. A user who changes the plant's airframe
+/// (a parameter set on the plant: a heavier aircraft, another C_mα) gets a controller that still
+/// designs on the nominal aircraft — as a real controller would, which never knows the aircraft
+/// it flies. Giving it the true plant (perfect model knowledge, the comparison issue 15 found
+/// flattering to the LQR) takes a deliberate second change: the same values in `design_model`.
+/// One source: the values come from the plant's declaration, as the controllers' defaults do.
+pub static DESIGN_AIRFRAME: LazyLock<Vec<(&'static str, f64)>> = LazyLock::new(|| {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../modelDescription");
+    let (decls, _) = model_description::load_declarations(&dir, &format!("{PLANT}.json"))
+        .unwrap_or_else(|e| panic!("plant declaration: {e}"));
+    decls
+        .into_iter()
+        .filter(|d| d.group.as_deref() == Some("airframe") && d.causality == model_description::Causality::Parameter)
+        .map(|d| match d.start {
+            Some(model_description::Start::Number(x)) => (&*d.name.leak(), x),
+            other => panic!("airframe parameter {} has start {other:?}", d.name),
+        })
+        .collect()
+});
+
 /// Default experiment: the default mission (docs/DESIGN.md §3), from t = 0 to the end
 /// of its last phase.
 fn stop_time() -> f64 {
@@ -290,13 +315,7 @@ type XmlResult = std::io::Result<()>;
 
 /// The connectors of one component: every output (recorded by tools that record connectors), and
 /// the inputs a connection drives.
-fn component(
-    w: &mut Xml,
-    name: &str,
-    fmu: &FmuInfo,
-    inputs: &[&str],
-    parameters: &[(&str, String, String)],
-) -> XmlResult {
+fn component(w: &mut Xml, name: &str, fmu: &FmuInfo, inputs: &[&str], parameter_sets: &[ParamSet]) -> XmlResult {
     w.create_element("ssd:Component")
         .with_attributes([
             ("name", name),
@@ -322,13 +341,15 @@ fn component(
                 }
                 Ok(())
             })?;
-            if !parameters.is_empty() {
+            if parameter_sets.iter().any(|(_, p)| !p.is_empty()) {
                 w.create_element("ssd:ParameterBindings").write_inner_content(|w| {
-                    w.create_element("ssd:ParameterBinding").write_inner_content(|w| {
-                        w.create_element("ssd:ParameterValues")
-                            .write_inner_content(|w| parameter_set(w, parameters))?;
-                        Ok(())
-                    })?;
+                    for (set, parameters) in parameter_sets.iter().filter(|(_, p)| !p.is_empty()) {
+                        w.create_element("ssd:ParameterBinding").write_inner_content(|w| {
+                            w.create_element("ssd:ParameterValues")
+                                .write_inner_content(|w| parameter_set(w, set, parameters))?;
+                            Ok(())
+                        })?;
+                    }
                     Ok(())
                 })?;
             }
@@ -337,10 +358,13 @@ fn component(
     Ok(())
 }
 
-/// An inline SSV parameter set named `mission`: (name, type element, value).
-fn parameter_set(w: &mut Xml, parameters: &[(&str, String, String)]) -> XmlResult {
+/// Named parameter sets of a component: (set name, [(name, type element, value)]).
+type ParamSet = (&'static str, Vec<(&'static str, String, String)>);
+
+/// An inline SSV parameter set named `set`: (name, type element, value).
+fn parameter_set(w: &mut Xml, set: &str, parameters: &[(&str, String, String)]) -> XmlResult {
     w.create_element("ssv:ParameterSet")
-        .with_attributes([("version", "1.0"), ("name", "mission")])
+        .with_attributes([("version", "1.0"), ("name", set)])
         .write_inner_content(|w| {
             w.create_element("ssv:Parameters").write_inner_content(|w| {
                 for (name, kind, value) in parameters {
@@ -378,14 +402,24 @@ fn bindings(
         .collect()
 }
 
+/// The controller's parameter sets: `mission` (the declared mission) and `design_model` (the
+/// plant's declared nominal airframe, [`DESIGN_AIRFRAME`]: the honest default).
+fn controller_sets(controller: &FmuInfo) -> Result<Vec<ParamSet>, String> {
+    let mission: Vec<_> = MISSION.iter().map(|(n, v)| (*n, "Real", real(*v))).collect();
+    let design: Vec<_> = DESIGN_AIRFRAME.iter().map(|(n, v)| (*n, "Real", real(*v))).collect();
+    Ok(vec![
+        ("mission", bindings(controller, &mission)?),
+        ("design_model", bindings(controller, &design)?),
+    ])
+}
+
 /// SystemStructure.ssd of the closed loop.
 pub fn system_description(plant: &FmuInfo, controller: &FmuInfo) -> Result<String, String> {
     let links = connections(plant, controller)?;
     let inputs_of =
         |end: &str| -> Vec<&str> { links.iter().filter(|c| c.end == end).map(|c| c.name.as_str()).collect() };
     let (plant_inputs, controller_inputs) = (inputs_of("plant"), inputs_of("controller"));
-    let mission: Vec<_> = MISSION.iter().map(|(n, v)| (*n, "Real", real(*v))).collect();
-    let controller_parameters = bindings(controller, &mission)?;
+    let controller_parameters = controller_sets(controller)?;
     let v_vertical = mission_default("v_vertical");
     // The plant starts in the trimmed vertical climb at the mission's climb speed (docs/DESIGN.md §3).
     let plant_parameters = bindings(
@@ -405,7 +439,7 @@ pub fn system_description(plant: &FmuInfo, controller: &FmuInfo) -> Result<Strin
         &description,
         &[
             ("controller", controller, controller_inputs, controller_parameters),
-            ("plant", plant, plant_inputs, plant_parameters),
+            ("plant", plant, plant_inputs, vec![("plant", plant_parameters)]),
         ],
         &links,
     )
@@ -481,8 +515,7 @@ pub fn avionics_system_description(
     }
     let inputs_of =
         |end: &str| -> Vec<&str> { links.iter().filter(|c| c.end == end).map(|c| c.name.as_str()).collect() };
-    let mission: Vec<_> = MISSION.iter().map(|(n, v)| (*n, "Real", real(*v))).collect();
-    let controller_parameters = bindings(controller, &mission)?;
+    let controller_parameters = controller_sets(controller)?;
     let plant_parameters = bindings(
         plant,
         &[
@@ -510,9 +543,14 @@ pub fn avionics_system_description(
         &description,
         &[
             ("controller", controller, inputs_of("controller"), controller_parameters),
-            ("estimator", ekf, inputs_of("estimator"), estimator_parameters),
+            (
+                "estimator",
+                ekf,
+                inputs_of("estimator"),
+                vec![("estimator", estimator_parameters)],
+            ),
             ("sensors", sensors, inputs_of("sensors"), Vec::new()),
-            ("plant", plant, inputs_of("plant"), plant_parameters),
+            ("plant", plant, inputs_of("plant"), vec![("plant", plant_parameters)]),
         ],
         &links,
     )
@@ -546,7 +584,7 @@ pub fn write_avionics_ssp(dir: &Path, controller_id: &str) -> Result<PathBuf, St
 }
 
 /// One element of a system: its name, FMU, connected inputs and parameter bindings.
-type Element<'a> = (&'a str, &'a FmuInfo, Vec<&'a str>, Vec<(&'static str, String, String)>);
+type Element<'a> = (&'a str, &'a FmuInfo, Vec<&'a str>, Vec<ParamSet>);
 
 /// SystemStructure.ssd of `elements` wired by `links`, with the default mission experiment.
 fn write_ssd(name: &str, description: &str, elements: &[Element], links: &[Connection]) -> Result<String, String> {
@@ -678,6 +716,7 @@ mod tests {
             port("ref_offset_n", "input", "Real"),
         ];
         ports.extend(MISSION.iter().map(|(n, _)| port(n, "parameter", "Real")));
+        ports.extend(DESIGN_AIRFRAME.iter().map(|(n, _)| port(n, "parameter", "Real")));
         FmuInfo {
             model_identifier: "tailsitter_tsd".into(),
             ports,
@@ -700,6 +739,28 @@ mod tests {
         let mut c = controller();
         c.ports.retain(|p| p.name != "thrust_cmd");
         assert!(connections(&plant(), &c).unwrap_err().contains("thrust_cmd"));
+    }
+
+    #[test]
+    fn design_model_is_the_plants_declared_airframe_bound_on_the_controller_only() {
+        let ssd = system_description(&plant(), &controller()).unwrap();
+        // 79 airframe parameters, the first the mass of 9 kg (thesis App. C.1.1)
+        assert!(DESIGN_AIRFRAME.len() > 70, "{}", DESIGN_AIRFRAME.len());
+        assert_eq!(DESIGN_AIRFRAME[0], ("mass", 9.0));
+        let set = ssd
+            .find(r#"<ssv:ParameterSet version="1.0" name="design_model">"#)
+            .expect("design set");
+        let controller_end = ssd
+            .find(r#"<ssd:Component name="plant""#)
+            .expect("plant after controller");
+        assert!(set < controller_end, "the design model is bound on the controller");
+        assert!(ssd[set..].contains(r#"<ssv:Parameter name="mass">"#));
+        // the plant's own airframe is not bound: a parameter set on the plant changes the plant only
+        assert!(!ssd[controller_end..].contains(r#"<ssv:Parameter name="mass">"#));
+        // a controller without a design model is refused, not silently left on its defaults
+        let mut c = controller();
+        c.ports.retain(|p| p.name != "mass");
+        assert!(system_description(&plant(), &c).unwrap_err().contains("mass"));
     }
 
     #[test]

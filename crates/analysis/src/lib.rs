@@ -13,5 +13,6 @@ pub mod closed;
 pub mod controllers;
 pub mod linalg;
 pub mod modes;
+pub mod native_campaign;
 pub mod robust;
 pub mod sensitivity;

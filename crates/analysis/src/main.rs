@@ -63,6 +63,47 @@ enum Cmd {
     /// Only the thesis-vs-global aerodynamic model comparison (aero_models.json), which
     /// `all` and `nonlinear` also write.
     Aero(Common),
+    /// The Monte-Carlo campaign's jobs flown natively (`python -m tailsim.campaign --native`
+    /// writes them): one JSON job per line in, one JSON row per line out, in job order.
+    CampaignJobs(CampaignJobs),
+}
+
+#[derive(clap::Args, Clone)]
+struct CampaignJobs {
+    /// JSON-lines file of jobs (`analysis::native_campaign::Job`).
+    #[arg(long)]
+    jobs: PathBuf,
+    /// JSON-lines file of rows (`analysis::native_campaign::Row`).
+    #[arg(long)]
+    out: PathBuf,
+    /// Threads (default: all cores; 1 for the per-run timing of one core).
+    #[arg(long)]
+    threads: Option<usize>,
+}
+
+fn campaign_jobs(a: &CampaignJobs) -> Result<usize, String> {
+    use analysis::native_campaign::{run, Job};
+    use rayon::prelude::*;
+    use std::io::Write;
+
+    let text = std::fs::read_to_string(&a.jobs).map_err(|e| format!("{}: {e}", a.jobs.display()))?;
+    let jobs: Vec<Job> = text
+        .lines()
+        .filter(|l| !l.trim().is_empty())
+        .enumerate()
+        .map(|(i, l)| serde_json::from_str(l).map_err(|e| format!("{} line {}: {e}", a.jobs.display(), i + 1)))
+        .collect::<Result<_, _>>()?;
+    let rows: Vec<String> = jobs
+        .par_iter()
+        .map(|j| serde_json::to_string(&run(j)).map_err(|e| e.to_string()))
+        .collect::<Result<_, _>>()?;
+    let mut f =
+        std::io::BufWriter::new(std::fs::File::create(&a.out).map_err(|e| format!("{}: {e}", a.out.display()))?);
+    for r in &rows {
+        writeln!(f, "{r}").map_err(|e| e.to_string())?;
+    }
+    f.flush().map_err(|e| e.to_string())?;
+    Ok(rows.len())
 }
 
 fn main() {
@@ -72,6 +113,19 @@ fn main() {
         Cmd::Linear(c) => (c, false, false, false),
         Cmd::Nonlinear(c) => (c, true, true, false),
         Cmd::Aero(c) => (c, false, false, true),
+        Cmd::CampaignJobs(a) => {
+            if let Some(t) = a.threads {
+                let _ = rayon::ThreadPoolBuilder::new().num_threads(t).build_global();
+            }
+            match campaign_jobs(&a) {
+                Ok(n) => eprintln!("wrote {} rows to {}", n, a.out.display()),
+                Err(e) => {
+                    eprintln!("campaign-jobs failed: {e}");
+                    std::process::exit(1);
+                }
+            }
+            return;
+        }
     };
     if let Some(t) = c.threads {
         let _ = rayon::ThreadPoolBuilder::new().num_threads(t).build_global();

@@ -98,6 +98,15 @@ pub enum Wind {
         duration: f64,
         amplitude: Vector3<f64>,
     },
+    /// A steady wind plus a 1 − cos gust (the Monte-Carlo campaign's samples):
+    /// `steady + amplitude · (1 − cos(2π (t − t_start)/duration)) / 2` inside the gust,
+    /// `steady` outside (`tailsim.campaign_sampling.wind_function`, same operations).
+    SteadyAndGust {
+        steady: Vector3<f64>,
+        t_start: f64,
+        duration: f64,
+        amplitude: Vector3<f64>,
+    },
 }
 
 impl Wind {
@@ -125,8 +134,34 @@ impl Wind {
                     Vector3::zeros()
                 }
             }
+            Wind::SteadyAndGust {
+                steady,
+                t_start,
+                duration,
+                amplitude,
+            } => {
+                let s = (t - t_start) / duration;
+                if (0.0..=1.0).contains(&s) {
+                    steady + amplitude * (0.5 * (1.0 - (2.0 * std::f64::consts::PI * s).cos()))
+                } else {
+                    steady
+                }
+            }
         }
     }
+}
+
+/// Which wind the plant outputs the controller samples at t were computed with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum MeasuredWind {
+    /// The wind at t (this master's default).
+    #[default]
+    Current,
+    /// The wind the plant flew its last step with, held at its input: the wind at t − h
+    /// (at t = 0 the initial wind). What an FMI master that reads the plant's outputs
+    /// before it sets the new wind input delivers (`tailsim.master.ClosedLoop`, the
+    /// campaign's fmpy runner); the native campaign uses it to fly identical jobs.
+    HeldInput,
 }
 
 /// One closed-loop run.
@@ -142,6 +177,8 @@ pub struct Scenario {
     pub wind: Wind,
     /// `(t, offset)`: from `t` on the reference offset is `offset` (NED, m).
     pub ref_offset_steps: Vec<(f64, Vector3<f64>)>,
+    /// The wind of the plant outputs the controller samples (default: the current wind).
+    pub measured_wind: MeasuredWind,
 }
 
 impl Scenario {
@@ -154,6 +191,7 @@ impl Scenario {
             ordering: Ordering::GaussSeidel,
             wind: Wind::Calm,
             ref_offset_steps: Vec::new(),
+            measured_wind: MeasuredWind::Current,
         }
     }
 
@@ -461,7 +499,12 @@ pub fn fly<C: FlightController>(plant: &Plant, x0: StateVector, controller: &mut
         let u_now = previous_command
             .map(|c| plant_inputs(&c))
             .unwrap_or_else(InputVector::zeros);
-        let measurement = measure(plant, &x, &u_now, &wind);
+        let measured_wind = match scenario.measured_wind {
+            MeasuredWind::Current => wind,
+            MeasuredWind::HeldInput if k > 0 => scenario.wind.at((k - 1) as f64 * h),
+            MeasuredWind::HeldInput => wind,
+        };
+        let measurement = measure(plant, &x, &u_now, &measured_wind);
         if clock.take(t) || held.is_none() {
             let input = ControllerInput {
                 t,
@@ -526,6 +569,22 @@ mod tests {
         assert!((g.at(2.0).x - 4.0).abs() < 1e-12);
         assert!((g.at(1.5).x - 2.0).abs() < 1e-12);
         assert_eq!(g.at(3.5), Vector3::zeros());
+    }
+
+    #[test]
+    fn steady_and_gust_is_the_sum() {
+        let steady = Vector3::new(1.0, -2.0, 0.0);
+        let w = Wind::SteadyAndGust {
+            steady,
+            t_start: 1.0,
+            duration: 2.0,
+            amplitude: Vector3::new(4.0, 0.0, -1.0),
+        };
+        assert_eq!(w.at(0.5), steady);
+        assert_eq!(w.at(3.5), steady);
+        // mid-gust: the full amplitude on top of the steady wind
+        assert!((w.at(2.0) - Vector3::new(5.0, -2.0, -1.0)).norm() < 1e-12);
+        assert!((w.at(1.5) - Vector3::new(3.0, -2.0, -0.5)).norm() < 1e-12);
     }
 
     #[test]
