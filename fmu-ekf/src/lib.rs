@@ -43,6 +43,8 @@ pub fn params_from(v: &Variables) -> EstimatorParams {
     p.filter.enabled = v.filter_enabled;
     p.filter.bandwidth = v.filter_bandwidth;
     p.filter.latency = v.measurement_latency;
+    p.prediction.model = v.model_prediction;
+    p.prediction.lead = v.prediction_lead;
     n.imu_period = v.imu_period;
     let q = &mut p.process;
     q.accel_model = v.accel_model_noise;
@@ -68,6 +70,7 @@ pub fn params_from(v: &Variables) -> EstimatorParams {
     t.sigma_sideslip = v.sigma_sideslip;
     t.sideslip_min_airspeed = v.sideslip_min_airspeed;
     t.gps_reset_after = v.gps_reset_after.max(1) as u32;
+    t.relative_to_start = v.position_relative_to_start;
     p.airframe = Airframe {
         tau_thrust: v.tau_thrust,
         thrust_min: v.thrust_min,
