@@ -3,9 +3,10 @@ controller → plant under fmpy (tailsim.avionics). Both controllers fly the
 default mission on the estimator's outputs; the true position error per phase
 and the estimation errors per phase are printed (pytest -s).
 
-The position error includes the estimation error, which starts at the first
-GPS fix's (σ 4 m per axis, Table D.1): the first vertical phase is bounded by
-that (8 m), the later phases, once the GPS has been averaged, by 5 m.
+The position error includes the estimation error. The estimator navigates
+relative to the start (`position_relative_to_start`): the first GPS fix's error
+(σ 4 m per axis, Table D.1) is not flown, every phase is held to the issue's
+bar of 5 m (measured 0.6–3.0 m, crates/state-estimator/README.md).
 """
 
 from __future__ import annotations
@@ -49,9 +50,7 @@ def check(result, fmus, controller, theta_trim):
     assert result["phase"][-1] == 4
     pe = phase_errors(result)
     assert [p.phase for p in pe] == ["vertical 1", "transition 1", "level", "transition 2", "vertical 2"]
-    # First vertical phase: the first GPS fix's error (σ 4 m per axis) is flown out.
-    assert pe[0].max_position_error < 8.0, pe[0]
-    for p in pe[1:]:
+    for p in pe:
         assert p.max_position_error < 5.0, p
     # Estimation errors: position within the GPS's averaging, attitude and airspeed
     # tight in forward flight; α, β weakly observable in vertical flight (reported only).

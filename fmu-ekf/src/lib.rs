@@ -45,6 +45,7 @@ pub fn params_from(v: &Variables) -> EstimatorParams {
     p.filter.latency = v.measurement_latency;
     p.prediction.model = v.model_prediction;
     p.prediction.lead = v.prediction_lead;
+    p.prediction.aero_model = v.aero_model;
     n.imu_period = v.imu_period;
     let q = &mut p.process;
     q.accel_model = v.accel_model_noise;

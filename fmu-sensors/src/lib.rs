@@ -167,12 +167,19 @@ impl FmuModel for SensorsModel {
         Ok(())
     }
 
-    fn do_step(&mut self, vars: &mut Variables, t: f64, h: f64, _log: &mut Logger<'_>) -> Result<(), ModelError> {
+    fn do_step(&mut self, vars: &mut Variables, t: f64, h: f64, log: &mut Logger<'_>) -> Result<(), ModelError> {
         let truth = truth_from(vars);
-        let out = self
+        let (out, held) = self
             .model(vars)?
-            .step(&truth, t, h)
+            .step_or_hold(&truth, t, h)
             .map_err(|e| ModelError::new(format!("step from t = {t} s: {e}")))?;
+        if held {
+            log.warning(format_args!(
+                "step from t = {t} s: every true-state input is 0 (the zero quaternion included) before any plant sample: \
+                 taken as no plant sample yet (a master that starts its connections at 0, e.g. fmpy simulate_ssp); \
+                 nothing sampled, the outputs of the start held"
+            ));
+        }
         write_outputs(vars, &out);
         Ok(())
     }

@@ -15,7 +15,8 @@ The parameters the sensors and the estimator share (reference point
 `ref_latitude`, `ref_longitude`, `ref_height`, Earth field `mag_field_total`,
 `mag_declination`, `mag_inclination`, the analogue filter `filter_enabled`,
 `filter_bandwidth`) are copied from the sensors' parameters to the estimator's
-unless the estimator's are given explicitly.
+unless the estimator's are given explicitly; so is the plant's `aero_model` to
+the estimator's (the aerodynamic model of its prediction).
 
 Orderings (per controller step h, at t = k h):
 
@@ -169,6 +170,9 @@ class AvionicsLoop:
         self.sensors_params = dict(sensors_params or {})
         shared = {n: v for n, v in self.sensors_params.items() if n in SHARED_PARAMETERS}
         self.ekf_params = {**shared, **dict(ekf_params or {})}
+        if "aero_model" in self.plant_params and "aero_model" not in self.ekf_params:
+            # The estimator predicts with the plant's configured aerodynamic model.
+            self.ekf_params["aero_model"] = self.plant_params["aero_model"]
         if ordering == "jacobi":
             # The delays a Jacobi master adds, one controller step each (set in `run`).
             self._jacobi_defaults = [n for n in ("measurement_latency", "prediction_lead") if n not in self.ekf_params]

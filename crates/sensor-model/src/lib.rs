@@ -224,6 +224,18 @@ impl Default for Truth {
 }
 
 impl Truth {
+    /// Every input exactly 0 (the zero quaternion included: never a state of the plant).
+    pub fn is_all_zero(&self) -> bool {
+        self.pos_ned == Vector3::zeros()
+            && self.vel_ned == Vector3::zeros()
+            && self.rates == Vector3::zeros()
+            && self.quat.iter().all(|x| *x == 0.0)
+            && self.airspeed == 0.0
+            && self.alpha == 0.0
+            && self.beta == 0.0
+            && self.specific_force == Vector3::zeros()
+    }
+
     fn check(&self) -> Result<(), InputError> {
         let named: [(&str, f64); 19] = [
             ("pos_n", self.pos_ned.x),
@@ -316,10 +328,12 @@ pub struct State {
     pub out: Measurements,
     /// Value of the stuck channel inside its fault window.
     pub stuck: Option<f64>,
+    /// A step has sampled a true state (after it, an all-zero input is an error).
+    pub fed: bool,
 }
 
 /// Number of u64 words of [`State::save`].
-pub const STATE_WORDS: usize = N_SENSORS * 4 + 1 + N_SENSORS + 2 * N_ANALOG + 8 + N_ANALOG + 2;
+pub const STATE_WORDS: usize = N_SENSORS * 4 + 1 + N_SENSORS + 2 * N_ANALOG + 8 + N_ANALOG + 3;
 
 impl State {
     /// Serialise to `STATE_WORDS` words (f64 as IEEE bits: bit-exact).
@@ -349,6 +363,7 @@ impl State {
         m.analog.iter().for_each(|x| out(x.to_bits()));
         out(u64::from(self.stuck.is_some()));
         out(self.stuck.unwrap_or(0.0).to_bits());
+        out(u64::from(self.fed));
     }
 
     /// Read what [`Self::save`] wrote; rejects truncated or inconsistent data.
@@ -394,6 +409,7 @@ impl State {
         }
         let has_stuck = flag(word()?, "stuck")?;
         let stuck = finite(f64::from_bits(word()?), "stuck value")?;
+        let fed = flag(word()?, "fed")?;
         Ok(Self {
             rng,
             t0,
@@ -409,6 +425,7 @@ impl State {
                 analog,
             },
             stuck: has_stuck.then_some(stuck),
+            fed,
         })
     }
 }
@@ -609,6 +626,7 @@ impl SensorModel {
                 filter: [[0.0; 2]; N_ANALOG],
                 out: zero,
                 stuck: None,
+                fed: false,
             },
         })
     }
@@ -680,6 +698,7 @@ impl SensorModel {
         };
         st.out.analog[PITOT] = indicated_airspeed(x[PITOT]);
         st.stuck = None;
+        st.fed = false;
         self.sample_until(
             truth,
             &x,
@@ -698,7 +717,23 @@ impl SensorModel {
         truth.check()?;
         let x = self.analog_truth(truth);
         self.sample_until(truth, &x, t + h);
+        self.state.fed = true;
         Ok(self.state.out)
+    }
+
+    /// As [`Self::step`], except that an all-zero true state before the first step that
+    /// sampled a true state is "no plant sample yet": nothing is sampled, the outputs of the
+    /// start are held and the sample schedule is not advanced (the samples due are taken at
+    /// the next step, on its true state, so each sensor's noise still depends only on its
+    /// sample number). A master whose connections start at 0.0 before any unit has stepped
+    /// (fmpy's `simulate_ssp`: every connector 0.0 in the first step, the zero quaternion
+    /// among them) gets `Ok((outputs, true))`, and should be told (a warning). After a
+    /// sampled step an all-zero state is refused like any other invalid state.
+    pub fn step_or_hold(&mut self, truth: &Truth, t: f64, h: f64) -> Result<(Measurements, bool), InputError> {
+        if !self.state.fed && truth.is_all_zero() && t.is_finite() && h.is_finite() && h >= 0.0 {
+            return Ok((self.state.out, true));
+        }
+        self.step(truth, t, h).map(|m| (m, false))
     }
 
     fn group(channel: usize) -> Sensor {

@@ -455,7 +455,7 @@ pub struct Ekf {
     params: EstimatorParams,
     frame: LocalFrame,
     mag_ned: Vector3<f64>,
-    /// The estimator's aircraft model (thesis aerodynamics, the parameters' airframe): the
+    /// The estimator's aircraft model (the parameters' airframe and aerodynamic model): the
     /// prediction over the delays.
     model: Plant,
     /// The filter state.
@@ -565,9 +565,12 @@ impl Ekf {
         Ok(Self {
             frame: LocalFrame::new(e.ref_latitude, e.ref_longitude, e.ref_height),
             mag_ned: e.mag_ned(),
-            model: Plant {
-                integration_step: MODEL_STEP,
-                ..Plant::new(params.airframe)
+            model: {
+                let mut m = Plant::new(params.airframe);
+                m.integration_step = MODEL_STEP;
+                m.aero.model =
+                    tailsitter_physics::AeroModel::from_index(params.prediction.aero_model).unwrap_or_default();
+                m
             },
             params,
             state: FilterState::zeroed(),

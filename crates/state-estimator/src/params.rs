@@ -240,11 +240,19 @@ pub struct Prediction {
     /// command computed from them this much later, e.g. one communication step under a
     /// Jacobi master (the plant gets the controller's output of the previous step).
     pub lead: f64,
+    /// Aerodynamic model of the prediction, as the plant's `aero_model` (–): 0 the thesis's
+    /// linear derivatives, 1 the global model (the plant FMU's default; identical to the
+    /// thesis's for |α| ≤ 10°, |β| ≤ 15°).
+    pub aero_model: i32,
 }
 
 impl Default for Prediction {
     fn default() -> Self {
-        Self { model: true, lead: 0.0 }
+        Self {
+            model: true,
+            lead: 0.0,
+            aero_model: 1,
+        }
     }
 }
 
@@ -322,6 +330,9 @@ impl EstimatorParams {
                 "prediction_lead = {} s must be within [0, 1] s",
                 self.prediction.lead
             ));
+        }
+        if tailsitter_physics::AeroModel::from_index(self.prediction.aero_model).is_none() {
+            return Err(format!("aero_model = {} must be 0 or 1", self.prediction.aero_model));
         }
         let e = &self.earth;
         if !e.ref_latitude.is_finite() || e.ref_latitude.abs() > 1.5 {
