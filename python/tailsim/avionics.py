@@ -500,7 +500,8 @@ def avionics_section(
         f"The controllers fly on the estimates of `tailsitter_ekf`, fed by `tailsitter_sensors` "
         f"(thesis Table D.1 noise, 8 Hz Butterworth on the analogue channels, GPS 4 Hz), {ordering} "
         "(tailsim.avionics). Position error: the TRUE position against the reference; it includes "
-        "the estimation error (the first GPS fix: σ 4 m per axis).",
+        "the estimation error of the displacement since the start (the estimator navigates "
+        "relative to the start, its estimate of the start refined by every GPS fix).",
     ]
     try:
         for m, params in missions.items():
