@@ -29,6 +29,12 @@ pub const MAX_SAMPLES_PER_STEP: u64 = 10_000;
 pub const MAX_RATE: f64 = 10_000.0;
 /// A truth quaternion whose norm is further than this from 1 is rejected.
 pub const QUAT_NORM_TOLERANCE: f64 = 0.1;
+/// Largest magnitude of a true-state input (SI units): beyond it a value is no state of an
+/// aircraft, and the filter and noise arithmetic could overflow to a non-finite (unsavable)
+/// state (found by the call-sequence fuzzer: 1e308 inputs).
+pub const INPUT_LIMIT: f64 = 1e7;
+/// Largest noise σ and bias magnitude of the parameters (SI units), for the same reason.
+pub const PARAM_LIMIT: f64 = 1e6;
 
 /// The sensors, each with its own clock and noise stream.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -262,6 +268,11 @@ impl Truth {
             if !value.is_finite() {
                 return Err(InputError(format!("input {name} = {value} is not finite")));
             }
+            if value.abs() > INPUT_LIMIT {
+                return Err(InputError(format!(
+                    "input {name} = {value} outside the plausible range ±{INPUT_LIMIT:e} (SI units)"
+                )));
+            }
         }
         let norm = self.quat.norm();
         if (norm - 1.0).abs() > QUAT_NORM_TOLERANCE {
@@ -480,8 +491,8 @@ impl Params {
             ("mag_std", self.mag_std),
             ("pitot_std", self.pitot_std),
         ] {
-            if !(std.is_finite() && std >= 0.0) {
-                return bad(name, std, "a standard deviation must be finite and >= 0");
+            if !(std.is_finite() && (0.0..=PARAM_LIMIT).contains(&std)) {
+                return bad(name, std, "a standard deviation must be finite, >= 0 and <= 1e6");
             }
         }
         let biases = [
@@ -491,8 +502,8 @@ impl Params {
             ("pitot_bias", self.pitot_bias),
         ];
         for (name, b) in biases {
-            if !b.is_finite() {
-                return bad(name, b, "a bias must be finite");
+            if !(b.is_finite() && b <= PARAM_LIMIT) {
+                return bad(name, b, "a bias must be finite and <= 1e6 in magnitude");
             }
         }
         if LocalTangent::new(self.ref_latitude, self.ref_longitude, self.ref_height).is_none() {

@@ -605,6 +605,13 @@ fn bad_truth_is_rejected_without_changing_the_state() {
                 ..still_truth()
             },
         ),
+        (
+            "plausible",
+            Truth {
+                vel_ned: Vector3::new(0.0, 1e300, 0.0),
+                ..still_truth()
+            },
+        ),
     ] {
         let e = m.step(&truth, 0.0, 0.02).unwrap_err();
         assert!(e.0.contains(what), "{e}");

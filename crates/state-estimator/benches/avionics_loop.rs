@@ -20,7 +20,7 @@ fn mission<C: FlightController>(c: &mut C) -> f64 {
     let trim = plant.trim_vertical_climb(m.v_vertical).unwrap();
     let (mut x, mut u) = (trim.state, trim.inputs);
     let wind = Vector3::zeros();
-    let truth = |x: &tailsitter_physics::StateVector, u| {
+    let truth = |x: &tailsitter_physics::StateVector, u: &tailsitter_physics::InputVector| {
         let y = plant.outputs(x, u, &wind);
         sensor_model::Truth {
             pos_ned: Vector3::new(x[idx::POS_N], x[idx::POS_E], x[idx::POS_D]),

@@ -419,7 +419,9 @@ impl FilterState {
         s.cov.iter_mut().for_each(|x| *x = take());
         s.actuators.thrust = take();
         s.actuators.surfaces.iter_mut().for_each(|x| *x = take());
-        let int = |v: f64| (v.fract() == 0.0 && v.abs() <= i32::MAX as f64).then_some(v);
+        // Integers, i32::MIN included (a fix counter input may hold any i32: found by the
+        // call-sequence fuzzer).
+        let int = |v: f64| (v.fract() == 0.0 && (i32::MIN as f64..=i32::MAX as f64).contains(&v)).then_some(v);
         s.last_fix = int(take())? as i32;
         s.has_fix = take() != 0.0;
         s.gps_rejections_in_row = [int(take())?.max(0.0) as u32, int(take())?.max(0.0) as u32];
@@ -1418,7 +1420,7 @@ mod tests {
         let mut s = FilterState::zeroed();
         s.pos = Vector3::new(1.0, 2.0, 3.0);
         s.cov[(3, 4)] = 0.25;
-        s.last_fix = -7;
+        s.last_fix = i32::MIN;
         s.has_fix = true;
         s.rejected = 12;
         s.gps_rejections_in_row = [3, 1];
