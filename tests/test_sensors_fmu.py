@@ -183,6 +183,7 @@ def test_all_zero_inputs_before_the_first_plant_sample_are_held_with_a_warning(s
     after one it is the invalid state it is (an error)."""
     log = LogRecorder()
     s = sensors.slave("zeros", log)
+    s.setDebugLogging(True, [])  # warnings are logged when logging is on
     start = outputs(sensors, s)
     sensors.set(s, **{n: 0.0 for n in TRUTH})
     s.doStep(0.0, H)
