@@ -176,6 +176,32 @@ def test_bad_input_is_an_fmi_error_naming_the_input(sensors):
     s.freeInstance()
 
 
+def test_all_zero_inputs_before_the_first_plant_sample_are_held_with_a_warning(sensors):
+    """A master that starts its connections at 0.0 (fmpy's simulate_ssp) hands the sensors
+    an all-zero true state (a zero quaternion) in the first step: before any plant sample
+    that is "no plant sample yet" (outputs of the start held, a warning naming the cause),
+    after one it is the invalid state it is (an error)."""
+    log = LogRecorder()
+    s = sensors.slave("zeros", log)
+    s.setDebugLogging(True, [])  # warnings are logged when logging is on
+    start = outputs(sensors, s)
+    sensors.set(s, **{n: 0.0 for n in TRUTH})
+    s.doStep(0.0, H)
+    assert outputs(sensors, s) == start
+    warnings = [m for st, _, m in log.messages if st == "Warning"]
+    assert any("no plant sample yet" in m for m in warnings), log.messages
+    assert not log.errors()
+    # A real sample, then zeros again: refused.
+    sensors.set(s, quat_1=0.0, quat_2=math.sqrt(0.5), quat_3=0.0, quat_4=math.sqrt(0.5), airspeed=3.0, accel_x=9.81)
+    s.doStep(H, H)
+    sensors.set(s, **{n: 0.0 for n in TRUTH})
+    log.clear()
+    with pytest.raises(Exception):
+        s.doStep(2 * H, H)
+    assert any("quaternion" in m for m in log.errors()), log.messages
+    s.freeInstance()
+
+
 def test_out_of_range_parameters_are_refused(sensors):
     log = LogRecorder()
     s = sensors.slave("params", log, init=False)

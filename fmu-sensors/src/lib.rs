@@ -48,11 +48,19 @@ impl SteppedUnit for Sensors {
             .map_err(|e| ControlError(format!("at the start time {t0} s: {e}")))
     }
 
-    fn step(&mut self, truth: &Truth, t: f64, h: f64, _log: &mut dyn UnitLog) -> Result<(), ControlError> {
-        self.model
-            .step(truth, t, h)
-            .map(|_| ())
-            .map_err(|e| ControlError(format!("step from t = {t} s: {e}")))
+    fn step(&mut self, truth: &Truth, t: f64, h: f64, log: &mut dyn UnitLog) -> Result<(), ControlError> {
+        let (_, held) = self
+            .model
+            .step_or_hold(truth, t, h)
+            .map_err(|e| ControlError(format!("step from t = {t} s: {e}")))?;
+        if held {
+            log.warning(format_args!(
+                "step from t = {t} s: every true-state input is 0 (the zero quaternion included) before any plant sample: \
+                 taken as no plant sample yet (a master that starts its connections at 0, e.g. fmpy simulate_ssp); \
+                 nothing sampled, the outputs of the start held"
+            ));
+        }
+        Ok(())
     }
 
     fn output(&self) -> Option<Self::Output> {

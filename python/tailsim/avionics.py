@@ -15,7 +15,8 @@ The parameters the sensors and the estimator share (reference point
 `ref_latitude`, `ref_longitude`, `ref_height`, Earth field `mag_field_total`,
 `mag_declination`, `mag_inclination`, the analogue filter `filter_enabled`,
 `filter_bandwidth`) are copied from the sensors' parameters to the estimator's
-unless the estimator's are given explicitly.
+unless the estimator's are given explicitly; so is the plant's `aero_model` to
+the estimator's (the aerodynamic model of its prediction).
 
 Orderings (per controller step h, at t = k h):
 
@@ -26,7 +27,10 @@ Orderings (per controller step h, at t = k h):
 * Jacobi: every unit's inputs are set from outputs at t before any steps: the
   estimator fuses the sensors' outputs of the previous step and the commands
   of the previous sample, the plant flies the command of the previous sample
-  (as `tailsim.master.ClosedLoop` under Jacobi).
+  (as `tailsim.master.ClosedLoop` under Jacobi). The estimator is told so:
+  unless given, its `measurement_latency` (the age of the samples) and its
+  `prediction_lead` (the outputs describe the time the command computed from
+  them reaches the plant) are set to the controller's step.
 
 Communication step of the plant and sensors, `plant_step` h_s (h_s = h / m,
 m an integer; default h): the plant and the sensors step m times per
@@ -42,19 +46,16 @@ each sensor's noise sequence depends on its sample index only. The estimator
 still reads the latest sample once per h (the sample taken in
 [t, t + h_s)), and the GPS fix instants (every 0.25 s) fall on the h_s grid.
 
-Known limits (tests/test_avionics.py, xfail): the estimator compensates the
-sensors' 8 Hz Butterworth to first order (crates/state-estimator/README.md);
-the TSD's normal-acceleration / pitch loop (which limit-cycles at ≈ 4.5 Hz
-without compensation) keeps little margin. It flies Gauss-Seidel at 20 ms, but
-not under Jacobi: the estimator then fuses the sensors' outputs of the previous
-step and the plant flies the previous command, two extra 20 ms delays in that
-loop (it fails with the Butterworth off too; `measurement_latency` = h does not
-save it); nor with plant and sensors at 5 ms (19 m in level flight: the latest
-sample is then that of t itself, not of a truth held for 15 ms, so the loop's
-effective delay is a few ms longer). The LQR flies all three. A model-based
-prediction of the rates and specific force over the delay (the aircraft model
-driven by the estimator's actuator states) would remove the differentiation
-and its noise.
+Delays: the latest IMU sample describes the aircraft the Butterworth's group
+delay (28 ms) plus `measurement_latency` before the communication point, and
+the controller's command reaches the plant `prediction_lead` after the end of
+the estimator's step. The estimator predicts its outputs over both with its own
+aircraft model driven by the commands (`model_prediction`,
+crates/state-estimator/README.md). Without it (extrapolating the samples by
+their backward difference) the TSD's normal-acceleration / pitch loop (≈ 4.5
+Hz) had no margin left: it diverged under Jacobi and lost 19–21 m with plant
+and sensors at 5 ms; with it both controllers fly Gauss-Seidel and Jacobi at
+20 ms and with plant and sensors at 5 ms (tests/test_avionics.py).
 
 The result is a `tailsim.master.RunResult` whose signals hold the plant's
 outputs (the truth) under their names, the controller's outputs, the
@@ -169,6 +170,14 @@ class AvionicsLoop:
         self.sensors_params = dict(sensors_params or {})
         shared = {n: v for n, v in self.sensors_params.items() if n in SHARED_PARAMETERS}
         self.ekf_params = {**shared, **dict(ekf_params or {})}
+        if "aero_model" in self.plant_params and "aero_model" not in self.ekf_params:
+            # The estimator predicts with the plant's configured aerodynamic model.
+            self.ekf_params["aero_model"] = self.plant_params["aero_model"]
+        if ordering == "jacobi":
+            # The delays a Jacobi master adds, one controller step each (set in `run`).
+            self._jacobi_defaults = [n for n in ("measurement_latency", "prediction_lead") if n not in self.ekf_params]
+        else:
+            self._jacobi_defaults = []
         self.controller_params = dict(controller_params or {})
         self.ordering = ordering
         self.plant_step = plant_step
@@ -278,7 +287,7 @@ class AvionicsLoop:
             S.set(s, self.sensors_params)
             self.plant_to_sensors.copy(p, s)
             s.exitInitializationMode()
-            E.set(e, self.ekf_params)
+            E.set(e, {**{n: h for n in self._jacobi_defaults}, **self.ekf_params})
             self.sensors_to_ekf.copy(s, e)
             e.exitInitializationMode()
             C.set(c, self.controller_params)
@@ -491,7 +500,8 @@ def avionics_section(
         f"The controllers fly on the estimates of `tailsitter_ekf`, fed by `tailsitter_sensors` "
         f"(thesis Table D.1 noise, 8 Hz Butterworth on the analogue channels, GPS 4 Hz), {ordering} "
         "(tailsim.avionics). Position error: the TRUE position against the reference; it includes "
-        "the estimation error (the first GPS fix: σ 4 m per axis).",
+        "the estimation error of the displacement since the start (the estimator navigates "
+        "relative to the start, its estimate of the start refined by every GPS fix).",
     ]
     try:
         for m, params in missions.items():

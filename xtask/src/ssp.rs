@@ -524,15 +524,14 @@ pub fn avionics_system_description(
         ],
     )?;
     // SSP importers (fmpy, libcosim) are Jacobi masters: the estimator fuses the sensors'
-    // outputs of the previous step, one `sample_time` old (its `measurement_latency`).
-    let estimator_parameters = if ekf.port("measurement_latency").is_some() {
-        bindings(
-            ekf,
-            &[("measurement_latency", "Real", real(mission_default("sample_time")))],
-        )?
-    } else {
-        Vec::new()
-    };
+    // outputs of the previous step, one `sample_time` old (its `measurement_latency`), and
+    // the plant gets the controller's output one step later (its `prediction_lead`).
+    let jacobi_delays: Vec<_> = ["measurement_latency", "prediction_lead"]
+        .into_iter()
+        .filter(|n| ekf.port(n).is_some())
+        .map(|n| (n, "Real", real(mission_default("sample_time"))))
+        .collect();
+    let estimator_parameters = bindings(ekf, &jacobi_delays)?;
     let name = format!("{}_avionics", controller.model_identifier);
     let description = format!(
         "Tail-sitter with avionics in the loop: {} flying {} on the estimates of {} from {} (port wiring by name).",

@@ -29,6 +29,12 @@ pub const MAX_SAMPLES_PER_STEP: u64 = 10_000;
 pub const MAX_RATE: f64 = 10_000.0;
 /// A truth quaternion whose norm is further than this from 1 is rejected.
 pub const QUAT_NORM_TOLERANCE: f64 = 0.1;
+/// Largest magnitude of a true-state input (SI units): beyond it a value is no state of an
+/// aircraft, and the filter and noise arithmetic could overflow to a non-finite (unsavable)
+/// state (found by the call-sequence fuzzer: 1e308 inputs).
+pub const INPUT_LIMIT: f64 = 1e7;
+/// Largest noise σ and bias magnitude of the parameters (SI units), for the same reason.
+pub const PARAM_LIMIT: f64 = 1e6;
 
 /// The sensors, each with its own clock and noise stream.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -224,6 +230,18 @@ impl Default for Truth {
 }
 
 impl Truth {
+    /// Every input exactly 0 (the zero quaternion included: never a state of the plant).
+    pub fn is_all_zero(&self) -> bool {
+        self.pos_ned == Vector3::zeros()
+            && self.vel_ned == Vector3::zeros()
+            && self.rates == Vector3::zeros()
+            && self.quat.iter().all(|x| *x == 0.0)
+            && self.airspeed == 0.0
+            && self.alpha == 0.0
+            && self.beta == 0.0
+            && self.specific_force == Vector3::zeros()
+    }
+
     fn check(&self) -> Result<(), InputError> {
         let named: [(&str, f64); 19] = [
             ("pos_n", self.pos_ned.x),
@@ -249,6 +267,11 @@ impl Truth {
         for (name, value) in named {
             if !value.is_finite() {
                 return Err(InputError(format!("input {name} = {value} is not finite")));
+            }
+            if value.abs() > INPUT_LIMIT {
+                return Err(InputError(format!(
+                    "input {name} = {value} outside the plausible range ±{INPUT_LIMIT:e} (SI units)"
+                )));
             }
         }
         let norm = self.quat.norm();
@@ -316,10 +339,12 @@ pub struct State {
     pub out: Measurements,
     /// Value of the stuck channel inside its fault window.
     pub stuck: Option<f64>,
+    /// A step has sampled a true state (after it, an all-zero input is an error).
+    pub fed: bool,
 }
 
 /// Number of u64 words of [`State::save`].
-pub const STATE_WORDS: usize = N_SENSORS * 4 + 1 + N_SENSORS + 2 * N_ANALOG + 8 + N_ANALOG + 2;
+pub const STATE_WORDS: usize = N_SENSORS * 4 + 1 + N_SENSORS + 2 * N_ANALOG + 8 + N_ANALOG + 3;
 
 impl State {
     /// Serialise to `STATE_WORDS` words (f64 as IEEE bits: bit-exact).
@@ -349,6 +374,7 @@ impl State {
         m.analog.iter().for_each(|x| out(x.to_bits()));
         out(u64::from(self.stuck.is_some()));
         out(self.stuck.unwrap_or(0.0).to_bits());
+        out(u64::from(self.fed));
     }
 
     /// Read what [`Self::save`] wrote; rejects truncated or inconsistent data.
@@ -394,6 +420,7 @@ impl State {
         }
         let has_stuck = flag(word()?, "stuck")?;
         let stuck = finite(f64::from_bits(word()?), "stuck value")?;
+        let fed = flag(word()?, "fed")?;
         Ok(Self {
             rng,
             t0,
@@ -409,6 +436,7 @@ impl State {
                 analog,
             },
             stuck: has_stuck.then_some(stuck),
+            fed,
         })
     }
 }
@@ -463,8 +491,8 @@ impl Params {
             ("mag_std", self.mag_std),
             ("pitot_std", self.pitot_std),
         ] {
-            if !(std.is_finite() && std >= 0.0) {
-                return bad(name, std, "a standard deviation must be finite and >= 0");
+            if !(std.is_finite() && (0.0..=PARAM_LIMIT).contains(&std)) {
+                return bad(name, std, "a standard deviation must be finite, >= 0 and <= 1e6");
             }
         }
         let biases = [
@@ -474,8 +502,8 @@ impl Params {
             ("pitot_bias", self.pitot_bias),
         ];
         for (name, b) in biases {
-            if !b.is_finite() {
-                return bad(name, b, "a bias must be finite");
+            if !(b.is_finite() && b <= PARAM_LIMIT) {
+                return bad(name, b, "a bias must be finite and <= 1e6 in magnitude");
             }
         }
         if LocalTangent::new(self.ref_latitude, self.ref_longitude, self.ref_height).is_none() {
@@ -609,6 +637,7 @@ impl SensorModel {
                 filter: [[0.0; 2]; N_ANALOG],
                 out: zero,
                 stuck: None,
+                fed: false,
             },
         })
     }
@@ -680,6 +709,7 @@ impl SensorModel {
         };
         st.out.analog[PITOT] = indicated_airspeed(x[PITOT]);
         st.stuck = None;
+        st.fed = false;
         self.sample_until(
             truth,
             &x,
@@ -698,7 +728,23 @@ impl SensorModel {
         truth.check()?;
         let x = self.analog_truth(truth);
         self.sample_until(truth, &x, t + h);
+        self.state.fed = true;
         Ok(self.state.out)
+    }
+
+    /// As [`Self::step`], except that an all-zero true state before the first step that
+    /// sampled a true state is "no plant sample yet": nothing is sampled, the outputs of the
+    /// start are held and the sample schedule is not advanced (the samples due are taken at
+    /// the next step, on its true state, so each sensor's noise still depends only on its
+    /// sample number). A master whose connections start at 0.0 before any unit has stepped
+    /// (fmpy's `simulate_ssp`: every connector 0.0 in the first step, the zero quaternion
+    /// among them) gets `Ok((outputs, true))`, and should be told (a warning). After a
+    /// sampled step an all-zero state is refused like any other invalid state.
+    pub fn step_or_hold(&mut self, truth: &Truth, t: f64, h: f64) -> Result<(Measurements, bool), InputError> {
+        if !self.state.fed && truth.is_all_zero() && t.is_finite() && h.is_finite() && h >= 0.0 {
+            return Ok((self.state.out, true));
+        }
+        self.step(truth, t, h).map(|m| (m, false))
     }
 
     fn group(channel: usize) -> Sensor {

@@ -494,7 +494,11 @@ fn saved_state_continues_bit_identically() {
     let mut it = bad.into_iter();
     assert!(State::restore(&mut || it.next()).is_err());
     let mut bad = words.clone();
-    bad[STATE_WORDS - 2] = 7; // the stuck flag
+    bad[STATE_WORDS - 3] = 7; // the stuck flag
+    let mut it = bad.into_iter();
+    assert!(State::restore(&mut || it.next()).is_err());
+    let mut bad = words.clone();
+    bad[STATE_WORDS - 1] = 2; // the fed flag
     let mut it = bad.into_iter();
     assert!(State::restore(&mut || it.next()).is_err());
 }
@@ -601,6 +605,13 @@ fn bad_truth_is_rejected_without_changing_the_state() {
                 ..still_truth()
             },
         ),
+        (
+            "plausible",
+            Truth {
+                vel_ned: Vector3::new(0.0, 1e300, 0.0),
+                ..still_truth()
+            },
+        ),
     ] {
         let e = m.step(&truth, 0.0, 0.02).unwrap_err();
         assert!(e.0.contains(what), "{e}");
@@ -691,4 +702,48 @@ fn out_of_range_parameters_are_refused_with_their_name() {
         ..Params::default()
     })
     .is_ok());
+}
+
+/// An all-zero true state before any sampled step (a master whose connections start at 0.0,
+/// fmpy's `simulate_ssp`) is "no plant sample yet": outputs of the start held, nothing
+/// sampled, the schedule not advanced, so the run continues exactly as one that never saw
+/// it. After a sampled step the same input is refused.
+#[test]
+fn all_zero_truth_before_the_first_sample_is_held_and_refused_after() {
+    let zero = Truth {
+        pos_ned: Vector3::zeros(),
+        vel_ned: Vector3::zeros(),
+        rates: Vector3::zeros(),
+        quat: Vector4::zeros(),
+        airspeed: 0.0,
+        alpha: 0.0,
+        beta: 0.0,
+        specific_force: Vector3::zeros(),
+    };
+    assert!(zero.is_all_zero() && !still_truth().is_all_zero());
+    let mut held = SensorModel::new(Params::default()).unwrap();
+    let start = held.start(&still_truth(), 0.0).unwrap();
+    let state = *held.state();
+    let (out, was_held) = held.step_or_hold(&zero, 0.0, 0.02).unwrap();
+    assert!(was_held);
+    assert_eq!(out, start);
+    assert_eq!(held.state(), &state);
+    // The next steps equal those of a run that never saw the zero input.
+    let mut plain = SensorModel::new(Params::default()).unwrap();
+    plain.start(&still_truth(), 0.0).unwrap();
+    for k in 0..10 {
+        let t = k as f64 * 0.02;
+        let (a, h) = held.step_or_hold(&still_truth(), t, 0.02).unwrap();
+        assert!(!h);
+        assert_eq!(a, plain.step(&still_truth(), t, 0.02).unwrap());
+    }
+    // Now a plant sample has been seen: all zero is an invalid state (zero quaternion).
+    let e = held.step_or_hold(&zero, 0.2, 0.02).unwrap_err();
+    assert!(e.0.contains("norm"), "{e}");
+    // The flag is part of the saved state.
+    let mut words = Vec::new();
+    held.state().save(&mut |w| words.push(w));
+    assert_eq!(words.len(), STATE_WORDS);
+    let mut it = words.into_iter();
+    assert!(State::restore(&mut || it.next()).unwrap().fed);
 }

@@ -2,7 +2,10 @@
 //!
 //! Nominal state: position p and velocity v (NED, m, m/s), attitude quaternion q
 //! (body relative to earth, thesis convention (A.2.8), q4 scalar), gyro bias b_g, accelerometer
-//! bias b_a (body axes) and the wind w (NED). Error state (18): δp, δv, φ, δb_g, δb_a, δw,
+//! bias b_a (body axes), the wind w (NED) and the start position p₀ (NED: a clone of p at
+//! initialisation, refined by every later fix through its correlation with p; the outputs
+//! navigate relative to it, see [`crate::Tuning::relative_to_start`]).
+//! Error state (21): δp, δv, φ, δb_g, δb_a, δw, δp₀,
 //! with the attitude error φ a small rotation in earth axes: R = (I + [φ×]) R̂, R = (DCM^BE)ᵀ.
 //!
 //! Prediction (IMU-driven, strapdown, IMU sample held over the step):
@@ -16,14 +19,16 @@
 //! e_yᵀ C (v − w) = 0 (the cross-wind is otherwise unobservable).
 
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3, Vector4};
-use tailsitter_physics::{dcm_earth_to_body, euler_321_from_quat, quat_from_dcm, InputVector, AIRSPEED_EPS};
+use tailsitter_physics::{
+    dcm_earth_to_body, euler_321_from_quat, idx, quat_from_dcm, InputVector, Plant, StateVector, AIRSPEED_EPS,
+};
 
 use crate::actuators::Actuators;
 use crate::geodesy::LocalFrame;
 use crate::params::EstimatorParams;
 
 /// Dimension of the error state.
-pub const N_ERR: usize = 18;
+pub const N_ERR: usize = 21;
 /// Error-state covariance.
 pub type Covariance = SMatrix<f64, N_ERR, N_ERR>;
 type ErrorVector = SVector<f64, N_ERR>;
@@ -42,6 +47,8 @@ pub mod ix {
     pub const ACCEL_BIAS: usize = 12;
     /// Wind error (m/s), NED.
     pub const WIND: usize = 15;
+    /// Start-position error (m), NED: static, no process noise.
+    pub const START: usize = 18;
 }
 
 /// χ² gate, 3 degrees of freedom, false-alarm probability 1e-4 (χ²₃ quantile 0.9999).
@@ -222,10 +229,26 @@ pub struct Estimate {
     pub rejected_measurements: i32,
 }
 
+/// Steps of actuator and command history kept for the model prediction over the delay
+/// (8 × 20 ms: delays up to 160 ms are compensated in full, longer ones from the oldest entry).
+pub const HISTORY: usize = 8;
+
+/// One step of the actuators' history: their state at the step's start, the command held
+/// over it and its length.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct HistoryEntry {
+    pub actuators: Actuators,
+    pub cmd: InputVector,
+    /// Length of the step (s).
+    pub h: f64,
+}
+
 /// The filter's complete dynamic state (Copy: saved and restored bit-identically).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FilterState {
     pub pos: Vector3<f64>,
+    /// Estimate of the position at initialisation (m), NED.
+    pub start: Vector3<f64>,
     pub vel: Vector3<f64>,
     pub quat: Vector4<f64>,
     pub gyro_bias: Vector3<f64>,
@@ -254,15 +277,34 @@ pub struct FilterState {
     pub rejected: i32,
     /// The measurements at initialisation were used to initialise: do not fuse them again.
     pub skip_updates: bool,
+    /// Actuator and command history, newest first (entry 0: the last step).
+    pub history: [HistoryEntry; HISTORY],
+    /// Valid entries of `history`.
+    pub history_len: usize,
+    /// Bias-corrected rates (rad/s) and specific force (m/s²) predicted for the output time
+    /// (end of the last step + the prediction lead).
+    pub out_rates: Vector3<f64>,
+    pub out_force: Vector3<f64>,
+    /// The model's mean rate of change of the rates (rad/s²) and of the specific force
+    /// (m/s³) over the last prediction's first part (sample time → middle of the step).
+    pub model_slope_rates: Vector3<f64>,
+    pub model_slope_force: Vector3<f64>,
+    /// Low-passed difference between the samples' rate of change and the model's (rad/s²,
+    /// m/s³): the model's systematic error (e.g. a moment it lacks at the estimated state),
+    /// added to its prediction so that an imperfect model does not bias the compensated
+    /// rates (a disturbance observer).
+    pub model_error_rates: Vector3<f64>,
+    pub model_error_force: Vector3<f64>,
 }
 
 /// Number of f64 words of [`FilterState::to_words`].
-pub const STATE_WORDS: usize = 3 * 11 + 4 + N_ERR * N_ERR + 7 + 7;
+pub const STATE_WORDS: usize = 3 * 12 + 4 + N_ERR * N_ERR + 7 + 7 + HISTORY * (7 + 7 + 1) + 1 + 6 + 12;
 
 impl FilterState {
     fn zeroed() -> Self {
         Self {
             pos: Vector3::zeros(),
+            start: Vector3::zeros(),
             vel: Vector3::zeros(),
             quat: Vector4::new(0.0, 0.0, 0.0, 1.0),
             gyro_bias: Vector3::zeros(),
@@ -282,6 +324,14 @@ impl FilterState {
             gps_rejections_in_row: [0; 2],
             rejected: 0,
             skip_updates: false,
+            history: [HistoryEntry::default(); HISTORY],
+            history_len: 0,
+            out_rates: Vector3::zeros(),
+            out_force: Vector3::zeros(),
+            model_slope_rates: Vector3::zeros(),
+            model_slope_force: Vector3::zeros(),
+            model_error_rates: Vector3::zeros(),
+            model_error_force: Vector3::zeros(),
         }
     }
 
@@ -295,6 +345,7 @@ impl FilterState {
         };
         for v in [
             &self.pos,
+            &self.start,
             &self.vel,
             &self.gyro_bias,
             &self.accel_bias,
@@ -319,6 +370,23 @@ impl FilterState {
         put(self.rejected as f64);
         put(if self.skip_updates { 1.0 } else { 0.0 });
         put(self.last_step);
+        for e in &self.history {
+            put(e.actuators.thrust);
+            e.actuators.surfaces.iter().for_each(|x| put(*x));
+            e.cmd.iter().for_each(|x| put(*x));
+            put(e.h);
+        }
+        put(self.history_len as f64);
+        self.out_rates.iter().for_each(|x| put(*x));
+        self.out_force.iter().for_each(|x| put(*x));
+        for v in [
+            &self.model_slope_rates,
+            &self.model_slope_force,
+            &self.model_error_rates,
+            &self.model_error_force,
+        ] {
+            v.iter().for_each(|x| put(*x));
+        }
         debug_assert_eq!(k, STATE_WORDS);
         w
     }
@@ -333,6 +401,7 @@ impl FilterState {
         };
         for v in [
             &mut s.pos,
+            &mut s.start,
             &mut s.vel,
             &mut s.gyro_bias,
             &mut s.accel_bias,
@@ -350,14 +419,35 @@ impl FilterState {
         s.cov.iter_mut().for_each(|x| *x = take());
         s.actuators.thrust = take();
         s.actuators.surfaces.iter_mut().for_each(|x| *x = take());
-        let int = |v: f64| (v.fract() == 0.0 && v.abs() <= i32::MAX as f64).then_some(v);
+        // Integers, i32::MIN included (a fix counter input may hold any i32: found by the
+        // call-sequence fuzzer).
+        let int = |v: f64| (v.fract() == 0.0 && (i32::MIN as f64..=i32::MAX as f64).contains(&v)).then_some(v);
         s.last_fix = int(take())? as i32;
         s.has_fix = take() != 0.0;
         s.gps_rejections_in_row = [int(take())?.max(0.0) as u32, int(take())?.max(0.0) as u32];
         s.rejected = int(take())? as i32;
         s.skip_updates = take() != 0.0;
         s.last_step = take();
-        (s.last_step.is_finite() && s.last_step >= 0.0).then_some(s)
+        for e in s.history.iter_mut() {
+            e.actuators.thrust = take();
+            e.actuators.surfaces.iter_mut().for_each(|x| *x = take());
+            e.cmd.iter_mut().for_each(|x| *x = take());
+            e.h = take();
+        }
+        let len = take();
+        s.out_rates.iter_mut().for_each(|x| *x = take());
+        s.out_force.iter_mut().for_each(|x| *x = take());
+        for v in [
+            &mut s.model_slope_rates,
+            &mut s.model_slope_force,
+            &mut s.model_error_rates,
+            &mut s.model_error_force,
+        ] {
+            v.iter_mut().for_each(|x| *x = take());
+        }
+        let history_ok = s.history.iter().all(|e| e.h.is_finite() && e.h >= 0.0);
+        s.history_len = int(len).filter(|l| (0.0..=HISTORY as f64).contains(l))? as usize;
+        (s.last_step.is_finite() && s.last_step >= 0.0 && history_ok).then_some(s)
     }
 }
 
@@ -367,6 +457,9 @@ pub struct Ekf {
     params: EstimatorParams,
     frame: LocalFrame,
     mag_ned: Vector3<f64>,
+    /// The estimator's aircraft model (the parameters' airframe and aerodynamic model): the
+    /// prediction over the delays.
+    model: Plant,
     /// The filter state.
     pub state: FilterState,
 }
@@ -453,6 +546,15 @@ fn quat_continuous(c: &Matrix3<f64>, previous: &Vector4<f64>) -> Vector4<f64> {
     }
 }
 
+/// RK4 step of the model prediction (s): the fastest mode of the airframe (short period,
+/// |λ| ≈ 20 rad/s) gives |λ|h = 0.2, well inside RK4's accuracy.
+const MODEL_STEP: f64 = 0.01;
+
+/// Time constant of the low-pass of the model's error ([`FilterState::model_error_rates`])
+/// (s): long against the noise of a difference of two samples (σ ≈ 1 rad/s² per 20 ms step),
+/// short against a manoeuvre's change of flight condition.
+const MODEL_ERROR_TIME: f64 = 0.5;
+
 fn finite3(v: &Vector3<f64>) -> bool {
     v.iter().all(|x| x.is_finite())
 }
@@ -465,6 +567,13 @@ impl Ekf {
         Ok(Self {
             frame: LocalFrame::new(e.ref_latitude, e.ref_longitude, e.ref_height),
             mag_ned: e.mag_ned(),
+            model: {
+                let mut m = Plant::new(params.airframe);
+                m.integration_step = MODEL_STEP;
+                m.aero.model =
+                    tailsitter_physics::AeroModel::from_index(params.prediction.aero_model).unwrap_or_default();
+                m
+            },
             params,
             state: FilterState::zeroed(),
         })
@@ -622,6 +731,12 @@ impl Ekf {
             cov[(ix::ACCEL_BIAS + k, ix::ACCEL_BIAS + k)] = p.tuning.init_std_accel_bias.powi(2);
             cov[(ix::WIND + k, ix::WIND + k)] = p.tuning.init_std_wind.powi(2);
         }
+        // The start position is the position now: a clone, fully correlated with it.
+        s.start = s.pos;
+        let pp = cov.fixed_view::<3, 3>(ix::POS, ix::POS).into_owned();
+        for (r, c) in [(ix::START, ix::START), (ix::START, ix::POS), (ix::POS, ix::START)] {
+            cov.fixed_view_mut::<3, 3>(r, c).copy_from(&pp);
+        }
         s.cov = cov;
         if Self::imu_ok(m).is_ok() {
             s.imu_accel = m.accel;
@@ -631,6 +746,8 @@ impl Ekf {
             s.imu_accel = dcm_earth_to_body(&s.quat) * Vector3::new(0.0, 0.0, -g);
         }
         s.actuators = Actuators::steady(&p.airframe, u);
+        s.out_rates = s.imu_gyro;
+        s.out_force = s.imu_accel;
         s.skip_updates = true;
         self.state = s;
         report
@@ -670,6 +787,14 @@ impl Ekf {
         let imu_inflation = match Self::imu_ok(m) {
             Ok(()) => {
                 let s = &mut self.state;
+                if self.params.prediction.model && s.last_step > 0.0 {
+                    // The samples' rate of change against the model's over the last step.
+                    let k = (s.last_step / MODEL_ERROR_TIME).min(1.0);
+                    let dr = (m.gyro - s.imu_gyro) / s.last_step - s.model_slope_rates;
+                    let df = (m.accel - s.imu_accel) / s.last_step - s.model_slope_force;
+                    s.model_error_rates += (dr - s.model_error_rates) * k;
+                    s.model_error_force += (df - s.model_error_force) * k;
+                }
                 if self.params.filter.delay() > 0.0 && s.last_step > 0.0 && h > 0.0 {
                     let accel_dot = (m.accel - s.imu_accel) / h;
                     let gyro_dot = (m.gyro - s.imu_gyro) / h;
@@ -697,6 +822,15 @@ impl Ekf {
             }
         };
         self.state.last_step = h;
+        // The actuators' history, newest first: their state at t and the command for [t, t + h).
+        let s = &mut self.state;
+        s.history.copy_within(0..HISTORY - 1, 1);
+        s.history[0] = HistoryEntry {
+            actuators: s.actuators,
+            cmd: *u,
+            h,
+        };
+        s.history_len = (s.history_len + 1).min(HISTORY);
 
         if self.state.skip_updates {
             self.state.skip_updates = false;
@@ -706,7 +840,7 @@ impl Ekf {
             self.fuse_pitot(m, &mut rep);
             self.fuse_sideslip();
         }
-        self.predict(h, imu_inflation);
+        self.predict_compensated(h, imu_inflation);
         self.state.actuators.advance(&self.params.airframe, u, h);
         self.condition();
 
@@ -714,10 +848,12 @@ impl Ekf {
             // Should not happen (every update is checked); keep the previous estimate and
             // only predict it.
             let fix = (self.state.last_fix, self.state.has_fix);
+            let history = (self.state.history, self.state.history_len);
             self.state = backup;
             self.state.last_fix = fix.0;
             self.state.has_fix = fix.1;
-            self.predict(h, imu_inflation);
+            (self.state.history, self.state.history_len) = history;
+            self.predict_compensated(h, imu_inflation);
             self.state.actuators.advance(&self.params.airframe, u, h);
             self.condition();
             rep.reverted = true;
@@ -732,6 +868,7 @@ impl Ekf {
     fn state_is_finite(&self) -> bool {
         let s = &self.state;
         finite3(&s.pos)
+            && finite3(&s.start)
             && finite3(&s.vel)
             && s.quat.iter().all(|x| x.is_finite())
             && finite3(&s.gyro_bias)
@@ -767,12 +904,133 @@ impl Ekf {
         }
     }
 
-    /// Strapdown prediction over `h` and the covariance Φ P Φᵀ + Q.
-    fn predict(&mut self, h: f64, imu_inflation: f64) {
+    /// Rates and specific force (bias-corrected) at the output time t + h + lead, the
+    /// sensors' delay compensated ([`crate::Prediction`]); with the model also its mean
+    /// slopes of the rates and the specific force from the sample's time to the middle of the
+    /// step (else zero).
+    fn compensated(&self, h: f64) -> [Vector3<f64>; 4] {
+        let s = &self.state;
+        let (bg, ba) = (s.gyro_bias, s.accel_bias);
+        let lead = self.params.prediction.lead;
+        if !self.params.prediction.model {
+            return [
+                self.unfiltered_gyro(h + lead) - bg,
+                self.unfiltered_accel(h + lead) - ba,
+                Vector3::zeros(),
+                Vector3::zeros(),
+            ];
+        }
+        let (w, f) = (s.imu_gyro - bg, s.imu_accel - ba);
+        match self.model_changes(&w, h) {
+            Some(([dw_mid, df_mid, dw_end, df_end], [to_mid, to_end])) => {
+                let (er, ef) = (s.model_error_rates, s.model_error_force);
+                [
+                    w + dw_end + er * to_end,
+                    f + df_end + ef * to_end,
+                    dw_mid / to_mid,
+                    df_mid / to_mid,
+                ]
+            }
+            // The model left its envelope (a diverged estimate): the samples as they are.
+            None => [w, f, Vector3::zeros(), Vector3::zeros()],
+        }
+    }
+
+    /// The model's change of the rates and of the specific force from the time the latest
+    /// IMU sample describes (t − [`crate::AnalogFilter::delay`]) to the middle of the step and
+    /// to the output time t + h + lead (rad/s, m/s²), `None` if the model fails.
+    ///
+    /// The model starts from the estimate (position, velocity, attitude, wind) with the
+    /// sample's rates `w0` and the actuators of the history at t − delay, and is driven by
+    /// the commands of the history, then by the current one. Its rates and specific force
+    /// at the start match the sample only up to the model error; only their changes are used.
+    /// Also returns the two prediction times (s).
+    fn model_changes(&self, w0: &Vector3<f64>, h: f64) -> Option<([Vector3<f64>; 4], [f64; 2])> {
+        let s = &self.state;
+        let a = &self.params.airframe;
+        let delay = self.params.filter.delay();
+        // The oldest history entry needed (entry 0 is the current step).
+        let (mut back, mut j) = (0.0, 0);
+        while back < delay && j + 1 < s.history_len {
+            j += 1;
+            back += s.history[j].h;
+        }
+        let offset = (back - delay).max(0.0);
+        let mut act = s.history[j].actuators;
+        if j > 0 {
+            act.advance(a, &s.history[j].cmd, offset);
+        }
+        let c = dcm_earth_to_body(&s.quat);
+        let v_body = c * s.vel;
+        let mut x = StateVector::zeros();
+        for k in 0..3 {
+            x[idx::POS_N + k] = s.pos[k];
+            x[idx::U + k] = v_body[k];
+            x[idx::P + k] = w0[k];
+        }
+        for k in 0..4 {
+            x[idx::Q1 + k] = s.quat[k];
+        }
+        x[idx::THRUST] = act.thrust;
+        for k in 0..6 {
+            x[idx::SURFACES + k] = act.surfaces[k];
+        }
+        let wind = s.wind;
+        let force = |x: &StateVector| self.model.forces_moments(x, &wind).force_body / a.mass;
+        let rates = |x: &StateVector| Vector3::new(x[idx::P], x[idx::Q], x[idx::R]);
+        let f0 = force(&x);
+        let advance = |x: &mut StateVector, cmd: &InputVector, dt: f64| -> Option<()> {
+            if dt > 0.0 {
+                self.model.advance(x, cmd, &wind, dt).ok()?;
+            }
+            Some(())
+        };
+        if j > 0 {
+            advance(&mut x, &s.history[j].cmd, s.history[j].h - offset)?;
+            for i in (1..j).rev() {
+                advance(&mut x, &s.history[i].cmd, s.history[i].h)?;
+            }
+        }
+        let u = s.history[0].cmd;
+        advance(&mut x, &u, 0.5 * h)?;
+        let (w_mid, f_mid) = (rates(&x), force(&x)); // the slope's reference
+        advance(&mut x, &u, 0.5 * h + self.params.prediction.lead)?;
+        let (w_end, f_end) = (rates(&x), force(&x));
+        let out = [w_mid - w0, f_mid - f0, w_end - w0, f_end - f0];
+        let to_mid = back - offset + 0.5 * h;
+        out.iter()
+            .all(finite3)
+            .then_some((out, [to_mid, to_mid + 0.5 * h + self.params.prediction.lead]))
+    }
+
+    /// The strapdown prediction over `h` and the outputs' rates and specific force.
+    ///
+    /// The strapdown integrates the samples extrapolated by their backward difference to the
+    /// step's middle ([`Ekf::inverse_filter`]), not the model's prediction: the model's error
+    /// at a wrong estimated state (e.g. the airspeed before the wind has converged: a wrong α
+    /// gives a moment the aircraft does not have) would otherwise bias the attitude and the
+    /// gyro-bias estimate (NEES far outside its χ² bounds in level flight in a wind, and the
+    /// q bias walked to −0.07 rad/s in the vertical climb of the avionics mission). The
+    /// model's prediction drives only what the controller reads.
+    fn predict_compensated(&mut self, h: f64, imu_inflation: f64) {
+        let [out_rates, out_force, slope_rates, slope_force] = self.compensated(h);
+        // The model's mean slopes (the reference of its error at the next sample).
+        self.state.model_slope_rates = slope_rates;
+        self.state.model_slope_force = slope_force;
+        let bg = self.state.gyro_bias;
+        let ba = self.state.accel_bias;
+        let omega = self.unfiltered_gyro(0.5 * h) - bg;
+        let f = self.unfiltered_accel(0.5 * h) - ba;
+        self.predict(h, imu_inflation, &omega, &f);
+        self.state.out_rates = out_rates;
+        self.state.out_force = out_force;
+    }
+
+    /// Strapdown prediction over `h` with the (bias-corrected, compensated) rate `omega` and
+    /// specific force `f` of the step's middle, and the covariance Φ P Φᵀ + Q.
+    fn predict(&mut self, h: f64, imu_inflation: f64, omega: &Vector3<f64>, f: &Vector3<f64>) {
         let pr = &self.params;
-        // Over [t, t + h) the rate and specific force at the midpoint, the filter inverted.
-        let omega = self.unfiltered_gyro(0.5 * h) - self.state.gyro_bias;
-        let f = self.unfiltered_accel(0.5 * h) - self.state.accel_bias;
+        let (omega, f) = (*omega, *f);
         let s = &mut self.state;
         let c0 = dcm_earth_to_body(&s.quat);
         let r0 = c0.transpose();
@@ -864,6 +1122,7 @@ impl Ekf {
         s.gyro_bias += dx.fixed_rows::<3>(ix::GYRO_BIAS);
         s.accel_bias += dx.fixed_rows::<3>(ix::ACCEL_BIAS);
         s.wind += dx.fixed_rows::<3>(ix::WIND);
+        s.start += dx.fixed_rows::<3>(ix::START);
     }
 
     fn fuse_gps(&mut self, m: &Measurements, rep: &mut StepReport) {
@@ -957,7 +1216,7 @@ impl Ekf {
         // The filtered field of t is that of the attitude at t − τ (group delay τ):
         // C(t − τ) ≈ (I + τ[ω×]) C(t) since Ċ = −[ω×]C for the earth-to-body DCM.
         let tau = self.params.filter.delay();
-        let c = (Matrix3::identity() + skew(&(self.rates() * tau))) * dcm_earth_to_body(&self.state.quat);
+        let c = (Matrix3::identity() + skew(&(self.state.out_rates * tau))) * dcm_earth_to_body(&self.state.quat);
         let y = m.mag - c * self.mag_ned;
         let mut hm = SMatrix::<f64, 3, N_ERR>::zeros();
         hm.fixed_view_mut::<3, 3>(0, ix::ATT)
@@ -1057,22 +1316,29 @@ impl Ekf {
         st.imu_accel + st.imu_accel_dot * c1 + st.imu_accel_ddot * c2
     }
 
-    /// Bias-corrected body rates at the end of the last step (rad/s): the last (filtered)
-    /// sample describes t, the estimate t + h.
-    fn rates(&self) -> Vector3<f64> {
-        self.unfiltered_gyro(self.state.last_step) - self.state.gyro_bias
-    }
-
-    /// Bias-corrected specific force at the end of the last step (m/s²).
-    fn specific_force(&self) -> Vector3<f64> {
-        self.unfiltered_accel(self.state.last_step) - self.state.accel_bias
-    }
-
-    /// The current estimate (at the end of the last step).
+    /// The current estimate, at the output time: the end of the last step plus the
+    /// prediction lead. Over the lead the attitude turns at the predicted rate and the
+    /// velocity changes with the predicted specific force; the motor and servos follow the
+    /// last command.
     pub fn estimate(&self) -> Estimate {
         let s = &self.state;
-        let c = dcm_earth_to_body(&s.quat);
-        let v_air = c * (s.vel - s.wind);
+        let lead = self.params.prediction.lead;
+        let (mut pos, mut vel, mut quat, mut actuators) = (s.pos, s.vel, s.quat, s.actuators);
+        if self.params.tuning.relative_to_start {
+            pos -= s.start;
+        }
+        if lead > 0.0 {
+            quat = quat_advance(&s.quat, &s.out_rates, lead);
+            let r = (dcm_earth_to_body(&s.quat).transpose() + dcm_earth_to_body(&quat).transpose()) * 0.5;
+            let acc = r * s.out_force + Vector3::new(0.0, 0.0, self.params.earth.gravity);
+            pos += s.vel * lead + acc * (0.5 * lead * lead);
+            vel += acc * lead;
+            if s.history_len > 0 {
+                actuators.advance(&self.params.airframe, &s.history[0].cmd, lead);
+            }
+        }
+        let c = dcm_earth_to_body(&quat);
+        let v_air = c * (vel - s.wind);
         let airspeed = v_air.norm();
         // α = atan2(w_a, u_a) (2.2.12), β = asin(v_a/V̄) (2.2.13), 0 at V̄ → 0 as the plant.
         let (alpha, beta) = if airspeed < AIRSPEED_EPS {
@@ -1082,22 +1348,22 @@ impl Ekf {
         };
         let trace = |k: usize| (s.cov[(k, k)] + s.cov[(k + 1, k + 1)] + s.cov[(k + 2, k + 2)]).sqrt();
         Estimate {
-            pos_ned: s.pos,
-            vel_ned: s.vel,
-            vel_body: c * s.vel,
-            rates: self.rates(),
-            quat: s.quat,
-            euler_321: euler_321_from_quat(&s.quat),
+            pos_ned: pos,
+            vel_ned: vel,
+            vel_body: c * vel,
+            rates: s.out_rates,
+            quat,
+            euler_321: euler_321_from_quat(&quat),
             airspeed,
             alpha,
             beta,
-            specific_force: self.specific_force(),
-            thrust: s.actuators.thrust,
-            surfaces: s.actuators.surfaces,
+            specific_force: s.out_force,
+            thrust: actuators.thrust,
+            surfaces: actuators.surfaces,
             induced_velocity: self
                 .params
                 .airframe
-                .induced_velocity(airspeed, v_air.x, s.actuators.thrust),
+                .induced_velocity(airspeed, v_air.x, actuators.thrust),
             std_pos: trace(ix::POS),
             std_vel: trace(ix::VEL),
             std_att: trace(ix::ATT),
@@ -1154,7 +1420,7 @@ mod tests {
         let mut s = FilterState::zeroed();
         s.pos = Vector3::new(1.0, 2.0, 3.0);
         s.cov[(3, 4)] = 0.25;
-        s.last_fix = -7;
+        s.last_fix = i32::MIN;
         s.has_fix = true;
         s.rejected = 12;
         s.gps_rejections_in_row = [3, 1];

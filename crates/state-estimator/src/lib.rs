@@ -17,4 +17,4 @@ pub use ekf::{
     Reason, Rejection, Sensor, StepReport, N_ERR, STATE_WORDS,
 };
 pub use geodesy::LocalFrame;
-pub use params::{AnalogFilter, Earth, EstimatorParams, ProcessNoise, SensorNoise, Tuning};
+pub use params::{AnalogFilter, Earth, EstimatorParams, Prediction, ProcessNoise, SensorNoise, Tuning};

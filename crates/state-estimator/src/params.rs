@@ -156,6 +156,13 @@ pub struct Tuning {
     /// After this many consecutive rejected GPS position (or velocity) fixes the filter
     /// resets that block to the GPS: the filter, not the GPS, has lost track.
     pub gps_reset_after: u32,
+    /// The position outputs are relative to the aircraft's position at initialisation (the
+    /// mission's start, where the reference path begins) instead of the reference point: the
+    /// estimate of the start position is a clone of the position at initialisation in the
+    /// filter state, refined by every later fix through its correlation, so the outputs carry
+    /// the error of the displacement since the start, not the first fix's (σ 4 m per axis).
+    /// The aircraft must start at the NED origin the controllers' mission assumes.
+    pub relative_to_start: bool,
 }
 
 impl Default for Tuning {
@@ -170,6 +177,7 @@ impl Default for Tuning {
             sigma_sideslip: 0.1,
             sideslip_min_airspeed: 10.0,
             gps_reset_after: 8,
+            relative_to_start: true,
         }
     }
 }
@@ -214,12 +222,48 @@ impl AnalogFilter {
     }
 }
 
+/// Delay compensation of the outputs by the estimator's aircraft model.
+///
+/// The latest IMU sample describes the aircraft [`AnalogFilter::delay`] before the
+/// communication point; the controller applies its command `lead` after the end of the
+/// estimator's step. With `model` the estimator integrates its own model of the aircraft
+/// (the [`Airframe`]'s forces and moments, motor and servos, driven by the commands it was
+/// given) from the sample's time to the output's and adds the model's change of the rates
+/// and specific force to the sample (a Smith predictor: the measurement anchors the
+/// prediction, the model only supplies the change over the delay). Without `model` the
+/// samples are extrapolated by their backward difference (noisy).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Prediction {
+    /// Predict with the aircraft model (else extrapolate the samples) (–).
+    pub model: bool,
+    /// Lead of the outputs beyond the end of the step (s) (0): the controller applies the
+    /// command computed from them this much later, e.g. one communication step under a
+    /// Jacobi master (the plant gets the controller's output of the previous step).
+    pub lead: f64,
+    /// Aerodynamic model of the prediction, as the plant's `aero_model` (–): 0 the thesis's
+    /// linear derivatives, 1 the global model (the plant FMU's default; identical to the
+    /// thesis's for |α| ≤ 10°, |β| ≤ 15°).
+    pub aero_model: i32,
+}
+
+impl Default for Prediction {
+    fn default() -> Self {
+        Self {
+            model: true,
+            lead: 0.0,
+            aero_model: 1,
+        }
+    }
+}
+
 /// Everything the estimator needs besides the measurements.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct EstimatorParams {
     pub noise: SensorNoise,
     /// The sensors' analogue filter (compensated).
     pub filter: AnalogFilter,
+    /// Compensation of the delays by the aircraft model.
+    pub prediction: Prediction,
     pub process: ProcessNoise,
     pub earth: Earth,
     pub tuning: Tuning,
@@ -280,6 +324,15 @@ impl EstimatorParams {
                 "measurement_latency = {} s must be within [0, 1] s",
                 self.filter.latency
             ));
+        }
+        if !(self.prediction.lead.is_finite() && (0.0..=1.0).contains(&self.prediction.lead)) {
+            return Err(format!(
+                "prediction_lead = {} s must be within [0, 1] s",
+                self.prediction.lead
+            ));
+        }
+        if tailsitter_physics::AeroModel::from_index(self.prediction.aero_model).is_none() {
+            return Err(format!("aero_model = {} must be 0 or 1", self.prediction.aero_model));
         }
         let e = &self.earth;
         if !e.ref_latitude.is_finite() || e.ref_latitude.abs() > 1.5 {

@@ -70,6 +70,11 @@ struct Flight {
     /// Max |true position − reference| after the first 5 s (m): the initial GPS-fix error
     /// has been flown out.
     max_true_error_after_5s: f64,
+    /// RMS error of the estimated rates (rad/s) and specific force (m/s²) against the truth.
+    rms_rates: f64,
+    rms_force: f64,
+    /// Max |true position − reference| per phase (m).
+    phase_max: [f64; 5],
     final_phase: Phase,
     rejected: i32,
 }
@@ -77,51 +82,103 @@ struct Flight {
 /// Communication step of the chain (s).
 const H: f64 = 0.02;
 
+/// How the chain is stepped.
+#[derive(Debug, Clone, Copy)]
+struct Chain {
+    /// Jacobi: every unit's inputs from the outputs at t before any unit steps (the
+    /// estimator fuses the sensors' outputs of the previous step, the plant flies the
+    /// command of the previous sample). Else Gauss-Seidel.
+    jacobi: bool,
+    /// Plant and sensor steps per controller step (plant and sensors at H / m).
+    substeps: usize,
+    /// The sensors' 8 Hz Butterworth.
+    butterworth: bool,
+}
+
+const GAUSS_SEIDEL: Chain = Chain {
+    jacobi: false,
+    substeps: 1,
+    butterworth: true,
+};
+
+/// The estimator's parameters for a chain: the measurement latency and the lead to the
+/// controller's application time are one communication step each under Jacobi.
+fn estimator_params(chain: Chain, sensor_params: &sensor_model::Params) -> EstimatorParams {
+    let mut params = EstimatorParams::default();
+    params.filter.enabled = chain.butterworth;
+    if !chain.butterworth {
+        // The sensors' σ's unfiltered (the defaults are those after their 8 Hz filter).
+        params.noise.sigma_mag = sensor_params.mag_std;
+        params.noise.sigma_pitot_dp = sensor_params.pitot_std;
+    }
+    if chain.jacobi {
+        params.filter.latency = H;
+        params.prediction.lead = H;
+    }
+    params
+}
+
 /// Gauss-Seidel per 20 ms, as the FMU chain: plant outputs at t → sensor model step
 /// [t, t + h) (its samples of the truth held at t, 8 Hz Butterworth on the analogue channels
 /// when `butterworth`) → controller(t) on the estimate at t → estimator step with the
-/// measurements at t and the command for [t, t + h) → plant step.
+/// measurements at t and the command for [t, t + h) → plant step. Jacobi as
+/// `tailsim.avionics` (see [`Chain`]).
 fn fly_on_estimates<C: FlightController>(c: &mut C, seed: u64, butterworth: bool) -> Flight {
+    fly_chain(
+        c,
+        seed,
+        Chain {
+            butterworth,
+            ..GAUSS_SEIDEL
+        },
+    )
+}
+
+fn fly_chain<C: FlightController>(c: &mut C, seed: u64, chain: Chain) -> Flight {
     let plant = Plant::new(Airframe::default());
     let m = MissionParams::default();
     let trim = plant.trim_vertical_climb(m.v_vertical).unwrap();
     let mut x = trim.state;
     let sensor_params = sensor_model::Params {
         seed,
-        filter_enabled: butterworth,
+        filter_enabled: chain.butterworth,
         ..Default::default()
     };
     let mut sensors = sensor_model::SensorModel::new(sensor_params).unwrap();
-    let mut params = EstimatorParams::default();
-    params.filter.enabled = butterworth;
-    if !butterworth {
-        // The sensors' σ's unfiltered (the defaults are those after their 8 Hz filter).
-        params.noise.sigma_mag = sensor_params.mag_std;
-        params.noise.sigma_pitot_dp = sensor_params.pitot_std;
-    }
-    let mut ekf = Ekf::new(params).unwrap();
+    let mut ekf = Ekf::new(estimator_params(chain, &sensor_params)).unwrap();
     let wind = Vector3::zeros();
     let m0 = sensors.start(&truth(&plant, &x, &trim.inputs, &wind), 0.0).unwrap();
     ekf.initialize(&to_estimator(&m0), &trim.inputs);
     let n = (m.end_time() / H).round() as usize;
+    let hs = H / chain.substeps as f64;
     let mut f = Flight {
         max_true_error: 0.0,
         max_est_error: 0.0,
         max_error_ratio: 0.0,
         max_att_error: 0.0,
         max_true_error_after_5s: 0.0,
+        phase_max: [0.0; 5],
+        rms_rates: 0.0,
+        rms_force: 0.0,
         final_phase: Phase::Vertical1,
         rejected: 0,
     };
     let mut u = trim.inputs;
+    // Jacobi: the sensors' outputs of the previous step.
+    let mut held = to_estimator(&m0);
     for k in 0..n {
         let t = k as f64 * H;
         // The sensors at t (their values do not depend on the command of this step).
-        let meas = to_estimator(
+        let fresh = to_estimator(
             &sensors
-                .step(&truth(&plant, &x, &u, &wind), t, H)
+                .step(&truth(&plant, &x, &u, &wind), t, hs)
                 .unwrap_or_else(|e| panic!("sensors failed at t = {t}: {e:?}")),
         );
+        let meas = if chain.jacobi {
+            std::mem::replace(&mut held, fresh)
+        } else {
+            fresh
+        };
         let input = ControllerInput {
             t,
             measurement: measurement(&ekf.estimate()),
@@ -130,10 +187,15 @@ fn fly_on_estimates<C: FlightController>(c: &mut C, seed: u64, butterworth: bool
         let out = c
             .sample(&input)
             .unwrap_or_else(|e| panic!("controller failed at t = {t}: {e}"));
-        u = closed_loop::plant_inputs(&out.command);
+        let u_new = closed_loop::plant_inputs(&out.command);
+        if !chain.jacobi {
+            u = u_new;
+        }
         let pos = Vector3::new(x[idx::POS_N], x[idx::POS_E], x[idx::POS_D]);
         let true_error = (pos - out.diagnostics.ref_pos_ned).norm();
         f.max_true_error = f.max_true_error.max(true_error);
+        let ph = out.diagnostics.phase as usize;
+        f.phase_max[ph] = f.phase_max[ph].max(true_error);
         if t >= 5.0 {
             f.max_true_error_after_5s = f.max_true_error_after_5s.max(true_error);
         }
@@ -142,17 +204,53 @@ fn fly_on_estimates<C: FlightController>(c: &mut C, seed: u64, butterworth: bool
             state_estimator::attitude_error(&dcm_earth_to_body(&q_true), &dcm_earth_to_body(&ekf.estimate().quat))
                 .norm(),
         );
+        let tr = truth(&plant, &x, &u, &wind);
+        f.rms_rates += (ekf.estimate().rates - tr.rates).norm_squared() / n as f64;
+        f.rms_force += (ekf.estimate().specific_force - tr.specific_force).norm_squared() / n as f64;
         let e = (pos - ekf.estimate().pos_ned).norm();
         f.max_est_error = f.max_est_error.max(e);
         f.max_error_ratio = f.max_error_ratio.max(e / (3.0 * ekf.estimate().std_pos));
         f.final_phase = out.diagnostics.phase;
         ekf.step(&meas, &u, H);
-        plant
-            .advance(&mut x, &u, &wind, H)
-            .unwrap_or_else(|e| panic!("plant failed after t = {t}: {e}"));
+        for j in 0..chain.substeps {
+            if j > 0 {
+                let tj = t + j as f64 * hs;
+                let mut unused = Measurements::default();
+                held_or_fresh(
+                    &mut sensors,
+                    &truth(&plant, &x, &u, &wind),
+                    tj,
+                    hs,
+                    if chain.jacobi { &mut held } else { &mut unused },
+                );
+            }
+            plant
+                .advance(&mut x, &u, &wind, hs)
+                .unwrap_or_else(|e| panic!("plant failed after t = {t}: {e}"));
+        }
+        if chain.jacobi {
+            u = u_new;
+        }
     }
     f.rejected = ekf.estimate().rejected_measurements;
+    f.rms_rates = f.rms_rates.sqrt();
+    f.rms_force = f.rms_force.sqrt();
     f
+}
+
+/// A sensor step at an inner point of the controller's step; its outputs replace `out`.
+fn held_or_fresh(
+    sensors: &mut sensor_model::SensorModel,
+    truth: &sensor_model::Truth,
+    t: f64,
+    h: f64,
+    out: &mut Measurements,
+) {
+    *out = to_estimator(
+        &sensors
+            .step(truth, t, h)
+            .unwrap_or_else(|e| panic!("sensors failed at t = {t}: {e:?}")),
+    );
 }
 
 #[test]
@@ -167,10 +265,11 @@ fn lqr_flies_the_mission_on_the_estimates() {
     assert_eq!(f.final_phase, Phase::Vertical2);
     // The estimate stays inside its reported 3σ (√trace) while the controller flies on it.
     // The controller flies the estimate: the true distance from the reference is its own
-    // tracking error (0.39 m on the true state) plus the estimation error, which starts
-    // at the first GPS fix's (σ 4 m per axis).
+    // tracking error (0.39 m on the true state) plus the estimation error of the
+    // displacement since the start (positions relative to the start: the first GPS fix's
+    // error, σ 4 m per axis, cancels); the issue's bar is 5 m.
     assert!(f.max_error_ratio < 1.0, "estimation error {} × 3σ", f.max_error_ratio);
-    assert!(f.max_true_error < 8.0, "true tracking error {}", f.max_true_error);
+    assert!(f.max_true_error < 5.0, "true tracking error {}", f.max_true_error);
 }
 
 #[test]
@@ -184,7 +283,7 @@ fn tsd_flies_the_mission_on_the_estimates() {
     );
     assert_eq!(f.final_phase, Phase::Vertical2);
     assert!(f.max_error_ratio < 1.0, "estimation error {} × 3σ", f.max_error_ratio);
-    assert!(f.max_true_error < 8.0, "true tracking error {}", f.max_true_error);
+    assert!(f.max_true_error < 5.0, "true tracking error {}", f.max_true_error);
 }
 
 /// With the avionics' 8 Hz second-order Butterworth on the analogue channels (App. D.3:
@@ -203,7 +302,7 @@ fn lqr_flies_the_mission_with_butterworth_filtered_sensors() {
     );
     assert_eq!(f.final_phase, Phase::Vertical2);
     assert!(f.max_error_ratio < 1.0, "estimation error {} × 3σ", f.max_error_ratio);
-    assert!(f.max_true_error < 8.0, "true tracking error {}", f.max_true_error);
+    assert!(f.max_true_error < 5.0, "true tracking error {}", f.max_true_error);
 }
 
 /// Formerly a known issue: without the compensation of the filter's delay (outputs p, q, r,
@@ -226,13 +325,73 @@ fn tsd_flies_the_mission_with_butterworth_filtered_sensors() {
         );
         assert_eq!(f.final_phase, Phase::Vertical2);
         assert!(f.max_error_ratio < 1.0, "estimation error {} × 3σ", f.max_error_ratio);
-        // As on the true state (0.4 m) plus the estimation error (first GPS fix: σ 4 m per
-        // axis); an unstable loop grows to tens of metres.
-        assert!(f.max_true_error < 8.0, "true tracking error {}", f.max_true_error);
+        // As on the true state (0.4 m) plus the estimation error of the displacement since
+        // the start; an unstable loop grows to tens of metres.
+        assert!(f.max_true_error < 5.0, "true tracking error {}", f.max_true_error);
         assert!(
             f.max_att_error < 10f64.to_radians(),
             "attitude error {}",
             f.max_att_error
         );
     }
+}
+
+/// Both controllers under each chain: Gauss-Seidel and Jacobi at 20 ms, Gauss-Seidel with
+/// plant and sensors at 5 ms, with the 8 Hz Butterworth and the model prediction over the
+/// delays ([`state_estimator::Prediction`]). Prints the max true position error per phase.
+#[test]
+fn both_controllers_fly_every_chain_on_the_model_compensated_estimates() {
+    let m = MissionParams::default();
+    let chains = [
+        ("Gauss-Seidel 20 ms", GAUSS_SEIDEL),
+        (
+            "Jacobi 20 ms",
+            Chain {
+                jacobi: true,
+                ..GAUSS_SEIDEL
+            },
+        ),
+        (
+            "Gauss-Seidel 5 ms",
+            Chain {
+                substeps: 4,
+                ..GAUSS_SEIDEL
+            },
+        ),
+        (
+            "Jacobi 5 ms",
+            Chain {
+                jacobi: true,
+                substeps: 4,
+                ..GAUSS_SEIDEL
+            },
+        ),
+    ];
+    let mut failures = Vec::new();
+    for (name, chain) in chains {
+        for seed in [1, 2] {
+            let mut lqr = LqrController::new(Airframe::default(), m, LqrParams::default()).unwrap();
+            let mut tsd = TsdController::new(Airframe::default(), m, TsdParams::default()).unwrap();
+            let flights = [
+                ("LQR", fly_chain(&mut lqr, seed, chain)),
+                ("TSD", fly_chain(&mut tsd, seed, chain)),
+            ];
+            for (ctrl, f) in flights {
+                eprintln!(
+                    "{ctrl} {name} seed {seed}: max |x − ref| per phase {:.2?} m, attitude error {:.2}°, est. error ≤ {:.2} × 3σ, RMS rates {:.3} rad/s, force {:.3} m/s²",
+                    f.phase_max,
+                    f.max_att_error.to_degrees(),
+                    f.max_error_ratio,
+                    f.rms_rates,
+                    f.rms_force
+                );
+                // Bar of the issue: < 5 m in every phase (positions relative to the start:
+                // the first GPS fix's error, σ 4 m per axis, is not flown).
+                if f.final_phase != Phase::Vertical2 || f.phase_max.iter().any(|e| *e >= 5.0) {
+                    failures.push(format!("{ctrl} {name} seed {seed}: {:.2?}", f.phase_max));
+                }
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
 }
