@@ -21,7 +21,7 @@ pub mod weights;
 
 use flight_mission::{
     Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, MissionParams, Notice, ParamError,
-    SampledUnit,
+    SampledUnit, Weathervane, WeathervaneParams,
 };
 use nalgebra::{SMatrix, SVector, Vector3};
 use tailsitter_physics::Airframe;
@@ -194,6 +194,8 @@ pub struct LqrController {
     rep: EulerRep,
     next_relinearisation: f64,
     stats: GainStats,
+    /// Heading reference in vertical flight (README, "Weathervaning").
+    weathervane: Weathervane,
 }
 
 /// Names of the commands, for [`Notice::Saturated`].
@@ -314,6 +316,12 @@ impl LqrController {
             },
         )
         .map_err(ControlError)?;
+        let weathervane = Weathervane::new(if params.configuration == 0 {
+            WeathervaneParams::tuned()
+        } else {
+            WeathervaneParams::disabled()
+        })
+        .map_err(ControlError)?;
         let mut c = Self {
             airframe,
             mission,
@@ -330,6 +338,7 @@ impl LqrController {
             rep: EulerRep::E231,
             next_relinearisation: 0.0,
             stats: GainStats::default(),
+            weathervane,
         };
         // Initial gains on the trajectory's start point, so a failure shows at construction.
         let p0 = c.trajectory.at(0.0);
@@ -374,6 +383,17 @@ impl LqrController {
     /// The position integrators ∫ΔN, ∫ΔE, ∫Δh (m·s) and the wind estimate (NED, m/s).
     pub fn integrator_states(&self) -> (f64, Vector3<f64>, Vector3<f64>) {
         (self.integrator, self.pos_integrator, self.wind)
+    }
+
+    /// The weathervane of the heading reference (tuned configuration: on; thesis: off).
+    pub fn weathervane(&self) -> &Weathervane {
+        &self.weathervane
+    }
+
+    /// Replace the weathervane's tuning (resets its state).
+    pub fn set_weathervane(&mut self, params: WeathervaneParams) -> Result<(), ControlError> {
+        self.weathervane = Weathervane::new(params).map_err(ControlError)?;
+        Ok(())
     }
 
     /// The weight schedule.
@@ -564,6 +584,7 @@ impl LqrController {
             out(*v);
         }
         out(f64::from(self.anchored_phase));
+        self.weathervane.save(out);
     }
 
     /// Positions in the [`Self::save`] layout of the controller's continuous states, with
@@ -608,6 +629,7 @@ impl LqrController {
             return Err(ControlError(format!("LQR controller state: anchored phase {phase}")));
         }
         self.anchored_phase = phase as i32;
+        self.weathervane.restore(&mut || next()).map_err(ControlError)?;
         Ok(())
     }
 }
@@ -673,7 +695,8 @@ impl SampledUnit for LqrController {
             return Err(ControlError(format!("sample time t = {t} is not finite")));
         }
         let measured_neh = Vector3::new(m.pos_ned.x, m.pos_ned.y, -m.pos_ned.z);
-        let reference = self.trajectory.at(t);
+        let heading = self.weathervane.update(&self.mission, t, m);
+        let reference = self.trajectory.at(t).turned(&heading);
         let off = &input.ref_offset_ned;
         let phase = self.mission.phase_at(t).0 as i32;
         if self.params.reanchors() && self.origin.is_some() && phase != self.anchored_phase {
