@@ -19,7 +19,7 @@ fn main() {
             Case::Gust { axis, phase } => format!("gust {} phase {phase}", ["N", "E", "D"][*axis]),
         };
         println!(
-            "{} {:<12} cfg{c} {name:<24} held {:<5} max {:8.2} m fin {:7.2} m |α| {:5.1} |β| {:5.1} tilt {:5.1} {}",
+            "{} {:<12} cfg{c} {name:<24} held {:<5} max {:8.2} m fin {:7.2} m |α| {:5.1} |β| {:5.1} tilt {:5.1} calm {:?} {}",
             k.name(),
             format!("{o:?}"),
             r.held,
@@ -28,6 +28,7 @@ fn main() {
             r.max_alpha_deg,
             r.max_beta_deg,
             r.max_tilt_deg,
+            r.calm_max_pos_error.map(|e| (e * 100.0).round() / 100.0),
             r.failure.unwrap_or_default()
         );
     }
