@@ -1,10 +1,18 @@
 //! Print the hover-in-wind campaign of issue 16 (`analysis::envelope_hover`) as a table.
-//! `cargo run --release -p analysis --example hover_scan [filter]`
+//! `cargo run --release -p analysis --example hover_scan [filter]`; with `--json` the
+//! `envelope_hover` key of report.json instead.
 use analysis::envelope_hover::{cases, fly_case, Case};
 use rayon::prelude::*;
 
 fn main() {
     let filter = std::env::args().nth(1).unwrap_or_default();
+    if filter == "--json" {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&analysis::envelope_hover::report()).expect("json")
+        );
+        return;
+    }
     let cases: Vec<_> = cases()
         .into_iter()
         .filter(|c| format!("{c:?}").contains(&filter))
