@@ -49,7 +49,8 @@ fn main() {
         run(&mut c, &s)
     };
     println!("t err dN dE dD V alpha beta tilt_deg nose_az belly_az p q r T_cmd de da dr dfc dfd dv");
-    for smp in trace.samples.iter().step_by(10) {
+    let every: usize = std::env::var("EVERY").ok().and_then(|s| s.parse().ok()).unwrap_or(10);
+    for smp in trace.samples.iter().step_by(every) {
         let q = smp.measurement.quat;
         let r = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(q[3], q[0], q[1], q[2]));
         let x = r * nalgebra::Vector3::x();

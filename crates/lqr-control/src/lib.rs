@@ -39,6 +39,10 @@ pub const MIN_AIRSPEED: f64 = 0.5;
 /// Bound on the magnitude of the wind estimate (m/s).
 pub const MAX_WIND_ESTIMATE: f64 = 20.0;
 
+/// |α| or |β| beyond which vertical flight counts as flight in wind (rad): the gains are then
+/// computed about the reference instead of the measured state (README, "Hover in wind").
+pub const HOVER_WIND_AIR_ANGLE: f64 = 0.5235987755982988; // 30°
+
 /// Size of the augmented ZOH exponential: states + integrator + inputs.
 const NM: usize = NA + NU;
 
@@ -723,12 +727,27 @@ impl SampledUnit for LqrController {
         xt[ix::ALPHA] = air_ref.y;
         xt[ix::BETA] = air_ref.z;
 
+        // Vertical flight in wind: the weathervane engaged (a filtered horizontal wind ≥ its
+        // engage speed) or, before the filter has caught up with a sudden wind, measured air
+        // angles beyond [`HOVER_WIND_AIR_ANGLE`] (in still air the climb's air comes from the
+        // nose: α, β ≈ 0). Tuned configuration only (the thesis's has no weathervane).
+        let in_wind = self.params.configuration == 0
+            && self.mission.phase_at(t).0.is_vertical()
+            && (self.weathervane.engaged()
+                || m.alpha.abs() > HOVER_WIND_AIR_ANGLE
+                || m.beta.abs() > HOVER_WIND_AIR_ANGLE);
         let mut notice = None;
         let due = t + 1e-9 >= self.next_relinearisation;
         if !self.have_gain || rep != self.rep || due {
             // Relinearise about the current estimated state with the trajectory's inputs
             // (§3.1.3, 3.2.7–3.2.9); positions do not enter the model.
-            match self.solve_gain(rep, &x, &reference.u, t) {
+            // Hover in wind (README, "Hover in wind"): relinearise about the reference (the
+            // weathervaned vertical attitude with the wind-consistent air data) rather than
+            // the measured state, whose tilt into the wind and α, β of 30–90° put the linear
+            // model far outside its range (gains that over-tilted and lost the aircraft
+            // from 7 m/s). In still air the weathervane is never engaged: unchanged.
+            let xl = if in_wind { xt } else { x };
+            match self.solve_gain(rep, &xl, &reference.u, t) {
                 Ok(sol) => {
                     self.gain = sol.gain;
                     self.have_gain = true;
