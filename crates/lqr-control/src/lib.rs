@@ -43,6 +43,11 @@ pub const MAX_WIND_ESTIMATE: f64 = 20.0;
 /// computed about the reference instead of the measured state (README, "Hover in wind").
 pub const HOVER_WIND_AIR_ANGLE: f64 = 0.5235987755982988; // 30°
 
+/// Time constant τ_s of the integral action on the horizontal position in wind (s).
+pub const HOVER_SHIFT_TIME: f64 = 3.0;
+/// Bound on that integral's shift of the regulated position (m).
+pub const HOVER_SHIFT_LIMIT: f64 = 5.0;
+
 /// Size of the augmented ZOH exponential: states + integrator + inputs.
 const NM: usize = NA + NU;
 
@@ -200,6 +205,8 @@ pub struct LqrController {
     stats: GainStats,
     /// Heading reference in vertical flight (README, "Weathervaning").
     weathervane: Weathervane,
+    /// Integrated horizontal position error in wind (N, E, 0) (m) (README, "Hover in wind").
+    wind_shift: Vector3<f64>,
 }
 
 /// Names of the commands, for [`Notice::Saturated`].
@@ -343,6 +350,7 @@ impl LqrController {
             next_relinearisation: 0.0,
             stats: GainStats::default(),
             weathervane,
+            wind_shift: Vector3::zeros(),
         };
         // Initial gains on the trajectory's start point, so a failure shows at construction.
         let p0 = c.trajectory.at(0.0);
@@ -589,6 +597,9 @@ impl LqrController {
         }
         out(f64::from(self.anchored_phase));
         self.weathervane.save(out);
+        for v in self.wind_shift.iter() {
+            out(*v);
+        }
     }
 
     /// Positions in the [`Self::save`] layout of the controller's continuous states, with
@@ -634,6 +645,8 @@ impl LqrController {
         }
         self.anchored_phase = phase as i32;
         self.weathervane.restore(&mut || next()).map_err(ControlError)?;
+        let mut take = || next().ok_or_else(|| ControlError("truncated LQR controller state".into()));
+        self.wind_shift = Vector3::new(take()?, take()?, take()?);
         Ok(())
     }
 }
@@ -713,20 +726,6 @@ impl SampledUnit for LqrController {
         // Reference position: start + trajectory + offset, as (N, E, h).
         let ref_neh = origin + reference.pos_neh + Vector3::new(off.x, off.y, -off.z);
         let rep = self.rep_for(&reference);
-
-        let mut x = state_of(
-            rep, m.airspeed, m.alpha, m.beta, &m.rates, &m.quat, &m.pos_ned, m.thrust,
-        );
-        let mut xt = reference.state(rep);
-        xt[ix::N] = ref_neh.x;
-        xt[ix::E] = ref_neh.y;
-        xt[ix::H] = ref_neh.z;
-        self.estimate_wind(m);
-        let air_ref = self.air_reference(&reference);
-        xt[ix::V] = air_ref.x;
-        xt[ix::ALPHA] = air_ref.y;
-        xt[ix::BETA] = air_ref.z;
-
         // Vertical flight in wind: the weathervane engaged (a filtered horizontal wind ≥ its
         // engage speed) or, before the filter has caught up with a sudden wind, measured air
         // angles beyond [`HOVER_WIND_AIR_ANGLE`] (in still air the climb's air comes from the
@@ -736,6 +735,49 @@ impl SampledUnit for LqrController {
             && (self.weathervane.engaged()
                 || m.alpha.abs() > HOVER_WIND_AIR_ANGLE
                 || m.beta.abs() > HOVER_WIND_AIR_ANGLE);
+        // Integral action on the horizontal position in wind (README, "Hover in wind"): the
+        // position the gains regulate to is the reference moved against the integrated error,
+        // s ← s + T_s/τ_s (p − p_ref), regulated to p_ref − s, so the steady error of a
+        // steady wind vanishes; out of wind s decays with τ_s, and in still air it stays 0.
+        {
+            let ts = self.mission.sample_time;
+            let e = Vector3::new(measured_neh.x - ref_neh.x, measured_neh.y - ref_neh.y, 0.0);
+            let next = if in_wind {
+                let mut s = self.wind_shift + e * (ts / HOVER_SHIFT_TIME);
+                let n = s.norm();
+                if n > HOVER_SHIFT_LIMIT {
+                    s *= HOVER_SHIFT_LIMIT / n;
+                }
+                s
+            } else if self.wind_shift != Vector3::zeros() {
+                let s = self.wind_shift * (-ts / HOVER_SHIFT_TIME).exp();
+                if s.norm() < 1e-6 {
+                    Vector3::zeros()
+                } else {
+                    s
+                }
+            } else {
+                self.wind_shift
+            };
+            if next.iter().all(|v| v.is_finite()) {
+                self.wind_shift = next;
+            }
+        }
+        let ctrl_neh = ref_neh - self.wind_shift;
+
+        let mut x = state_of(
+            rep, m.airspeed, m.alpha, m.beta, &m.rates, &m.quat, &m.pos_ned, m.thrust,
+        );
+        let mut xt = reference.state(rep);
+        xt[ix::N] = ctrl_neh.x;
+        xt[ix::E] = ctrl_neh.y;
+        xt[ix::H] = ctrl_neh.z;
+        self.estimate_wind(m);
+        let air_ref = self.air_reference(&reference);
+        xt[ix::V] = air_ref.x;
+        xt[ix::ALPHA] = air_ref.y;
+        xt[ix::BETA] = air_ref.z;
+
         let mut notice = None;
         let due = t + 1e-9 >= self.next_relinearisation;
         if !self.have_gain || rep != self.rep || due {
@@ -763,9 +805,9 @@ impl SampledUnit for LqrController {
                             self.rep, m.airspeed, m.alpha, m.beta, &m.rates, &m.quat, &m.pos_ned, m.thrust,
                         );
                         xt = reference.state(self.rep);
-                        xt[ix::N] = ref_neh.x;
-                        xt[ix::E] = ref_neh.y;
-                        xt[ix::H] = ref_neh.z;
+                        xt[ix::N] = ctrl_neh.x;
+                        xt[ix::E] = ctrl_neh.y;
+                        xt[ix::H] = ctrl_neh.z;
                         xt[ix::V] = air_ref.x;
                         xt[ix::ALPHA] = air_ref.y;
                         xt[ix::BETA] = air_ref.z;
