@@ -311,4 +311,43 @@ mod tests {
             assert!(o.held, "{}: {o:?}", kind.name());
         }
     }
+
+    /// The goal for the LQR: 8 m/s steps from every 45° held (Gauss-Seidel), where
+    /// it tumbled from 7 m/s before the weathervane, the gains about the reference in wind
+    /// and the integral action in wind.
+    #[test]
+    fn lqr_holds_8_m_s_steps_from_every_bearing() {
+        for from_deg in BEARINGS_DEG {
+            let o = fly_case(Kind::Lqr, Ordering::GaussSeidel, 0, Case::Step { speed: 8.0, from_deg });
+            assert!(o.held, "from {from_deg}°: {o:?}");
+        }
+    }
+
+    /// The thesis configurations fly without weathervane; the tuned ones with it.
+    #[test]
+    fn weathervane_only_in_the_tuned_configuration() {
+        let m = hover_mission();
+        for (configuration, on) in [(0, true), (1, false)] {
+            let lqr = LqrController::new(
+                Airframe::default(),
+                m,
+                LqrParams {
+                    configuration,
+                    ..Default::default()
+                },
+            )
+            .unwrap();
+            let tsd = TsdController::new(
+                Airframe::default(),
+                m,
+                TsdParams {
+                    configuration,
+                    ..Default::default()
+                },
+            )
+            .unwrap();
+            assert_eq!(lqr.weathervane().params().enabled, on);
+            assert_eq!(tsd.weathervane().params().enabled, on);
+        }
+    }
 }

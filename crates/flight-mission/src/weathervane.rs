@@ -30,7 +30,9 @@
 //! aircraft turns by at most 90°. Released, the heading is held. In the first vertical phase
 //! the target is 0 from `return_window` = (π/2)/`max_rate` + `return_margin` before the
 //! transition (the transitions and level flight follow the mission's heading); in the
-//! transitions and level flight it is 0; in the last vertical phase it is free.
+//! transitions and level flight it is 0; in the last vertical phase it is free from
+//! `settle_time` after its start (the back transition's errors settle first: turning at once
+//! left the LQR 40° off vertical at the end of the default mission in a 3 m/s crosswind).
 //!
 //! **Rate limit.** ψ̇_w = clamp((target − ψ_w)/`time_constant`, ±`max_rate`): a first-order
 //! approach, rate-limited, so the heading reference and its rate are continuous.
@@ -38,6 +40,11 @@
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
 use crate::{Measurement, MissionParams, Phase};
+
+/// Time constant of the tuned wind estimate (s).
+const FILTER_TIME: f64 = 4.0;
+/// Engage speed of the tuned weathervane (m/s).
+const ENGAGE_SPEED: f64 = 3.0;
 
 /// Tuning of the weathervane (not FMU parameters: fixed per controller configuration).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -57,6 +64,9 @@ pub struct WeathervaneParams {
     /// Time the heading is back at the mission's before the first transition, beyond the
     /// worst-case turn (π/2)/`max_rate` + 3 `time_constant` (s).
     pub return_margin: f64,
+    /// Time into the last vertical phase from which the heading follows the wind (s): the
+    /// back transition's errors settle first.
+    pub settle_time: f64,
 }
 
 impl WeathervaneParams {
@@ -69,17 +79,20 @@ impl WeathervaneParams {
     }
 
     /// The tuned configuration's weathervane (README of each controller, "Weathervaning"):
-    /// a 2 s estimate (a 1 − cos gust of 2 s turns the aircraft little), engaged from 2 m/s
-    /// (below, a crosswind is flown as it comes), a 90° turn in about 5 s at most 20°/s.
+    /// a 4 s estimate and engaged from 3 m/s, so that a 1 − cos gust turns the aircraft little
+    /// (with 2 s and 2 m/s a 6 m/s, 5 s crosswind gust turned the TSD mid-gust: 11 m off;
+    /// below 3 m/s a crosswind is flown as it comes), released below 1 m/s, a 90° turn in
+    /// about 5 s at most 20°/s, following the wind from 5 s into the last vertical phase.
     pub fn tuned() -> Self {
         Self {
             enabled: true,
-            filter_time: 2.0,
-            engage_speed: 2.0,
+            filter_time: FILTER_TIME,
+            engage_speed: ENGAGE_SPEED,
             release_speed: 1.0,
             max_rate: 20f64.to_radians(),
             time_constant: 0.5,
             return_margin: 0.5,
+            settle_time: 5.0,
         }
     }
 
@@ -106,11 +119,13 @@ impl WeathervaneParams {
             && self.engage_speed.is_finite()
             && self.engage_speed >= self.release_speed
             && self.return_margin.is_finite()
-            && self.return_margin >= 0.0)
+            && self.return_margin >= 0.0
+            && self.settle_time.is_finite()
+            && self.settle_time >= 0.0)
         {
             return Err(format!(
-                "weathervane speeds {} / {} m/s and margin {} s: need 0 <= release <= engage, margin >= 0",
-                self.release_speed, self.engage_speed, self.return_margin
+                "weathervane speeds {} / {} m/s and margin {} s: need 0 <= release <= engage, margin >= 0 (settle time {} s: >= 0)",
+                self.release_speed, self.engage_speed, self.return_margin, self.settle_time
             ));
         }
         Ok(())
@@ -182,23 +197,36 @@ impl Weathervane {
         self.wind
     }
 
-    /// Whether the heading follows the wind.
+    /// Whether the wind estimate has engaged the weathervane (it may still be held at the
+    /// mission's heading by the phase: see [`Self::active`]).
     pub fn engaged(&self) -> bool {
         self.engaged
     }
 
-    /// The target heading for the filtered wind, phase and the present heading (rad).
-    fn target(&mut self, mission: &MissionParams, t: f64) -> f64 {
+    /// Whether the mission phase at `t` lets the heading follow the wind (the first vertical
+    /// phase until the return window, the last one from `settle_time`).
+    pub fn free(&self, mission: &MissionParams, t: f64) -> bool {
         let p = &self.params;
         let (phase, tau) = mission.phase_at(t);
-        let free = match phase {
-            Phase::Vertical1 => mission.t_vertical_1 - tau > p.return_window(),
-            Phase::Vertical2 => true,
-            _ => false,
-        };
-        if !free {
+        p.enabled
+            && match phase {
+                Phase::Vertical1 => mission.t_vertical_1 - tau > p.return_window(),
+                Phase::Vertical2 => tau >= p.settle_time,
+                _ => false,
+            }
+    }
+
+    /// Whether the heading follows the wind now: engaged and [`Self::free`].
+    pub fn active(&self, mission: &MissionParams, t: f64) -> bool {
+        self.engaged && self.free(mission, t)
+    }
+
+    /// The target heading for the filtered wind, phase and the present heading (rad).
+    fn target(&mut self, mission: &MissionParams, t: f64) -> f64 {
+        if !self.free(mission, t) {
             return 0.0;
         }
+        let p = &self.params;
         let w = Vector3::new(self.wind.x, self.wind.y, 0.0);
         let speed = w.norm();
         if !speed.is_finite() {
@@ -366,7 +394,7 @@ mod tests {
     #[test]
     fn idle_in_still_air_and_below_the_engage_speed() {
         let mission = hover_mission();
-        for w in [Vector3::zeros(), Vector3::new(0.0, 1.9, 0.0)] {
+        for w in [Vector3::zeros(), Vector3::new(0.0, 2.9, 0.0)] {
             let mut wv = Weathervane::new(WeathervaneParams::tuned()).unwrap();
             for k in 0..500 {
                 let h = wv.update(&mission, k as f64 * 0.02, &hovering(0.0, w));

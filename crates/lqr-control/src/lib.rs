@@ -726,15 +726,17 @@ impl SampledUnit for LqrController {
         // Reference position: start + trajectory + offset, as (N, E, h).
         let ref_neh = origin + reference.pos_neh + Vector3::new(off.x, off.y, -off.z);
         let rep = self.rep_for(&reference);
-        // Vertical flight in wind: the weathervane engaged (a filtered horizontal wind ≥ its
-        // engage speed) or, before the filter has caught up with a sudden wind, measured air
-        // angles beyond [`HOVER_WIND_AIR_ANGLE`] (in still air the climb's air comes from the
-        // nose: α, β ≈ 0). Tuned configuration only (the thesis's has no weathervane).
+        // Vertical flight in wind: where the weathervane may turn (`Weathervane::free`), it
+        // is engaged (a filtered horizontal wind ≥ its engage speed) or, before the filter has caught up with a sudden wind, measured air
+        // angles beyond [`HOVER_WIND_AIR_ANGLE`] with an unfiltered air-data wind ≥ the engage
+        // speed (in still air the climb's air comes from the nose, α, β ≈ 0, and the air-data
+        // wind is zero). Tuned configuration only (the thesis's has no weathervane).
         let in_wind = self.params.configuration == 0
-            && self.mission.phase_at(t).0.is_vertical()
+            && self.weathervane.free(&self.mission, t)
             && (self.weathervane.engaged()
-                || m.alpha.abs() > HOVER_WIND_AIR_ANGLE
-                || m.beta.abs() > HOVER_WIND_AIR_ANGLE);
+                || (m.alpha.abs() > HOVER_WIND_AIR_ANGLE || m.beta.abs() > HOVER_WIND_AIR_ANGLE)
+                    && flight_mission::weathervane::air_data_wind(m).xy().norm()
+                        >= self.weathervane.params().engage_speed);
         // Integral action on the horizontal position in wind (README, "Hover in wind"): the
         // position the gains regulate to is the reference moved against the integrated error,
         // s ← s + T_s/τ_s (p − p_ref), regulated to p_ref − s, so the steady error of a
