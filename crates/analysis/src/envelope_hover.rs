@@ -66,26 +66,26 @@ pub fn hover_mission() -> MissionParams {
     }
 }
 
-/// Configuration: 0 tuned (weathervane on), 1 thesis.
-fn controller(kind: Kind, mission: &MissionParams, configuration: i32) -> Box<dyn FnMut(&Plant, &Scenario) -> Trace> {
-    let m = *mission;
+/// Fly `kind` (configuration 0 tuned, weathervane on; 1 thesis) through `s` on `p`.
+fn fly_with(kind: Kind, configuration: i32, p: &Plant, s: &Scenario) -> Trace {
+    let m = s.mission;
     match kind {
-        Kind::Lqr => Box::new(move |p, s| {
+        Kind::Lqr => {
             let params = LqrParams {
                 configuration,
                 ..Default::default()
             };
             let mut c = LqrController::new(Airframe::default(), m, params).expect("LQR");
             run(p, &mut c, s)
-        }),
-        Kind::Tsd => Box::new(move |p, s| {
+        }
+        Kind::Tsd => {
             let params = TsdParams {
                 configuration,
                 ..Default::default()
             };
             let mut c = TsdController::new(Airframe::default(), m, params).expect("TSD");
             run(p, &mut c, s)
-        }),
+        }
     }
 }
 
@@ -172,7 +172,7 @@ pub fn fly_case(kind: Kind, ordering: Ordering, configuration: i32, case: Case) 
             s.stop_time = STEP_STOP;
             s.ordering = ordering;
             s.wind = Wind::step_from(STEP_TIME, from_deg.to_radians(), speed);
-            let trace = controller(kind, &mission, configuration)(&p, &s);
+            let trace = fly_with(kind, configuration, &p, &s);
             outcome(&p, &trace, 0.0, f64::INFINITY)
         }
         Case::Gust { axis, phase } => {
@@ -183,10 +183,10 @@ pub fn fly_case(kind: Kind, ordering: Ordering, configuration: i32, case: Case) 
             s.stop_time = mission.end_time() + 5.0;
             s.ordering = ordering;
             let (t0, t1) = (mid - 0.5 * GUST_DURATION, mid + 0.5 * GUST_DURATION + GUST_WINDOW_AFTER);
-            let calm = controller(kind, &mission, configuration)(&p, &s);
+            let calm = fly_with(kind, configuration, &p, &s);
             let calm = outcome(&p, &calm, t0, t1);
             s.wind = Wind::gust_along(axis, GUST_AMPLITUDE, t0, GUST_DURATION);
-            let trace = controller(kind, &mission, configuration)(&p, &s);
+            let trace = fly_with(kind, configuration, &p, &s);
             let mut o = outcome(&p, &trace, t0, t1);
             o.held = o.completed
                 && !o.ground_contact
