@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from fmu_util import ROOT
-from tailsim.master import EDGE_TOLERANCE, RunResult, one_minus_cosine_gust, step
+from tailsim.master import EDGE_TOLERANCE, RunResult, one_minus_cosine_gust, step, wind_from
 from tailsim.metrics import CRITERIA, mission_check
 
 DATA = ROOT / "tests" / "data"
@@ -92,3 +92,18 @@ def test_rust_mission_defaults_are_the_declared_ones(rust):
     declared = {v["name"]: v["start"] for v in fragment["variables"] if v.get("group") == "mission"}
     for name, value in rust["inputs"]["mission"].items():
         assert declared[name] == value, name
+
+
+def test_wind_from_a_bearing_agrees_with_rust(rust):
+    """`wind_from` and the steady step from a bearing (`closed_loop::wind_from`,
+    `Wind::step_from`), 7 m/s from eight bearings, switched on at 2.1 s."""
+    assert len(rust["winds_from"]) == 8
+    for w in rust["winds_from"]:
+        ours = wind_from(w["bearing"], 7.0)
+        assert list(ours) == pytest.approx(w["wind"], rel=1e-15, abs=1e-15)
+        profile = step(2.1, ours)
+        assert list(profile(2.1 - 1e-6)) == w["step_before"] == [0.0, 0.0, 0.0]
+        assert list(profile(105 * 0.02)) == pytest.approx(w["step_at"], rel=1e-15, abs=1e-15)
+        # Blowing *from* the bearing: the air moves away from it.
+        b = w["bearing"]
+        assert ours[0] * math.cos(b) + ours[1] * math.sin(b) == pytest.approx(-7.0)

@@ -19,6 +19,7 @@ import json
 import pathlib
 
 from . import aero_report
+from . import report_hover
 from .report import fmt_or_dash, fmt_pole, markdown_to_html, shortest
 
 OPEN_LOOP_NOTES = (
@@ -281,6 +282,7 @@ SECTIONS = {
     "robustness.md": robustness,
     "gusts.md": gusts,
     "aero_models.md": aero_report.section,
+    "envelope_hover.md": report_hover.section,
 }
 
 

@@ -46,6 +46,14 @@ def step(t_step: float, value: Vector3) -> TimeFunction:
     return f
 
 
+def wind_from(from_bearing: float, speed: float) -> Vector3:
+    """Air-mass velocity (NED, m/s) of a horizontal wind of `speed` blowing *from* the
+    bearing `from_bearing` (rad, 0 = from the north, π/2 = from the east):
+    −speed (cos b, sin b, 0), as `closed_loop::wind_from`. A steady wind switched on at
+    t is `step(t, wind_from(b, speed))` (`closed_loop::Wind::step_from`)."""
+    return (-speed * math.cos(from_bearing), -speed * math.sin(from_bearing), 0.0)
+
+
 def one_minus_cosine_gust(t_start: float, duration: float, amplitude: Vector3) -> TimeFunction:
     """The 1 − cos gust: amplitude · (1 − cos(2π(t − t_start)/duration))/2 for
     0 ≤ (t − t_start)/duration ≤ 1, zero outside (as `closed_loop::Wind::OneMinusCosine`)."""

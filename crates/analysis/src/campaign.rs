@@ -47,6 +47,8 @@ pub struct Config {
     pub gusts: bool,
     /// Show progress bars.
     pub progress: bool,
+    /// Fly the hover-in-wind campaign of issue 16 ([`crate::envelope_hover`]).
+    pub envelope_hover: bool,
     /// The mission.
     pub mission: MissionParams,
 }
@@ -65,6 +67,7 @@ impl Config {
             wide_tau_power: 3.0,
             gusts: true,
             progress: true,
+            envelope_hover: true,
             mission: MissionParams::default(),
         }
     }
@@ -776,6 +779,7 @@ pub fn write_report(out: &Path, s: &Summary, cfg: &Config) -> std::io::Result<()
         "sensitivity": sensitivity,
         "robustness": robustness,
         "gusts": gusts,
+        "envelope_hover": if cfg.envelope_hover { crate::envelope_hover::report() } else { serde_json::Value::Null },
     });
     let text = serde_json::to_string_pretty(&report).map_err(std::io::Error::other)?;
     write(out, "report.json", &text)?;

@@ -11,6 +11,7 @@ pub mod cache;
 pub mod campaign;
 pub mod closed;
 pub mod controllers;
+pub mod envelope_hover;
 pub mod linalg;
 pub mod modes;
 pub mod native_campaign;

@@ -109,7 +109,36 @@ pub enum Wind {
     },
 }
 
+/// Air-mass velocity, NED (m/s), of a horizontal wind of `speed` (m/s) blowing *from* the
+/// bearing `from_bearing` (rad, 0 = from the north, π/2 = from the east): the meteorological
+/// convention, `−speed (cos b, sin b, 0)`. `tailsim.master.wind_from` mirrors it.
+pub fn wind_from(from_bearing: f64, speed: f64) -> Vector3<f64> {
+    let (s, c) = from_bearing.sin_cos();
+    Vector3::new(-speed * c, -speed * s, 0.0)
+}
+
 impl Wind {
+    /// A steady wind of `speed` (m/s) from `from_bearing` (rad) switched on at `t_start` (s):
+    /// [`Wind::Step`] of [`wind_from`].
+    pub fn step_from(t_start: f64, from_bearing: f64, speed: f64) -> Self {
+        Wind::Step {
+            t_start,
+            wind: wind_from(from_bearing, speed),
+        }
+    }
+
+    /// A 1 − cos gust of peak `amplitude` (m/s) along the earth axis `axis` (0 N, 1 E, 2 D;
+    /// + = towards north/east/down) from `t_start` over `duration` (s).
+    pub fn gust_along(axis: usize, amplitude: f64, t_start: f64, duration: f64) -> Self {
+        let mut a = Vector3::zeros();
+        a[axis.min(2)] = amplitude;
+        Wind::OneMinusCosine {
+            t_start,
+            duration,
+            amplitude: a,
+        }
+    }
+
     /// Wind at time `t`.
     pub fn at(&self, t: f64) -> Vector3<f64> {
         match *self {
@@ -585,6 +614,21 @@ mod tests {
         // mid-gust: the full amplitude on top of the steady wind
         assert!((w.at(2.0) - Vector3::new(5.0, -2.0, -1.0)).norm() < 1e-12);
         assert!((w.at(1.5) - Vector3::new(3.0, -2.0, -0.5)).norm() < 1e-12);
+    }
+
+    #[test]
+    fn wind_from_bearings() {
+        // From the east: blows towards the west.
+        let e = wind_from(std::f64::consts::FRAC_PI_2, 5.0);
+        assert!((e - Vector3::new(0.0, -5.0, 0.0)).norm() < 1e-12);
+        let n = wind_from(0.0, 3.0);
+        assert_eq!(n, Vector3::new(-3.0, 0.0, 0.0));
+        let sw = wind_from(225f64.to_radians(), 2f64.sqrt());
+        assert!((sw - Vector3::new(1.0, 1.0, 0.0)).norm() < 1e-12);
+        assert_eq!(Wind::step_from(1.0, 0.0, 3.0).at(1.0), n);
+        assert_eq!(Wind::step_from(1.0, 0.0, 3.0).at(0.5), Vector3::zeros());
+        let g = Wind::gust_along(1, 5.0, 2.0, 2.0);
+        assert_eq!(g.at(3.0), Vector3::new(0.0, 5.0, 0.0));
     }
 
     #[test]

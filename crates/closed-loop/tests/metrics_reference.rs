@@ -10,7 +10,7 @@
 
 use std::path::PathBuf;
 
-use closed_loop::{CheckSample, Criteria, MissionCheck, Scenario, Wind};
+use closed_loop::{wind_from, CheckSample, Criteria, MissionCheck, Scenario, Wind};
 use flight_mission::MissionParams;
 use nalgebra::Vector3;
 use serde_json::{json, Value};
@@ -85,7 +85,24 @@ fn computed() -> Value {
         })
         .collect();
 
+    // Steady winds from eight bearings (rad) at 7 m/s, switched on at 2.1 s (issue 16).
+    let bearings: Vec<f64> = (0..8)
+        .map(|k| f64::from(k) * std::f64::consts::FRAC_PI_4 + 0.1)
+        .collect();
+    let winds_from: Vec<Value> = bearings
+        .iter()
+        .map(|&b| {
+            json!({
+                "bearing": b,
+                "wind": wind_from(b, 7.0).as_slice(),
+                "step_before": Wind::step_from(2.1, b, 7.0).at(2.1 - 1e-6).as_slice(),
+                "step_at": Wind::step_from(2.1, b, 7.0).at(105.0 * 0.02).as_slice(),
+            })
+        })
+        .collect();
+
     json!({
+        "winds_from": winds_from,
         "inputs": {
             "theta_level_trim": THETA_LEVEL_TRIM,
             "mission": {

@@ -13,7 +13,9 @@ use nalgebra::{Vector3, Vector4};
 use std::fmt;
 
 mod unit;
+pub mod weathervane;
 pub use unit::{HeldOutput, Sampled, SampledUnit, SteppedUnit, UnitLog};
+pub use weathervane::{HeadingRef, Weathervane, WeathervaneParams};
 
 /// Mission parameters (docs/DESIGN.md §3), the same names and defaults in both controllers.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -21,7 +21,7 @@ pub mod weights;
 
 use flight_mission::{
     Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, MissionParams, Notice, ParamError,
-    SampledUnit,
+    SampledUnit, Weathervane, WeathervaneParams,
 };
 use nalgebra::{SMatrix, SVector, Vector3};
 use tailsitter_physics::Airframe;
@@ -38,6 +38,15 @@ pub const MIN_AIRSPEED: f64 = 0.5;
 
 /// Bound on the magnitude of the wind estimate (m/s).
 pub const MAX_WIND_ESTIMATE: f64 = 20.0;
+
+/// |α| or |β| beyond which vertical flight counts as flight in wind (rad): the gains are then
+/// computed about the reference instead of the measured state (README, "Hover in wind").
+pub const HOVER_WIND_AIR_ANGLE: f64 = 0.5235987755982988; // 30°
+
+/// Time constant τ_s of the integral action on the horizontal position in wind (s).
+pub const HOVER_SHIFT_TIME: f64 = 3.0;
+/// Bound on that integral's shift of the regulated position (m).
+pub const HOVER_SHIFT_LIMIT: f64 = 5.0;
 
 /// Size of the augmented ZOH exponential: states + integrator + inputs.
 const NM: usize = NA + NU;
@@ -194,6 +203,10 @@ pub struct LqrController {
     rep: EulerRep,
     next_relinearisation: f64,
     stats: GainStats,
+    /// Heading reference in vertical flight (README, "Weathervaning").
+    weathervane: Weathervane,
+    /// Integrated horizontal position error in wind (N, E, 0) (m) (README, "Hover in wind").
+    wind_shift: Vector3<f64>,
 }
 
 /// Names of the commands, for [`Notice::Saturated`].
@@ -314,6 +327,12 @@ impl LqrController {
             },
         )
         .map_err(ControlError)?;
+        let weathervane = Weathervane::new(if params.configuration == 0 {
+            WeathervaneParams::tuned()
+        } else {
+            WeathervaneParams::disabled()
+        })
+        .map_err(ControlError)?;
         let mut c = Self {
             airframe,
             mission,
@@ -330,6 +349,8 @@ impl LqrController {
             rep: EulerRep::E231,
             next_relinearisation: 0.0,
             stats: GainStats::default(),
+            weathervane,
+            wind_shift: Vector3::zeros(),
         };
         // Initial gains on the trajectory's start point, so a failure shows at construction.
         let p0 = c.trajectory.at(0.0);
@@ -374,6 +395,17 @@ impl LqrController {
     /// The position integrators ∫ΔN, ∫ΔE, ∫Δh (m·s) and the wind estimate (NED, m/s).
     pub fn integrator_states(&self) -> (f64, Vector3<f64>, Vector3<f64>) {
         (self.integrator, self.pos_integrator, self.wind)
+    }
+
+    /// The weathervane of the heading reference (tuned configuration: on; thesis: off).
+    pub fn weathervane(&self) -> &Weathervane {
+        &self.weathervane
+    }
+
+    /// Replace the weathervane's tuning (resets its state).
+    pub fn set_weathervane(&mut self, params: WeathervaneParams) -> Result<(), ControlError> {
+        self.weathervane = Weathervane::new(params).map_err(ControlError)?;
+        Ok(())
     }
 
     /// The weight schedule.
@@ -564,6 +596,10 @@ impl LqrController {
             out(*v);
         }
         out(f64::from(self.anchored_phase));
+        self.weathervane.save(out);
+        for v in self.wind_shift.iter() {
+            out(*v);
+        }
     }
 
     /// Positions in the [`Self::save`] layout of the controller's continuous states, with
@@ -608,6 +644,9 @@ impl LqrController {
             return Err(ControlError(format!("LQR controller state: anchored phase {phase}")));
         }
         self.anchored_phase = phase as i32;
+        self.weathervane.restore(&mut || next()).map_err(ControlError)?;
+        let mut take = || next().ok_or_else(|| ControlError("truncated LQR controller state".into()));
+        self.wind_shift = Vector3::new(take()?, take()?, take()?);
         Ok(())
     }
 }
@@ -673,7 +712,8 @@ impl SampledUnit for LqrController {
             return Err(ControlError(format!("sample time t = {t} is not finite")));
         }
         let measured_neh = Vector3::new(m.pos_ned.x, m.pos_ned.y, -m.pos_ned.z);
-        let reference = self.trajectory.at(t);
+        let heading = self.weathervane.update(&self.mission, t, m);
+        let reference = self.trajectory.at(t).turned(&heading);
         let off = &input.ref_offset_ned;
         let phase = self.mission.phase_at(t).0 as i32;
         if self.params.reanchors() && self.origin.is_some() && phase != self.anchored_phase {
@@ -686,14 +726,54 @@ impl SampledUnit for LqrController {
         // Reference position: start + trajectory + offset, as (N, E, h).
         let ref_neh = origin + reference.pos_neh + Vector3::new(off.x, off.y, -off.z);
         let rep = self.rep_for(&reference);
+        // Vertical flight in wind: where the weathervane may turn (`Weathervane::free`), it
+        // is engaged (a filtered horizontal wind ≥ its engage speed) or, before the filter has caught up with a sudden wind, measured air
+        // angles beyond [`HOVER_WIND_AIR_ANGLE`] with an unfiltered air-data wind ≥ the engage
+        // speed (in still air the climb's air comes from the nose, α, β ≈ 0, and the air-data
+        // wind is zero). Tuned configuration only (the thesis's has no weathervane).
+        let in_wind = self.params.configuration == 0
+            && self.weathervane.free(&self.mission, t)
+            && (self.weathervane.engaged()
+                || (m.alpha.abs() > HOVER_WIND_AIR_ANGLE || m.beta.abs() > HOVER_WIND_AIR_ANGLE)
+                    && flight_mission::weathervane::air_data_wind(m).xy().norm()
+                        >= self.weathervane.params().engage_speed);
+        // Integral action on the horizontal position in wind (README, "Hover in wind"): the
+        // position the gains regulate to is the reference moved against the integrated error,
+        // s ← s + T_s/τ_s (p − p_ref), regulated to p_ref − s, so the steady error of a
+        // steady wind vanishes; out of wind s decays with τ_s, and in still air it stays 0.
+        {
+            let ts = self.mission.sample_time;
+            let e = Vector3::new(measured_neh.x - ref_neh.x, measured_neh.y - ref_neh.y, 0.0);
+            let next = if in_wind {
+                let mut s = self.wind_shift + e * (ts / HOVER_SHIFT_TIME);
+                let n = s.norm();
+                if n > HOVER_SHIFT_LIMIT {
+                    s *= HOVER_SHIFT_LIMIT / n;
+                }
+                s
+            } else if self.wind_shift != Vector3::zeros() {
+                let s = self.wind_shift * (-ts / HOVER_SHIFT_TIME).exp();
+                if s.norm() < 1e-6 {
+                    Vector3::zeros()
+                } else {
+                    s
+                }
+            } else {
+                self.wind_shift
+            };
+            if next.iter().all(|v| v.is_finite()) {
+                self.wind_shift = next;
+            }
+        }
+        let ctrl_neh = ref_neh - self.wind_shift;
 
         let mut x = state_of(
             rep, m.airspeed, m.alpha, m.beta, &m.rates, &m.quat, &m.pos_ned, m.thrust,
         );
         let mut xt = reference.state(rep);
-        xt[ix::N] = ref_neh.x;
-        xt[ix::E] = ref_neh.y;
-        xt[ix::H] = ref_neh.z;
+        xt[ix::N] = ctrl_neh.x;
+        xt[ix::E] = ctrl_neh.y;
+        xt[ix::H] = ctrl_neh.z;
         self.estimate_wind(m);
         let air_ref = self.air_reference(&reference);
         xt[ix::V] = air_ref.x;
@@ -705,7 +785,13 @@ impl SampledUnit for LqrController {
         if !self.have_gain || rep != self.rep || due {
             // Relinearise about the current estimated state with the trajectory's inputs
             // (§3.1.3, 3.2.7–3.2.9); positions do not enter the model.
-            match self.solve_gain(rep, &x, &reference.u, t) {
+            // Hover in wind (README, "Hover in wind"): relinearise about the reference (the
+            // weathervaned vertical attitude with the wind-consistent air data) rather than
+            // the measured state, whose tilt into the wind and α, β of 30–90° put the linear
+            // model far outside its range (gains that over-tilted and lost the aircraft
+            // from 7 m/s). In still air the weathervane is never engaged: unchanged.
+            let xl = if in_wind { xt } else { x };
+            match self.solve_gain(rep, &xl, &reference.u, t) {
                 Ok(sol) => {
                     self.gain = sol.gain;
                     self.have_gain = true;
@@ -721,9 +807,9 @@ impl SampledUnit for LqrController {
                             self.rep, m.airspeed, m.alpha, m.beta, &m.rates, &m.quat, &m.pos_ned, m.thrust,
                         );
                         xt = reference.state(self.rep);
-                        xt[ix::N] = ref_neh.x;
-                        xt[ix::E] = ref_neh.y;
-                        xt[ix::H] = ref_neh.z;
+                        xt[ix::N] = ctrl_neh.x;
+                        xt[ix::E] = ctrl_neh.y;
+                        xt[ix::H] = ctrl_neh.z;
                         xt[ix::V] = air_ref.x;
                         xt[ix::ALPHA] = air_ref.y;
                         xt[ix::BETA] = air_ref.z;

@@ -34,7 +34,7 @@
 
 use std::sync::Arc;
 
-use flight_mission::{MissionParams, Phase};
+use flight_mission::{HeadingRef, MissionParams, Phase};
 use nalgebra::{Matrix3, Vector3, Vector4};
 use tailsitter_physics::{quat_from_euler_321, Airframe};
 
@@ -113,6 +113,20 @@ impl TrajPoint {
             thrust: l(self.thrust, o.thrust),
             u: self.u.lerp(&o.u, s),
         }
+    }
+
+    /// The reference turned about the earth's down axis by the weathervane's heading ψ_w
+    /// (3-2-1 heading + ψ_w: `DCM^BE · rot_z(ψ_w)`), its rate added to the body rates as
+    /// `DCM^BE (0, 0, ψ̇_w)`; positions, air data and inputs unchanged. Zero heading and
+    /// rate: `self` unchanged.
+    pub fn turned(mut self, h: &HeadingRef) -> TrajPoint {
+        if h.heading == 0.0 && h.rate == 0.0 {
+            return self;
+        }
+        self.euler_321.z += h.heading;
+        let c = EulerRep::E321.dcm(&self.euler_321);
+        self.rates += c * Vector3::new(0.0, 0.0, h.rate);
+        self
     }
 
     /// Attitude quaternion (A.2.8) of the reference.

@@ -43,13 +43,14 @@ pub use trajectory::{Reference, Trajectory};
 
 use flight_mission::{
     Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, MissionParams, Notice, ParamError, Phase,
-    SampledUnit,
+    SampledUnit, Weathervane, WeathervaneParams,
 };
 use nalgebra::{Matrix3, Quaternion, RowVector3, UnitQuaternion, Vector3};
 use tailsitter_physics::Airframe;
 
-/// Number of f64 values written by [`TsdController::save`].
-pub const STATE_LEN: usize = 6;
+/// Number of f64 values written by [`TsdController::save`]: the loops' six and the
+/// weathervane's.
+pub const STATE_LEN: usize = 6 + flight_mission::weathervane::WEATHERVANE_STATE_LEN;
 
 /// Internal signals of the last sample, for tests, plots and tuning.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -162,6 +163,8 @@ pub struct TsdController {
     /// Bit mask of the saturated commands at the last sample (notices on new saturation only).
     saturated: u32,
     internals: Internals,
+    /// Heading reference in vertical flight (README, "Weathervaning").
+    weathervane: Weathervane,
 }
 
 /// Names of the commands, bit order of the saturation mask.
@@ -191,7 +194,24 @@ impl TsdController {
             initialized: false,
             saturated: 0,
             internals: Internals::default(),
+            weathervane: Weathervane::new(if params.configuration == 0 {
+                WeathervaneParams::tuned()
+            } else {
+                WeathervaneParams::disabled()
+            })
+            .map_err(ParamError)?,
         })
+    }
+
+    /// The weathervane of the heading reference (tuned configuration: on; thesis: off).
+    pub fn weathervane(&self) -> &Weathervane {
+        &self.weathervane
+    }
+
+    /// Replace the weathervane's tuning (resets its state).
+    pub fn set_weathervane(&mut self, params: WeathervaneParams) -> Result<(), ParamError> {
+        self.weathervane = Weathervane::new(params).map_err(ParamError)?;
+        Ok(())
     }
 
     /// The nominal airframe and Table 4.3 poles for `mission`.
@@ -234,6 +254,7 @@ impl TsdController {
         out(self.integrators.roll);
         out(self.integrators.directional);
         out(self.saturated as f64);
+        self.weathervane.save(out);
     }
 
     /// Restore what [`Self::save`] wrote; a truncated state is an error and leaves `self` unchanged.
@@ -242,6 +263,10 @@ impl TsdController {
         for slot in v.iter_mut() {
             *slot = next().ok_or_else(|| ControlError("truncated TSD controller state".into()))?;
         }
+        let mut weathervane = self.weathervane;
+        let mut rest = v[6..].iter().copied();
+        weathervane.restore(&mut || rest.next()).map_err(ControlError)?;
+        self.weathervane = weathervane;
         self.initialized = v[0] != 0.0;
         self.integrators = Integrators {
             thrust: v[1],
@@ -466,6 +491,9 @@ impl SampledUnit for TsdController {
         // ---- Reference (§4.3.3) ------------------------------------------------------
         let reference = self.trajectory.at(input.t);
         let ref_pos = reference.pos + input.ref_offset_ned;
+        // Heading reference (weathervane, README "Weathervaning"): the prescribed normal
+        // vector turned about the earth's down axis by ψ_w; zero in still air.
+        let heading = self.weathervane.update(&self.mission, input.t, meas);
         let pos_error_vec = meas.pos_ned - ref_pos;
 
         // ---- Measured wind axes and specific accelerations ----------------------------
@@ -538,7 +566,13 @@ impl SampledUnit for TsdController {
         let a_cmd = sigma.dot(&iw);
         let n_vec = sigma - iw * a_cmd;
         let n_norm = n_vec.norm();
-        let k_pres = reference.prescribed_normal();
+        let k_pres = if heading.heading == 0.0 {
+            reference.prescribed_normal()
+        } else {
+            let k = reference.prescribed_normal();
+            let (s, c) = heading.heading.sin_cos();
+            Vector3::new(c * k.x - s * k.y, s * k.x + c * k.y, k.z)
+        };
         // Weight of the computed normal vector: 1 inside level flight, ramping over the
         // blend time at both ends, and faded out when the normal command is too small.
         let normal_weight = if reference.phase == Phase::Level {
