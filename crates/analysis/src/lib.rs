@@ -10,6 +10,7 @@ pub mod cache;
 pub mod campaign;
 pub mod closed;
 pub mod controllers;
+pub mod envelope_transitions;
 pub mod linalg;
 pub mod modes;
 pub mod robust;
