@@ -18,6 +18,7 @@ import argparse
 import json
 import pathlib
 
+from . import report_envelope
 from .report import fmt_or_dash, fmt_pole, markdown_to_html, shortest
 
 OPEN_LOOP_NOTES = (
@@ -277,6 +278,7 @@ SECTIONS = {
     "table_5_1.md": table_5_1,
     "robustness.md": robustness,
     "gusts.md": gusts,
+    "envelope_transitions.md": report_envelope.section,
 }
 
 

@@ -298,9 +298,11 @@ pub fn min_times() -> Vec<MinTime> {
     out
 }
 
-/// Time series of one flown mission for the plot (every 5th sample).
-fn series(trace: &Trace) -> Value {
-    let pick: Vec<&closed_loop::Sample> = trace.samples.iter().step_by(5).collect();
+/// Time series of one flown mission for the plot: every 5th sample (0.1 s) from 1 s before
+/// the first transition to 4 s after the second.
+fn series(trace: &Trace, m: &MissionParams) -> Value {
+    let s = m.phase_starts();
+    let pick: Vec<&closed_loop::Sample> = trace.window(s[1] - 1.0, s[4] + 4.0).step_by(5).collect();
     json!({
         "t": pick.iter().map(|s| s.t).collect::<Vec<_>>(),
         "alpha_deg": pick.iter().map(|s| s.measurement.alpha.to_degrees()).collect::<Vec<_>>(),
@@ -351,7 +353,7 @@ pub fn report() -> Value {
                 let m = mission(t1, t2);
                 fastest.insert(
                     kind.name().to_string(),
-                    json!({"t1": t1, "t2": t2, "phase_starts": m.phase_starts(), "series": series(&trace)}),
+                    json!({"t1": t1, "t2": t2, "phase_starts": m.phase_starts(), "series": series(&trace, &m)}),
                 );
             }
         }
