@@ -19,14 +19,14 @@ def section(d: dict) -> list[str]:
     e = d.get("envelope_transitions")
     if not e:
         return []
-    bound = shortest(e["alpha_bound_deg"])
+    bound = shortest(round(e["alpha_bound_deg"], 6))
     out = [
         "",
         "## Transitions inside the linear α range (issue 16)",
         "",
         f"Global aerodynamics (aero_model = {e['aero_model']}), flown natively (`closed_loop::fly`). The tuned "
         "controllers (configuration 0) fly the α- and thrust-limited point-mass profile "
-        f"(|α_ref| ≤ {shortest(e['profile_alpha_max_deg'])}°, T_ref ≤ {shortest(e['profile_thrust_fraction'])} T_max; "
+        f"(|α_ref| ≤ {shortest(round(e['profile_alpha_max_deg'], 6))}°, T_ref ≤ {shortest(e['profile_thrust_fraction'])} T_max; "
         "derivation in `crates/flight-mission/README.md`); the thesis configuration (1) flies the thesis's "
         "transitions unchanged. Altitude deviation: max |h − h_ref| from the start of a transition to "
         f"{shortest(e['settle_window_s'])} s after its end; max α: largest |α| from the first transition to "
@@ -65,9 +65,17 @@ def section(d: dict) -> list[str]:
         )
     fastest = e.get("fastest", {})
     if fastest:
-        out += ["", "Fastest timing each tuned controller flies with α ≤ " + bound + "° (both masters):", ""]
+        out += [
+            "",
+            f"Fastest transitions each tuned controller flies with α ≤ {bound}° in both masters (shortest flown "
+            "rotations; plot `envelope_fastest.png`):",
+            "",
+        ]
         for k, f in fastest.items():
-            out.append(f"- {k}: T1 = {shortest(f['t1'])} s, T2 = {shortest(f['t2'])} s (plot `envelope_fastest.png`)")
+            out.append(
+                f"- {k}: T1 = {shortest(f['t1'])} s, T2 = {shortest(f['t2'])} s: flown rotations "
+                f"{fmt_or_dash(f['rotation_t1'])} s (front) and {fmt_or_dash(f['rotation_t2'])} s (back)"
+            )
     return out
 
 
