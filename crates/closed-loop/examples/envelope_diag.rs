@@ -60,7 +60,7 @@ fn main() {
                 dh1,
                 if tr.completed() { "" } else { "FAIL" }
             );
-            if verbose && t1 == 2.0 && ord == Ordering::GaussSeidel {
+            if verbose && t1 == 3.0 && ord == Ordering::GaussSeidel {
                 for s in tr.samples.iter().filter(|s| s.t > 4.9 && s.t < 12.0).step_by(10) {
                     let e = s.measurement.pos_ned - s.diagnostics.ref_pos_ned;
                     println!(

@@ -41,6 +41,12 @@ pub const PROFILE_STEP: f64 = 0.01;
 pub const CONTROL_LAG: f64 = 0.12;
 /// Gain k_γ of the flight-path-angle tracking of the guidance law (1/s).
 pub const K_GAMMA: f64 = 3.0;
+/// Largest negative α of the profile as a fraction of `alpha_max`: the push-over from the
+/// vertical climb may use −α_max (thrust tilted over the path), but the pull-out to level
+/// follows at +α_max within a second at low speed, and the controllers then lag the swing
+/// of 2 α_max (TSD: sink of 3.3 m and α 17° in the fast mission; 2.3 m and 6° with 0.3).
+/// With 0.3 gravity does most of the turn-over (γ̇ = −g cos γ / V once the path leans).
+pub const PUSH_OVER_ALPHA_FRACTION: f64 = 0.3;
 /// Gain k_V of the speed tracking of the guidance law (1/s).
 pub const K_SPEED: f64 = 1.5;
 const FRAC_PI_2: f64 = core::f64::consts::FRAC_PI_2;
@@ -238,7 +244,8 @@ impl Profile {
             let gamma_dot_c = gd_dot + K_GAMMA * (gd - gamma);
             let (_, _, q) = lift_drag(v, alpha);
             let fn_req = pm.mass * (v * gamma_dot_c + pm.gravity * gamma.cos());
-            let alpha_c = (fn_req / (thrust + q * pm.c_l_alpha)).clamp(-limits.alpha_max, limits.alpha_max);
+            let alpha_c = (fn_req / (thrust + q * pm.c_l_alpha))
+                .clamp(-PUSH_OVER_ALPHA_FRACTION * limits.alpha_max, limits.alpha_max);
             let v_dot_c = vd_dot + K_SPEED * (vd - v);
             let (_, drag, _) = lift_drag(v, alpha);
             let thrust_c = ((pm.mass * (v_dot_c + pm.gravity * gamma.sin()) + drag) / alpha.cos()).clamp(t_lo, t_hi);
@@ -379,7 +386,13 @@ mod tests {
             let p = Profile::new(&m, &pm, &lim).unwrap();
             for w in p.points().windows(2) {
                 let (a, b) = (&w[0], &w[1]);
-                assert!(a.alpha.abs() <= lim.alpha_max + 1e-12, "α {} at {}", a.alpha, a.t);
+                assert!(a.alpha <= lim.alpha_max + 1e-12, "α {} at {}", a.alpha, a.t);
+                assert!(
+                    a.alpha >= -PUSH_OVER_ALPHA_FRACTION * lim.alpha_max - 1e-12,
+                    "α {} at {}",
+                    a.alpha,
+                    a.t
+                );
                 assert!(a.thrust <= lim.thrust_fraction * pm.thrust_max + 1e-9);
                 // The recorded rates are the derivatives of the recorded path (V̈ steps where
                 // a phase boundary steps the thrust command: hence the looser V̇ bound).
