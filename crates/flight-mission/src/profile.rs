@@ -41,7 +41,7 @@ pub const PROFILE_STEP: f64 = 0.01;
 pub const CONTROL_LAG: f64 = 0.12;
 /// Gain k_γ of the flight-path-angle tracking of the guidance law (1/s).
 pub const K_GAMMA: f64 = 3.0;
-/// Largest negative α of the profile as a fraction of `alpha_max`: the push-over from the
+/// Largest negative α of the missions' profiles as a fraction of `alpha_max`: the push-over from the
 /// vertical climb may use −α_max (thrust tilted over the path), but the pull-out to level
 /// follows at +α_max within a second at low speed, and the controllers then lag the swing
 /// of 2 α_max (TSD: sink of 3.3 m and α 17° in the fast mission; 2.3 m and 6° with 0.3).
@@ -81,6 +81,8 @@ pub struct ProfileLimits {
     pub thrust_fraction: f64,
     /// Smallest reference thrust as a fraction of the weight (slip-stream over the surfaces).
     pub thrust_floor: f64,
+    /// Largest negative α as a fraction of `alpha_max` ([`PUSH_OVER_ALPHA_FRACTION`]).
+    pub push_over_fraction: f64,
 }
 
 impl ProfileLimits {
@@ -90,6 +92,7 @@ impl ProfileLimits {
             alpha_max: mission.transition_alpha_max,
             thrust_fraction: mission.transition_thrust_fraction,
             thrust_floor: 0.1,
+            push_over_fraction: PUSH_OVER_ALPHA_FRACTION,
         }
     }
 }
@@ -206,6 +209,12 @@ impl Profile {
                 return Err(ParamError(format!("point mass {name} = {v}: must be finite and > 0")));
             }
         }
+        if !(0.0..=1.0).contains(&limits.push_over_fraction) {
+            return Err(ParamError(format!(
+                "push_over_fraction = {}: must lie in [0, 1]",
+                limits.push_over_fraction
+            )));
+        }
         if !(limits.alpha_max > 0.0 && limits.alpha_max < 0.5) {
             return Err(ParamError(format!(
                 "transition_alpha_max = {}: must lie in (0, 0.5) rad",
@@ -245,7 +254,7 @@ impl Profile {
             let (_, _, q) = lift_drag(v, alpha);
             let fn_req = pm.mass * (v * gamma_dot_c + pm.gravity * gamma.cos());
             let alpha_c = (fn_req / (thrust + q * pm.c_l_alpha))
-                .clamp(-PUSH_OVER_ALPHA_FRACTION * limits.alpha_max, limits.alpha_max);
+                .clamp(-limits.push_over_fraction * limits.alpha_max, limits.alpha_max);
             let v_dot_c = vd_dot + K_SPEED * (vd - v);
             let (_, drag, _) = lift_drag(v, alpha);
             let thrust_c = ((pm.mass * (v_dot_c + pm.gravity * gamma.sin()) + drag) / alpha.cos()).clamp(t_lo, t_hi);
