@@ -79,7 +79,8 @@ pub struct ProfileLimits {
     pub alpha_max: f64,
     /// Largest reference thrust as a fraction of T_max (the rest is the controller's margin).
     pub thrust_fraction: f64,
-    /// Smallest reference thrust as a fraction of the weight (slip-stream over the surfaces).
+    /// Smallest reference thrust from the back transition on, as a fraction of the weight
+    /// (slip-stream over the surfaces while the wing unloads).
     pub thrust_floor: f64,
     /// Largest negative α as a fraction of `alpha_max` ([`PUSH_OVER_ALPHA_FRACTION`]).
     pub push_over_fraction: f64,
@@ -257,7 +258,11 @@ impl Profile {
                 .clamp(-limits.push_over_fraction * limits.alpha_max, limits.alpha_max);
             let v_dot_c = vd_dot + K_SPEED * (vd - v);
             let (_, drag, _) = lift_drag(v, alpha);
-            let thrust_c = ((pm.mass * (v_dot_c + pm.gravity * gamma.sin()) + drag) / alpha.cos()).clamp(t_lo, t_hi);
+            // The floor keeps the slip-stream from the back transition on; before it the level
+            // phase may cut the thrust below its trim (9.3 N ≈ the floor) to shed the speed
+            // overshoot of a thrust-limited front transition.
+            let floor = if t >= back_start { t_lo } else { 0.0 };
+            let thrust_c = ((pm.mass * (v_dot_c + pm.gravity * gamma.sin()) + drag) / alpha.cos()).clamp(floor, t_hi);
             (alpha_c, thrust_c)
         };
         let rates = |t: f64, x: &PState| -> PState {
