@@ -44,6 +44,7 @@ def test_every_section_and_file_is_written(rendered):
         "### Wider sweep: τ^3 (0.30 … 1.00 aerodynamic, 0.751 … 1.000 m and I)",
         "## Gust sweep (beyond the thesis)",
         "## Thesis (linear) against global aerodynamics (beyond the thesis, issue 13)",
+        "## Transitions inside the linear α range (issue 16)",
     ]:
         assert heading in text.splitlines(), heading
     for name in analysis_report.SECTIONS:
@@ -79,11 +80,18 @@ def test_tables_hold_the_data(rendered):
     # Gusts: 3 phases × 3 axes.
     gu = [line for line in lines_of(folder, "gusts.md") if line.startswith("| ") and not line.startswith("| phase")]
     assert len(gu) == 9
+    # Transitions (issue 16): one row per tuned run, the thesis configuration on the issue's timings.
+    env = d["envelope_transitions"]
+    tr = [line for line in lines_of(folder, "envelope_transitions.md") if line.startswith("| LQR") or line.startswith("| TSD")]
+    assert len(tr) == len(env["rows"])
+    fast = next(r for r in env["rows"] if r["controller"] == "LQR" and r["configuration"] == 0 and r["t1"] == 2.0)
+    assert f"| {fast['max_alpha_deg']:.1f} | {fast['alt_dev_t1']:.2f} / {fast['alt_dev_t2']:.2f} |" in "\n".join(tr)
 
 
 def test_every_plot_is_drawn_and_embedded(rendered):
     folder, d = rendered
     expected = {"open_loop_modes", "table_5_1", "robustness", "gusts", "aero_coefficients", "aero_flights"}
+    expected |= {"envelope_fastest"}
     expected |= {f"closed_loop_poles_{c}" for c in d["conditions"]}
     expected |= {f"loci_{k}_{c}_{kind}" for k in d["controllers"] for c in d["conditions"] for kind in ("pitch", "all")}
     assert {p.stem for p in folder.glob("*.png")} == expected

@@ -21,6 +21,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+from tailsim import report_envelope  # noqa: E402
+
 
 def rows(path):
     with open(path, newline="") as f:
@@ -185,3 +187,5 @@ def main(out):
         fig.tight_layout()
         fig.savefig(out / "gusts.png", dpi=110)
         plt.close(fig)
+
+    report_envelope.plot(out, json.loads((out / "report.json").read_text())) if (out / "report.json").exists() else None

@@ -20,6 +20,7 @@ import pathlib
 
 from . import aero_report
 from . import report_hover
+from . import report_envelope
 from .report import fmt_or_dash, fmt_pole, markdown_to_html, shortest
 
 OPEN_LOOP_NOTES = (
@@ -283,6 +284,7 @@ SECTIONS = {
     "gusts.md": gusts,
     "aero_models.md": aero_report.section,
     "envelope_hover.md": report_hover.section,
+    "envelope_transitions.md": report_envelope.section,
 }
 
 

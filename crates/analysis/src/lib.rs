@@ -12,6 +12,7 @@ pub mod campaign;
 pub mod closed;
 pub mod controllers;
 pub mod envelope_hover;
+pub mod envelope_transitions;
 pub mod linalg;
 pub mod modes;
 pub mod native_campaign;

@@ -324,6 +324,8 @@ impl LqrController {
                 mode,
                 alpha_max: params.alpha_max,
                 turn_radius: params.turn_radius,
+                // The thesis configuration flies the thesis's cosine blends (3.3.1–3.3.6).
+                limited_path: params.configuration == 0,
             },
         )
         .map_err(ControlError)?;

@@ -34,7 +34,7 @@
 
 use std::sync::Arc;
 
-use flight_mission::{HeadingRef, MissionParams, Phase};
+use flight_mission::{HeadingRef, MissionParams, Phase, PointMass, Profile, ProfileLimits};
 use nalgebra::{Matrix3, Vector3, Vector4};
 use tailsitter_physics::{quat_from_euler_321, Airframe};
 
@@ -64,6 +64,9 @@ pub struct TrajectoryOptions {
     pub alpha_max: f64,
     /// Turn radius ρ (m) of the level segment (3.3.18–3.3.21); 0 = straight, < 0 left.
     pub turn_radius: f64,
+    /// V and γ of the α- and thrust-limited point-mass profile
+    /// ([`flight_mission::profile`], issue 16) instead of the thesis's cosine blends.
+    pub limited_path: bool,
 }
 
 impl Default for TrajectoryOptions {
@@ -72,6 +75,7 @@ impl Default for TrajectoryOptions {
             mode: TrajectoryMode::ForceBalance,
             alpha_max: 15f64.to_radians(),
             turn_radius: 0.0,
+            limited_path: true,
         }
     }
 }
@@ -162,8 +166,32 @@ pub struct Trajectory {
     mission: MissionParams,
 }
 
-/// Kinematic reference of the flight path at τ: (V, V̇, γ, γ̇, γ̈).
-fn path(m: &MissionParams, t: f64) -> (Phase, [f64; 5]) {
+/// The point-mass model of `af` for the flight-path profile: the lift slope of the trimmed
+/// aircraft from the level trim at `v_level` (L = m g − T sin α at α_L, C_L0 = 0).
+pub fn point_mass(af: &Airframe, v_level: f64) -> Result<PointMass, String> {
+    let level = tailsitter_physics::Plant::new(*af)
+        .trim_level(v_level)
+        .map_err(|e| format!("level trim at v_level = {v_level} failed: {e}"))?;
+    let q_s = 0.5 * af.air_density * v_level * v_level * af.wing_area;
+    Ok(PointMass {
+        mass: af.mass,
+        gravity: af.gravity,
+        air_density: af.air_density,
+        wing_area: af.wing_area,
+        c_l_alpha: (af.mass * af.gravity - level.thrust * level.alpha.sin()) / (q_s * level.alpha),
+        c_d0: af.c_D0,
+        k_induced: 1.0 / (PI * af.oswald_efficiency * af.aspect_ratio),
+        thrust_max: af.thrust_max,
+    })
+}
+
+/// Kinematic reference of the flight path at τ: (V, V̇, γ, γ̇, γ̈), from the limited
+/// profile if given, else the thesis's cosine blends.
+fn path(m: &MissionParams, profile: Option<&Profile>, t: f64) -> (Phase, [f64; 5]) {
+    if let Some(p) = profile {
+        let q = p.at(t);
+        return (m.phase_at(t).0, [q.v, q.v_dot, q.gamma, q.gamma_dot, q.gamma_ddot]);
+    }
     let (phase, tau) = m.phase_at(t);
     let dv = m.v_level - m.v_vertical;
     let r = match phase {
@@ -279,13 +307,20 @@ impl Trajectory {
             .trim_level(mission.v_level)
             .map_err(|e| format!("level trim at v_level = {} failed: {e}", mission.v_level))?;
 
+        let profile = if opt.limited_path {
+            let pm = point_mass(af, mission.v_level)?;
+            Some(Profile::new(mission, &pm, &ProfileLimits::of(mission)).map_err(|e| e.0)?)
+        } else {
+            None
+        };
+        let profile = profile.as_ref();
         // Pass 0: kinematic path, heading, bank.
         let mut pts: Vec<TrajPoint> = Vec::with_capacity(n);
         let mut psi = 0.0;
         let mut alphas = Vec::with_capacity(n);
         for i in 0..n {
             let t = i as f64 * TABLE_STEP;
-            let (_, [v, _, gamma, _, _]) = path(mission, t);
+            let (_, [v, _, gamma, _, _]) = path(mission, profile, t);
             if i > 0 {
                 let (w0, _) = turn_rate(mission, t - TABLE_STEP, opt.turn_radius);
                 let (w1, _) = turn_rate(mission, t, opt.turn_radius);
@@ -321,7 +356,7 @@ impl Trajectory {
             let mut chord: Option<nalgebra::LU<f64, nalgebra::U3, nalgebra::U3>> = None;
             for i in 0..n {
                 let t = pts[i].t;
-                let (_, [v, vdot, gamma, gdot, gddot]) = path(mission, t);
+                let (_, [v, vdot, gamma, gdot, gddot]) = path(mission, profile, t);
                 let (w, wdot) = turn_rate(mission, t, opt.turn_radius);
                 let phi = (v * w / g).atan(); // (3.3.18)
                 let psi = pts[i].euler_321.z;
@@ -561,22 +596,31 @@ mod tests {
     fn trajectory_is_continuous_across_phase_boundaries() {
         let af = Airframe::default();
         let m = MissionParams::default();
-        for mode in [TrajectoryMode::ForceBalance, TrajectoryMode::Thesis] {
+        for (mode, limited_path) in [
+            (TrajectoryMode::ForceBalance, true),
+            (TrajectoryMode::ForceBalance, false),
+            (TrajectoryMode::Thesis, false),
+        ] {
             let traj = Trajectory::new(
                 &af,
                 &m,
                 &TrajectoryOptions {
                     mode,
+                    limited_path,
                     ..Default::default()
                 },
             )
             .unwrap();
-            // Per table step (10 ms): no jumps in any reference quantity.
-            assert!(max_jump(&traj, |p| p.v) < 0.1, "{mode:?} V");
+            // Per table step (10 ms): no jumps in any reference quantity. V: the limited
+            // profile accelerates at up to 0.8 T_max / m = 13.3 m/s² (0.133 m/s per step).
+            assert!(max_jump(&traj, |p| p.v) < 0.14, "{mode:?} V");
             assert!(max_jump(&traj, |p| p.euler_321.y) < 0.01, "{mode:?} θ");
             assert!(max_jump(&traj, |p| p.pos_neh.norm()) < 0.3, "{mode:?} pos");
+            // T_c: the limited profile slews its thrust between the floor and 0.8 T_max
+            // (111 N) through two 60 ms lags, so T_c = T + τ_T Ṫ moves up to ~20 N per step.
+            let t_jump = if limited_path { 20.0 } else { 3.0 };
             assert!(
-                max_jump(&traj, |p| p.u[0]) < 3.0,
+                max_jump(&traj, |p| p.u[0]) < t_jump,
                 "{mode:?} T_c: {}",
                 max_jump(&traj, |p| p.u[0])
             );
@@ -602,7 +646,8 @@ mod tests {
         let traj = Trajectory::new(&af, &m, &TrajectoryOptions::default()).unwrap();
         let plant = tailsitter_physics::Plant::new(af);
         let level = plant.trim_level(m.v_level).unwrap();
-        let p = traj.at(15.0);
+        // Late in the level segment (the limited profile settles on V_L after the transition).
+        let p = traj.at(19.5);
         assert!((p.alpha - level.alpha).abs() < 1e-6, "{} vs {}", p.alpha, level.alpha);
         assert!((p.u[0] - level.thrust).abs() < 1e-3);
         assert!((p.u[1] - level.elevator).abs() < 1e-6);

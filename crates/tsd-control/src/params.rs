@@ -124,8 +124,8 @@ impl Default for TsdParams {
             nvd_pole_level: -3.5,
             guidance_pole_re_vertical: -0.5,
             guidance_pole_im_vertical: 0.2,
-            guidance_pole_re_level: -0.75,
-            guidance_pole_im_level: 0.45,
+            guidance_pole_re_level: -2.0,
+            guidance_pole_im_level: 1.0,
             antiwindup_gain: 50.0,
             flap_mixing_factor: 1.1,
             vertical_flap_mixing_factor: 1.1,
@@ -134,7 +134,7 @@ impl Default for TsdParams {
             min_normal_accel: 2.0,
             wind_frame_speed_low: 4.0,
             wind_frame_speed_high: 10.0,
-            feedforward_lead: 0.15,
+            feedforward_lead: 0.1,
             configuration: 0,
         }
     }
@@ -185,7 +185,8 @@ impl TsdParams {
     /// The parameters the controller flies with: `self` for `configuration` 0 (tuned); for
     /// 1 (thesis) the thesis's vertical-flight frame, the wind axes at every speed (§4.2:
     /// the low-speed path frame is a deviation of this repository), and the feed-forward
-    /// Σ^RE taken at the sample time (4.3.24), no preview.
+    /// Σ^RE taken at the sample time (4.3.24), no preview, and Table 4.3's level-flight
+    /// guidance poles (−0.75 ± 0.45i).
     pub fn effective(&self) -> Result<Self, ParamError> {
         match self.configuration {
             0 => Ok(*self),
@@ -193,6 +194,9 @@ impl TsdParams {
                 wind_frame_speed_low: 0.0,
                 wind_frame_speed_high: 1e-6,
                 feedforward_lead: 0.0,
+                // Table 4.3, level-flight guidance (the tuned default is faster, issue 16).
+                guidance_pole_re_level: -0.75,
+                guidance_pole_im_level: 0.45,
                 ..*self
             }),
             c => Err(ParamError(format!(

@@ -21,7 +21,7 @@
 //!   phase boundary; a vertical climb at V_V precedes and follows the loops.
 
 use core::f64::consts::FRAC_PI_2;
-use flight_mission::{MissionParams, Phase};
+use flight_mission::{MissionParams, Phase, Profile};
 use nalgebra::Vector3;
 
 /// The reference at one instant.
@@ -56,8 +56,11 @@ impl Reference {
 }
 
 /// The kinematic trajectory of a mission.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Trajectory {
+    /// The α- and thrust-limited point-mass path ([`flight_mission::profile`], issue 16)
+    /// replacing the quarter loops, if set.
+    profile: Option<Profile>,
     mission: MissionParams,
     gravity: f64,
     /// Radii of the two quarter loops (m).
@@ -79,11 +82,21 @@ impl Trajectory {
         let p3 = p2 + Vector3::new(vl * mission.t_level, 0.0, 0.0);
         let p4 = p3 + Vector3::new(r2, 0.0, -r2);
         Self {
+            profile: None,
             mission,
             gravity,
             r1,
             r2,
             starts: [p0, p1, p2, p3, p4],
+        }
+    }
+
+    /// The trajectory of `mission` along the limited flight-path `profile` (built for the
+    /// same mission): position, velocity and acceleration of the point mass, heading north.
+    pub fn limited(mission: MissionParams, gravity: f64, profile: Profile) -> Self {
+        Self {
+            profile: Some(profile),
+            ..Self::new(mission, gravity)
         }
     }
 
@@ -106,6 +119,22 @@ impl Trajectory {
     /// The reference at mission time `t`.
     pub fn at(&self, t: f64) -> Reference {
         let m = &self.mission;
+        if let Some(profile) = &self.profile {
+            // t̂ = (cos γ, 0, −sin γ), dt̂/dγ = (−sin γ, 0, −cos γ): a = V̇ t̂ + V γ̇ dt̂/dγ.
+            let p = profile.at(t);
+            let (sg, cg) = p.gamma.sin_cos();
+            let tangent = Vector3::new(cg, 0.0, -sg);
+            let turn = Vector3::new(-sg, 0.0, -cg);
+            let a = tangent * p.v_dot + turn * (p.v * p.gamma_dot);
+            return Reference {
+                phase: m.phase_at(t).0,
+                pos: Vector3::new(p.north, 0.0, -p.height),
+                vel: tangent * p.v,
+                specific_accel: a - Vector3::new(0.0, 0.0, self.gravity),
+                airspeed: p.v,
+                gamma: p.gamma,
+            };
+        }
         let (vv, vl) = (m.v_vertical, m.v_level);
         let g = Vector3::new(0.0, 0.0, self.gravity);
         let (phase, tau) = m.phase_at(t);
