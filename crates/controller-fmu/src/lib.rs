@@ -381,7 +381,7 @@ mod tests {
         write_held(&mut w, &Some(bad));
         let mut bytes = w.into_bytes();
         let phase_at = bytes.len() - 8;
-        bytes[phase_at..].copy_from_slice(&9.0f64.to_le_bytes());
+        bytes[phase_at..].copy_from_slice(&11.0f64.to_le_bytes());
         assert!(read_held::<ControllerOutput>(&mut StateReader::new(&bytes)).is_err());
     }
 
