@@ -14,3 +14,4 @@ pub mod linalg;
 pub mod modes;
 pub mod robust;
 pub mod sensitivity;
+pub mod takeoff_landing;

@@ -29,7 +29,9 @@
 //!   [`DESCENT_RAMP_TIME`], then stays at V_d until `landing_flare_height` h_f above the
 //!   target.
 //! * [`Phase::Flare`]: the sink rate falls linearly in time from V_d to the touchdown rate
-//!   V_td over `t_f = 2 h_f/(V_d + V_td)` (covering exactly h_f), then stays at V_td down to
+//!   V_td over `t_f = 2 (h_f − h_td)/(V_d + V_td)` (covering h_f − h_td), then stays at V_td
+//!   over the last `h_td = V_td ·` [`FINAL_SEGMENT_TIME`] (the gear meets the ground at a
+//!   steady sink, thrust ≈ weight: no flare thrust to bounce on) and down to
 //!   [`TOUCHDOWN_OVERSHOOT`] below the target (the reference keeps sinking until the gear
 //!   carries the aircraft).
 //! * [`Phase::Landed`]: latched when, in the flare, the CG is within
@@ -50,6 +52,8 @@ pub const DESCENT_RAMP_TIME: f64 = 2.0;
 pub const APPROACH_MIN_TIME: f64 = 4.0;
 /// How far the touchdown reference sinks below the target before it holds (m).
 pub const TOUCHDOWN_OVERSHOOT: f64 = 0.3;
+/// Time flown at the touchdown rate before the target, after the flare (s).
+pub const FINAL_SEGMENT_TIME: f64 = 1.0;
 /// Time the touchdown condition must hold before the landing is declared (s).
 pub const TOUCHDOWN_DWELL: f64 = 0.1;
 
@@ -199,7 +203,10 @@ impl GroundPhases {
         let height = target.z - pa.z;
         let d_ramp = 0.5 * vd * tr;
         let t_const = ((height - d_ramp - m.landing_flare_height) / vd).max(0.0);
-        let d_flare = (height - d_ramp - vd * t_const).max(0.0);
+        // The flare ends FINAL_SEGMENT_TIME before the target: the aircraft meets the
+        // ground at a steady sink rate (thrust ≈ weight, no deceleration thrust to bounce on).
+        let d_final = vtd * FINAL_SEGMENT_TIME;
+        let d_flare = (height - d_ramp - vd * t_const - d_final).max(0.0);
         let t_flare = 2.0 * d_flare / (vd + vtd);
         // (phase, distance sunk, sink rate, sink acceleration)
         let (phase, s, v, a) = if tau < tr {
@@ -232,8 +239,10 @@ impl GroundPhases {
     }
 
     /// The mode at time `t` (s) with measurement `meas`; `mission_ref(τ)` is the
-    /// controller's own mission reference (position, velocity; NED, offsets included) at
-    /// mission time τ, asked once, at the end of the mission, when landing.
+    /// controller's own mission reference (position, velocity; NED) at mission time τ with
+    /// the mission origin and the user's reference offset but without the take-off shift
+    /// (the `offset` of [`GroundMode::Mission`], added here), asked once, at the end of the
+    /// mission, when landing.
     pub fn step(
         &mut self,
         t: f64,
@@ -276,7 +285,10 @@ impl GroundPhases {
         if !self.landing() || tm < end {
             return GroundMode::Mission { t: tm, offset };
         }
-        let (p0, v0) = *self.approach_start.get_or_insert_with(|| mission_ref(end));
+        let (p0, v0) = *self.approach_start.get_or_insert_with(|| {
+            let (p, v) = mission_ref(end);
+            (p + offset, v)
+        });
         let target = origin + Vector3::new(m.landing_target_n, m.landing_target_e, m.landing_target_d);
         let r = self.landing_reference(tm - end, &p0, &v0, &target);
         if r.phase == Phase::Flare {
@@ -423,9 +435,10 @@ mod tests {
         let mut g = GroundPhases::new(m, 100.0);
         let air = meas(Vector3::new(0.0, 0.0, -50.0), Vector3::zeros());
         g.step(0.0, &meas(origin, Vector3::zeros()), |_| unreachable!());
-        let offset = origin - Vector3::new(0.0, 0.0, g.takeoff_height());
+        let shift = Vector3::new(0.0, 0.0, -g.takeoff_height());
+        let offset = origin + shift;
         let t_end = g.mission_start() + m.end_time();
-        let reference = |g: &mut GroundPhases, t: f64| match g.step(t, &air, climb(&m, offset)) {
+        let reference = |g: &mut GroundPhases, t: f64| match g.step(t, &air, climb(&m, origin)) {
             GroundMode::Vertical(r) => r,
             GroundMode::Mission { t: tm, .. } => {
                 let (p, v) = climb(&m, offset)(tm);
