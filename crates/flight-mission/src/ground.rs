@@ -55,7 +55,7 @@ pub const TOUCHDOWN_OVERSHOOT: f64 = 0.3;
 /// Time flown at the touchdown rate before the target, after the flare (s).
 pub const FINAL_SEGMENT_TIME: f64 = 1.0;
 /// Time the touchdown condition must hold before the landing is declared (s).
-pub const TOUCHDOWN_DWELL: f64 = 0.1;
+pub const TOUCHDOWN_DWELL: f64 = 0.04;
 
 /// A reference for vertical (nose-up) flight, NED, mission origin included.
 #[derive(Debug, Clone, Copy, PartialEq)]
