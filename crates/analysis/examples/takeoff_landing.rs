@@ -6,8 +6,16 @@ use closed_loop::Ordering;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let kind = if args.get(1).map(String::as_str) == Some("lqr") { Kind::Lqr } else { Kind::Tsd };
-    let ordering = if args.get(2).map(String::as_str) == Some("jacobi") { Ordering::Jacobi } else { Ordering::GaussSeidel };
+    let kind = if args.get(1).map(String::as_str) == Some("lqr") {
+        Kind::Lqr
+    } else {
+        Kind::Tsd
+    };
+    let ordering = if args.get(2).map(String::as_str) == Some("jacobi") {
+        Ordering::Jacobi
+    } else {
+        Ordering::GaussSeidel
+    };
     let mut m = mission();
     let env = |k: &str, d: f64| std::env::var(k).ok().and_then(|v| v.parse().ok()).unwrap_or(d);
     m.landing_target_n = env("TL_N", m.landing_target_n);
@@ -18,7 +26,10 @@ fn main() {
     let traj = std::mem::take(&mut f.trajectory);
     if std::env::var("TRACE").is_ok() {
         for r in traj.iter() {
-            println!("{:.1} N {:.2} E {:.2} D {:.2} | ref {:.2} {:.2} {:.2} ph {} tilt {:.1} T {:.1}", r[0], r[1], r[2], r[3], r[4], r[5], r[6], r[7], r[8], r[9]);
+            println!(
+                "{:.1} N {:.2} E {:.2} D {:.2} | ref {:.2} {:.2} {:.2} ph {} tilt {:.1} T {:.1}",
+                r[0], r[1], r[2], r[3], r[4], r[5], r[6], r[7], r[8], r[9]
+            );
         }
     }
     println!("{}", serde_json::to_string_pretty(&f).unwrap());

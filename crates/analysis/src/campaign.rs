@@ -776,6 +776,7 @@ pub fn write_report(out: &Path, s: &Summary, cfg: &Config) -> std::io::Result<()
         "sensitivity": sensitivity,
         "robustness": robustness,
         "gusts": gusts,
+        "takeoff_landing": crate::takeoff_landing::report_value(cfg),
     });
     let text = serde_json::to_string_pretty(&report).map_err(std::io::Error::other)?;
     write(out, "report.json", &text)?;

@@ -18,7 +18,7 @@ use closed_loop::{fly, Ordering, Scenario, Trace, N_PHASES};
 use flight_mission::{GroundPhases, MissionParams, Phase, SampledUnit};
 use nalgebra::Vector3;
 use serde::Serialize;
-use tailsitter_physics::{dcm_earth_to_body, idx, Airframe, AeroModel, Ground, Plant, StateVector};
+use tailsitter_physics::{dcm_earth_to_body, idx, AeroModel, Airframe, Ground, Plant, StateVector};
 
 use crate::controllers::{AnyController, Kind};
 
@@ -64,8 +64,8 @@ pub fn plant() -> (Plant, StateVector) {
 pub fn stop_time(mission: &MissionParams) -> f64 {
     let g = GroundPhases::new(*mission, 1.0);
     let climb = 400.0;
-    let approach = 1.5 * (mission.landing_target_n.hypot(mission.landing_target_e) + 50.0)
-        / mission.landing_approach_speed;
+    let approach =
+        1.5 * (mission.landing_target_n.hypot(mission.landing_target_e) + 50.0) / mission.landing_approach_speed;
     g.mission_start() + mission.end_time() + approach + climb / mission.landing_descent_rate + 20.0
 }
 
@@ -170,11 +170,7 @@ fn fly_until_landed(plant: &Plant, x0: StateVector, controller: &mut AnyControll
     // One run to the stop time is simplest; the closed loop has no early stop, so fly to
     // the bound and cut the trace after the landing.
     let mut trace = fly(plant, x0, controller, scenario);
-    if let Some(k) = trace
-        .samples
-        .iter()
-        .position(|s| s.diagnostics.phase == Phase::Landed)
-    {
+    if let Some(k) = trace.samples.iter().position(|s| s.diagnostics.phase == Phase::Landed) {
         let t_end = trace.samples[k].t + AFTER_LANDING;
         trace.samples.retain(|s| s.t <= t_end + 1e-9);
     }
@@ -183,8 +179,16 @@ fn fly_until_landed(plant: &Plant, x0: StateVector, controller: &mut AnyControll
 
 /// The figures of a flown trace.
 pub fn evaluate(plant: &Plant, kind: Kind, ordering: Ordering, mission: &MissionParams, trace: &Trace) -> Flight {
-    let origin = trace.samples.first().map_or(Vector3::zeros(), |s| s.measurement.pos_ned);
-    let target = origin + Vector3::new(mission.landing_target_n, mission.landing_target_e, mission.landing_target_d);
+    let origin = trace
+        .samples
+        .first()
+        .map_or(Vector3::zeros(), |s| s.measurement.pos_ned);
+    let target = origin
+        + Vector3::new(
+            mission.landing_target_n,
+            mission.landing_target_e,
+            mission.landing_target_d,
+        );
     let contact = |s: &closed_loop::Sample| {
         plant
             .outputs(&s.x, &closed_loop::plant_inputs(&s.command), &s.wind)
@@ -207,7 +211,8 @@ pub fn evaluate(plant: &Plant, kind: Kind, ordering: Ordering, mission: &Mission
         }
     }
     let end = trace.samples.last();
-    let (mut speed, mut cg_sink, mut miss_td, mut tilt_td, mut hspeed) = (f64::NAN, f64::NAN, f64::NAN, f64::NAN, f64::NAN);
+    let (mut speed, mut cg_sink, mut miss_td, mut tilt_td, mut hspeed) =
+        (f64::NAN, f64::NAN, f64::NAN, f64::NAN, f64::NAN);
     let (mut bounced, mut rebound) = (false, 0.0f64);
     if let Some(k) = touchdown {
         let s = &trace.samples[k];
@@ -351,4 +356,13 @@ pub fn report(kinds: &[Kind]) -> Report {
         },
         flights,
     }
+}
+
+/// The `takeoff_landing` value of `report.json`: the flights of the configured controllers
+/// with the nonlinear campaigns (`cfg.robustness`), else null.
+pub fn report_value(cfg: &crate::campaign::Config) -> serde_json::Value {
+    if !cfg.robustness || cfg.controllers.is_empty() {
+        return serde_json::Value::Null;
+    }
+    serde_json::to_value(report(&cfg.controllers)).unwrap_or(serde_json::Value::Null)
 }

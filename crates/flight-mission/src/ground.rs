@@ -181,7 +181,13 @@ impl GroundPhases {
     }
 
     /// The reference of the landing at time τ after the mission's end.
-    fn landing_reference(&self, tau: f64, p0: &Vector3<f64>, v0: &Vector3<f64>, target: &Vector3<f64>) -> VerticalReference {
+    fn landing_reference(
+        &self,
+        tau: f64,
+        p0: &Vector3<f64>,
+        v0: &Vector3<f64>,
+        target: &Vector3<f64>,
+    ) -> VerticalReference {
         let m = &self.mission;
         let t_a = self.approach_time(p0, target);
         let pa = self.approach_end(p0, v0, target, t_a);
@@ -387,8 +393,18 @@ mod tests {
         let mut g = GroundPhases::new(m, 88.0);
         assert!(!g.takeoff() && !g.landing());
         for t in [0.0, 3.0, 35.0, 200.0] {
-            let mode = g.step(t, &meas(Vector3::new(1.0, 2.0, 3.0), Vector3::zeros()), |_| unreachable!());
-            assert_eq!(mode, GroundMode::Mission { t, offset: Vector3::zeros() });
+            let mode = g.step(
+                t,
+                &meas(Vector3::new(1.0, 2.0, 3.0), Vector3::zeros()),
+                |_| unreachable!(),
+            );
+            assert_eq!(
+                mode,
+                GroundMode::Mission {
+                    t,
+                    offset: Vector3::zeros()
+                }
+            );
         }
     }
 
@@ -398,9 +414,18 @@ mod tests {
         let start = Vector3::new(5.0, 1.0, 9.56);
         let mut g = GroundPhases::new(m, 100.0);
         let at = |g: &mut GroundPhases, t| g.step(t, &meas(start, Vector3::zeros()), |_| unreachable!());
-        assert_eq!(at(&mut g, 0.0), GroundMode::Idle { phase: Phase::OnGround, thrust: 0.0 });
+        assert_eq!(
+            at(&mut g, 0.0),
+            GroundMode::Idle {
+                phase: Phase::OnGround,
+                thrust: 0.0
+            }
+        );
         match at(&mut g, 1.0) {
-            GroundMode::Idle { phase: Phase::OnGround, thrust } => assert!((thrust - 45.0).abs() < 1e-12),
+            GroundMode::Idle {
+                phase: Phase::OnGround,
+                thrust,
+            } => assert!((thrust - 45.0).abs() < 1e-12),
             other => panic!("{other:?}"),
         }
         let h = 1e-6;
@@ -419,13 +444,23 @@ mod tests {
         }
         // Starts at rest at the measured point, ends climbing at V_V at height V_V T/2,
         // where the mission takes over with the matching offset.
-        let GroundMode::Vertical(r0) = at(&mut g, 2.0) else { panic!() };
+        let GroundMode::Vertical(r0) = at(&mut g, 2.0) else {
+            panic!()
+        };
         assert!((r0.pos - start).norm() < 1e-12 && r0.vel.norm() < 1e-12);
-        let GroundMode::Vertical(r1) = at(&mut g, 4.0 - 1e-9) else { panic!() };
+        let GroundMode::Vertical(r1) = at(&mut g, 4.0 - 1e-9) else {
+            panic!()
+        };
         assert!((r1.pos - (start - Vector3::new(0.0, 0.0, 3.0))).norm() < 1e-6);
         assert!((r1.vel.z + 3.0).abs() < 1e-6);
         let mode = at(&mut g, 4.0);
-        assert_eq!(mode, GroundMode::Mission { t: 0.0, offset: Vector3::new(0.0, 0.0, -3.0) });
+        assert_eq!(
+            mode,
+            GroundMode::Mission {
+                t: 0.0,
+                offset: Vector3::new(0.0, 0.0, -3.0)
+            }
+        );
     }
 
     #[test]
@@ -442,7 +477,12 @@ mod tests {
             GroundMode::Vertical(r) => r,
             GroundMode::Mission { t: tm, .. } => {
                 let (p, v) = climb(&m, offset)(tm);
-                VerticalReference { phase: Phase::Vertical2, pos: p, vel: v, accel: Vector3::zeros() }
+                VerticalReference {
+                    phase: Phase::Vertical2,
+                    pos: p,
+                    vel: v,
+                    accel: Vector3::zeros(),
+                }
             }
             other => panic!("{other:?}"),
         };
@@ -458,7 +498,12 @@ mod tests {
             // (The one velocity step: the hold below the target, reached only if the
             // touchdown is never detected.)
             let held = r.vel == Vector3::zeros() && r.phase == Phase::Flare;
-            assert!(held || (r.vel - last.vel).norm() < 0.01 * 2.0, "velocity jump at {t}: {:?} {:?}", last.vel, r.vel);
+            assert!(
+                held || (r.vel - last.vel).norm() < 0.01 * 2.0,
+                "velocity jump at {t}: {:?} {:?}",
+                last.vel,
+                r.vel
+            );
             if r.phase != Phase::Vertical2 {
                 let (a, b) = (reference(&mut g, t - h), reference(&mut g, t + h));
                 if a.phase == b.phase && r.vel.norm() > 0.0 {
@@ -472,7 +517,10 @@ mod tests {
             }
             last = r;
         }
-        assert_eq!(phases, [Phase::Vertical2, Phase::Approach, Phase::Descent, Phase::Flare]);
+        assert_eq!(
+            phases,
+            [Phase::Vertical2, Phase::Approach, Phase::Descent, Phase::Flare]
+        );
         // Ends held just below the target, centred on it.
         assert!((last.pos - (target + Vector3::new(0.0, 0.0, TOUCHDOWN_OVERSHOOT))).norm() < 1e-9);
         assert_eq!(last.vel, Vector3::zeros());
@@ -507,7 +555,10 @@ mod tests {
         // Stopped on the target: landed after the dwell, and stays landed.
         let down = meas(Vector3::new(0.0, 0.0, 19.995), Vector3::new(0.0, 0.0, 0.01));
         assert!(matches!(g.step(t + 0.3, &down, mref), GroundMode::Vertical(_)));
-        let landed = GroundMode::Idle { phase: Phase::Landed, thrust: 0.0 };
+        let landed = GroundMode::Idle {
+            phase: Phase::Landed,
+            thrust: 0.0,
+        };
         assert_eq!(g.step(t + 0.3 + TOUCHDOWN_DWELL, &down, mref), landed);
         assert_eq!(g.step(t + 5.0, &sinking, mref), landed);
         // Round trip of the state.

@@ -155,7 +155,9 @@ fn path(m: &MissionParams, t: f64) -> (Phase, [f64; 5]) {
     let r = match phase {
         Phase::Vertical1 | Phase::Vertical2 => [m.v_vertical, 0.0, FRAC_PI_2, 0.0, 0.0],
         // Take-off and landing: flown from flight_mission::ground, never a mission time.
-        Phase::OnGround | Phase::TakeOff | Phase::Approach | Phase::Descent | Phase::Flare | Phase::Landed => [m.v_vertical, 0.0, FRAC_PI_2, 0.0, 0.0],
+        Phase::OnGround | Phase::TakeOff | Phase::Approach | Phase::Descent | Phase::Flare | Phase::Landed => {
+            [m.v_vertical, 0.0, FRAC_PI_2, 0.0, 0.0]
+        }
         Phase::Level => [m.v_level, 0.0, 0.0, 0.0, 0.0],
         Phase::TransitionToLevel => {
             let w = PI / m.t_transition_1;

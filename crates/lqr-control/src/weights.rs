@@ -179,7 +179,9 @@ impl WeightSchedule {
         let cur = self.phases[table_index(phase)];
         let prev = match phase {
             Phase::Vertical1 => return cur,
-            Phase::OnGround | Phase::TakeOff | Phase::Approach | Phase::Descent | Phase::Flare | Phase::Landed => return cur,
+            Phase::OnGround | Phase::TakeOff | Phase::Approach | Phase::Descent | Phase::Flare | Phase::Landed => {
+                return cur
+            }
             Phase::TransitionToLevel => Phase::Vertical1,
             Phase::Level => Phase::TransitionToLevel,
             Phase::TransitionToVertical => Phase::Level,

@@ -42,8 +42,8 @@ pub use params::TsdParams;
 pub use trajectory::{Reference, Trajectory};
 
 use flight_mission::{
-    Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, GroundMode, GroundPhases, MissionParams, Notice, ParamError, Phase,
-    SampledUnit,
+    Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, GroundMode, GroundPhases, MissionParams,
+    Notice, ParamError, Phase, SampledUnit,
 };
 use nalgebra::{Matrix3, Quaternion, RowVector3, UnitQuaternion, Vector3};
 use tailsitter_physics::Airframe;
