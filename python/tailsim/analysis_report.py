@@ -18,6 +18,7 @@ import argparse
 import json
 import pathlib
 
+from . import report_takeoff
 from .report import fmt_or_dash, fmt_pole, markdown_to_html, shortest
 
 OPEN_LOOP_NOTES = (
@@ -277,6 +278,7 @@ SECTIONS = {
     "table_5_1.md": table_5_1,
     "robustness.md": robustness,
     "gusts.md": gusts,
+    "takeoff_landing.md": report_takeoff.section,
 }
 
 
@@ -312,6 +314,7 @@ def write(folder: str | pathlib.Path, with_plots: bool = True) -> pathlib.Path:
         from . import analysis_plots
 
         analysis_plots.main(folder)
+        report_takeoff.plot(folder)
     md = markdown(d)
     pngs = plots(folder)
     if pngs:
