@@ -11,7 +11,8 @@
 //!   does not run (no integrator wind-up, no gain computation against a ground reaction it
 //!   does not model); the thrust command ramps linearly to `takeoff_spinup_thrust · m g`
 //!   (below the weight: the aircraft stays on the gear), surfaces centred (no moment, no
-//!   tip-over). The mission origin O is the CG position measured at the first sample.
+//!   tip-over). The mission origin O is the CG position measured at the last sample on the
+//!   gear (a master may hand the first sample start values, not the plant's outputs).
 //! * [`Phase::TakeOff`], `τ < T_to` (`takeoff_time`): vertical reference from rest,
 //!   climb rate `v(τ) = V_V (1 − cos(πτ/T_to))/2`, height `h(τ) = V_V (τ/2 − T_to/(2π)
 //!   sin(πτ/T_to))`, acceleration `V_V π/(2T_to) sin(πτ/T_to)`: continuous in position,
@@ -256,7 +257,10 @@ impl GroundPhases {
         mission_ref: impl FnOnce(f64) -> (Vector3<f64>, Vector3<f64>),
     ) -> GroundMode {
         let m = self.mission;
-        if self.takeoff() && self.origin.is_none() {
+        if self.takeoff() && (self.origin.is_none() || t < m.takeoff_spinup_time) {
+            // Re-measured at every sample on the gear, frozen at the take-off: a master may
+            // hand the first sample the inputs' start values instead of the plant's outputs
+            // (Jacobi, fmpy's SSP master), never those of the last sample of the spin-up.
             self.origin = Some(meas.pos_ned);
         }
         if self.landed {
@@ -461,6 +465,18 @@ mod tests {
                 offset: Vector3::new(0.0, 0.0, -3.0)
             }
         );
+
+        // A first sample with the inputs' start values (a Jacobi master) does not fix the
+        // origin: the last sample on the gear does.
+        let mut g = GroundPhases::new(m, 100.0);
+        let none = |_| -> (Vector3<f64>, Vector3<f64>) { unreachable!() };
+        g.step(0.0, &meas(Vector3::zeros(), Vector3::zeros()), none);
+        g.step(1.98, &meas(start, Vector3::zeros()), none);
+        let lifted = meas(start + Vector3::new(0.0, 0.0, -0.01), Vector3::zeros());
+        let GroundMode::Vertical(r) = g.step(2.0, &lifted, none) else {
+            panic!()
+        };
+        assert_eq!(r.pos, start);
     }
 
     #[test]

@@ -750,11 +750,6 @@ impl SampledUnit for LqrController {
         // t is the FMU time less the spin-up and take-off climb (the same without take-off).
         let t = input.t - self.ground.mission_start();
         let measured_neh = Vector3::new(m.pos_ned.x, m.pos_ned.y, -m.pos_ned.z);
-        if self.origin.is_none() && self.ground.takeoff() {
-            // Mission origin: the take-off point; gains relinearised from the first flying sample.
-            self.origin = Some(measured_neh);
-            self.next_relinearisation = f64::NEG_INFINITY;
-        }
         let (trajectory, lqr_origin) = (&self.trajectory, self.origin);
         let mode = self.ground.step(input.t, m, |tm| {
             let p = trajectory.at(tm);
@@ -789,6 +784,13 @@ impl SampledUnit for LqrController {
                 });
             }
         };
+        if self.origin.is_none() && self.ground.takeoff() {
+            // Mission origin: the take-off point (measured on the gear); gains relinearised
+            // from the first flying sample.
+            let o = self.ground.origin().unwrap_or(m.pos_ned);
+            self.origin = Some(Vector3::new(o.x, o.y, -o.z));
+            self.next_relinearisation = f64::NEG_INFINITY;
+        }
         if ground_ref.is_some() != self.ground_active {
             // Into or out of the take-off / landing phases: the gains change structure (the
             // position integrators' columns); relinearise now, integrators from zero.
