@@ -93,3 +93,31 @@ def test_ssp_flies_take_off_to_landing():
     assert miss < 0.5
     assert abs(math.degrees(r["plant.theta"][-1]) - 90.0) < 10.0
     assert np.all(contact[k:] > 0), "no bounce"
+
+
+def test_report_section_and_plot_from_the_campaign_data(tmp_path):
+    """The analysis report renders the `takeoff_landing` key of report.json (fixture of a
+    tiny campaign): the table per flight, the per-phase errors and the plot."""
+    import json
+    import shutil
+
+    from fmu_util import ROOT
+    from tailsim import analysis_report, report_takeoff
+
+    data = ROOT / "tests" / "data" / "analysis"
+    for f in data.iterdir():
+        shutil.copy(f, tmp_path / f.name)
+    d = json.loads((data / "report.json").read_text())
+    lines = report_takeoff.section(d)
+    assert "## Take-off and landing (issue 16)" in lines
+    rows = [x for x in lines if x.startswith("| LQR |") or x.startswith("| TSD |")]
+    # One row per flight in each of the two tables.
+    assert len(rows) == 2 * len(d["takeoff_landing"]["flights"]) == 8
+    for f in d["takeoff_landing"]["flights"]:
+        assert f["passed"] and 0.0 < f["touchdown_speed"] < 0.5
+        assert any(f"{f['touchdown_speed']:.3f}" in x for x in rows)
+    assert report_takeoff.section({}) == []
+    analysis_report.write(tmp_path)
+    assert (tmp_path / "takeoff_landing.png").stat().st_size > 10_000
+    text = (tmp_path / "report.md").read_text()
+    assert "## Take-off and landing (issue 16)" in text and "takeoff_landing.png" in text

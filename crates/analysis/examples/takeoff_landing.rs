@@ -1,11 +1,18 @@
 //! Fly the take-off-to-landing mission once and print the figures:
-//! `cargo run --release -p analysis --example takeoff_landing -- tsd [jacobi]`.
+//! `cargo run --release -p analysis --example takeoff_landing -- tsd [jacobi]`, or `-- report`
+//! for the `takeoff_landing` value of report.json.
 use analysis::controllers::Kind;
 use analysis::takeoff_landing::{fly_one, mission};
 use closed_loop::Ordering;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
+    if args.get(1).map(String::as_str) == Some("report") {
+        // The `takeoff_landing` value of report.json, both controllers, both orderings.
+        let r = analysis::takeoff_landing::report(&Kind::ALL);
+        println!("{}", serde_json::to_string(&r).unwrap());
+        return;
+    }
     let kind = if args.get(1).map(String::as_str) == Some("lqr") {
         Kind::Lqr
     } else {
