@@ -95,18 +95,19 @@ def plot(folder: str | pathlib.Path) -> pathlib.Path | None:
         rows = f["trajectory"]
         t = [r[0] for r in rows]
         n = [r[1] for r in rows]
-        h = [-r[3] for r in rows]
+        d0 = rows[0][3]  # heights above the take-off point
+        h = [d0 - r[3] for r in rows]
         (line,) = axes[0].plot(n, h, lw=1.2, label=f["controller"])
-        axes[0].plot([r[4] for r in rows], [-r[6] for r in rows], "--", lw=0.8, color=line.get_color())
+        axes[0].plot([r[4] for r in rows], [d0 - r[6] for r in rows], "--", lw=0.8, color=line.get_color())
         axes[1].plot(t, h, lw=1.2, color=line.get_color(), label=f["controller"])
         axes[2].plot(t, [r[8] for r in rows], lw=1.0, color=line.get_color(), label=f["controller"])
         tgt = f["target"]
-        axes[0].plot([tgt[0]], [-tgt[2]], "kx")
+        axes[0].plot([tgt[0]], [d0 - tgt[2]], "kx")
     axes[0].set_xlabel("north (m)")
-    axes[0].set_ylabel("height (m, −pos_d)")
+    axes[0].set_ylabel("height above take-off (m)")
     axes[0].set_title("track (dashed: reference; x: target)", fontsize=9)
     axes[1].set_xlabel("t (s)")
-    axes[1].set_ylabel("height (m)")
+    axes[1].set_ylabel("height above take-off (m)")
     axes[1].set_title("height", fontsize=9)
     axes[2].set_xlabel("t (s)")
     axes[2].set_ylabel("tilt from vertical (°)")
