@@ -93,6 +93,7 @@ def test_every_plot_is_drawn_and_embedded(rendered):
     expected = {"open_loop_modes", "table_5_1", "robustness", "gusts", "aero_coefficients", "aero_flights"}
     expected |= {"envelope_fastest"}
     expected |= {f"closed_loop_poles_{c}" for c in d["conditions"]}
+    expected |= {"takeoff_landing"} if d.get("takeoff_landing") else set()
     expected |= {f"loci_{k}_{c}_{kind}" for k in d["controllers"] for c in d["conditions"] for kind in ("pitch", "all")}
     assert {p.stem for p in folder.glob("*.png")} == expected
     html = (folder / "report.html").read_text()

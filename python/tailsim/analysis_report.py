@@ -21,6 +21,7 @@ import pathlib
 from . import aero_report
 from . import report_hover
 from . import report_envelope
+from . import report_takeoff
 from .report import fmt_or_dash, fmt_pole, markdown_to_html, shortest
 
 OPEN_LOOP_NOTES = (
@@ -285,6 +286,7 @@ SECTIONS = {
     "aero_models.md": aero_report.section,
     "envelope_hover.md": report_hover.section,
     "envelope_transitions.md": report_envelope.section,
+    "takeoff_landing.md": report_takeoff.section,
 }
 
 
@@ -321,6 +323,7 @@ def write(folder: str | pathlib.Path, with_plots: bool = True) -> pathlib.Path:
 
         analysis_plots.main(folder)
         aero_report.plot(folder)
+        report_takeoff.plot(folder)
     md = markdown(d)
     pngs = plots(folder)
     if pngs:

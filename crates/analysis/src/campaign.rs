@@ -781,6 +781,7 @@ pub fn write_report(out: &Path, s: &Summary, cfg: &Config) -> std::io::Result<()
         "gusts": gusts,
         "envelope_hover": if cfg.envelope_hover { crate::envelope_hover::report() } else { serde_json::Value::Null },
         "envelope_transitions": crate::envelope_transitions::report(),
+        "takeoff_landing": crate::takeoff_landing::report_value(cfg),
     });
     let text = serde_json::to_string_pretty(&report).map_err(std::io::Error::other)?;
     write(out, "report.json", &text)?;

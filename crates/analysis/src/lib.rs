@@ -18,3 +18,4 @@ pub mod modes;
 pub mod native_campaign;
 pub mod robust;
 pub mod sensitivity;
+pub mod takeoff_landing;

@@ -316,6 +316,9 @@ pub struct Trace {
     pub notices: Vec<(f64, Notice)>,
 }
 
+/// Number of phase codes ([`flight_mission::Phase`]: the mission's five, take-off and landing).
+pub const N_PHASES: usize = 11;
+
 /// Position error statistics of one phase.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct PhaseErrors {
@@ -332,10 +335,11 @@ impl Trace {
         self.failure.is_none()
     }
 
-    /// Position-error statistics per phase, in [`Phase`] order.
-    pub fn phase_errors(&self) -> [PhaseErrors; 5] {
-        let mut out = [PhaseErrors::default(); 5];
-        let mut sums = [0.0; 5];
+    /// Position-error statistics per phase, indexed by the phase code (0…4 the thesis's
+    /// mission, 5…10 take-off and landing, [`flight_mission::Phase`]).
+    pub fn phase_errors(&self) -> [PhaseErrors; N_PHASES] {
+        let mut out = [PhaseErrors::default(); N_PHASES];
+        let mut sums = [0.0; N_PHASES];
         for s in &self.samples {
             let k = s.diagnostics.phase as usize;
             let e = s.pos_error();

@@ -12,9 +12,11 @@
 use nalgebra::{Vector3, Vector4};
 use std::fmt;
 
+pub mod ground;
 pub mod profile;
 mod unit;
 pub mod weathervane;
+pub use ground::{GroundMode, GroundPhases, VerticalReference};
 pub use profile::{PathPoint, PointMass, Profile, ProfileLimits};
 pub use unit::{HeldOutput, Sampled, SampledUnit, SteppedUnit, UnitLog};
 pub use weathervane::{HeadingRef, Weathervane, WeathervaneParams};
@@ -42,6 +44,29 @@ pub struct MissionParams {
     pub transition_alpha_max: f64,
     /// Largest thrust of the flight-path profile as a fraction of T_max.
     pub transition_thrust_fraction: f64,
+    /// Spin-up time on the gear before the take-off climb (s); 0 = the mission starts in
+    /// flight (no take-off, the thesis's mission). See [`ground`].
+    pub takeoff_spinup_time: f64,
+    /// Thrust at the end of the spin-up as a fraction of the weight m g.
+    pub takeoff_spinup_thrust: f64,
+    /// Take-off climb: time of the cosine ramp of the climb rate from 0 to `v_vertical` (s).
+    pub takeoff_time: f64,
+    /// Descent rate of the landing (m/s); 0 = no landing (the thesis's mission).
+    pub landing_descent_rate: f64,
+    /// Landing target north of the mission origin (m).
+    pub landing_target_n: f64,
+    /// Landing target east of the mission origin (m).
+    pub landing_target_e: f64,
+    /// Landing target down of the mission origin: the CG position at rest on the gear (m).
+    pub landing_target_d: f64,
+    /// Peak horizontal speed of the approach to above the target (m/s).
+    pub landing_approach_speed: f64,
+    /// Height above the target where the flare begins (m).
+    pub landing_flare_height: f64,
+    /// Reference sink rate at touchdown (m/s).
+    pub landing_touchdown_rate: f64,
+    /// Touchdown detection: height tolerance of the CG over the target (m).
+    pub landing_touchdown_tolerance: f64,
 }
 
 // `impl Default for MissionParams` (the declared start values) and
@@ -72,7 +97,9 @@ impl MissionParams {
     pub fn validate(&self) -> Result<(), ParamError> {
         let named = self.named_values();
         for (name, value) in named {
-            if !value.is_finite() || value < 0.0 {
+            // The landing target is a position: any finite value.
+            let signed = name.starts_with("landing_target_");
+            if !value.is_finite() || value < 0.0 && !signed {
                 return Err(ParamError(format!("{name} = {value}: must be finite and ≥ 0")));
             }
         }
@@ -99,6 +126,29 @@ impl MissionParams {
             return Err(ParamError(format!(
                 "transition_thrust_fraction = {}: must lie in [0.6, 1]",
                 self.transition_thrust_fraction
+            )));
+        }
+        for (name, value) in [
+            ("takeoff_time", self.takeoff_time),
+            ("landing_approach_speed", self.landing_approach_speed),
+            ("landing_touchdown_rate", self.landing_touchdown_rate),
+            ("landing_touchdown_tolerance", self.landing_touchdown_tolerance),
+        ] {
+            if value <= 0.0 {
+                return Err(ParamError(format!("{name} = {value}: must be > 0")));
+            }
+        }
+        if self.takeoff_spinup_thrust > 1.0 {
+            return Err(ParamError(format!(
+                "takeoff_spinup_thrust = {}: a fraction of the weight in [0, 1] (above 1 the aircraft lifts off \
+                 before the controller runs)",
+                self.takeoff_spinup_thrust
+            )));
+        }
+        if self.landing_descent_rate > 0.0 && self.landing_touchdown_rate > self.landing_descent_rate {
+            return Err(ParamError(format!(
+                "landing_touchdown_rate = {} must not exceed landing_descent_rate = {}",
+                self.landing_touchdown_rate, self.landing_descent_rate
             )));
         }
         if self.v_level <= self.v_vertical {
@@ -167,6 +217,18 @@ pub enum Phase {
     TransitionToVertical = 3,
     /// Vertical flight after the mission's second transition.
     Vertical2 = 4,
+    /// On the gear, motors spinning up (take-off, [`ground`]).
+    OnGround = 5,
+    /// Take-off climb, climb rate ramping up to `v_vertical`.
+    TakeOff = 6,
+    /// Approach: stop the climb and move over the landing target.
+    Approach = 7,
+    /// Descent at `landing_descent_rate`.
+    Descent = 8,
+    /// Flare and touchdown at `landing_touchdown_rate`.
+    Flare = 9,
+    /// Landed: thrust cut, surfaces centred.
+    Landed = 10,
 }
 
 impl Phase {
@@ -183,13 +245,22 @@ impl Phase {
             2 => Phase::Level,
             3 => Phase::TransitionToVertical,
             4 => Phase::Vertical2,
+            5 => Phase::OnGround,
+            6 => Phase::TakeOff,
+            7 => Phase::Approach,
+            8 => Phase::Descent,
+            9 => Phase::Flare,
+            10 => Phase::Landed,
             _ => return None,
         })
     }
 
     /// Whether the aircraft hangs on its propellers in this phase.
     pub fn is_vertical(self) -> bool {
-        matches!(self, Phase::Vertical1 | Phase::Vertical2)
+        matches!(
+            self,
+            Phase::Vertical1 | Phase::Vertical2 | Phase::TakeOff | Phase::Approach | Phase::Descent | Phase::Flare
+        )
     }
 }
 
@@ -525,7 +596,7 @@ mod tests {
         assert_eq!(saved.len(), ControllerOutput::SAVED_LEN);
         let mut it = saved.clone().into_iter();
         assert_eq!(ControllerOutput::restore(&mut || it.next()), Some(output));
-        saved[12] = 7.0;
+        saved[12] = 11.0;
         let mut it = saved.clone().into_iter();
         assert_eq!(ControllerOutput::restore(&mut || it.next()), None, "invalid phase");
         let mut it = saved[..5].iter().copied();

@@ -163,6 +163,11 @@ fn desired(m: &MissionParams, t: f64) -> [f64; 4] {
     let dv = m.v_level - m.v_vertical;
     match phase {
         Phase::Vertical1 | Phase::Vertical2 => [m.v_vertical, 0.0, FRAC_PI_2, 0.0],
+        // `phase_at` yields mission phases only; the take-off and landing phases around the
+        // mission (`ground`) are vertical.
+        Phase::OnGround | Phase::TakeOff | Phase::Approach | Phase::Descent | Phase::Flare | Phase::Landed => {
+            [m.v_vertical, 0.0, FRAC_PI_2, 0.0]
+        }
         Phase::Level => [m.v_level, 0.0, 0.0, 0.0],
         Phase::TransitionToLevel => {
             let tt = m.t_transition_1;

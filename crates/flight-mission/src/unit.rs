@@ -365,7 +365,7 @@ mod tests {
             assert!(v.restore(&mut || it.next()).is_err(), "{n}");
         }
         let mut bad = saved.clone();
-        bad[2 + 12] = 9.0f64.to_bits(); // the held phase
+        bad[2 + 12] = 11.0f64.to_bits(); // the held phase (codes 0–10 are valid)
         let mut it = bad.iter().copied();
         assert!(v.restore(&mut || it.next()).is_err());
         bad = saved;

@@ -20,8 +20,8 @@ pub mod trajectory;
 pub mod weights;
 
 use flight_mission::{
-    Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, MissionParams, Notice, ParamError,
-    SampledUnit, Weathervane, WeathervaneParams,
+    Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, GroundMode, GroundPhases, MissionParams,
+    Notice, ParamError, SampledUnit, VerticalReference, Weathervane, WeathervaneParams,
 };
 use nalgebra::{SMatrix, SVector, Vector3};
 use tailsitter_physics::Airframe;
@@ -207,6 +207,10 @@ pub struct LqrController {
     weathervane: Weathervane,
     /// Integrated horizontal position error in wind (N, E, 0) (m) (README, "Hover in wind").
     wind_shift: Vector3<f64>,
+    /// Take-off and landing phases around the mission (flight_mission::ground).
+    ground: GroundPhases,
+    /// Whether the last sample flew a take-off / landing reference (position integrators on).
+    ground_active: bool,
 }
 
 /// Names of the commands, for [`Notice::Saturated`].
@@ -353,6 +357,8 @@ impl LqrController {
             stats: GainStats::default(),
             weathervane,
             wind_shift: Vector3::zeros(),
+            ground: GroundPhases::new(mission, airframe.mass * airframe.gravity),
+            ground_active: false,
         };
         // Initial gains on the trajectory's start point, so a failure shows at construction.
         let p0 = c.trajectory.at(0.0);
@@ -391,7 +397,16 @@ impl LqrController {
 
     /// Whether the position-error integrators are active (`position_integral = 1`).
     pub fn has_position_integral(&self) -> bool {
-        self.params.position_integral != 0
+        self.params.position_integral != 0 || self.ground_active
+    }
+
+    /// Whether the integrator of position axis `j` (N, E, h) is active: all three with
+    /// `position_integral = 1`; the height's alone in the take-off and landing phases, where
+    /// the touchdown needs the height without a steady error (the descent's thrust differs
+    /// from the vertical trim's; the horizontal integrators destabilise the hover
+    /// translation of the approach).
+    fn position_integral_on(&self, j: usize) -> bool {
+        self.params.position_integral != 0 || self.ground_active && j == 2
     }
 
     /// The position integrators ∫ΔN, ∫ΔE, ∫Δh (m·s) and the wind estimate (NED, m/s).
@@ -447,7 +462,7 @@ impl LqrController {
         a[(0, 1 + ix::V)] = 1.0;
         a.fixed_view_mut::<NX, NX>(1, 1).copy_from(&f);
         for j in 0..3 {
-            if self.has_position_integral() {
+            if self.position_integral_on(j) {
                 // ẋ_Ip = p − p_t − λ_p x_Ip, p ∈ {N, E, h}.
                 a[(I_POS + j, 1 + ix::N + j)] = 1.0;
                 a[(I_POS + j, I_POS + j)] = -self.params.position_integrator_leak;
@@ -559,6 +574,9 @@ impl LqrController {
         let lim = self.params.position_integrator_limit;
         let decay = (-self.params.position_integrator_leak * ts).exp();
         for j in 0..3 {
+            if !self.position_integral_on(j) {
+                continue;
+            }
             let old = self.pos_integrator[j];
             let next = (decay * old + ts * (x[ix::N + j] - xt[ix::N + j])).clamp(-lim, lim);
             let delta = next - old;
@@ -569,6 +587,57 @@ impl LqrController {
                 self.pos_integrator[j] = next;
             }
         }
+    }
+
+    /// The reference point of a take-off / landing reference (flight_mission::ground): the
+    /// mission's vertical attitude (nose up, belly north) and rates, the position relative
+    /// to the origin, airspeed |v|, and the vertical trim inputs with the thrust
+    /// `T = m (g + a_up) + (T_trim − m g) · climb/V_V` (weight, the reference acceleration and
+    /// the trim's drag scaled with the climb rate).
+    fn ground_point(&self, v: &VerticalReference) -> TrajPoint {
+        let mut p = self.trajectory.at(f64::NEG_INFINITY);
+        let af = &self.airframe;
+        let w = af.mass * af.gravity;
+        let climb = -v.vel.z;
+        let thrust = w + af.mass * (-v.accel.z) + (p.u[0] - w) * (climb / self.mission.v_vertical).clamp(-1.0, 1.0);
+        let o = self.origin.unwrap_or_else(Vector3::zeros);
+        p.v = v.vel.norm();
+        p.pos_neh = Vector3::new(v.pos.x, v.pos.y, -v.pos.z) - o;
+        p.thrust = thrust;
+        p.u[0] = thrust;
+        p
+    }
+
+    /// Air data in the take-off and landing phases: near hover V, α, β are undefined (α
+    /// jumps to π in the tail-first descent), so x and x_t carry the body air velocity
+    /// `v_a = V (cα cβ, sβ, sα cβ)` as `(u_a, w_a/V_e, v_a/V_e)` in place of `(V, α, β)`, the
+    /// reference's from `DCM_t (v_ref − ŵ)`, with `V_e = max(u_a,t, 1 m/s)`: to first order
+    /// the model's (V, α, β) at α = β = 0 and V = V_e, where `solve_gain` linearises (the same
+    /// 1 m/s floor), and continuous through V = 0 and reversed flow.
+    fn hover_air_data(
+        &self,
+        m: &flight_mission::Measurement,
+        v: &VerticalReference,
+        reference: &TrajPoint,
+        x: &mut X,
+        xt: &mut X,
+    ) {
+        let (sa, ca) = m.alpha.sin_cos();
+        let (sb, cb) = m.beta.sin_cos();
+        let va = m.airspeed * Vector3::new(ca * cb, sb, sa * cb);
+        let wind = if self.wind.iter().all(|w| w.is_finite()) {
+            self.wind
+        } else {
+            Vector3::zeros()
+        };
+        let vat = model::dcm_of_quat(&reference.quat()) * (v.vel - wind);
+        let ve = vat.x.max(1.0);
+        x[ix::V] = va.x;
+        x[ix::ALPHA] = va.z / ve;
+        x[ix::BETA] = va.y / ve;
+        xt[ix::V] = vat.x;
+        xt[ix::ALPHA] = vat.z / ve;
+        xt[ix::BETA] = vat.y / ve;
     }
 
     /// Append the controller's state (everything `sample` depends on besides its
@@ -602,6 +671,8 @@ impl LqrController {
         for v in self.wind_shift.iter() {
             out(*v);
         }
+        self.ground.save(out);
+        out(f64::from(u8::from(self.ground_active)));
     }
 
     /// Positions in the [`Self::save`] layout of the controller's continuous states, with
@@ -649,6 +720,10 @@ impl LqrController {
         self.weathervane.restore(&mut || next()).map_err(ControlError)?;
         let mut take = || next().ok_or_else(|| ControlError("truncated LQR controller state".into()));
         self.wind_shift = Vector3::new(take()?, take()?, take()?);
+        self.ground
+            .restore(&mut || take().ok())
+            .ok_or_else(|| ControlError("truncated LQR controller state".into()))?;
+        self.ground_active = take()? != 0.0;
         Ok(())
     }
 }
@@ -709,31 +784,95 @@ impl SampledUnit for LqrController {
         if let Some(name) = m.first_non_finite() {
             return Err(ControlError(format!("measurement {name} is not finite")));
         }
-        let t = input.t;
-        if !t.is_finite() {
-            return Err(ControlError(format!("sample time t = {t} is not finite")));
+        if !input.t.is_finite() {
+            return Err(ControlError(format!("sample time t = {} is not finite", input.t)));
         }
+        // Take-off and landing around the mission (flight_mission::ground): the mission time
+        // t is the FMU time less the spin-up and take-off climb (the same without take-off).
+        let t = input.t - self.ground.mission_start();
         let measured_neh = Vector3::new(m.pos_ned.x, m.pos_ned.y, -m.pos_ned.z);
+        let (trajectory, lqr_origin) = (&self.trajectory, self.origin);
+        let mode = self.ground.step(input.t, m, |tm| {
+            let p = trajectory.at(tm);
+            let o = lqr_origin.unwrap_or(measured_neh);
+            let off = &input.ref_offset_ned;
+            let (sg, cg) = p.gamma.sin_cos();
+            let (sp, cp) = p.euler_321.z.sin_cos();
+            let pos = o + p.pos_neh + Vector3::new(off.x, off.y, -off.z);
+            (
+                Vector3::new(pos.x, pos.y, -pos.z),
+                p.v * Vector3::new(cg * cp, cg * sp, -sg),
+            )
+        });
+        let (offset, ground_ref) = match mode {
+            GroundMode::Mission { offset, .. } => (offset, None),
+            GroundMode::Vertical(v) => (Vector3::zeros(), Some(v)),
+            GroundMode::Idle { phase, thrust } => {
+                // On the gear: no gain computation, no integration (no wind-up).
+                let af = &self.airframe;
+                return Ok(ControllerOutput {
+                    command: Command {
+                        thrust: thrust.clamp(af.thrust_min, af.thrust_max),
+                        ..Command::default()
+                    },
+                    diagnostics: Diagnostics {
+                        ref_pos_ned: m.pos_ned,
+                        ref_airspeed: 0.0,
+                        phase,
+                        pos_error: 0.0,
+                    },
+                    notice: None,
+                });
+            }
+        };
+        if self.origin.is_none() && self.ground.takeoff() {
+            // Mission origin: the take-off point (measured on the gear); gains relinearised
+            // from the first flying sample.
+            let o = self.ground.origin().unwrap_or(m.pos_ned);
+            self.origin = Some(Vector3::new(o.x, o.y, -o.z));
+            self.next_relinearisation = f64::NEG_INFINITY;
+        }
+        if ground_ref.is_some() != self.ground_active {
+            // Into or out of the take-off / landing phases: the gains change structure (the
+            // position integrators' columns); relinearise now, integrators from zero.
+            self.ground_active = ground_ref.is_some();
+            self.next_relinearisation = f64::NEG_INFINITY;
+            if self.params.position_integral == 0 {
+                self.pos_integrator = Vector3::zeros();
+            }
+        }
+        // Heading reference in vertical flight (README, "Weathervaning"); the take-off and
+        // landing phases keep their own vertical reference.
         let heading = self.weathervane.update(&self.mission, t, m);
-        let reference = self.trajectory.at(t).turned(&heading);
-        let off = &input.ref_offset_ned;
+        let reference = match &ground_ref {
+            Some(v) => self.ground_point(v),
+            None => self.trajectory.at(t).turned(&heading),
+        };
+        let off = &(input.ref_offset_ned + offset);
         let phase = self.mission.phase_at(t).0 as i32;
-        if self.params.reanchors() && self.origin.is_some() && phase != self.anchored_phase {
+        if ground_ref.is_none() && self.params.reanchors() && self.origin.is_some() && phase != self.anchored_phase {
             // §3.5.1: each new trajectory starts at the current position, so the reference
             // position equals the measured one at the first sample of the segment.
             self.origin = Some(measured_neh - reference.pos_neh - Vector3::new(off.x, off.y, -off.z));
         }
-        self.anchored_phase = phase;
+        if ground_ref.is_none() {
+            self.anchored_phase = phase;
+        }
         let origin = *self.origin.get_or_insert(measured_neh);
-        // Reference position: start + trajectory + offset, as (N, E, h).
-        let ref_neh = origin + reference.pos_neh + Vector3::new(off.x, off.y, -off.z);
+        // Reference position: start + trajectory + offset, as (N, E, h); in the take-off and
+        // landing phases the vertical reference (NED, origin included) + offset.
+        let ref_neh = match &ground_ref {
+            Some(v) => Vector3::new(v.pos.x + off.x, v.pos.y + off.y, -(v.pos.z + off.z)),
+            None => origin + reference.pos_neh + Vector3::new(off.x, off.y, -off.z),
+        };
         let rep = self.rep_for(&reference);
         // Vertical flight in wind: where the weathervane may turn (`Weathervane::free`), it
         // is engaged (a filtered horizontal wind ≥ its engage speed) or, before the filter has caught up with a sudden wind, measured air
         // angles beyond [`HOVER_WIND_AIR_ANGLE`] with an unfiltered air-data wind ≥ the engage
         // speed (in still air the climb's air comes from the nose, α, β ≈ 0, and the air-data
         // wind is zero). Tuned configuration only (the thesis's has no weathervane).
-        let in_wind = self.params.configuration == 0
+        let in_wind = ground_ref.is_none()
+            && self.params.configuration == 0
             && self.weathervane.free(&self.mission, t)
             && (self.weathervane.engaged()
                 || (m.alpha.abs() > HOVER_WIND_AIR_ANGLE || m.beta.abs() > HOVER_WIND_AIR_ANGLE)
@@ -781,6 +920,9 @@ impl SampledUnit for LqrController {
         xt[ix::V] = air_ref.x;
         xt[ix::ALPHA] = air_ref.y;
         xt[ix::BETA] = air_ref.z;
+        if let Some(v) = &ground_ref {
+            self.hover_air_data(m, v, &reference, &mut x, &mut xt);
+        }
 
         let mut notice = None;
         let due = t + 1e-9 >= self.next_relinearisation;
@@ -792,8 +934,14 @@ impl SampledUnit for LqrController {
             // the measured state, whose tilt into the wind and α, β of 30–90° put the linear
             // model far outside its range (gains that over-tilted and lost the aircraft
             // from 7 m/s). In still air the weathervane is never engaged: unchanged.
-            let xl = if in_wind { xt } else { x };
-            match self.solve_gain(rep, &xl, &reference.u, t) {
+            let mut x_lin = if in_wind { xt } else { x };
+            // In the take-off and landing phases linearise at α = β = 0: x carries the body
+            // air velocity there (`hover_air_data`), exact at α = β = 0 for any w/V_e.
+            if ground_ref.is_some() {
+                x_lin[ix::ALPHA] = 0.0;
+                x_lin[ix::BETA] = 0.0;
+            }
+            match self.solve_gain(rep, &x_lin, &reference.u, t) {
                 Ok(sol) => {
                     self.gain = sol.gain;
                     self.have_gain = true;
@@ -815,6 +963,9 @@ impl SampledUnit for LqrController {
                         xt[ix::V] = air_ref.x;
                         xt[ix::ALPHA] = air_ref.y;
                         xt[ix::BETA] = air_ref.z;
+                        if let Some(v) = &ground_ref {
+                            self.hover_air_data(m, v, &reference, &mut x, &mut xt);
+                        }
                     }
                 }
             }
@@ -888,7 +1039,7 @@ impl SampledUnit for LqrController {
         let diagnostics = Diagnostics {
             ref_pos_ned: Vector3::new(ref_neh.x, ref_neh.y, -ref_neh.z),
             ref_airspeed: reference.v,
-            phase: self.mission.phase_at(t).0,
+            phase: ground_ref.map_or(self.mission.phase_at(t).0, |v| v.phase),
             pos_error: flight_mission::distance(&pos, &ref_neh),
         };
         let command = Command {

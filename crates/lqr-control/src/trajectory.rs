@@ -196,6 +196,10 @@ fn path(m: &MissionParams, profile: Option<&Profile>, t: f64) -> (Phase, [f64; 5
     let dv = m.v_level - m.v_vertical;
     let r = match phase {
         Phase::Vertical1 | Phase::Vertical2 => [m.v_vertical, 0.0, FRAC_PI_2, 0.0, 0.0],
+        // Take-off and landing: flown from flight_mission::ground, never a mission time.
+        Phase::OnGround | Phase::TakeOff | Phase::Approach | Phase::Descent | Phase::Flare | Phase::Landed => {
+            [m.v_vertical, 0.0, FRAC_PI_2, 0.0, 0.0]
+        }
         Phase::Level => [m.v_level, 0.0, 0.0, 0.0, 0.0],
         Phase::TransitionToLevel => {
             let w = PI / m.t_transition_1;
@@ -230,6 +234,7 @@ fn alpha_thesis(m: &MissionParams, t: f64, alpha_level: f64, alpha_max: f64) -> 
     let (phase, tau) = m.phase_at(t);
     match phase {
         Phase::Vertical1 | Phase::Vertical2 => 0.0,
+        Phase::OnGround | Phase::TakeOff | Phase::Approach | Phase::Descent | Phase::Flare | Phase::Landed => 0.0,
         Phase::Level => alpha_level,
         Phase::TransitionToLevel => alpha_level * (tau / m.t_transition_1 * FRAC_PI_2).sin(),
         Phase::TransitionToVertical => {

@@ -149,6 +149,8 @@ pub fn load_set(json: &str, index: usize) -> Result<WeightSet, String> {
 fn table_index(phase: Phase) -> usize {
     match phase {
         Phase::Vertical1 | Phase::Vertical2 => 0,
+        // Take-off and landing (flight_mission::ground): vertical flight.
+        Phase::OnGround | Phase::TakeOff | Phase::Approach | Phase::Descent | Phase::Flare | Phase::Landed => 0,
         Phase::TransitionToLevel => 1,
         Phase::Level => 2,
         Phase::TransitionToVertical => 3,
@@ -177,6 +179,9 @@ impl WeightSchedule {
         let cur = self.phases[table_index(phase)];
         let prev = match phase {
             Phase::Vertical1 => return cur,
+            Phase::OnGround | Phase::TakeOff | Phase::Approach | Phase::Descent | Phase::Flare | Phase::Landed => {
+                return cur
+            }
             Phase::TransitionToLevel => Phase::Vertical1,
             Phase::Level => Phase::TransitionToLevel,
             Phase::TransitionToVertical => Phase::Level,

@@ -42,15 +42,15 @@ pub use params::TsdParams;
 pub use trajectory::{Reference, Trajectory};
 
 use flight_mission::{
-    Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, MissionParams, Notice, ParamError, Phase,
-    SampledUnit, Weathervane, WeathervaneParams,
+    Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, GroundMode, GroundPhases, MissionParams,
+    Notice, ParamError, Phase, SampledUnit, Weathervane, WeathervaneParams,
 };
 use nalgebra::{Matrix3, Quaternion, RowVector3, UnitQuaternion, Vector3};
 use tailsitter_physics::Airframe;
 
-/// Number of f64 values written by [`TsdController::save`]: the loops' six and the
-/// weathervane's.
-pub const STATE_LEN: usize = 6 + flight_mission::weathervane::WEATHERVANE_STATE_LEN;
+/// Number of f64 values written by [`TsdController::save`]: the loops' six, the
+/// weathervane's and the take-off / landing phases'.
+pub const STATE_LEN: usize = 6 + flight_mission::weathervane::WEATHERVANE_STATE_LEN + GroundPhases::SAVED_LEN;
 
 /// Internal signals of the last sample, for tests, plots and tuning.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -92,6 +92,9 @@ pub struct FlightCondition {
     /// the low-speed frame blend κ ([`TsdController::frame_weight`]). Equal to V̄ when the
     /// air flows from the nose; in hover in a crosswind it stays at the climb rate.
     pub axial_airspeed: f64,
+    /// Airspeed of the reference path (m/s): where it is the hover's (≤ v_vertical + 1 m/s)
+    /// the tuned guidance poles are blended on `axial_airspeed` instead of V̄.
+    pub reference_airspeed: f64,
 }
 
 /// Every loop's linear model and gains at one flight condition (§4.2, §4.3, Table 4.3).
@@ -160,6 +163,8 @@ pub struct TsdController {
     trajectory: Trajectory,
     integrators: Integrators,
     initialized: bool,
+    /// Take-off and landing phases around the mission (flight_mission::ground).
+    ground: GroundPhases,
     /// Bit mask of the saturated commands at the last sample (notices on new saturation only).
     saturated: u32,
     internals: Internals,
@@ -220,6 +225,7 @@ impl TsdController {
             trajectory,
             integrators: Integrators::default(),
             initialized: false,
+            ground: GroundPhases::new(mission, airframe.mass * airframe.gravity),
             saturated: 0,
             internals: Internals::default(),
             weathervane: Weathervane::new(if params.configuration == 0 {
@@ -283,6 +289,7 @@ impl TsdController {
         out(self.integrators.directional);
         out(self.saturated as f64);
         self.weathervane.save(out);
+        self.ground.save(out);
     }
 
     /// Restore what [`Self::save`] wrote; a truncated state is an error and leaves `self` unchanged.
@@ -307,6 +314,12 @@ impl TsdController {
         } else {
             0
         };
+        let mut rest = v[6 + flight_mission::weathervane::WEATHERVANE_STATE_LEN..]
+            .iter()
+            .copied();
+        self.ground
+            .restore(&mut || rest.next())
+            .ok_or_else(|| ControlError("truncated TSD controller state".into()))?;
         Ok(())
     }
 
@@ -361,9 +374,23 @@ impl TsdController {
         let (ixx, iyy, izz) = (af.i_xx, af.i_yy, af.i_zz);
         let blend = |a: f64, b: f64| lerp(a, b, sched);
 
+        // Tuned configuration, hover (the path at the vertical speed): the guidance poles are
+        // blended on the axial airspeed, not on V̄ — a wind across the hovering aircraft
+        // (V̄ of 5–8 m/s) must not pull the hover guidance towards the faster level-flight
+        // poles (it lost the 5 m/s crosswind that way). Elsewhere, and in the thesis
+        // configuration, on the measured V̄ as before (README, "Hover in wind").
+        let sched_path = if p.configuration == 0 {
+            if fc.reference_airspeed > vv + 1.0 {
+                sched
+            } else {
+                ((fc.axial_airspeed - vv) / (vl - vv)).clamp(0.0, 1.0)
+            }
+        } else {
+            sched
+        };
         let guidance = gains::guidance_gains(
-            blend(p.guidance_pole_re_vertical, p.guidance_pole_re_level),
-            blend(p.guidance_pole_im_vertical, p.guidance_pole_im_level),
+            lerp(p.guidance_pole_re_vertical, p.guidance_pole_re_level, sched_path),
+            lerp(p.guidance_pole_im_vertical, p.guidance_pole_im_level, sched_path),
         );
         let axial = gains::axial_gains(
             m,
@@ -516,12 +543,62 @@ impl SampledUnit for TsdController {
         let g = af.gravity;
         let ts = self.mission.sample_time;
 
-        // ---- Reference (§4.3.3) ------------------------------------------------------
-        let reference = self.trajectory.at(input.t);
-        let ref_pos = reference.pos + input.ref_offset_ned;
+        // ---- Reference (§4.3.3), or the take-off / landing phases around it -------------
+        let trajectory = &self.trajectory;
+        let origin = self.ground.origin().unwrap_or_else(Vector3::zeros);
+        let mission_ref = |tm: f64| {
+            let r = trajectory.at(tm);
+            (r.pos + input.ref_offset_ned + origin, r.vel)
+        };
+        // Mission time of the trajectory (the FMU time shifted by the take-off), the
+        // reference, its position with every offset, and the feed-forward Σ of a vertical
+        // reference of the ground phases.
+        let (t_mission, reference, ref_pos, sigma_ground) = match self.ground.step(input.t, meas, mission_ref) {
+            GroundMode::Mission { t, offset } => {
+                let r = self.trajectory.at(t);
+                let shift = offset + origin;
+                (t, r, r.pos + input.ref_offset_ned + shift, None)
+            }
+            GroundMode::Vertical(v) => {
+                let r = trajectory::Reference {
+                    phase: v.phase,
+                    pos: v.pos,
+                    vel: v.vel,
+                    specific_accel: v.accel - Vector3::new(0.0, 0.0, g),
+                    airspeed: v.vel.norm(),
+                    gamma: core::f64::consts::FRAC_PI_2,
+                };
+                (f64::NAN, r, v.pos + input.ref_offset_ned, Some(r.specific_accel))
+            }
+            GroundMode::Idle { phase, thrust } => {
+                // On the gear: no loop runs (no integrator wind-up); the next flight phase
+                // starts bumpless from the measured thrust and surfaces.
+                self.initialized = false;
+                self.saturated = 0;
+                let command = Command {
+                    thrust: thrust.clamp(af.thrust_min, af.thrust_max),
+                    ..Command::default()
+                };
+                return Ok(ControllerOutput {
+                    command,
+                    diagnostics: Diagnostics {
+                        ref_pos_ned: meas.pos_ned,
+                        ref_airspeed: 0.0,
+                        phase,
+                        pos_error: 0.0,
+                    },
+                    notice: None,
+                });
+            }
+        };
         // Heading reference (weathervane, README "Weathervaning"): the prescribed normal
-        // vector turned about the earth's down axis by ψ_w; zero in still air.
-        let heading = self.weathervane.update(&self.mission, input.t, meas);
+        // vector turned about the earth's down axis by ψ_w; zero in still air and in the
+        // take-off and landing phases (their own vertical reference).
+        let heading = if sigma_ground.is_some() {
+            flight_mission::HeadingRef::default()
+        } else {
+            self.weathervane.update(&self.mission, t_mission, meas)
+        };
         let pos_error_vec = meas.pos_ned - ref_pos;
 
         // ---- Measured wind axes and specific accelerations ----------------------------
@@ -567,13 +644,22 @@ impl SampledUnit for TsdController {
         let r_s = rr * ca - pr * sa;
 
         // ---- Gain schedule: every loop designed at this flight condition ----------------
+        // In the take-off and landing phases (vertical, slow, the air possibly from behind
+        // in the descent, α → π) the loops are designed for hover at the axial airspeed:
+        // the attached-flow models of (4.2.x) at α ≈ π would reverse the surfaces' sign.
+        let (fc_airspeed, fc_alpha) = if sigma_ground.is_some() {
+            (axial_airspeed.max(0.0), 0.0)
+        } else {
+            (meas.airspeed, meas.alpha)
+        };
         let d = self
             .design(&FlightCondition {
-                airspeed: meas.airspeed,
-                alpha: meas.alpha,
+                airspeed: fc_airspeed,
+                alpha: fc_alpha,
                 thrust: meas.thrust,
                 induced_velocity: meas.induced_velocity,
                 axial_airspeed,
+                reference_airspeed: reference.airspeed,
             })
             .map_err(|what| Self::err(format!("{what} gains not computable at t = {} s", input.t)))?;
         let (v, sched) = (d.v, d.schedule);
@@ -583,8 +669,10 @@ impl SampledUnit for TsdController {
         // ---- Guidance (4.3.24) ---------------------------------------------------------
         let (kp_g, kv_g) = d.guidance;
         let vel_error = meas.vel_ned - reference.vel;
-        let sigma_ff = if p.feedforward_lead > 0.0 {
-            self.trajectory.at(input.t + p.feedforward_lead).specific_accel
+        let sigma_ff = if let Some(s) = sigma_ground {
+            s
+        } else if p.feedforward_lead > 0.0 {
+            self.trajectory.at(t_mission + p.feedforward_lead).specific_accel
         } else {
             reference.specific_accel
         };
@@ -604,7 +692,7 @@ impl SampledUnit for TsdController {
         // Weight of the computed normal vector: 1 inside level flight, ramping over the
         // blend time at both ends, and faded out when the normal command is too small.
         let normal_weight = if reference.phase == Phase::Level {
-            let (_, tau) = self.mission.phase_at(input.t);
+            let (_, tau) = self.mission.phase_at(t_mission);
             let bt = p.normal_vector_blend_time;
             let ramp = if bt > 0.0 {
                 (tau / bt).min((self.mission.t_level - tau) / bt).clamp(0.0, 1.0)
@@ -872,6 +960,7 @@ mod tests {
             thrust: 88.3,
             induced_velocity: 10.4,
             axial_airspeed: 3.0,
+            reference_airspeed: 3.0,
         };
         let level = FlightCondition {
             airspeed: 25.0,
@@ -879,6 +968,7 @@ mod tests {
             thrust: 9.3,
             induced_velocity: 0.6,
             axial_airspeed: 25.0 * 0.092f64.cos(),
+            reference_airspeed: 25.0,
         };
         for (fc, lvl) in [(vertical, false), (level, true)] {
             let d = ctl.design(&fc).unwrap();

@@ -150,6 +150,10 @@ impl Trajectory {
         match phase {
             Phase::Vertical1 => climb(self.starts[0]),
             Phase::Vertical2 => climb(self.starts[4]),
+            // Take-off and landing: flown from flight_mission::ground, never a mission time.
+            Phase::OnGround | Phase::TakeOff | Phase::Approach | Phase::Descent | Phase::Flare | Phase::Landed => {
+                climb(self.starts[4])
+            }
             Phase::Level => Reference {
                 phase,
                 pos: self.starts[2] + Vector3::new(vl * tau, 0.0, 0.0),
