@@ -16,8 +16,8 @@ from fmu_util import DIST
 from tailsim import ClosedLoop
 from tailsim.report_takeoff import MISSION, PLANT, touchdown
 
-#: Long enough for the mission, the approach and the 2 m/s descent from ≈ 165 m (s).
-STOP = 145.0
+#: Long enough for the mission, the approach and the 2 m/s descent from ≈ 230 m (s).
+STOP = 190.0
 
 
 def check(td: dict, what: str) -> None:

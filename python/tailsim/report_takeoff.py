@@ -129,7 +129,7 @@ MISSION = {
     "takeoff_spinup_time": 2.0,
     "takeoff_time": 2.0,
     "landing_descent_rate": 2.0,
-    "landing_target_n": 400.0,
+    "landing_target_n": 460.0,
     "landing_target_e": 0.0,
     "landing_target_d": 0.0,
     "landing_approach_speed": 3.0,

@@ -33,15 +33,17 @@ pub const AFTER_LANDING: f64 = 5.0;
 
 /// The report's take-off-to-landing mission: the thesis's timings (5 s vertical,
 /// T1 = 5 s, 10 s level, T2 = 10 s, 5 s vertical), a 2 s spin-up and a 2 s take-off climb,
-/// the landing target 400 m north of the take-off point (16 m beyond the end of the TSD's
-/// flight path, 19 m short of the LQR's: both reposition along the belly axis), a 2 m/s
+/// the landing target 460 m north of the take-off point (12 m beyond where the α-limited
+/// flight path of both controllers ends, 448 m north and 221 m up: both reposition forwards
+/// along the belly axis; moving back by 8–48 m — targets at 440 and 400 m — lost the TSD
+/// under Jacobi, α −40…−90° in the backward translation), a 2 m/s
 /// descent tail first, a flare from 1.5 m to 0.3 m/s.
 pub fn mission() -> MissionParams {
     MissionParams {
         takeoff_spinup_time: 2.0,
         takeoff_time: 2.0,
         landing_descent_rate: 2.0,
-        landing_target_n: 400.0,
+        landing_target_n: 460.0,
         landing_target_e: 0.0,
         landing_target_d: 0.0,
         landing_approach_speed: 3.0,
