@@ -169,7 +169,9 @@ def test_libcosim_parameters_reach_the_fmus(tmp_path):
     window = level_window(r.time, {**MISSION, "v_level": 22.0})
     assert window.sum() > 0
     assert np.max(np.abs(r["airspeed"][window] - 22.0)) <= CRITERIA["level_airspeed_error_max"]
-    assert np.max(np.abs(r["ref_airspeed"][window] - 22.0)) < 1e-9
+    # The α-limited profile's speed settles onto v_level exponentially (1.7e-5 m/s at the
+    # window's start); the default 25 m/s would be 3 m/s off.
+    assert np.max(np.abs(r["ref_airspeed"][window] - 22.0)) < 1e-3
 
 
 def test_unloadable_fmu_is_an_error_not_a_crash(tmp_path):
