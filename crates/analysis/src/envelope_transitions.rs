@@ -235,7 +235,7 @@ pub fn runs() -> Vec<TransitionRun> {
 /// The point mass of the default airframe with thrust-to-weight `tw`.
 pub fn point_mass(tw: f64) -> PointMass {
     let af = Airframe::default();
-    let mut pm = lqr_control::trajectory::point_mass(&af, MissionParams::default().v_level).expect("level trim");
+    let mut pm = flight_mission::PointMass::from_level_trim(&af, MissionParams::default().v_level).expect("level trim");
     pm.thrust_max = tw * af.mass * af.gravity;
     pm
 }

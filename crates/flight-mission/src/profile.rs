@@ -72,6 +72,27 @@ pub struct PointMass {
     pub thrust_max: f64,
 }
 
+impl PointMass {
+    /// The point-mass model of `af`: the lift slope of the trimmed aircraft from its level
+    /// trim at `v_level` (L = m g − T sin α at α_L, C_L0 = 0); k = 1/(π e A).
+    pub fn from_level_trim(af: &tailsitter_physics::Airframe, v_level: f64) -> Result<Self, ParamError> {
+        let level = tailsitter_physics::Plant::new(*af)
+            .trim_level(v_level)
+            .map_err(|e| ParamError(format!("level trim at v_level = {v_level} failed: {e}")))?;
+        let q_s = 0.5 * af.air_density * v_level * v_level * af.wing_area;
+        Ok(Self {
+            mass: af.mass,
+            gravity: af.gravity,
+            air_density: af.air_density,
+            wing_area: af.wing_area,
+            c_l_alpha: (af.mass * af.gravity - level.thrust * level.alpha.sin()) / (q_s * level.alpha),
+            c_d0: af.c_D0,
+            k_induced: 1.0 / (core::f64::consts::PI * af.oswald_efficiency * af.aspect_ratio),
+            thrust_max: af.thrust_max,
+        })
+    }
+}
+
 /// The limits the profile respects.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ProfileLimits {

@@ -166,25 +166,6 @@ pub struct Trajectory {
     mission: MissionParams,
 }
 
-/// The point-mass model of `af` for the flight-path profile: the lift slope of the trimmed
-/// aircraft from the level trim at `v_level` (L = m g − T sin α at α_L, C_L0 = 0).
-pub fn point_mass(af: &Airframe, v_level: f64) -> Result<PointMass, String> {
-    let level = tailsitter_physics::Plant::new(*af)
-        .trim_level(v_level)
-        .map_err(|e| format!("level trim at v_level = {v_level} failed: {e}"))?;
-    let q_s = 0.5 * af.air_density * v_level * v_level * af.wing_area;
-    Ok(PointMass {
-        mass: af.mass,
-        gravity: af.gravity,
-        air_density: af.air_density,
-        wing_area: af.wing_area,
-        c_l_alpha: (af.mass * af.gravity - level.thrust * level.alpha.sin()) / (q_s * level.alpha),
-        c_d0: af.c_D0,
-        k_induced: 1.0 / (PI * af.oswald_efficiency * af.aspect_ratio),
-        thrust_max: af.thrust_max,
-    })
-}
-
 /// Kinematic reference of the flight path at τ: (V, V̇, γ, γ̇, γ̈), from the limited
 /// profile if given, else the thesis's cosine blends.
 fn path(m: &MissionParams, profile: Option<&Profile>, t: f64) -> (Phase, [f64; 5]) {
@@ -313,7 +294,7 @@ impl Trajectory {
             .map_err(|e| format!("level trim at v_level = {} failed: {e}", mission.v_level))?;
 
         let profile = if opt.limited_path {
-            let pm = point_mass(af, mission.v_level)?;
+            let pm = PointMass::from_level_trim(af, mission.v_level).map_err(|e| e.0)?;
             Some(Profile::new(mission, &pm, &ProfileLimits::of(mission)).map_err(|e| e.0)?)
         } else {
             None

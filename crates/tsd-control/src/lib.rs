@@ -180,25 +180,6 @@ fn lerp(a: f64, b: f64, s: f64) -> f64 {
     a + (b - a) * s
 }
 
-/// The point-mass model of `af` for the flight-path profile: the lift slope of the trimmed
-/// aircraft from the level trim at `v_level` (L = m g − T sin α at α_L, C_L0 = 0).
-fn point_mass(af: &Airframe, v_level: f64) -> Result<flight_mission::PointMass, ParamError> {
-    let level = tailsitter_physics::Plant::new(*af)
-        .trim_level(v_level)
-        .map_err(|e| ParamError(format!("level trim at v_level = {v_level} failed: {e}")))?;
-    let q_s = 0.5 * af.air_density * v_level * v_level * af.wing_area;
-    Ok(flight_mission::PointMass {
-        mass: af.mass,
-        gravity: af.gravity,
-        air_density: af.air_density,
-        wing_area: af.wing_area,
-        c_l_alpha: (af.mass * af.gravity - level.thrust * level.alpha.sin()) / (q_s * level.alpha),
-        c_d0: af.c_D0,
-        k_induced: 1.0 / (core::f64::consts::PI * af.oswald_efficiency * af.aspect_ratio),
-        thrust_max: af.thrust_max,
-    })
-}
-
 impl TsdController {
     /// A controller for `mission` with tuning `params`, using `airframe` (its own model of
     /// the aircraft, not necessarily the plant's) for gains and feedback linearisation.
@@ -212,7 +193,7 @@ impl TsdController {
         // The tuned configuration flies the α- and thrust-limited profile (issue 16), the
         // thesis configuration the quarter loops of §4.3.3.
         let trajectory = if params.configuration == 0 {
-            let pm = point_mass(&airframe, mission.v_level)?;
+            let pm = flight_mission::PointMass::from_level_trim(&airframe, mission.v_level)?;
             let profile = flight_mission::Profile::new(&mission, &pm, &flight_mission::ProfileLimits::of(&mission))?;
             Trajectory::limited(mission, airframe.gravity, profile)
         } else {
