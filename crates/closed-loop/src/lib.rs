@@ -163,18 +163,20 @@ impl Wind {
                     Vector3::zeros()
                 }
             }
+            // The 1 − cos gust on top of the steady wind (same operations as the campaign's).
             Wind::SteadyAndGust {
                 steady,
                 t_start,
                 duration,
                 amplitude,
             } => {
-                let s = (t - t_start) / duration;
-                if (0.0..=1.0).contains(&s) {
-                    steady + amplitude * (0.5 * (1.0 - (2.0 * std::f64::consts::PI * s).cos()))
-                } else {
-                    steady
-                }
+                steady
+                    + Wind::OneMinusCosine {
+                        t_start,
+                        duration,
+                        amplitude,
+                    }
+                    .at(t)
             }
         }
     }
