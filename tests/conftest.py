@@ -45,3 +45,18 @@ class _Fmus(dict):
 def fmus(tmp_path_factory) -> dict[str, Fmu]:
     """The three packaged FMUs (extracted once, on first use)."""
     return _Fmus(tmp_path_factory.mktemp("closed-loop"))
+
+
+@pytest.fixture(scope="session")
+def level_trim_theta(fmus):
+    """Pitch of the plant's level trim at the declared v_level (θ = α in level flight)."""
+    plant = fmus["tailsitter_plant"]
+    s = plant.instantiate("trim")
+    s.setupExperiment(startTime=0.0)
+    s.enterInitializationMode()
+    plant.set(s, {"initial_condition": 1, "initial_speed": fmus["tailsitter_lqr"].start("v_level")})
+    s.exitInitializationMode()
+    (theta,) = s.getReal([plant.variables["theta"].valueReference])
+    s.terminate()
+    s.freeInstance()
+    return theta

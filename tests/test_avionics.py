@@ -27,20 +27,6 @@ MISSION = ["t_vertical_1", "t_transition_1", "t_level", "t_transition_2", "t_ver
 CONTROLLERS = ["tailsitter_lqr", "tailsitter_tsd"]
 
 
-@pytest.fixture(scope="module")
-def level_trim_theta(fmus):
-    plant = fmus["tailsitter_plant"]
-    s = plant.instantiate("trim")
-    s.setupExperiment(startTime=0.0)
-    s.enterInitializationMode()
-    plant.set(s, {"initial_condition": 1, "initial_speed": fmus["tailsitter_lqr"].start("v_level")})
-    s.exitInitializationMode()
-    (theta,) = s.getReal([plant.variables["theta"].valueReference])
-    s.terminate()
-    s.freeInstance()
-    return theta
-
-
 def check(result, fmus, controller, theta_trim):
     print("\n" + format_phase_errors(result))
     mc = mission_check(result, fmus[controller].starts(MISSION), theta_trim)

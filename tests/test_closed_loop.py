@@ -19,21 +19,6 @@ CONTROLLERS = ["tailsitter_lqr", "tailsitter_tsd"]
 PHASES = ["vertical 1", "transition 1", "level", "transition 2", "vertical 2"]
 
 
-@pytest.fixture(scope="module")
-def level_trim_theta(fmus):
-    """Pitch of the plant's level trim at the declared v_level (θ = α in level flight)."""
-    plant = fmus["tailsitter_plant"]
-    s = plant.instantiate("trim")
-    s.setupExperiment(startTime=0.0)
-    s.enterInitializationMode()
-    plant.set(s, {"initial_condition": 1, "initial_speed": fmus["tailsitter_lqr"].start("v_level")})
-    s.exitInitializationMode()
-    (theta,) = s.getReal([plant.variables["theta"].valueReference])
-    s.terminate()
-    s.freeInstance()
-    return theta
-
-
 def fly(fmus, controller, **kw):
     run_kw = {k: kw.pop(k) for k in ("stop_time", "ref_offset", "wind") if k in kw}
     loop = ClosedLoop(fmus["tailsitter_plant"], fmus[controller], **kw)

@@ -4,11 +4,15 @@
 //! Real-time factor = 35 s / the time per mission (issue 14's target: ≥ 200×).
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use flight_mission::{ControllerInput, FlightController, Measurement, MissionParams};
+use flight_mission::{ControllerInput, FlightController, MissionParams};
 use lqr_control::{LqrController, LqrParams};
 use nalgebra::Vector3;
-use state_estimator::{Ekf, EstimatorParams, Measurements};
+use state_estimator::{Ekf, EstimatorParams};
 use std::hint::black_box;
+
+#[path = "../tests/support/chain.rs"]
+mod chain;
+use chain::{measurement, to_estimator, truth};
 use tailsitter_physics::{idx, Airframe, Plant};
 use tsd_control::{TsdController, TsdParams};
 
@@ -20,55 +24,19 @@ fn mission<C: FlightController>(c: &mut C) -> f64 {
     let trim = plant.trim_vertical_climb(m.v_vertical).unwrap();
     let (mut x, mut u) = (trim.state, trim.inputs);
     let wind = Vector3::zeros();
-    let truth = |x: &tailsitter_physics::StateVector, u: &tailsitter_physics::InputVector| {
-        let y = plant.outputs(x, u, &wind);
-        sensor_model::Truth {
-            pos_ned: Vector3::new(x[idx::POS_N], x[idx::POS_E], x[idx::POS_D]),
-            vel_ned: y.vel_ned,
-            rates: Vector3::new(x[idx::P], x[idx::Q], x[idx::R]),
-            quat: x.fixed_rows::<4>(idx::Q1).into_owned(),
-            airspeed: y.airspeed,
-            alpha: y.alpha,
-            beta: y.beta,
-            specific_force: y.specific_force_body,
-        }
-    };
-    let meas = |m: &sensor_model::Measurements| Measurements {
-        gps_latitude: m.gps_latitude,
-        gps_longitude: m.gps_longitude,
-        gps_height: m.gps_height,
-        gps_vel: m.gps_vel,
-        gps_fix_count: m.gps_fix_count as i32,
-        gps_valid: m.gps_valid,
-        accel: m.accel(),
-        gyro: m.gyro(),
-        mag: m.mag(),
-        pitot: m.pitot_airspeed(),
-    };
     let mut sensors = sensor_model::SensorModel::new(sensor_model::Params::default()).unwrap();
     let mut ekf = Ekf::new(EstimatorParams::default()).unwrap();
-    ekf.initialize(&meas(&sensors.start(&truth(&x, &u), 0.0).unwrap()), &u);
+    ekf.initialize(
+        &to_estimator(&sensors.start(&truth(&plant, &x, &u, &wind), 0.0).unwrap()),
+        &u,
+    );
     let n = (m.end_time() / H).round() as usize;
     for k in 0..n {
         let t = k as f64 * H;
-        let s = meas(&sensors.step(&truth(&x, &u), t, H).unwrap());
-        let e = ekf.estimate();
+        let s = to_estimator(&sensors.step(&truth(&plant, &x, &u, &wind), t, H).unwrap());
         let input = ControllerInput {
             t,
-            measurement: Measurement {
-                pos_ned: e.pos_ned,
-                vel_ned: e.vel_ned,
-                vel_body: e.vel_body,
-                rates: e.rates,
-                quat: e.quat,
-                airspeed: e.airspeed,
-                alpha: e.alpha,
-                beta: e.beta,
-                thrust: e.thrust,
-                surfaces: e.surfaces,
-                specific_force_body: e.specific_force,
-                induced_velocity: e.induced_velocity,
-            },
+            measurement: measurement(&ekf.estimate()),
             ref_offset_ned: Vector3::zeros(),
         };
         u = closed_loop::plant_inputs(&c.sample(&input).unwrap().command);

@@ -2,61 +2,15 @@
 //! estimator → controller → plant, and controller commands → estimator, flying the
 //! default mission. The controllers read the estimate exactly as they read the plant.
 
-use flight_mission::{ControllerInput, FlightController, Measurement, MissionParams, Phase};
+use flight_mission::{ControllerInput, FlightController, MissionParams, Phase};
 use lqr_control::{LqrController, LqrParams};
 use nalgebra::Vector3;
-use state_estimator::{Ekf, Estimate, EstimatorParams, Measurements};
-use tailsitter_physics::{dcm_earth_to_body, idx, Airframe, InputVector, Plant, StateVector};
+use state_estimator::{Ekf, EstimatorParams, Measurements};
+use tailsitter_physics::{dcm_earth_to_body, idx, Airframe, Plant};
 use tsd_control::{TsdController, TsdParams};
 
-/// The estimate as the controller's measurement (the plant outputs of the same names).
-fn measurement(e: &Estimate) -> Measurement {
-    Measurement {
-        pos_ned: e.pos_ned,
-        vel_ned: e.vel_ned,
-        vel_body: e.vel_body,
-        rates: e.rates,
-        quat: e.quat,
-        airspeed: e.airspeed,
-        alpha: e.alpha,
-        beta: e.beta,
-        thrust: e.thrust,
-        surfaces: e.surfaces,
-        specific_force_body: e.specific_force,
-        induced_velocity: e.induced_velocity,
-    }
-}
-
-/// The true state as the sensor model sees it (the plant outputs of the same names).
-fn truth(plant: &Plant, x: &StateVector, u: &InputVector, wind: &Vector3<f64>) -> sensor_model::Truth {
-    let y = plant.outputs(x, u, wind);
-    sensor_model::Truth {
-        pos_ned: Vector3::new(x[idx::POS_N], x[idx::POS_E], x[idx::POS_D]),
-        vel_ned: y.vel_ned,
-        rates: Vector3::new(x[idx::P], x[idx::Q], x[idx::R]),
-        quat: x.fixed_rows::<4>(idx::Q1).into_owned(),
-        airspeed: y.airspeed,
-        alpha: y.alpha,
-        beta: y.beta,
-        specific_force: y.specific_force_body,
-    }
-}
-
-/// The sensor model's outputs as the estimator's inputs (the FMU connections by name).
-fn to_estimator(m: &sensor_model::Measurements) -> Measurements {
-    Measurements {
-        gps_latitude: m.gps_latitude,
-        gps_longitude: m.gps_longitude,
-        gps_height: m.gps_height,
-        gps_vel: m.gps_vel,
-        gps_fix_count: m.gps_fix_count as i32,
-        gps_valid: m.gps_valid,
-        accel: m.accel(),
-        gyro: m.gyro(),
-        mag: m.mag(),
-        pitot: m.pitot_airspeed(),
-    }
-}
+mod support;
+use support::chain::{measurement, to_estimator, truth};
 
 struct Flight {
     /// Max distance of the true position from the reference (m).
