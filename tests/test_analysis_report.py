@@ -73,10 +73,25 @@ def test_tables_hold_the_data(rendered):
             assert f"| {p['damping']:.3f} | {p['omega_n']:.3f} | {p['dominant']} |" in cl
     assert cl.count("| loop | placed | achieved (ours) | thesis Table 4.4 |") == 2
     assert "| Roll rate |" in cl and "−10.6 ± 4.5i" in cl  # thesis Table 4.4, roll rate, level
-    # Robustness: range, passes and worst error of each controller.
+    # Robustness: range, passes and worst error of each controller, thesis / global model
+    # side by side (issue 13).
     rb = next(line for line in lines_of(folder, "robustness.md") if line.startswith("| C_mδe |"))
-    for r in d["robustness"]["rows"]:
-        assert f"{r['range'][0]:.3f} … {r['range'][1]:.3f} | {r['passes']}/{r['points']} | {r['worst_pos_error']:.2f}" in rb
+    cells = [c.strip() for c in rb.strip("|").split("|")]
+    by = {(r["controller"], r["aero_model"]): r for r in d["robustness"]["rows"]}
+    assert set(by) == {(k, m) for k in d["controllers"] for m in (0, 1)}
+    for i, k in enumerate(d["controllers"]):
+        t, g = by[k, 0], by[k, 1]
+        assert cells[1 + 3 * i] == f"{t['range'][0]:.3f} … {t['range'][1]:.3f} / {g['range'][0]:.3f} … {g['range'][1]:.3f}"
+        assert cells[2 + 3 * i] == f"{t['passes']}/{t['points']} / {g['passes']}/{g['points']}"
+        assert cells[3 + 3 * i] == f"{t['worst_pos_error']:.2f} / {g['worst_pos_error']:.2f}"
+    # The generated comparison: one line per controller with its nominal flight on both models.
+    text = lines_of(folder, "robustness.md")
+    assert text.count("Linear against global (generated from the rows above):") == 2  # thesis range + wide
+    for k in d["controllers"]:
+        t, g = by[k, 0]["nominal"], by[k, 1]["nominal"]
+        line = next(x for x in text if x.startswith(f"- **{k}**: the nominal airframe (factor 1)"))
+        assert f"position error {t['max_pos_error']:.2f} / {g['max_pos_error']:.2f} m" in line
+    assert sum(x.startswith("Why: ") for x in text) == 2
     # Gusts: 3 phases × 3 axes.
     gu = [line for line in lines_of(folder, "gusts.md") if line.startswith("| ") and not line.startswith("| phase")]
     assert len(gu) == 9
@@ -121,18 +136,19 @@ def test_aero_models_section_shows_both_models_side_by_side(rendered):
         assert cells[8].startswith("LOST with the global model") == lost
     # Gust sweep on both models: 3 phases × 3 axes, thesis / global per controller.
     i = lines.index("### Gust sweep on both models")
-    j = lines.index("### Parameter end points on both models")
+    j = lines.index("### Parameter sweep on both models")
     gust = [line for line in lines[i:j] if line.startswith("| ") and not line.startswith("| phase")]
     assert len(gust) == 9
     g = {(r["phase"], r["axis"], r["controller"], r["aero_model"]): r["largest_survived"] for r in a["gusts"]["rows"]}
     first = [c.strip() for c in gust[0].strip("|").split("|")]
     assert first[2] == f"{g[first[0], first[1], 'LQR', 0]:.0f} / {g[first[0], first[1], 'LQR', 1]:.0f}"
-    # Parameter end points: one row per parameter of Table 5.1, ÷τ and ×τ per controller.
-    i = lines.index("### Parameter end points on both models")
-    scaled = [line for line in lines[i:] if line.startswith("| ") and not line.startswith("| parameter")]
-    assert len(scaled) == len({r["param"] for r in a["scaled"]}) == 25
-    r = next(r for r in a["scaled"] if r["param"] == "CLa" and r["controller"] == "LQR" and r["factor"] < 1)
-    assert scaled[0].startswith(f"| {r['name']} | {r['max_pos_error_m']:.2f}{'' if r['passed'] else ' ✗'} / ")
+    # The parameter sweep on both models: its pass counts from report.json's robustness rows.
+    i = lines.index("### Parameter sweep on both models")
+    rows = json.loads((DATA / "report.json").read_text())["robustness"]["rows"]
+    for m, name in ((0, "thesis"), (1, "global")):
+        passes = sum(r["passes"] for r in rows if r["aero_model"] == m)
+        points = sum(r["points"] for r in rows if r["aero_model"] == m)
+        assert f"{name} {passes}/{points}" in lines[i + 2]
     # Coefficient curves: both models over 0…180°, identical in attached flow.
     c = a["coefficients"]
     assert c["alpha_deg"][0] == 0 and c["alpha_deg"][-1] == 180
@@ -157,3 +173,45 @@ def test_aero_verdicts():
     assert verdict(row(False, 170, 90, 80, 1.0), row(False, 170, 90, 80, 1.0)) == "lost with both models"
     v = verdict(row(True, 22, 0.4, 0.2, 0.5), row(True, 52, 12.9, 12.7, 1.0))
     assert v.startswith("passes with both; worse with the global model (error +12.50 m, max α +30.0°")
+
+
+def test_robustness_changes_say_what_changed_and_why():
+    """The linear-against-global sentences on hand-made sweep rows (independent of any run):
+    fewer and more passing factors on the global model are listed with their counts, the
+    largest change of the worst error is named, and the reason depends on whether the
+    changed sweeps left attached flow."""
+    from tailsim.aero_report import robustness_changes
+
+    d = {"controllers": ["LQR"], "params": [{"id": "CLa", "name": "C_Lα"}, {"id": "Cma", "name": "C_mα"},
+                                            {"id": "Cnb", "name": "C_nβ"}]}
+
+    def row(pid, model, passes, worst, alpha, stall, rng=(0.8, 1.2)):
+        nominal = {"passed": True, "max_pos_error": 0.4 + model, "max_alpha_deg": 11.0, "max_stall_fraction": 0.01}
+        return {"param": pid, "controller": "LQR", "aero_model": model, "passes": passes, "points": 50,
+                "range": list(rng), "worst_pos_error": worst, "max_alpha_deg": alpha,
+                "max_stall_fraction": stall, "nominal": nominal}
+
+    rows = [
+        row("CLa", 0, 50, 0.5, 22, 0.4), row("CLa", 1, 44, 3.5, 60, 1.0, (0.9, 1.2)),  # fewer, stalled
+        row("Cma", 0, 40, 2.0, 30, 0.5, (0.9, 1.2)), row("Cma", 1, 46, 2.0, 35, 0.6),  # more, stalled
+        row("Cnb", 0, 50, 0.7, 8, 0.0), row("Cnb", 1, 50, 0.7, 8, 0.0),  # attached, identical
+    ]
+    out = robustness_changes(d, rows)
+    line = next(x for x in out if x.startswith("- **LQR**"))
+    assert "position error 0.40 / 1.40 m" in line
+    assert "1 of 3 sweeps pass at as many factors" in line
+    assert "fewer on the global model: C_Lα 50 → 44" in line and "more on the global model: C_mα 40 → 46" in line
+    assert "in 1 sweep (most: C_Lα, 0.50 / 3.50 m)" in line
+    why = out[-1]
+    assert why.startswith("Why: all 2 changed sweeps left attached flow") and "α up to 60°" in why
+    assert "1 sweep stayed in attached flow on both models and fly identically" in why
+    # A sweep that changed although it stayed attached is called out, not explained away.
+    rows[5] = row("Cnb", 1, 49, 0.7, 8, 0.0)
+    why = robustness_changes(d, rows)[-1]
+    assert "1 sweep changed without leaving attached flow (LQR C_nβ)" in why and not why.startswith("Why: all")
+    # Nothing changed, all attached.
+    same = [row("Cnb", 0, 50, 0.7, 8, 0.0), row("Cnb", 1, 50, 0.7, 8, 0.0)]
+    assert robustness_changes(d, same)[-1] == (
+        "Why: nothing changed — every flight stayed in attached flow, where the global model is the thesis's."
+    )
+    assert not any("nominal airframe" in x for x in robustness_changes(d, same, nominal=False))

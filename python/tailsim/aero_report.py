@@ -6,9 +6,11 @@ which `cargo run --release -p analysis -- all|aero --out DIR` writes.
     cargo run --release -p analysis -- aero --out out/analysis
     PYTHONPATH=python .venv/bin/python -m tailsim.analysis_report out/analysis
 
-Tables: the flight cases (default and fast mission, hover wind steps), the
-analysis's gust sweep and the end points of its parameter sweep, each with the
-thesis / global values side by side and what changed. Writes `aero_models.md`
+Tables: the flight cases (default and fast mission, hover wind steps) and the
+analysis's gust sweep, each with the thesis / global values side by side and
+what changed; the parameter sweep of Table 5.1 on both models is in the
+robustness section (`tailsim.analysis_report`, rendered with
+`robustness_changes` from here). Writes `aero_models.md`
 (via `tailsim.analysis_report`) and the plots
 `aero_coefficients.png` (C_L, C_D, C_m of both models over α = 0…180°) and
 `aero_flights.png` (largest position error of every flight).
@@ -40,7 +42,10 @@ MODEL_NOTES = (
     "({ra}°–{rs}° from 180°). Where a run leaves attached flow the thesis's model gives the aircraft lift, "
     "restoring moments and control authority a real wing does not have, so the two models differ there — the "
     "verdict column says in which direction. The controllers are not retuned (issue 13): where one now fails, "
-    "the table says so."
+    "the table says so. What the global model leaves out: it is quasi-steady (no dynamic stall, stall hysteresis "
+    "or stall delay in fast pitch-ups, which add transient lift and pitching moment in the quickest transitions), has "
+    "no jet-height correction of the slip-stream strip (it overestimates slip-stream lift in a crosswind), and "
+    "stalls symmetrically (no spin autorotation)."
 )
 
 
@@ -177,7 +182,7 @@ def section(d: dict) -> list[str]:
             )
     ctls = d.get("controllers") or sorted({r["controller"] for r in a["rows"]})
     out += gust_table(a, ctls)
-    out += scaled_table(a, ctls)
+    out += sweep_summary(d)
     lost = [
         f"{r['controller']} — {desc[r['case']]}"
         for r in a["rows"]
@@ -236,45 +241,169 @@ def gust_table(a: dict, controllers: list[str]) -> list[str]:
     return out
 
 
-def scaled_table(a: dict, controllers: list[str]) -> list[str]:
-    """The parameter sweep's end points (÷τ, ×τ) flown on both models."""
-    rows = a.get("scaled") or []
-    if not rows:
+def sweep_summary(d: dict) -> list[str]:
+    """Pointer to the robustness sweep flown on both models, with its pass counts."""
+    rb = d.get("robustness")
+    if not rb or sorted(rb.get("aero_models") or [0]) != [0, 1]:
         return []
 
-    def cell(r: dict) -> str:
-        return f"{fmt_or_dash(_num(r['max_pos_error_m']), 2)}{'' if r['passed'] else ' ✗'}"
+    def counts(rows: list[dict]) -> str:
+        c = {m: (sum(r["passes"] for r in rows if r["aero_model"] == m), sum(r["points"] for r in rows if r["aero_model"] == m)) for m in (0, 1)}
+        return f"thesis {c[0][0]}/{c[0][1]}, global {c[1][0]}/{c[1][1]}"
 
-    by = {(r["param"], r["controller"], r["aero_model"], r["factor"] > 1): r for r in rows}
-    params: list[tuple[str, str]] = []
-    for r in rows:
-        if (r["param"], r["name"]) not in params:
-            params.append((r["param"], r["name"]))
-    passes = {m: sum(r["passed"] for r in rows if r["aero_model"] == m) for m in (0, 1)}
-    total = {m: sum(1 for r in rows if r["aero_model"] == m) for m in (0, 1)}
-    out = [
-        "",
-        "### Parameter end points on both models",
-        "",
-        "The default mission on a plant with one parameter of Table 5.1 scaled to an end of the thesis's range "
-        "(÷τ / ×τ; τ = 1.5 aerodynamic, 1.1 mass and inertia), controllers designed on the nominal airframe. Cells: "
-        "largest position error (m), thesis / global; ✗ = mission criteria missed or ground touched. Passes: "
-        f"thesis {passes[0]}/{total[0]}, global {passes[1]}/{total[1]}.",
-        "",
-    ]
-    header, rule = "| parameter |", "|---|"
-    for k in controllers:
-        header += f" {k} ÷τ | {k} ×τ |"
-        rule += "---|---|"
-    out += [header, rule]
-    for pid, name in params:
-        line = f"| {name} |"
-        for k in controllers:
-            for up in (False, True):
-                t, g = by.get((pid, k, 0, up)), by.get((pid, k, 1, up))
-                line += f" {cell(t)} / {cell(g)} |" if t and g else " – |"
-        out.append(line)
+    text = (
+        "The parameter sweep of Table 5.1 (every parameter, every factor of the sweep, both controllers) is flown "
+        "on both models in the nonlinear robustness section, side by side with what changed and why. Flights "
+        f"passing the mission criteria: {counts(rb['rows'])}"
+    )
+    w = rb.get("wide")
+    if w:
+        text += f" (wider sweep τ^{shortest(w['tau_power'])}: {counts(w['rows'])})"
+    return ["", "### Parameter sweep on both models", "", text + "."]
+
+
+#: A worst position error that moves by more than this (m) counts as changed.
+ERROR_CHANGE = 0.05
+
+
+def _sweep_changed(t: dict, g: dict) -> bool:
+    """Whether one parameter's sweep (thesis row `t`, global row `g`) differs between the models."""
+    if t["passes"] != g["passes"] or t["range"] != g["range"]:
+        return True
+    et, eg = _num(t["worst_pos_error"]), _num(g["worst_pos_error"])
+    if math.isfinite(et) != math.isfinite(eg):
+        return True
+    return math.isfinite(et) and abs(eg - et) > ERROR_CHANGE
+
+
+def _n(count: int, word: str) -> str:
+    """`1 sweep`, `2 sweeps`."""
+    return f"{count} {word}{'' if count == 1 else 's'}"
+
+
+def robustness_changes(d: dict, rows: list[dict], alpha_attached: float = 10.0, nominal: bool = True) -> list[str]:
+    """Which results of a robustness sweep flown on both models (rows with `aero_model` 0 and
+    1) changed, and why, in words generated from the rows: per controller the nominal
+    flight on both models, the sweeps that pass at fewer / more factors on the global model,
+    the largest change of the worst position error, and whether the changed sweeps left
+    attached flow (where the models differ) while the unchanged ones stayed in it.
+    `nominal`: also state the nominal flight (factor 1) on both models."""
+    by = {(r["param"], r["controller"], r.get("aero_model", 0)): r for r in rows}
+    names = {p["id"]: p["name"] for p in d["params"]}
+    out = ["Linear against global (generated from the rows above):", ""]
+    for k in d["controllers"]:
+        pairs = [
+            (pid, by[pid, k, 0], by[pid, k, 1])
+            for pid in names
+            if (pid, k, 0) in by and (pid, k, 1) in by
+        ]
+        if not pairs:
+            continue
+        parts = []
+        nt, ng = pairs[0][1].get("nominal"), pairs[0][2].get("nominal")
+        if nominal and nt and ng:
+            ok = {True: "passes", False: "**fails**"}
+            parts.append(
+                f"the nominal airframe (factor 1) {ok[nt['passed']]} / {ok[ng['passed']]}, position error "
+                f"{_pair(nt['max_pos_error'], ng['max_pos_error'], 2)} m, max α "
+                f"{_pair(nt['max_alpha_deg'], ng['max_alpha_deg'], 0)}°, stall fraction "
+                f"{_pair(nt['max_stall_fraction'], ng['max_stall_fraction'], 2)}"
+            )
+        fewer = [(pid, t, g) for pid, t, g in pairs if g["passes"] < t["passes"]]
+        more = [(pid, t, g) for pid, t, g in pairs if g["passes"] > t["passes"]]
+        same = len(pairs) - len(fewer) - len(more)
+        text = f"{same} of {_n(len(pairs), 'sweep')} pass at as many factors on both models"
+
+        def listing(xs):
+            return ", ".join(f"{names[pid]} {t['passes']} → {g['passes']}" for pid, t, g in xs)
+
+        if fewer:
+            text += f"; fewer on the global model: {listing(fewer)}"
+        if more:
+            text += f"; more on the global model: {listing(more)}"
+        parts.append(text)
+        moved = [
+            (abs(_num(g["worst_pos_error"]) - _num(t["worst_pos_error"])), pid, t, g)
+            for pid, t, g in pairs
+            if math.isfinite(_num(t["worst_pos_error"]))
+            and math.isfinite(_num(g["worst_pos_error"]))
+            and abs(_num(g["worst_pos_error"]) - _num(t["worst_pos_error"])) > ERROR_CHANGE
+        ]
+        if moved:
+            _, pid, t, g = max(moved, key=lambda x: x[0])
+            parts.append(
+                f"the worst position error moves by more than {shortest(ERROR_CHANGE)} m in {_n(len(moved), 'sweep')} "
+                f"(most: {names[pid]}, {_pair(t['worst_pos_error'], g['worst_pos_error'], 2)} m)"
+            )
+        else:
+            parts.append(f"no worst position error moves by more than {shortest(ERROR_CHANGE)} m")
+        out.append(f"- **{k}**: " + "; ".join(parts) + ".")
+    out += ["", why_sweeps(d, rows, alpha_attached)]
     return out
+
+
+def why_sweeps(d: dict, rows: list[dict], alpha_attached: float = 10.0) -> str:
+    """Why the changed sweeps changed: whether they left attached flow, from the rows."""
+    by = {(r["param"], r["controller"], r.get("aero_model", 0)): r for r in rows}
+    names = {p["id"]: p["name"] for p in d["params"]}
+    changed, changed_attached, same_attached, same_stalled = [], [], 0, 0
+    fewer = more = 0
+    for k in d["controllers"]:
+        for pid in names:
+            t, g = by.get((pid, k, 0)), by.get((pid, k, 1))
+            if t is None or g is None:
+                continue
+            stalled = max(_num(t["max_stall_fraction"]), _num(g["max_stall_fraction"])) > 0.0
+            if _sweep_changed(t, g):
+                (changed if stalled else changed_attached).append((k, pid, t, g))
+                fewer += g["passes"] < t["passes"]
+                more += g["passes"] > t["passes"]
+            elif stalled:
+                same_stalled += 1
+            else:
+                same_attached += 1
+    if not changed and not changed_attached:
+        return (
+            "Why: nothing changed — "
+            + (
+                "every flight stayed in attached flow, where the global model is the thesis's."
+                if not same_stalled
+                else f"{_n(same_stalled, 'sweep')} left attached flow, but too briefly or too little to change a result."
+            )
+        )
+    text = "Why: "
+    if changed:
+        alpha = max(max(_num(t["max_alpha_deg"]), _num(g["max_alpha_deg"])) for _, _, t, g in changed)
+        stall = max(max(_num(t["max_stall_fraction"]), _num(g["max_stall_fraction"])) for _, _, t, g in changed)
+        text += (
+            f"all {len(changed)} changed {'sweep' if len(changed) == 1 else 'sweeps'} left attached flow (stall "
+            f"fraction > 0: part of the wing beyond |α| = {shortest(alpha_attached)}° or at large β; α up to "
+            f"{alpha:.0f}°, stall fraction up to {stall:.2f}), where the thesis's lift, moments and control power "
+            "keep growing linearly while the global model's saturate into flat-plate behaviour (lift capped, drag "
+            "rising to broadside, centre of pressure moving aft, control surfaces fading)"
+        )
+        reasons = []
+        if fewer:
+            reasons.append(f"in {fewer} the global model's lost lift and control power past stall costs passing factors")
+        if more:
+            reasons.append(f"in {more} the thesis's unphysical post-stall forces were what failed the mission")
+        if reasons:
+            text += "; " + ", and ".join(reasons)
+        text += ". "
+        if changed_attached:
+            text = text.replace("all ", "", 1)
+    if changed_attached:
+        text += (
+            f"{_n(len(changed_attached), 'sweep')} changed without leaving attached flow "
+            f"({', '.join(f'{k} {names[pid]}' for k, pid, _, _ in changed_attached)}): not explained by the stall model. "
+        )
+    text += (
+        f"{_n(same_attached, 'sweep')} stayed in attached flow on both models and fly identically (the global model "
+        "is the thesis's there)"
+    )
+    if same_stalled:
+        text += f"; {same_stalled} left attached flow without a result changing"
+    return text + "."
 
 
 def plot(folder: str | pathlib.Path) -> list[pathlib.Path]:

@@ -8,7 +8,8 @@ Writes PNGs beside the CSVs:
   loci_<ctl>_<cond>_pitch.png         pole loci for C_mα, C_mq, C_mδe (Figs. 5.1/5.2)
   loci_<ctl>_<cond>_all.png           pole loci for every parameter of Table 5.1 (Figs. E.4–E.15)
   table_5_1.png                       regenerated Table 5.1 next to the thesis's
-  robustness.png, gusts.png           nonlinear robustness ranges and largest survived gusts
+  robustness.png, gusts.png           nonlinear robustness ranges (per aerodynamic model) and
+                                      largest survived gusts
 """
 
 import csv
@@ -145,17 +146,22 @@ def main(out):
         for x in r:
             if x["param"] not in params:
                 params.append(x["param"])
-        fig, axs = plt.subplots(1, 2, figsize=(12, 5), sharey=True)
-        for ax, ctl in zip(axs, ("LQR", "TSD")):
-            for i, p in enumerate(params):
-                pts = [(float(x["factor"]), x["passed"] == "true") for x in r if x["param"] == p and x["controller"] == ctl]
-                ax.scatter([q[0] for q in pts], [i] * len(pts), c=["g" if q[1] else "r" for q in pts], s=6)
-            ax.set_xscale("log")
-            ax.set_yticks(range(len(params)))
-            ax.set_yticklabels(params, fontsize=8)
-            ax.set_xlabel("scale factor (plant only)")
-            ax.set_title(f"{ctl}: mission passed (green) / failed (red)")
-            ax.axvline(1, color="k", lw=0.5)
+        # One row of panels per aerodynamic model (issue 13: thesis 0, global 1).
+        models = sorted({x.get("aero_model", "0") for x in r})
+        name = {"0": "thesis aero", "1": "global aero"}
+        fig, axs = plt.subplots(len(models), 2, figsize=(12, 5 * len(models)), sharey=True, squeeze=False)
+        for row, model in zip(axs, models):
+            for ax, ctl in zip(row, ("LQR", "TSD")):
+                for i, p in enumerate(params):
+                    pts = [(float(x["factor"]), x["passed"] == "true") for x in r
+                           if x["param"] == p and x["controller"] == ctl and x.get("aero_model", "0") == model]
+                    ax.scatter([q[0] for q in pts], [i] * len(pts), c=["g" if q[1] else "r" for q in pts], s=6)
+                ax.set_xscale("log")
+                ax.set_yticks(range(len(params)))
+                ax.set_yticklabels(params, fontsize=8)
+                ax.set_xlabel("scale factor (plant only)")
+                ax.set_title(f"{ctl}, {name.get(model, model)}: mission passed (green) / failed (red)", fontsize=9)
+                ax.axvline(1, color="k", lw=0.5)
         fig.tight_layout()
         fig.savefig(out / "robustness.png", dpi=110)
         plt.close(fig)

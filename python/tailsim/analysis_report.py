@@ -184,22 +184,34 @@ def table_5_1(d: dict) -> list[str]:
     return out
 
 
+def _range(r: dict | None) -> str:
+    if r is None:
+        return "—"
+    return f"{r['range'][0]:.3f} … {r['range'][1]:.3f}" if r["range"] is not None else "nominal fails"
+
+
 def _robustness_table(d: dict, rows: list[dict]) -> list[str]:
+    """One row per parameter; with rows on both aerodynamic models (issue 13) every cell is
+    `thesis / global`."""
+    models = sorted({r.get("aero_model", 0) for r in rows})
+    both = models == [0, 1]
     header, rule = "| parameter |", "|---|"
     for k in d["controllers"]:
         header += f" {k} range | {k} passes | {k} worst pos. err (m) |"
         rule += "---|---|---|"
     out = [header, rule]
-    by = {(r["param"], r["controller"]): r for r in rows}
+    by = {(r["param"], r["controller"], r.get("aero_model", 0)): r for r in rows}
     for p in d["params"]:
         line = f"| {p['name']} |"
         for k in d["controllers"]:
-            r = by.get((p["id"], k))
-            if r is None:
-                line += " — | — | — |"
-                continue
-            rng = f"{r['range'][0]:.3f} … {r['range'][1]:.3f}" if r["range"] is not None else "nominal fails"
-            line += f" {rng} | {r['passes']}/{r['points']} | {fmt_or_dash(r['worst_pos_error'])} |"
+            cells = []
+            for m in models if both else models[:1]:
+                r = by.get((p["id"], k, m))
+                if r is None:
+                    cells.append(("—", "—", "—"))
+                    continue
+                cells.append((_range(r), f"{r['passes']}/{r['points']}", fmt_or_dash(r["worst_pos_error"])))
+            line += "".join(f" {' / '.join(c[i] for c in cells)} |" for i in range(3))
         out.append(line)
     return out
 
@@ -208,6 +220,7 @@ def robustness(d: dict) -> list[str]:
     rb = d.get("robustness")
     if not rb:
         return []
+    both = sorted(rb.get("aero_models") or [0]) == [0, 1]
     out = [
         "",
         "## Nonlinear robustness (beyond the thesis)",
@@ -217,9 +230,19 @@ def robustness(d: dict) -> list[str]:
         "controller issues' criteria (`MissionCheck::passed`); worst = largest position error over that range; passes "
         "= passing points of N. The mission is symmetric and flown in calm air, so the lateral derivatives are hardly "
         "excited (identical position errors): their robustness shows in the gust sweep.",
-        "",
     ]
+    if both:
+        out += [
+            "",
+            "Every flight is flown twice (issue 13): on the thesis's linear aerodynamics (`aero_model` 0, the "
+            "controllers' design model) and on the global model (`aero_model` 1, the plant FMU's default); same "
+            "plant otherwise (no ground), same untuned controllers. Cells: thesis / global.",
+        ]
+    out.append("")
+    alpha_attached = rb.get("alpha_attached_deg", 10.0)
     out += _robustness_table(d, rb["rows"])
+    if both:
+        out += ["", *aero_report.robustness_changes(d, rb["rows"], alpha_attached)]
     w = rb.get("wide")
     if w:
         a, m = w["aerodynamic_range"], w["mass_inertia_range"]
@@ -228,10 +251,13 @@ def robustness(d: dict) -> list[str]:
             f"### Wider sweep: τ^{shortest(w['tau_power'])} ({a[0]:.2f} … {a[1]:.2f} aerodynamic, "
             f"{m[0]:.3f} … {m[1]:.3f} m and I)",
             "",
-            "The same flights over a wider range, to find where the missions start failing.",
+            "The same flights over a wider range, to find where the missions start failing"
+            + (", on both models (cells: thesis / global)." if both else "."),
             "",
         ]
         out += _robustness_table(d, w["rows"])
+        if both:
+            out += ["", *aero_report.robustness_changes(d, w["rows"], alpha_attached, nominal=False)]
     return out
 
 

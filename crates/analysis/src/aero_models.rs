@@ -2,8 +2,10 @@
 //! global model (`aero_model` = 1, the FMU's default) side by side. Both controllers, untuned,
 //! fly the same cases on a plant with each model (and the FMU's default ground, 10 m below
 //! the start): the default and the fast mission, hover wind steps, the analysis's gust
-//! sweep and the end points (÷τ, ×τ) of its parameter sweep; plus the force and moment coefficients of both models over α = 0…180°. Data only: `aero_models.json` and
-//! two CSV files; `python -m tailsim.analysis_report` renders them (`tailsim.aero_report`).
+//! sweep; plus the force and moment coefficients of both models over α = 0…180°. (The
+//! parameter sweep of Table 5.1 is flown on both models by the robustness sweep itself,
+//! [`crate::campaign`].) Data only: `aero_models.json` and three CSV files;
+//! `python -m tailsim.analysis_report` renders them (`tailsim.aero_report`).
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -254,60 +256,6 @@ pub fn gust_rows(mission: &MissionParams, amplitudes: &[f64]) -> Vec<GustRow> {
         .collect()
 }
 
-/// The default mission on a plant with one parameter of Table 5.1 scaled to an end of the
-/// thesis's range (÷τ or ×τ), one controller, one model.
-#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
-pub struct ScaledRow {
-    /// Parameter id (`CLa`, …, `Iz`).
-    pub param: String,
-    /// Its symbol.
-    pub name: String,
-    /// Scale factor (1/τ or τ).
-    pub factor: f64,
-    /// "LQR" / "TSD".
-    pub controller: String,
-    /// 0 thesis, 1 global.
-    pub aero_model: i32,
-    /// Mission criteria met, no ground contact.
-    pub passed: bool,
-    /// Largest position error (m).
-    pub max_pos_error_m: f64,
-    /// Largest stall fraction.
-    pub max_stall_fraction: f64,
-}
-
-/// The robustness sweep's end points on both models: every parameter of Table 5.1 at ÷τ and
-/// ×τ (τ = 1.5 aerodynamic, 1.1 mass and inertia), default mission.
-pub fn scaled_rows(mission: &MissionParams) -> Vec<ScaledRow> {
-    let nominal = Airframe::default();
-    let mut jobs = Vec::new();
-    for p in crate::sensitivity::params() {
-        for factor in [1.0 / p.tau(), p.tau()] {
-            for kind in Kind::ALL {
-                for model in [AeroModel::Thesis, AeroModel::Global] {
-                    jobs.push((p, factor, kind, model));
-                }
-            }
-        }
-    }
-    jobs.par_iter()
-        .map(|(p, factor, kind, model)| {
-            let af = p.scaled(&nominal, *factor);
-            let r = fly_scenario(p.id, &Scenario::mission(*mission), *kind, *model, true, &af);
-            ScaledRow {
-                param: p.id.into(),
-                name: p.name.into(),
-                factor: *factor,
-                controller: kind.name().into(),
-                aero_model: model.index(),
-                passed: r.passed,
-                max_pos_error_m: r.max_pos_error_m,
-                max_stall_fraction: r.max_stall_fraction,
-            }
-        })
-        .collect()
-}
-
 /// Lift, drag and pitching-moment coefficients (wind axes, about the CG, no thrust, no
 /// rotation, surfaces neutral, β = 0) of one model at α (rad).
 pub fn coefficients(a: &Airframe, g: &GlobalAero, model: AeroModel, alpha: f64) -> [f64; 3] {
@@ -329,9 +277,8 @@ pub fn coefficients(a: &Airframe, g: &GlobalAero, model: AeroModel, alpha: f64) 
 }
 
 /// Fly every case and the gust sweep (`gust_amplitudes`, ascending; empty = none) with both
-/// controllers on both models (in parallel), and the parameter end points ([`scaled_rows`]),
-/// and write `aero_models.json`, `aero_models.csv`, `aero_gusts.csv`, `aero_scaled.csv` and
-/// `aero_coefficients.csv` into `out`.
+/// controllers on both models (in parallel), and write `aero_models.json`,
+/// `aero_models.csv`, `aero_gusts.csv` and `aero_coefficients.csv` into `out`.
 pub fn run(out: &Path, mission: &MissionParams, gust_amplitudes: &[f64]) -> std::io::Result<Vec<AeroRow>> {
     std::fs::create_dir_all(out)?;
     let cases = cases(mission);
@@ -401,20 +348,8 @@ pub fn run(out: &Path, mission: &MissionParams, gust_amplitudes: &[f64]) -> std:
     }
     std::fs::write(out.join("aero_gusts.csv"), gcsv)?;
 
-    let scaled = scaled_rows(mission);
-    let mut scsv = String::from("param,factor,controller,aero_model,passed,max_pos_error_m,max_stall_fraction\n");
-    for r in &scaled {
-        let _ = writeln!(
-            scsv,
-            "{},{},{},{},{},{},{}",
-            r.param, r.factor, r.controller, r.aero_model, r.passed, r.max_pos_error_m, r.max_stall_fraction
-        );
-    }
-    std::fs::write(out.join("aero_scaled.csv"), scsv)?;
-
     let report = json!({
         "ground_height_m": Ground::default().height,
-        "scaled": scaled,
         "gusts": {"duration_s": GUST_DURATION, "amplitudes": gust_amplitudes, "rows": gusts},
         "coefficients": {
             "airspeed_m_s": CURVE_AIRSPEED,

@@ -13,7 +13,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
-use tailsitter_physics::{Airframe, Plant};
+use tailsitter_physics::{AeroModel, Airframe, Plant};
 
 use crate::cache::{self, Cache};
 use crate::closed::{poles_at, Condition};
@@ -40,6 +40,9 @@ pub struct Config {
     pub gust_amplitudes: Vec<f64>,
     /// Run the nonlinear robustness sweep.
     pub robustness: bool,
+    /// Aerodynamic models the robustness sweeps fly (issue 13: the thesis's linear model
+    /// and the global one, side by side).
+    pub aero_models: Vec<AeroModel>,
     /// Also sweep the nonlinear robustness over τ^this (≤ 1: no wide sweep), to find
     /// where the missions start failing.
     pub wide_tau_power: f64,
@@ -64,6 +67,7 @@ impl Config {
             params: Vec::new(),
             gust_amplitudes: (1..=20).map(f64::from).collect(),
             robustness: true,
+            aero_models: vec![AeroModel::Thesis, AeroModel::Global],
             wide_tau_power: 3.0,
             gusts: true,
             progress: true,
@@ -201,6 +205,8 @@ pub struct RobustnessResult {
     pub name: String,
     /// Controller.
     pub controller: Kind,
+    /// The plant's aerodynamic model (0 thesis, 1 global).
+    pub aero_model: i32,
     /// Factors.
     pub factors: Vec<f64>,
     /// Outcome per factor.
@@ -357,22 +363,30 @@ pub fn run(cfg: &Config) -> std::io::Result<Summary> {
     if cfg.robustness {
         let sweep = |tau_power: f64, msg: &str| -> Vec<RobustnessResult> {
             let taus: Vec<f64> = params.iter().map(|p| p.tau().powf(tau_power)).collect();
-            let mut jobs: Vec<(usize, Kind, f64)> = Vec::new();
+            let mut jobs: Vec<(usize, Kind, AeroModel, f64)> = Vec::new();
             for (pi, tau) in taus.iter().enumerate() {
                 for &kind in &cfg.controllers {
-                    for fk in sensitivity::factors(*tau, cfg.n) {
-                        jobs.push((pi, kind, fk));
+                    for &model in &cfg.aero_models {
+                        for fk in sensitivity::factors(*tau, cfg.n) {
+                            jobs.push((pi, kind, model, fk));
+                        }
                     }
                 }
             }
             let pb = bar(cfg, jobs.len(), msg);
             let out: Vec<FlightOutcome> = jobs
                 .par_iter()
-                .map(|(pi, kind, fk)| {
+                .map(|(pi, kind, model, fk)| {
                     let af = params[*pi].scaled(&nominal, *fk);
                     let sc = closed_loop::Scenario::mission(mission);
-                    let key = cache::key(&format!("mission|{}|{:?}|{:?}", id_of(*kind), sc, af));
-                    let r = flights_cache.get_or(&key, || robust::fly_mission(&af, kind.make(&mission), &sc));
+                    let key = cache::key(&format!(
+                        "mission|{}|{:?}|{:?}|aero_model {}",
+                        id_of(*kind),
+                        sc,
+                        af,
+                        model.index()
+                    ));
+                    let r = flights_cache.get_or(&key, || robust::fly_mission(&af, *model, kind.make(&mission), &sc));
                     pb.inc(1);
                     r
                 })
@@ -382,7 +396,11 @@ pub fn run(cfg: &Config) -> std::io::Result<Summary> {
             let mut at = 0;
             for (p, tau) in params.iter().zip(&taus) {
                 let f = sensitivity::factors(*tau, cfg.n);
-                for &kind in &cfg.controllers {
+                for (&kind, &model) in cfg
+                    .controllers
+                    .iter()
+                    .flat_map(|k| cfg.aero_models.iter().map(move |m| (k, m)))
+                {
                     let outcomes: Vec<FlightOutcome> = out[at..at + f.len()].to_vec();
                     at += f.len();
                     let passed: Vec<bool> = outcomes.iter().map(|o| o.passed).collect();
@@ -401,6 +419,7 @@ pub fn run(cfg: &Config) -> std::io::Result<Summary> {
                         param: p.id.into(),
                         name: p.name.into(),
                         controller: kind,
+                        aero_model: model.index(),
                         factors: f.clone(),
                         outcomes,
                         range,
@@ -434,8 +453,10 @@ pub fn run(cfg: &Config) -> std::io::Result<Summary> {
             .par_iter()
             .map(|(kind, ph, axis, a)| {
                 let sc = robust::gust_scenario(&mission, *ph, *axis, *a);
-                let key = cache::key(&format!("mission|{}|{:?}|{:?}", id_of(*kind), sc, nominal));
-                let r = flights_cache.get_or(&key, || robust::fly_mission(&nominal, kind.make(&mission), &sc));
+                let key = cache::key(&format!("mission|{}|{:?}|{:?}|aero_model 0", id_of(*kind), sc, nominal));
+                let r = flights_cache.get_or(&key, || {
+                    robust::fly_mission(&nominal, AeroModel::Thesis, kind.make(&mission), &sc)
+                });
                 pb.inc(1);
                 r
             })
@@ -707,7 +728,12 @@ pub fn write_report(out: &Path, s: &Summary, cfg: &Config) -> std::io::Result<()
                 "rows": rows,
             });
         }
-        robustness = json!({"rows": rows, "wide": wide});
+        robustness = json!({
+            "aero_models": cfg.aero_models.iter().map(|m| m.index()).collect::<Vec<_>>(),
+            "alpha_attached_deg": tailsitter_physics::GlobalAero::default().alpha_attached.to_degrees(),
+            "rows": rows,
+            "wide": wide,
+        });
     }
 
     // ---- gusts
@@ -790,37 +816,62 @@ pub fn write_report(out: &Path, s: &Summary, cfg: &Config) -> std::io::Result<()
     Ok(())
 }
 
-/// Table rows (JSON) and CSV of a robustness sweep.
+/// Table rows (JSON) and CSV of a robustness sweep: one row per parameter, controller and
+/// aerodynamic model, with the sweep's largest α and stall fraction (where the thesis's
+/// model left its validity) and the nominal flight (factor 1).
 fn robustness_data(results: &[RobustnessResult], cfg: &Config) -> (Vec<serde_json::Value>, String) {
     let mut rows = Vec::new();
     let mut csv = String::from(
-        "param,controller,factor,passed,completed,max_pos_error,level_airspeed_error,level_pitch_error_deg,failure\n",
+        "param,controller,aero_model,factor,passed,completed,max_pos_error,level_airspeed_error,\
+         level_pitch_error_deg,max_alpha_deg,max_stall_fraction,failure\n",
     );
     for p in cfg.selected_params() {
         for &k in &cfg.controllers {
-            let Some(r) = results.iter().find(|r| r.param == p.id && r.controller == k) else {
-                continue;
-            };
-            rows.push(json!({
-                "param": p.id, "controller": k.name(), "range": r.range,
-                "passes": r.outcomes.iter().filter(|o| o.passed).count(),
-                "points": r.outcomes.len(),
-                "worst_pos_error": r.worst_pos_error,
-            }));
-            for (f, o) in r.factors.iter().zip(&r.outcomes) {
-                let _ = writeln!(
-                    csv,
-                    "{},{},{},{},{},{},{},{},\"{}\"",
-                    p.id,
-                    k.name(),
-                    f,
-                    o.passed,
-                    o.completed,
-                    o.max_pos_error,
-                    o.level_airspeed_error,
-                    o.level_pitch_error_deg,
-                    o.failure.clone().unwrap_or_default().replace('"', "'")
-                );
+            for model in &cfg.aero_models {
+                let Some(r) = results
+                    .iter()
+                    .find(|r| r.param == p.id && r.controller == k && r.aero_model == model.index())
+                else {
+                    continue;
+                };
+                let fold = |f: fn(&FlightOutcome) -> f64| {
+                    r.outcomes
+                        .iter()
+                        .map(f)
+                        .filter(|v| v.is_finite())
+                        .fold(0.0, f64::max)
+                };
+                let nominal = r.outcomes.get(sensitivity::nominal_index(&r.factors));
+                rows.push(json!({
+                    "param": p.id, "controller": k.name(), "aero_model": r.aero_model, "range": r.range,
+                    "passes": r.outcomes.iter().filter(|o| o.passed).count(),
+                    "points": r.outcomes.len(),
+                    "worst_pos_error": r.worst_pos_error,
+                    "max_alpha_deg": fold(|o| o.max_alpha_deg),
+                    "max_stall_fraction": fold(|o| o.max_stall_fraction),
+                    "nominal": nominal.map(|o| json!({
+                        "passed": o.passed, "max_pos_error": o.max_pos_error,
+                        "max_alpha_deg": o.max_alpha_deg, "max_stall_fraction": o.max_stall_fraction,
+                    })),
+                }));
+                for (f, o) in r.factors.iter().zip(&r.outcomes) {
+                    let _ = writeln!(
+                        csv,
+                        "{},{},{},{},{},{},{},{},{},{},{},\"{}\"",
+                        p.id,
+                        k.name(),
+                        r.aero_model,
+                        f,
+                        o.passed,
+                        o.completed,
+                        o.max_pos_error,
+                        o.level_airspeed_error,
+                        o.level_pitch_error_deg,
+                        o.max_alpha_deg,
+                        o.max_stall_fraction,
+                        o.failure.clone().unwrap_or_default().replace('"', "'")
+                    );
+                }
             }
         }
     }

@@ -3,13 +3,16 @@
 //! ([`closed_loop::fly`]) with a modified plant or a gust, and judged by the controller
 //! issues' completion criteria ([`closed_loop::MissionCheck::passed`]: airspeed within
 //! 1 m/s and pitch within 5° of trim over the last 5 s of level flight, within 10° of
-//! vertical at the end, every value finite, no failure).
+//! vertical at the end, every value finite, no failure). The plant's aerodynamics are
+//! chosen per flight (issue 13): the thesis's linear model ([`AeroModel::Thesis`], the
+//! controllers' design model and [`Plant::new`]'s choice) or the global model
+//! ([`AeroModel::Global`], the plant FMU's default); no ground in either.
 
-use closed_loop::{fly, MissionCheck, Scenario, Wind};
+use closed_loop::{fly, plant_inputs, MissionCheck, Scenario, Wind};
 use flight_mission::MissionParams;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
-use tailsitter_physics::{Airframe, Plant};
+use tailsitter_physics::{AeroModel, Airframe, Plant};
 
 use crate::closed::Analysable;
 
@@ -28,13 +31,33 @@ pub struct FlightOutcome {
     pub level_airspeed_error: f64,
     /// Largest |θ − θ_trim| over the last 5 s of level flight (deg).
     pub level_pitch_error_deg: f64,
+    /// Largest |α| of the free stream over the flight (deg).
+    #[serde(default)]
+    pub max_alpha_deg: f64,
+    /// Largest `stall_fraction` over the flight (share of the wing in post-stall flow; for
+    /// the thesis's model: how far outside its validity it was used).
+    #[serde(default)]
+    pub max_stall_fraction: f64,
 }
 
-/// Fly the mission of `scenario` with `controller` on a plant with `airframe`, from the
-/// plant's own vertical-climb trim (the nominal one if the modified plant cannot trim).
-pub fn fly_mission<C: Analysable>(airframe: &Airframe, mut controller: C, scenario: &Scenario) -> FlightOutcome {
-    let plant = Plant::new(*airframe);
-    let nominal = Plant::new(Airframe::default());
+/// A plant with `airframe` and aerodynamic `model` (no ground).
+pub fn plant(airframe: &Airframe, model: AeroModel) -> Plant {
+    let mut p = Plant::new(*airframe);
+    p.aero.model = model;
+    p
+}
+
+/// Fly the mission of `scenario` with `controller` on a plant with `airframe` and the
+/// aerodynamic `model`, from the plant's own vertical-climb trim (the nominal one if the
+/// modified plant cannot trim).
+pub fn fly_mission<C: Analysable>(
+    airframe: &Airframe,
+    model: AeroModel,
+    mut controller: C,
+    scenario: &Scenario,
+) -> FlightOutcome {
+    let plant = plant(airframe, model);
+    let nominal = plant_nominal(model);
     let m = &scenario.mission;
     let x0 = plant
         .trim_vertical_climb(m.v_vertical)
@@ -52,11 +75,19 @@ pub fn fly_mission<C: Analysable>(airframe: &Airframe, mut controller: C, scenar
             max_pos_error: f64::MAX,
             level_airspeed_error: f64::MAX,
             level_pitch_error_deg: f64::MAX,
+            max_alpha_deg: f64::NAN,
+            max_stall_fraction: f64::NAN,
         };
     };
     let trace = fly(&plant, x0, &mut controller, scenario);
     let check = MissionCheck::of(&trace, m, theta);
     let finite = |v: f64| if v.is_finite() { v } else { f64::MAX };
+    let (mut alpha, mut stall) = (0.0f64, 0.0f64);
+    for s in &trace.samples {
+        alpha = alpha.max(s.measurement.alpha.abs());
+        let y = plant.outputs(&s.x, &plant_inputs(&s.command), &s.wind);
+        stall = stall.max(y.stall_fraction);
+    }
     FlightOutcome {
         passed: trace.completed() && check.passed(),
         completed: trace.completed(),
@@ -64,7 +95,13 @@ pub fn fly_mission<C: Analysable>(airframe: &Airframe, mut controller: C, scenar
         max_pos_error: finite(trace.max_pos_error()),
         level_airspeed_error: finite(check.level_airspeed_error),
         level_pitch_error_deg: finite(check.level_pitch_error.to_degrees()),
+        max_alpha_deg: alpha.to_degrees(),
+        max_stall_fraction: stall,
     }
+}
+
+fn plant_nominal(model: AeroModel) -> Plant {
+    plant(&Airframe::default(), model)
 }
 
 /// Where in the mission a gust hits.
