@@ -835,11 +835,7 @@ fn robustness_data(results: &[RobustnessResult], cfg: &Config) -> (Vec<serde_jso
                     continue;
                 };
                 let fold = |f: fn(&FlightOutcome) -> f64| {
-                    r.outcomes
-                        .iter()
-                        .map(f)
-                        .filter(|v| v.is_finite())
-                        .fold(0.0, f64::max)
+                    r.outcomes.iter().map(f).filter(|v| v.is_finite()).fold(0.0, f64::max)
                 };
                 let nominal = r.outcomes.get(sensitivity::nominal_index(&r.factors));
                 rows.push(json!({

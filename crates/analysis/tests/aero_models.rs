@@ -85,14 +85,7 @@ fn writes_the_data_the_renderer_reads() {
     let fixture = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/analysis/aero_models.json");
     let fixture: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(fixture).unwrap()).unwrap();
     let keys = |v: &serde_json::Value| v.as_object().unwrap().keys().cloned().collect::<Vec<_>>();
-    for path in [
-        "",
-        "/coefficients",
-        "/rows/0",
-        "/cases/0",
-        "/gusts",
-        "/gusts/rows/0",
-    ] {
+    for path in ["", "/coefficients", "/rows/0", "/cases/0", "/gusts", "/gusts/rows/0"] {
         assert_eq!(
             keys(written.pointer(path).unwrap()),
             keys(fixture.pointer(path).unwrap()),

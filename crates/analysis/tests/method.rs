@@ -348,10 +348,16 @@ fn tiny_campaign_tables_come_from_runs_and_are_cached() {
     }
     let csv = std::fs::read_to_string(dir.join("robustness.csv")).unwrap();
     let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
-    let col = header.iter().position(|h| *h == "aero_model").expect("aero_model column");
+    let col = header
+        .iter()
+        .position(|h| *h == "aero_model")
+        .expect("aero_model column");
     for model in ["0", "1"] {
         assert_eq!(
-            csv.lines().skip(1).filter(|l| l.split(',').nth(col) == Some(model)).count(),
+            csv.lines()
+                .skip(1)
+                .filter(|l| l.split(',').nth(col) == Some(model))
+                .count(),
             4,
             "{csv}"
         );
@@ -412,7 +418,10 @@ fn robustness_on_both_models(results: &[analysis::campaign::RobustnessResult]) {
                 assert!(same, "{kind:?}: attached on both models but {t:?} vs {g:?}");
             }
             if !same {
-                assert!(t.max_stall_fraction > 0.0 || g.max_stall_fraction > 0.0, "{kind:?}: {t:?} vs {g:?}");
+                assert!(
+                    t.max_stall_fraction > 0.0 || g.max_stall_fraction > 0.0,
+                    "{kind:?}: {t:?} vs {g:?}"
+                );
             }
         }
     }
