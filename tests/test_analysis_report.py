@@ -1,9 +1,12 @@
 """The analysis report is rendered by Python from the data the Rust campaign
 writes. `tests/data/analysis/` holds the output of a tiny campaign
-(`cargo run --release -p analysis -- all --n 2 --params Cmde --max-gust 2`,
-report.json + CSV; `aero_models.json` + CSV of
-`-- aero --max-gust 2 --out tests/data/analysis`); the Rust test `tiny_campaign_tables_come_from_runs_and_are_cached`
-checks that a campaign still writes report.json with the same structure."""
+(`cargo run --release -p analysis -- all --n 2 --params Cmde --max-gust 2 --out /tmp/fx`:
+report.json + CSV + aero_models.json, copied without summary.json and the cache, with
+"out" set back to "out/analysis" and each take-off/landing trajectory trimmed to 11 points;
+crates/analysis/README.md); the Rust test `tiny_campaign_tables_come_from_runs_and_are_cached`
+checks that a campaign still writes report.json with the same structure. The robustness
+sweep is flown on both aerodynamic models (issue 13): its table shows thesis / global side
+by side with a generated what-changed-and-why."""
 
 from __future__ import annotations
 

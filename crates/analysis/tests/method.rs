@@ -377,19 +377,36 @@ fn tiny_campaign_tables_come_from_runs_and_are_cached() {
 }
 
 /// The robustness sweep on both aerodynamic models (issue 13), checked against what each
-/// model is independently of the sweep:
-/// * the thesis-model (aero_model 0) rows are the sweep as it was before the global model
-///   existed: at factor 1 the flight equals the default mission flown directly on
-///   `Plant::new` (the thesis's linear model, no ground), and it meets the controller
-///   issues' mission criteria (their acceptance, with both controllers);
-/// * the global model is the thesis's model inside attached flow, so a flight that never
-///   left attached flow on either model must be identical on both, and any flight that
-///   differs must have left it (stall fraction > 0 on one of the models).
+/// model is independently of the sweep's code:
+/// * every flight equals the mission flown here directly on a plant built for its label:
+///   `Plant::new` as it is for `aero_model` 0 (the thesis's linear model, what the sweep flew
+///   before the global model existed) and `aero.model = Global` for 1 (so a row cannot carry
+///   the wrong label or ignore its model where the models' flights differ);
+/// * at factor 1 (the nominal airframe) the mission meets the controller issues' criteria on
+///   the thesis's model with both controllers (their acceptance);
+/// * the global model is the thesis's inside attached flow, so a flight that never left
+///   attached flow on either model is identical on both, and any flight that differs left it
+///   (stall fraction > 0 on one of the models).
 fn robustness_on_both_models(results: &[analysis::campaign::RobustnessResult]) {
     use closed_loop::{fly, MissionCheck, Scenario};
     use flight_mission::MissionParams;
+    use tailsitter_physics::AeroModel;
 
     let m = MissionParams::default();
+    let direct = |airframe: &Airframe, model: i32, kind: Kind| {
+        let plant = if model == 0 {
+            Plant::new(*airframe)
+        } else {
+            let mut p = Plant::new(*airframe);
+            p.aero.model = AeroModel::Global;
+            p
+        };
+        let x0 = plant.trim_vertical_climb(m.v_vertical).unwrap().state;
+        let theta = plant.trim_level(m.v_level).unwrap().theta;
+        let trace = fly(&plant, x0, &mut kind.make(&m), &Scenario::mission(m));
+        let passed = trace.completed() && MissionCheck::of(&trace, &m, theta).passed();
+        (passed, trace.max_pos_error())
+    };
     for kind in Kind::ALL {
         let get = |model: i32| {
             results
@@ -399,18 +416,23 @@ fn robustness_on_both_models(results: &[analysis::campaign::RobustnessResult]) {
         };
         let (thesis, global) = (get(0), get(1));
         assert_eq!(thesis.factors, global.factors);
-        // Factor 1 on the thesis's model = the mission on Plant::new, flown here directly.
-        let plant = Plant::new(Airframe::default());
-        let x0 = plant.trim_vertical_climb(m.v_vertical).unwrap().state;
-        let theta = plant.trim_level(m.v_level).unwrap().theta;
-        let trace = fly(&plant, x0, &mut kind.make(&m), &Scenario::mission(m));
-        let nominal = &thesis.outcomes[1];
-        assert!(
-            trace.completed() && MissionCheck::of(&trace, &m, theta).passed(),
-            "{kind:?}: the thesis mission"
-        );
-        assert!(nominal.passed, "{kind:?}: {nominal:?}");
-        assert_eq!(nominal.max_pos_error, trace.max_pos_error(), "{kind:?}");
+        let param = analysis::sensitivity::params()
+            .into_iter()
+            .find(|p| p.id == thesis.param)
+            .unwrap();
+        for row in [thesis, global] {
+            for (f, o) in row.factors.iter().zip(&row.outcomes) {
+                let (passed, err) = direct(&param.scaled(&Airframe::default(), *f), row.aero_model, kind);
+                assert_eq!(
+                    (o.passed, o.max_pos_error),
+                    (passed, err),
+                    "{kind:?} model {} ×{f}",
+                    row.aero_model
+                );
+            }
+        }
+        assert_eq!(thesis.factors[1], 1.0);
+        assert!(thesis.outcomes[1].passed, "{kind:?}: {:?}", thesis.outcomes[1]);
         // Identical where attached on both; a difference only after leaving attached flow.
         for (t, g) in thesis.outcomes.iter().zip(&global.outcomes) {
             let same = t.passed == g.passed && (t.max_pos_error - g.max_pos_error).abs() <= 1e-6;
