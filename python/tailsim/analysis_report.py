@@ -275,7 +275,9 @@ def gusts(d: dict) -> list[str]:
         "vertical phase (3 m/s climb, from t = 1.5 s), centred on the middle of the first transition, and in level "
         "flight (from 2 s after its start). Largest amplitude A such that every amplitude ≤ A still passes the mission "
         "criteria (0 = the smallest fails); the criteria do not bound the position error, so the last column also "
-        f"requires a position error ≤ {shortest(g['pos_bound_m'])} m.",
+        f"requires a position error ≤ {shortest(g['pos_bound_m'])} m. Flown on the thesis's linear aerodynamics "
+        "(`aero_model` 0, no ground); the same sweep on both models (with the plant FMU's ground) is in the section "
+        "on thesis against global aerodynamics.",
         "",
     ]
     header, rule = "| phase | axis |", "|---|---|"
