@@ -248,8 +248,10 @@ def sweep_summary(d: dict) -> list[str]:
         return []
 
     def counts(rows: list[dict]) -> str:
-        c = {m: (sum(r["passes"] for r in rows if r["aero_model"] == m), sum(r["points"] for r in rows if r["aero_model"] == m)) for m in (0, 1)}
-        return f"thesis {c[0][0]}/{c[0][1]}, global {c[1][0]}/{c[1][1]}"
+        def of(m: int, key: str) -> int:
+            return sum(r[key] for r in rows if r["aero_model"] == m)
+
+        return f"thesis {of(0, 'passes')}/{of(0, 'points')}, global {of(1, 'passes')}/{of(1, 'points')}"
 
     text = (
         "The parameter sweep of Table 5.1 (every parameter, every factor of the sweep, both controllers) is flown "
