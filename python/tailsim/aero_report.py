@@ -378,7 +378,7 @@ def why_sweeps(d: dict, rows: list[dict], alpha_attached: float = 10.0) -> str:
         alpha = max(max(_num(t["max_alpha_deg"]), _num(g["max_alpha_deg"])) for _, _, t, g in changed)
         stall = max(max(_num(t["max_stall_fraction"]), _num(g["max_stall_fraction"])) for _, _, t, g in changed)
         text += (
-            f"all {len(changed)} changed {'sweep' if len(changed) == 1 else 'sweeps'} left attached flow (stall "
+            f"{'the changed sweep' if len(changed) == 1 else f'all {len(changed)} changed sweeps'} left attached flow (stall "
             f"fraction > 0: part of the wing beyond |α| = {shortest(alpha_attached)}° or at large β; α up to "
             f"{alpha:.0f}°, stall fraction up to {stall:.2f}), where the thesis's lift, moments and control power "
             "keep growing linearly while the global model's saturate into flat-plate behaviour (lift capped, drag "
@@ -386,14 +386,16 @@ def why_sweeps(d: dict, rows: list[dict], alpha_attached: float = 10.0) -> str:
         )
         reasons = []
         if fewer:
-            reasons.append(f"in {fewer} the global model's lost lift and control power past stall costs passing factors")
+            reasons.append(
+                f"in {fewer} of them the global model's lost lift and control power past stall costs passing factors"
+            )
         if more:
-            reasons.append(f"in {more} the thesis's unphysical post-stall forces were what failed the mission")
+            reasons.append(f"in {more} of them the thesis's unphysical post-stall forces were what failed the mission")
         if reasons:
             text += "; " + ", and ".join(reasons)
         text += ". "
         if changed_attached:
-            text = text.replace("all ", "", 1)
+            text = text.replace("Why: all ", "Why: ", 1).replace("Why: the changed sweep", "Why: one changed sweep", 1)
     if changed_attached:
         text += (
             f"{_n(len(changed_attached), 'sweep')} changed without leaving attached flow "

@@ -96,8 +96,6 @@ fn writes_the_data_the_renderer_reads() {
     // mission survives 1 m/s gusts everywhere (the analysis's gust sweep on it, report.json).
     let gusts = written["gusts"]["rows"].as_array().unwrap();
     assert_eq!(gusts.len(), 36);
-    // The parameter sweep on both models is the robustness sweep's (crate::campaign).
-    assert!(written.get("scaled").is_none());
     for f in ["aero_models.csv", "aero_coefficients.csv", "aero_gusts.csv"] {
         let text = std::fs::read_to_string(dir.join(f)).unwrap();
         assert!(text.lines().count() > rows.len().min(24), "{f}");
