@@ -409,6 +409,22 @@ def test_tumble_mid_flight_is_a_divergence_and_the_next_run_is_clean(serial, tmp
         assert clean["completed"] and clean["max_err"] == ref[f"1/{c}/tuned/perfect"]["max_err"]
 
 
+def test_avionics_tumble_keeps_what_was_flown(tmp_path):
+    """Issue 14: with avionics in the loop, a plant envelope error mid-flight is a divergence
+    whose metrics cover what was flown (the phase reached, t_end, the errors so far), as on
+    the perfect state. The avionics loop used to drop its record on an FMI error, so every
+    such run was reported as failing "before the first step" (LQR 13, TSD 43 of 200)."""
+    spec = short_spec(n_samples=1, state_sources=("avionics",), overrides={0: {"c_m_q_a0": 30.0, "c_m_q_a1": 30.0}})
+    rows = {r["key"]: r for r in run_campaign(spec, tmp_path, DIST, serial=True, progress=False).to_pylist()}
+    for c in ("lqr", "tsd"):
+        r = rows[f"0/{c}/tuned/avionics"]
+        assert not r["completed"] and r["failure"] == "divergence" and "envelope" in r["detail"], r["detail"]
+        assert 0 < r["t_end"] < spec.stop_time, r["t_end"]
+        assert f"at t = {r['t_end']:.2f} s" in r["detail"], r["detail"]  # the last recorded step
+        assert math.isfinite(r["last_phase"]) and r["last_phase"] >= 0
+        assert r["max_err_p0"] >= 0 and r["max_err"] >= r["max_err_p0"]
+
+
 def test_native_campaign_flies_identical_jobs_to_the_same_rows(serial, tmp_path):
     """The native Rust loop (`analysis campaign-jobs`) on the campaign's jobs: the same
     outcome for every run (an invalid parameter, a tumble) and the same metrics, to the

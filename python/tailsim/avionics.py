@@ -147,6 +147,14 @@ class AvionicsLoop:
     `*_params`: values set in initialisation mode by name. `plant_step`: the
     communication step of the plant and the sensors (s), a divisor of the
     controller's step (default: the controller's step).
+
+    A run that fails mid-flight (an FMI error status, e.g. the plant's envelope check)
+    raises the unit's exception with the record up to the last completed step attached
+    as `exc.partial_result` (a `RunResult`; no rows when it failed in initialisation).
+
+    `truth_inputs` (diagnostics only): controller inputs taken from the plant's outputs of
+    the same names (the truth of t) instead of the estimator's, e.g. ("alpha", "beta") to
+    see whether the α/β estimate is what loses a run.
     """
 
     def __init__(
@@ -162,6 +170,7 @@ class AvionicsLoop:
         ordering: str = "gauss-seidel",
         plant_step: float | None = None,
         callbacks=None,
+        truth_inputs: tuple[str, ...] = (),
     ):
         if ordering not in ("gauss-seidel", "jacobi"):
             raise ValueError(f"ordering must be 'gauss-seidel' or 'jacobi', not {ordering!r}")
@@ -200,6 +209,13 @@ class AvionicsLoop:
         ]
         if not_estimated:
             raise ValueError(f"{ekf.identifier} does not estimate controller inputs {not_estimated}")
+        unknown = [n for n in truth_inputs if n not in _wire(ekf, controller) or n not in p_out]
+        if unknown:
+            raise ValueError(f"truth_inputs {unknown} are not estimator outputs the controller reads")
+        # Diagnostic oracle: these controller inputs come from the plant (the truth), the
+        # others from the estimator; flying with one estimate replaced by the truth tells
+        # whether that estimate is what loses a run.
+        self.truth_to_controller = _Link(plant, controller, list(truth_inputs)) if truth_inputs else None
         self.controller_to_plant = _Link(controller, plant, _wire(controller, plant))
         self.controller_to_ekf = _Link(controller, ekf, _wire(controller, ekf))
         missing = [n for n in plant.names("input") if n.endswith("_cmd") and n not in _wire(controller, plant)]
@@ -260,6 +276,7 @@ class AvionicsLoop:
         )
         data = np.full((n + 1, len(names)), np.nan)
         t_ctrl = t_plant = 0.0
+        k_done = -1  # the last recorded row
 
         def step_plant_sensors(t0: float, first_sensor_step_done: bool) -> float:
             """Plant over [t0, t0 + h) in m steps; the sensors step at every inner
@@ -292,6 +309,8 @@ class AvionicsLoop:
             e.exitInitializationMode()
             C.set(c, self.controller_params)
             self.ekf_to_controller.copy(e, c)
+            if self.truth_to_controller:
+                self.truth_to_controller.copy(p, c)
             c.setReal(offset_vr, list(ref_offset(0.0)))
             c.exitInitializationMode()
 
@@ -304,6 +323,8 @@ class AvionicsLoop:
                     s.doStep(currentCommunicationPoint=t, communicationStepSize=hs)
                     # Controller on the estimate of t.
                     self.ekf_to_controller.copy(e, c)
+                    if self.truth_to_controller:
+                        self.truth_to_controller.copy(p, c)
                     c.setReal(offset_vr, list(off))
                     w0 = wall.perf_counter()
                     c.doStep(currentCommunicationPoint=t, communicationStepSize=h)
@@ -323,6 +344,8 @@ class AvionicsLoop:
                     self.sensors_to_ekf.set(e, y_s)
                     self.controller_to_ekf.set(e, u_prev_e)
                     self.ekf_to_controller.set(c, y_e)
+                    if self.truth_to_controller:
+                        self.truth_to_controller.copy(p, c)
                     c.setReal(offset_vr, list(off))
                     self.controller_to_plant.set(p, u_prev)
                     s.doStep(currentCommunicationPoint=t, communicationStepSize=hs)
@@ -345,18 +368,27 @@ class AvionicsLoop:
                     data[k, col : col + len(vals)] = vals
                     col += len(vals)
                 data[k, col : col + 6] = list(wind(t)) + list(off)
+                k_done = k
                 if k < n:
                     e.doStep(currentCommunicationPoint=t, communicationStepSize=h)
                     t_plant += step_plant_sensors(t, sensors_stepped)
             for x in slaves:
                 x.terminate()
+        except Exception as exc:
+            # Keep what was flown: an error status mid-flight (e.g. the plant's envelope
+            # check) is a result of the run, and its record up to the failing step is part of it.
+            exc.partial_result = self._result(names, data[: k_done + 1], n, t_ctrl, t_plant)
+            raise
         finally:
             for x in slaves:
                 try:
                     x.freeInstance()
                 except Exception:  # noqa: BLE001 - already failed; free what can be freed
                     pass
+        return self._result(names, data, n, t_ctrl, t_plant)
 
+    def _result(self, names: list[str], data: np.ndarray, n: int, t_ctrl: float, t_plant: float) -> RunResult:
+        P, E, C = self.plant, self.ekf, self.controller
         units = {"time": "s"}
         for x in self.plant_outputs:
             units[x] = P.variables[x].unit or ""
@@ -377,7 +409,7 @@ class AvionicsLoop:
             ordering=self.ordering,
             wall_time_controller=t_ctrl,
             wall_time_plant=t_plant,
-            steps=n + 1,
+            steps=len(data),
         )
 
 

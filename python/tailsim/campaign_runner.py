@@ -408,8 +408,9 @@ def _run_avionics(
     error, altitude loss and α are the TRUE ones (plant outputs against the controller's
     reference), not the controller's view of its estimate. A run whose true position error
     exceeds `divergence_m` is a divergence, its metrics taken up to that point; an FMI error
-    (the plant's envelope check included) ends the run with NaN metrics (the loop keeps no
-    partial record)."""
+    (the plant's envelope check: a divergence; any other: an fmi_error) ends the run, its
+    metrics taken over the record up to the last completed step (`partial_result`, as `fly`
+    keeps what was flown)."""
     from .avionics import AvionicsLoop
     from .master import pos_error
 
@@ -433,6 +434,7 @@ def _run_avionics(
             sensors_params={"seed": int(job["noise_seed"])},
             controller_params=cp,
         )
+        failure = detail = ""
         try:
             r = loop.run(stop_time=spec.stop_time, step_size=spec.step_size, wind=wind_function(job))
         except Exception as exc:  # noqa: BLE001 - an error status mid-flight
@@ -442,21 +444,27 @@ def _run_avionics(
                 raise
             logs = [m for m in messages if m.startswith("[3]") or m.startswith("[4]")]
             failure = "divergence" if any("left its envelope" in m for m in logs) else "fmi_error"
-            return {"completed": False, "failure": failure, "detail": " | ".join([str(exc), *logs])}
+            r = getattr(exc, "partial_result", None)
+            t_fail = f" at t = {r.time[-1]:.2f} s" if r is not None and r.time.size else " in initialisation"
+            detail = " | ".join([f"{exc}{t_fail}", *logs])
     finally:
         for n in names:
             fmilog.unroute(n)
-    sig = {k: r[k] for k in ("time", "phase", "pos_d", "alpha", "ref_pos_d", *COMMANDS)}
-    sig["phase"] = sig["phase"].astype(np.int64)
-    sig["pos_error"] = pos_error(r)  # the truth against the reference
-    failure = detail = ""
-    over = np.nonzero(~(sig["pos_error"] <= spec.divergence_m))[0]
-    if over.size:
-        k = int(over[0])
-        failure = "divergence"
-        detail = f"true position error {sig['pos_error'][k]:.1f} m > {spec.divergence_m:g} m at t = {sig['time'][k]:.2f} s"
-        sig = {n: v[: k + 1] for n, v in sig.items()}
-    out: dict[str, Any] = run_metrics(sig)
+    if r is None:
+        out: dict[str, Any] = {}
+    else:
+        sig = {k: r[k] for k in ("time", "phase", "pos_d", "alpha", "ref_pos_d", *COMMANDS)}
+        sig["phase"] = sig["phase"].astype(np.int64)
+        sig["pos_error"] = pos_error(r)  # the truth against the reference
+        over = np.nonzero(~(sig["pos_error"] <= spec.divergence_m))[0]
+        if over.size:  # the true error crossed the limit first: the run ends there
+            k = int(over[0])
+            failure = "divergence"
+            detail = (
+                f"true position error {sig['pos_error'][k]:.1f} m > {spec.divergence_m:g} m at t = {sig['time'][k]:.2f} s"
+            )
+            sig = {n: v[: k + 1] for n, v in sig.items()}
+        out = run_metrics(sig)
     out.update(completed=not failure, failure=failure, detail=detail)
     return out
 

@@ -678,21 +678,33 @@ impl Ekf {
             attitude_from_sensors: false,
             accel_ratio: f64::NAN,
         };
-        let triad = (Self::imu_ok(m).is_ok() && Self::mag_ok(m).is_ok())
-            .then(|| self.triad(&m.accel, &m.mag))
+        let triad = (Self::imu_ok(m).is_ok() && Self::mag_ok(m).is_ok() && m.accel.norm() >= 0.1 * g)
+            .then(|| {
+                let (d_b, accelerated) = self.down_direction(&m.accel, &m.mag);
+                self.triad(&d_b, &m.mag).map(|c| (c, accelerated))
+            })
             .flatten();
         let tilt_std;
         let heading_std;
         match triad {
-            Some(c) => {
+            Some((c, accelerated)) => {
                 s.quat = quat_from_dcm(&c);
                 report.attitude_from_sensors = true;
-                report.accel_ratio = m.accel.norm() / g;
-                tilt_std = p.noise.sigma_accel / m.accel.norm();
-                heading_std = p.noise.sigma_mag / (p.earth.mag_field_total * p.earth.mag_inclination.cos());
+                let f = m.accel.norm();
+                report.accel_ratio = f / g;
+                tilt_std = if accelerated {
+                    // The cone |f| cos(tilt) = g the solution lies on: half its angle (the
+                    // neglected vertical acceleration), or the noise of |f| carried through it.
+                    let cone = (g / f).min(1.0).acos();
+                    (0.5 * cone).max(p.noise.sigma_accel / (f * cone.tan().max(1e-3)))
+                } else {
+                    p.noise.sigma_accel / f
+                };
+                heading_std = (p.noise.sigma_mag / (p.earth.mag_field_total * p.earth.mag_inclination.cos()))
+                    .max(if accelerated { tilt_std } else { 0.0 });
             }
             None => {
-                s.quat = tailsitter_physics::quat_from_euler_321(0.0, std::f64::consts::FRAC_PI_2, 0.0);
+                s.quat = Self::default_attitude();
                 tilt_std = 0.5;
                 heading_std = 0.5;
             }
@@ -753,13 +765,61 @@ impl Ekf {
         report
     }
 
-    /// TRIAD: `DCM^BE` from the down direction −f/|f| and the field direction.
-    fn triad(&self, f: &Vector3<f64>, mag: &Vector3<f64>) -> Option<Matrix3<f64>> {
+    /// The down direction in body axes from the specific force `f` and the field `mag` of one
+    /// sample, and whether the sample shows an acceleration.
+    ///
+    /// Unaccelerated (| |f| − g | ≤ 3σ_a): −f/|f| (accelerometer levelling). Otherwise (e.g. a
+    /// hover start into a crosswind: the wing's normal force accelerates the aircraft, |f| up
+    /// to 1.6 g, and levelling would tilt the estimate by up to 47°, the TRIAD heading by up
+    /// to 170°) the down direction d is solved assuming no VERTICAL acceleration: f·d = −g
+    /// (f = a − g e_D, a ⊥ e_D) and the field's dip m̂·d = m_D/F; the two conditions leave two
+    /// unit vectors, mirror images about the plane of f and m, with the same |a| = √(|f|² − g²).
+    /// The one closer to the default start attitude's down direction (nose up) is taken.
+    fn down_direction(&self, f: &Vector3<f64>, mag: &Vector3<f64>) -> (Vector3<f64>, bool) {
+        let g = self.params.earth.gravity;
         let fn_ = f.norm();
-        if fn_ < 0.1 * self.params.earth.gravity || mag.norm() < 1e-3 {
+        let levelled = -f / fn_.max(1e-12);
+        let (mn, m_norm) = (self.mag_ned.norm(), mag.norm());
+        if (fn_ - g).abs() <= 3.0 * self.params.noise.sigma_accel || mn < 1e-9 || m_norm < 1e-3 {
+            return (levelled, false);
+        }
+        let m_hat = mag / m_norm;
+        let dip = self.mag_ned.z / mn;
+        // d = α f + β m̂ + t n, n ⊥ f, m̂: [|f|² f·m̂; f·m̂ 1] (α, β) = (−g, dip).
+        let fm = f.dot(&m_hat);
+        let det = fn_ * fn_ - fm * fm;
+        let n = f.cross(&m_hat);
+        if det < 1e-6 * fn_ * fn_ || n.norm() < 1e-9 {
+            return (levelled, false);
+        }
+        let alpha = (-g - fm * dip) / det;
+        let beta = (fn_ * fn_ * dip + fm * g) / det;
+        let d0 = alpha * f + beta * m_hat;
+        let t = (1.0 - d0.norm_squared()).max(0.0).sqrt();
+        let n = n.normalize();
+        // The mirror ambiguity is resolved by the prior: the default start attitude (a
+        // tail-sitter starts nose up), the same prior as the fallback of `initialize`.
+        let prior = dcm_earth_to_body(&Self::default_attitude()) * Vector3::z();
+        let (d1, d2) = ((d0 + t * n).normalize(), (d0 - t * n).normalize());
+        let d = if d1.dot(&prior) >= d2.dot(&prior) { d1 } else { d2 };
+        if d.iter().all(|x| x.is_finite()) {
+            (d, true)
+        } else {
+            (levelled, false)
+        }
+    }
+
+    /// The plant's default attitude (nose up, heading north): the prior of the initialisation.
+    fn default_attitude() -> Vector4<f64> {
+        tailsitter_physics::quat_from_euler_321(0.0, std::f64::consts::FRAC_PI_2, 0.0)
+    }
+
+    /// TRIAD: `DCM^BE` from the body down direction `d_b` (unit) and the field direction.
+    fn triad(&self, d_b: &Vector3<f64>, mag: &Vector3<f64>) -> Option<Matrix3<f64>> {
+        if !d_b.iter().all(|x| x.is_finite()) || (d_b.norm() - 1.0).abs() > 1e-6 || mag.norm() < 1e-3 {
             return None;
         }
-        let d_b = -f / fn_;
+        let d_b = *d_b;
         let d_n = Vector3::z();
         let e_b = d_b.cross(mag);
         let e_n = d_n.cross(&self.mag_ned);
@@ -1413,6 +1473,53 @@ mod tests {
         let phi = Vector3::new(0.01, -0.02, 0.03);
         let c_true = c_est * rotation_exp(&phi).transpose();
         assert!((attitude_error(&c_true, &c_est) - phi).norm() < 1e-12);
+    }
+
+    /// Issue 14: a start into a crosswind (hover, nose up) accelerates the aircraft at once
+    /// (the wing's normal force; |f| up to 1.6 g in the campaign). Accelerometer levelling
+    /// then tilted the initial estimate by atan(|a|/g) (here 22–42°) and the TRIAD heading by
+    /// up to 170°, with σ 0.8°; the filter rejected the GPS as outliers and the controllers
+    /// flew the wrong attitude from t = 0. With no vertical acceleration the attitude follows
+    /// exactly from f and the field: the error is rounding, inside the reported σ.
+    #[test]
+    fn initial_attitude_of_an_accelerating_start_is_solved_exactly() {
+        let params = EstimatorParams::default();
+        let g = params.earth.gravity;
+        let m_ned = params.earth.mag_ned();
+        let cases = [
+            ((0.0, std::f64::consts::FRAC_PI_2, 0.0), Vector3::new(-2.0, 4.8, 0.0)),
+            ((0.05, 1.4, 0.7), Vector3::new(3.0, -6.0, 0.0)),
+            ((-0.1, 1.5, -0.5), Vector3::new(-8.0, 5.0, 0.0)),
+        ];
+        for ((phi, theta, psi), a) in cases {
+            let q = quat_from_euler_321(phi, theta, psi);
+            let c = dcm_earth_to_body(&q);
+            let m = Measurements {
+                gps_latitude: 0.0,
+                gps_longitude: 0.0,
+                gps_height: 0.0,
+                gps_vel: Vector3::zeros(),
+                gps_fix_count: 0,
+                gps_valid: false,
+                accel: c * (a - Vector3::new(0.0, 0.0, g)),
+                gyro: Vector3::zeros(),
+                mag: c * m_ned,
+                pitot: 0.0,
+            };
+            let mut ekf = Ekf::new(params.clone()).unwrap();
+            let r = ekf.initialize(&m, &InputVector::zeros());
+            assert!(r.attitude_from_sensors && r.accel_ratio > 1.1, "{r:?}");
+            let levelled_tilt = (a.norm() / g).atan();
+            assert!(levelled_tilt > 0.38, "the case must be one levelling gets wrong");
+            let err = attitude_error(&c, &dcm_earth_to_body(&ekf.state.quat)).norm();
+            assert!(err < 1e-6, "attitude error {err} rad for {:?}", (phi, theta, psi));
+            // The reported σ admits the acceleration the sample could hide.
+            assert!(
+                ekf.estimate().std_att > 0.5 * levelled_tilt,
+                "{}",
+                ekf.estimate().std_att
+            );
+        }
     }
 
     #[test]
