@@ -546,7 +546,7 @@ impl GlobalAero {
 
     /// [`GlobalAero::forces_moments`] with the induced-velocity solve warm-started from
     /// `w_start` ([`Airframe::induced_velocity_from`]; NaN for a cold start).
-    #[inline]
+    #[inline(always)]
     pub fn forces_moments_from(
         &self,
         a: &Airframe,

@@ -148,7 +148,8 @@ impl Plant {
     }
 
     /// [`Plant::eval`] with the induced velocity warm-started from `w_start` (NaN: cold).
-    #[inline]
+    /// Inlined into [`Plant::derivatives`] so the forces do not return through memory.
+    #[inline(always)]
     fn eval_from(
         &self,
         x: &StateVector,
