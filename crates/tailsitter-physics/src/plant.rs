@@ -194,7 +194,7 @@ impl Plant {
 
     /// [`Plant::derivatives`] with the induced velocity warm-started from `*w` (NaN: cold),
     /// which is then set to this evaluation's induced velocity (the start of the next stage).
-    #[inline]
+    #[inline(always)]
     fn derivatives_from(&self, x: &StateVector, u: &InputVector, wind_ned: &Vector3<f64>, w: &mut f64) -> StateVector {
         let a = &self.airframe;
         let (fm, c) = self.eval_from(x, wind_ned, *w);
