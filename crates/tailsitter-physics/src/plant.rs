@@ -162,9 +162,10 @@ impl Plant {
         let omega = Vector3::new(x[P], x[Q], x[R]);
         let v_air = v - c * wind_ned;
         let fm = match self.aero.model {
-            AeroModel::Thesis => self
-                .airframe
-                .forces_moments_from(&v_air, &omega, x[THRUST], &Self::surfaces(x), w_start),
+            AeroModel::Thesis => {
+                self.airframe
+                    .forces_moments_from(&v_air, &omega, x[THRUST], &Self::surfaces(x), w_start)
+            }
             AeroModel::Global => {
                 self.aero
                     .forces_moments_from(&self.airframe, &v_air, &omega, x[THRUST], &Self::surfaces(x), w_start)
