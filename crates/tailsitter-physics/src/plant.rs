@@ -401,10 +401,25 @@ impl Plant {
     /// Outputs at a state. The commands `u` are not used (no direct feedthrough) but are
     /// part of the signature for symmetry with [`Plant::derivatives`].
     pub fn outputs(&self, x: &StateVector, _u: &InputVector, wind_ned: &Vector3<f64>) -> Outputs {
-        let (fm, c) = self.eval(x, wind_ned);
         let q = Vector4::new(x[Q1], x[Q2], x[Q3], x[Q4]);
+        let c = dcm_earth_to_body(&q);
         let v_air = Vector3::new(x[U], x[V], x[W]) - c * wind_ned;
-        let stall_fraction = self.aero.diagnostics(&self.airframe, &v_air, x[THRUST]).stall_fraction;
+        let omega = Vector3::new(x[P], x[Q], x[R]);
+        // The global model's evaluation carries its stall fraction; the thesis's model gets
+        // it from the diagnostics (the same quantities, evaluated once).
+        let (fm, stall_fraction) = match self.aero.model {
+            AeroModel::Thesis => (
+                self.airframe
+                    .forces_moments(&v_air, &omega, x[THRUST], &Self::surfaces(x)),
+                self.aero.diagnostics(&self.airframe, &v_air, x[THRUST]).stall_fraction,
+            ),
+            AeroModel::Global => {
+                let (fm, d) =
+                    self.aero
+                        .forces_moments(&self.airframe, &v_air, &omega, x[THRUST], &Self::surfaces(x));
+                (fm, d.stall_fraction)
+            }
+        };
         let (f_ground, _) = self.ground.contact(&self.airframe, x, &c);
         Outputs {
             vel_ned: c.tr_mul(&Vector3::new(x[U], x[V], x[W])),
