@@ -414,9 +414,9 @@ impl Plant {
                 self.aero.diagnostics(&self.airframe, &v_air, x[THRUST]).stall_fraction,
             ),
             AeroModel::Global => {
-                let (fm, d) =
-                    self.aero
-                        .forces_moments(&self.airframe, &v_air, &omega, x[THRUST], &Self::surfaces(x));
+                let (fm, d) = self
+                    .aero
+                    .forces_moments(&self.airframe, &v_air, &omega, x[THRUST], &Self::surfaces(x));
                 (fm, d.stall_fraction)
             }
         };
