@@ -243,7 +243,9 @@ impl Plant {
     /// communication steps give the same trajectory to rounding when h is a multiple of the
     /// step). After each substep: quaternion renormalised, thrust clamped to its limits and
     /// deflections to ±deflection_limit, every state checked finite and inside the
-    /// [`Envelope`]. On error `x` keeps the last good substep. Does not allocate.
+    /// [`Envelope`]. On error `x` keeps the last good substep. Does not allocate. Each
+    /// stage's induced-velocity solve starts at the previous stage's value
+    /// ([`Airframe::induced_velocity_from`]): the same root to rounding, fewer iterations.
     pub fn advance(
         &self,
         x: &mut StateVector,
