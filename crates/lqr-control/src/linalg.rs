@@ -7,6 +7,7 @@ use nalgebra::{ArrayStorage, SMatrix, SVector};
 
 /// Whether this CPU runs the AVX2 + FMA builds (checked once per call; cached by std).
 #[inline]
+#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
 fn fused_build() -> bool {
     #[cfg(target_arch = "x86_64")]
     {
