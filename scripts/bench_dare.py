@@ -13,7 +13,7 @@ loaded machine: it excludes the time spent waiting for a core); wall-clock media
 printed beside them. BLAS is limited to one thread so that scipy's CPU time is all on
 this thread (17×17 problems do not profit from threads).
 
-    PYTHONPATH=python .venv/bin/python scripts/bench_dare.py [--t 15] [--batches 15]
+    PYTHONPATH=python .venv/bin/python scripts/bench_dare.py [--t 15] [--batches 15] [--exe BINARY]
 """
 
 from __future__ import annotations
@@ -67,15 +67,19 @@ def main() -> int:
     ap.add_argument("--batches", type=int, default=15, help="timing batches (medians are reported)")
     ap.add_argument("--out", default=str(ROOT / "target" / "dare"), help="folder of the JSON case")
     ap.add_argument("--no-build", action="store_true", help="use the already built example binary")
+    ap.add_argument(
+        "--exe",
+        help="run this dare_benchmark binary instead (e.g. a base commit's build, for before/after runs; implies --no-build)",
+    )
     a = ap.parse_args()
 
-    if not a.no_build:
+    if not (a.no_build or a.exe):
         subprocess.run(
             ["cargo", "build", "--release", "-q", "-p", "lqr-control", "--example", "dare_benchmark"],
             cwd=ROOT,
             check=True,
         )
-    exe = ROOT / "target" / "release" / "examples" / "dare_benchmark"
+    exe = pathlib.Path(a.exe) if a.exe else ROOT / "target" / "release" / "examples" / "dare_benchmark"
     out = subprocess.run(
         [str(exe), repr(a.t), a.out, str(a.batches)], cwd=ROOT, check=True, capture_output=True, text=True
     ).stdout

@@ -5,26 +5,50 @@
 
 use nalgebra::{ArrayStorage, SMatrix, SVector};
 
-/// Run `$body` (an expression calling `#[inline(always)]` code) compiled for AVX2 when the
-/// CPU has it, else for the baseline target. Both builds perform the same floating-point
-/// operations in the same order (no FMA contraction), so they give bit-identical results.
-macro_rules! simd_dispatch {
-    ($ret:ty, $body:expr) => {{
+/// Whether this CPU runs the AVX2 + FMA builds (checked once per call; cached by std).
+#[inline]
+#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
+fn fused_build() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// Defines `$name`, an `unsafe` wrapper compiled for AVX2 + FMA that calls the
+/// `#[inline(always)]` generic `$imp::<…, true>` (so the whole kernel is inlined and compiled
+/// with those features: fused multiply-adds, 4-wide vectors). The public entry points call
+/// it when [`fused_build`] says the CPU has both, else `$imp::<…, false>` (baseline target,
+/// separate multiply and add). The two builds differ only in the matrix products'
+/// multiply-adds ([`dense::madd`]), so they agree to rounding, not bit for bit; calling
+/// `$imp::<…, true>` directly (software `fma`, also correctly rounded) gives the fused
+/// build's bits on any CPU.
+macro_rules! fused_wrapper {
+    ($name:ident, $imp:ident, [$(const $g:ident: usize),*], ($($arg:ident: $ty:ty),*) -> $ret:ty) => {
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = "avx2,fma")]
+        unsafe fn $name<$(const $g: usize),*>($($arg: $ty),*) -> $ret {
+            $imp::<$($g,)* true>($($arg),*)
+        }
+    };
+}
+
+/// Call the fused wrapper `$fused` when the CPU has AVX2 + FMA, else `$imp::<…, false>`.
+macro_rules! dispatch {
+    ($fused:ident, $imp:ident, [$($g:ident),*], ($($arg:expr),*)) => {{
         #[cfg(target_arch = "x86_64")]
         {
-            #[target_feature(enable = "avx2")]
-            #[inline]
-            unsafe fn avx2<R, F: FnOnce() -> R>(f: F) -> R {
-                f()
-            }
-            if std::arch::is_x86_feature_detected!("avx2") {
-                // SAFETY: the CPU supports AVX2 (checked just above), the only requirement
-                // of the `#[target_feature(enable = "avx2")]` function.
-                let r: $ret = unsafe { avx2(|| $body) };
-                return r;
+            if fused_build() {
+                // SAFETY: the CPU supports AVX2 and FMA (checked just above), the only
+                // requirement of the `#[target_feature(enable = "avx2,fma")]` wrapper.
+                return unsafe { $fused::<$($g),*>($($arg),*) };
             }
         }
-        $body
+        $imp::<$($g,)* false>($($arg),*)
     }};
 }
 
@@ -60,11 +84,13 @@ impl RiccatiError {
 /// approximant: A is scaled by 2^-s so that ‖A/2^s‖₁ ≤ 1/2, where the [6/6] Padé
 /// error is below 1e-16 relative (Moler & Van Loan, "Nineteen dubious ways", method 3).
 pub fn expm<const N: usize>(a: &SMatrix<f64, N, N>) -> SMatrix<f64, N, N> {
-    simd_dispatch!(SMatrix<f64, N, N>, expm_impl(a))
+    dispatch!(expm_fused, expm_impl, [N], (a))
 }
 
+fused_wrapper!(expm_fused, expm_impl, [const N: usize], (a: &SMatrix<f64, N, N>) -> SMatrix<f64, N, N>);
+
 #[inline(always)]
-fn expm_impl<const N: usize>(a: &SMatrix<f64, N, N>) -> SMatrix<f64, N, N> {
+fn expm_impl<const N: usize, const F: bool>(a: &SMatrix<f64, N, N>) -> SMatrix<f64, N, N> {
     // Padé coefficients c_k = (2q−k)! q! / ((2q)! k! (q−k)!), q = 6.
     const C: [f64; 7] = [
         1.0,
@@ -87,9 +113,9 @@ fn expm_impl<const N: usize>(a: &SMatrix<f64, N, N>) -> SMatrix<f64, N, N> {
             *v *= scale;
         }
     }
-    let x2 = dense::mul(&x, &x);
-    let x4 = dense::mul(&x2, &x2);
-    let x6 = dense::mul(&x4, &x2);
+    let x2 = dense::mul::<_, _, _, F>(&x, &x);
+    let x4 = dense::mul::<_, _, _, F>(&x2, &x2);
+    let x6 = dense::mul::<_, _, _, F>(&x4, &x2);
     // Even part U and odd part V: N = U + V, D = U − V.
     let mut u = [[0.0; N]; N];
     let mut vi = [[0.0; N]; N];
@@ -101,7 +127,7 @@ fn expm_impl<const N: usize>(a: &SMatrix<f64, N, N>) -> SMatrix<f64, N, N> {
         u[j][j] += C[0];
         vi[j][j] += C[1];
     }
-    let v = dense::mul(&x, &vi);
+    let v = dense::mul::<_, _, _, F>(&x, &vi);
     let mut den = [[0.0; N]; N];
     let mut num = [[0.0; N]; N];
     for j in 0..N {
@@ -119,7 +145,7 @@ fn expm_impl<const N: usize>(a: &SMatrix<f64, N, N>) -> SMatrix<f64, N, N> {
         [[f64::NAN; N]; N]
     };
     for _ in 0..s {
-        e = dense::mul(&e, &e);
+        e = dense::mul::<_, _, _, F>(&e, &e);
     }
     SMatrix::from_data(ArrayStorage(e))
 }
@@ -247,22 +273,33 @@ fn all_finite<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> bool {
 ///
 /// The iteration runs on [`dense`] kernels (column-major arrays, constant trip counts,
 /// no heap) compiled twice: for the baseline target and, selected at run time when the
-/// CPU has it, for AVX2. Both perform the same floating-point operations in the same
-/// order (no FMA contraction), so they return bit-identical results.
+/// CPU has them, for AVX2 + FMA (fused multiply-adds in the products). The two agree to
+/// rounding (not bit for bit, see `fused_wrapper!`). The H and G updates are symmetric
+/// congruences (H W⁻¹ = (I + H G)⁻¹ H and W⁻¹ G are symmetric), computed as half products
+/// ([`dense::sym_mul_add`]), so every H_k, G_k and the returned P are exactly symmetric.
 pub fn dare_sda<const N: usize, const U: usize>(
     phi: &SMatrix<f64, N, N>,
     gamma: &SMatrix<f64, N, U>,
     q: &SMatrix<f64, N, N>,
     r_diag: &SVector<f64, U>,
 ) -> Result<SMatrix<f64, N, N>, RiccatiError> {
-    simd_dispatch!(
-        Result<SMatrix<f64, N, N>, RiccatiError>,
-        dare_sda_impl(phi, gamma, q, r_diag)
-    )
+    dispatch!(dare_sda_fused, dare_sda_impl, [N, U], (phi, gamma, q, r_diag))
 }
 
+fused_wrapper!(
+    dare_sda_fused,
+    dare_sda_impl,
+    [const N: usize, const U: usize],
+    (
+        phi: &SMatrix<f64, N, N>,
+        gamma: &SMatrix<f64, N, U>,
+        q: &SMatrix<f64, N, N>,
+        r_diag: &SVector<f64, U>
+    ) -> Result<SMatrix<f64, N, N>, RiccatiError>
+);
+
 #[inline(always)]
-fn dare_sda_impl<const N: usize, const U: usize>(
+fn dare_sda_impl<const N: usize, const U: usize, const F: bool>(
     phi: &SMatrix<f64, N, N>,
     gamma: &SMatrix<f64, N, U>,
     q: &SMatrix<f64, N, N>,
@@ -280,13 +317,13 @@ fn dare_sda_impl<const N: usize, const U: usize>(
         }
     }
     let gt = dense::transpose(&gamma.data.0);
-    let mut g = dense::mul(&gr, &gt);
+    let mut g = dense::mul::<_, _, _, F>(&gr, &gt);
     dense::symmetrise(&mut g);
     let mut a = phi.data.0;
     let mut h = q.data.0;
     for _ in 0..60 {
         // W = I + G H; X₁ = W⁻¹ A, X₂ = W⁻¹ G.
-        let mut w = dense::mul(&g, &h);
+        let mut w = dense::mul::<_, _, _, F>(&g, &h);
         for (i, col) in w.iter_mut().enumerate() {
             col[i] += 1.0;
         }
@@ -297,14 +334,12 @@ fn dare_sda_impl<const N: usize, const U: usize>(
         if !dense::lu_solve2(&mut w, &mut y1, &mut y2) {
             return Err(RiccatiError::Singular("I + G H singular in doubling"));
         }
-        let x1 = dense::transpose(&y1);
-        let x2 = dense::transpose(&y2);
-        // H ← H + Aᵀ (H X₁), G ← G + (A X₂) Aᵀ, A ← A X₁.
-        let mut h_new = dense::mul_add(&h, &at, &dense::mul(&h, &x1));
-        dense::symmetrise(&mut h_new);
-        g = dense::mul_add(&g, &dense::mul(&a, &x2), &at);
-        dense::symmetrise(&mut g);
-        a = dense::mul(&a, &x1);
+        // y1, y2 are X₁ = W⁻¹ A and X₂ = W⁻¹ G row-major: used as right factors as they are.
+        // H ← H + Aᵀ (H X₁), G ← G + (A X₂) Aᵀ: both updates are symmetric (H W⁻¹ = (I + H G)⁻¹ H
+        // and W⁻¹ G are), so only their lower triangles are computed and mirrored.
+        let h_new = dense::sym_mul_add::<_, _, F>(&h, &at, &dense::mul_rows::<_, _, _, F>(&h, &y1));
+        g = dense::sym_mul_add::<_, _, F>(&g, &dense::mul_rows::<_, _, _, F>(&a, &y2), &at);
+        a = dense::mul_rows::<_, _, _, F>(&a, &y1);
         let change2 = dense::diff_norm2(&h_new, &h);
         h = h_new;
         let g_norm2 = dense::norm2(&g);
@@ -333,9 +368,23 @@ fn dare_sda_impl<const N: usize, const U: usize>(
 // adaptors over partial ranges do not always.
 #[allow(clippy::needless_range_loop)]
 pub mod dense {
-    /// `A B`, two result columns at a time (each column of A loaded once per pair).
+    /// `acc + a b`: fused (one rounding, [`f64::mul_add`]) when `F`, else a product and a sum.
     #[inline(always)]
-    pub fn mul<const R: usize, const K: usize, const C: usize>(a: &[[f64; R]; K], b: &[[f64; K]; C]) -> [[f64; R]; C] {
+    pub fn madd<const F: bool>(acc: f64, a: f64, b: f64) -> f64 {
+        if F {
+            a.mul_add(b, acc)
+        } else {
+            acc + a * b
+        }
+    }
+
+    /// `A B`, two result columns at a time (each column of A loaded once per pair);
+    /// multiply-adds fused when `F` ([`madd`]).
+    #[inline(always)]
+    pub fn mul<const R: usize, const K: usize, const C: usize, const F: bool>(
+        a: &[[f64; R]; K],
+        b: &[[f64; K]; C],
+    ) -> [[f64; R]; C] {
         let mut c = [[0.0; R]; C];
         let mut j = 0;
         while j + 1 < C {
@@ -346,8 +395,8 @@ pub mod dense {
                 let (s0, s1) = (b0[k], b1[k]);
                 let ak = &a[k];
                 for i in 0..R {
-                    acc0[i] += ak[i] * s0;
-                    acc1[i] += ak[i] * s1;
+                    acc0[i] = madd::<F>(acc0[i], ak[i], s0);
+                    acc1[i] = madd::<F>(acc1[i], ak[i], s1);
                 }
             }
             c[j] = acc0;
@@ -358,7 +407,7 @@ pub mod dense {
             let mut acc = [0.0; R];
             for (ak, &s) in a.iter().zip(b[j].iter()) {
                 for i in 0..R {
-                    acc[i] += ak[i] * s;
+                    acc[i] = madd::<F>(acc[i], ak[i], s);
                 }
             }
             c[j] = acc;
@@ -366,14 +415,110 @@ pub mod dense {
         c
     }
 
+    /// `A B` with B given row-major (`b[k]` = row k of B): the operations of
+    /// `mul(a, &transpose(b))` without the transpose.
+    #[inline(always)]
+    pub fn mul_rows<const R: usize, const K: usize, const C: usize, const F: bool>(
+        a: &[[f64; R]; K],
+        b: &[[f64; C]; K],
+    ) -> [[f64; R]; C] {
+        let mut c = [[0.0; R]; C];
+        let mut j = 0;
+        while j + 1 < C {
+            let mut acc0 = [0.0; R];
+            let mut acc1 = [0.0; R];
+            for k in 0..K {
+                let (s0, s1) = (b[k][j], b[k][j + 1]);
+                let ak = &a[k];
+                for i in 0..R {
+                    acc0[i] = madd::<F>(acc0[i], ak[i], s0);
+                    acc1[i] = madd::<F>(acc1[i], ak[i], s1);
+                }
+            }
+            c[j] = acc0;
+            c[j + 1] = acc1;
+            j += 2;
+        }
+        if j < C {
+            let mut acc = [0.0; R];
+            for k in 0..K {
+                let s = b[k][j];
+                for i in 0..R {
+                    acc[i] = madd::<F>(acc[i], a[k][i], s);
+                }
+            }
+            c[j] = acc;
+        }
+        c
+    }
+
+    /// `D + A B` for a product known to be symmetric (and D symmetric): the columns of the
+    /// upper half skip the rows above the 4-aligned row block `L = ⌊N/2⌋ & !3` (constant trip
+    /// counts), and the upper triangle is mirrored from the lower, so the result is exactly
+    /// symmetric at ≈ 80 % of the full product's work.
+    #[inline(always)]
+    pub fn sym_mul_add<const N: usize, const K: usize, const F: bool>(
+        d: &[[f64; N]; N],
+        a: &[[f64; N]; K],
+        b: &[[f64; K]; N],
+    ) -> [[f64; N]; N] {
+        let lo = (N / 2) & !3;
+        let mut c = [[0.0; N]; N];
+        let mut j = 0;
+        while j + 1 < lo {
+            let (b0, b1) = (&b[j], &b[j + 1]);
+            let mut acc0 = [0.0; N];
+            let mut acc1 = [0.0; N];
+            for k in 0..K {
+                let (s0, s1) = (b0[k], b1[k]);
+                let ak = &a[k];
+                for i in 0..N {
+                    acc0[i] = madd::<F>(acc0[i], ak[i], s0);
+                    acc1[i] = madd::<F>(acc1[i], ak[i], s1);
+                }
+            }
+            c[j] = acc0;
+            c[j + 1] = acc1;
+            j += 2;
+        }
+        while j < N {
+            let j1 = (j + 1).min(N - 1);
+            let (b0, b1) = (&b[j], &b[j1]);
+            let mut acc0 = [0.0; N];
+            let mut acc1 = [0.0; N];
+            for k in 0..K {
+                let (s0, s1) = (b0[k], b1[k]);
+                let ak = &a[k];
+                for i in lo..N {
+                    acc0[i] = madd::<F>(acc0[i], ak[i], s0);
+                    acc1[i] = madd::<F>(acc1[i], ak[i], s1);
+                }
+            }
+            c[j] = acc0;
+            c[j1] = acc1;
+            j += 2;
+        }
+        for (cj, dj) in c.iter_mut().zip(d.iter()) {
+            for i in 0..N {
+                cj[i] += dj[i];
+            }
+        }
+        for j in 0..N {
+            for i in (j + 1)..N {
+                c[i][j] = c[j][i];
+            }
+        }
+        c
+    }
+
     /// `D + A B`.
     #[inline(always)]
-    pub fn mul_add<const R: usize, const K: usize, const C: usize>(
+    pub fn mul_add<const R: usize, const K: usize, const C: usize, const F: bool>(
         d: &[[f64; R]; C],
         a: &[[f64; R]; K],
         b: &[[f64; K]; C],
     ) -> [[f64; R]; C] {
-        let mut c = mul(a, b);
+        let mut c = mul::<R, K, C, F>(a, b);
         for (cj, dj) in c.iter_mut().zip(d.iter()) {
             for i in 0..R {
                 cj[i] += dj[i];
@@ -629,11 +774,13 @@ pub fn riccati_backward<const N: usize, const U: usize>(
 /// κ the eigenvector condition number, so a value < 1 proves stability). Each square is
 /// normalised and the scale accumulated in logarithms, so nothing overflows.
 pub fn spectral_radius_bound<const N: usize>(m: &SMatrix<f64, N, N>) -> f64 {
-    simd_dispatch!(f64, spectral_radius_bound_impl(m))
+    dispatch!(spectral_radius_bound_fused, spectral_radius_bound_impl, [N], (m))
 }
 
+fused_wrapper!(spectral_radius_bound_fused, spectral_radius_bound_impl, [const N: usize], (m: &SMatrix<f64, N, N>) -> f64);
+
 #[inline(always)]
-fn spectral_radius_bound_impl<const N: usize>(m: &SMatrix<f64, N, N>) -> f64 {
+fn spectral_radius_bound_impl<const N: usize, const F: bool>(m: &SMatrix<f64, N, N>) -> f64 {
     let n0 = dense::norm2(&m.data.0).sqrt();
     if !n0.is_finite() {
         return f64::INFINITY;
@@ -646,7 +793,7 @@ fn spectral_radius_bound_impl<const N: usize>(m: &SMatrix<f64, N, N>) -> f64 {
     let mut log = n0.ln();
     let mut power = 1.0;
     for _ in 0..16 {
-        let mut y = dense::mul(&x, &x);
+        let mut y = dense::mul::<_, _, _, F>(&x, &x);
         let n = dense::norm2(&y).sqrt();
         if n == 0.0 {
             return 0.0;
@@ -780,7 +927,7 @@ mod tests {
     fn dense_kernels_match_nalgebra() {
         let a = test_matrix::<17, 13>(1);
         let b = test_matrix::<13, 9>(2);
-        let c = SMatrix::<f64, 17, 9>::from_data(ArrayStorage(dense::mul(&a.data.0, &b.data.0)));
+        let c = SMatrix::<f64, 17, 9>::from_data(ArrayStorage(dense::mul::<_, _, _, false>(&a.data.0, &b.data.0)));
         assert!((c - a * b).norm() < 1e-14 * (a.norm() * b.norm()));
         let t = SMatrix::<f64, 13, 17>::from_data(ArrayStorage(dense::transpose(&a.data.0)));
         assert_eq!(t, a.transpose());
@@ -805,20 +952,39 @@ mod tests {
     }
 
     #[test]
-    fn simd_and_baseline_builds_agree_bitwise() {
-        // The dispatcher picks the AVX2 build on CPUs that have it; the `_impl` functions
-        // called directly are the baseline build. Same operations, same order: same bits.
+    fn simd_and_baseline_builds_agree() {
+        // The dispatched build equals the `_impl` of its own flavour bit for bit (software
+        // `fma` is correctly rounded like the instruction), and the fused and unfused
+        // flavours agree to rounding.
         let phi = test_matrix::<9, 9>(6) * 0.4 + SMatrix::<f64, 9, 9>::identity();
         let gamma = test_matrix::<9, 3>(7);
         let q = SMatrix::<f64, 9, 9>::from_diagonal(&SVector::<f64, 9>::from_fn(|i, _| 1.0 + i as f64));
         let r = SVector::<f64, 3>::new(0.5, 2.0, 7.0);
         let p = dare_sda(&phi, &gamma, &q, &r).unwrap();
-        assert_eq!(p, dare_sda_impl(&phi, &gamma, &q, &r).unwrap());
+        let p_fused = dare_sda_impl::<9, 3, true>(&phi, &gamma, &q, &r).unwrap();
+        let p_plain = dare_sda_impl::<9, 3, false>(&phi, &gamma, &q, &r).unwrap();
+        assert_eq!(p, if fused_build() { p_fused } else { p_plain });
+        assert!(
+            (p_fused - p_plain).norm() <= 1e-13 * p.norm(),
+            "{}",
+            (p_fused - p_plain).norm() / p.norm()
+        );
         let k = lqr_gain(&phi, &gamma, &p, &r).unwrap();
         assert!(dare_residual(&phi, &gamma, &q, &p, &k) < 1e-12);
-        assert_eq!(expm(&(phi * 0.3)), expm_impl(&(phi * 0.3)));
+        let m = phi * 0.3;
+        let (e_fused, e_plain) = (expm_impl::<9, true>(&m), expm_impl::<9, false>(&m));
+        assert_eq!(expm(&m), if fused_build() { e_fused } else { e_plain });
+        assert!((e_fused - e_plain).norm() <= 1e-14 * e_plain.norm());
         let cl = phi - gamma * k;
-        assert_eq!(spectral_radius_bound(&cl), spectral_radius_bound_impl(&cl));
+        let (s_fused, s_plain) = (
+            spectral_radius_bound_impl::<9, true>(&cl),
+            spectral_radius_bound_impl::<9, false>(&cl),
+        );
+        assert_eq!(
+            spectral_radius_bound(&cl),
+            if fused_build() { s_fused } else { s_plain }
+        );
+        assert!((s_fused - s_plain).abs() <= 1e-12 * s_plain);
     }
 
     #[test]

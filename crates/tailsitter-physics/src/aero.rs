@@ -28,6 +28,10 @@ use crate::airframe::{Airframe, Coefficients};
 /// Below this airspeed (m/s) α, β are defined as 0 and the wind axes as the body axes.
 pub const AIRSPEED_EPS: f64 = 1e-9;
 
+/// Halley iterations a warm-started induced-velocity solve may take before it falls back to
+/// the cold, bracketed one ([`Airframe::induced_velocity_from`]).
+pub const WARM_ITERATIONS: usize = 4;
+
 /// The six surface deflections (rad); positive deflection gives a negative moment (§2.3.1).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Surfaces {
@@ -132,6 +136,57 @@ impl Airframe {
     /// so the result is the root to rounding (a bisection step never stops it early), or when
     /// the bracket is below 1e-14 (1 + w).
     pub fn induced_velocity(&self, airspeed: f64, axial_airspeed: f64, thrust: f64) -> f64 {
+        self.induced_velocity_from(airspeed, axial_airspeed, thrust, f64::NAN)
+    }
+
+    /// [`Airframe::induced_velocity`] warm-started from `start` (a nearby root, e.g. the
+    /// previous RK4 stage's; NaN or ≤ 0 for a cold start). From a warm start Halley's method
+    /// runs without the bracket and stops on the same test (a Halley step ≤ 1e-6 w, after
+    /// which the error is O(1e-18) w by cubic convergence: the root to rounding, whatever the
+    /// start); if it does not within [`WARM_ITERATIONS`] iterations, or leaves w > 0, the cold,
+    /// bracketed solve runs. Purely axial flow uses the closed form either way.
+    pub fn induced_velocity_from(&self, airspeed: f64, axial_airspeed: f64, thrust: f64, start: f64) -> f64 {
+        let denom = 2.0 * self.air_density * self.prop_disc_area;
+        if thrust <= 0.0 || denom <= 0.0 || !thrust.is_finite() {
+            return 0.0;
+        }
+        let k = thrust / denom; // w V' = k
+        let vx = axial_airspeed;
+        let v2 = (airspeed * airspeed).max(vx * vx);
+        // Unique positive root (so a warm start cannot land on another branch): g(w) =
+        // w²(w² + 2V_x w + V̄²) increases on w > 0 when 2w² + 3V_x w + V̄² > 0 there, i.e.
+        // V_x ≥ 0 or 9V_x² ≤ 8V̄²; otherwise (steep axial descent) the cold solve takes the largest.
+        let monotone = vx >= 0.0 || 9.0 * vx * vx <= 8.0 * v2;
+        if monotone && start > 0.0 && start.is_finite() && v2 != vx * vx {
+            let k2 = k * k;
+            let mut w = start;
+            for _ in 0..WARM_ITERATIONS {
+                let w2 = w * w;
+                let val = w2 * (w2 + 2.0 * vx * w + v2) - k2;
+                if val == 0.0 {
+                    return w;
+                }
+                let der = 4.0 * w2 * w + 6.0 * vx * w2 + 2.0 * v2 * w;
+                let der2 = 12.0 * w2 + 12.0 * vx * w + 2.0 * v2;
+                let den = 2.0 * der * der - val * der2;
+                if !(der > 0.0 && den > 0.0) {
+                    break;
+                }
+                let next = w - 2.0 * val * der / den;
+                if !(next > 0.0 && next.is_finite()) {
+                    break;
+                }
+                let step = (next - w).abs();
+                w = next;
+                if step <= 1e-6 * w {
+                    return w;
+                }
+            }
+        }
+        self.induced_velocity_cold(airspeed, axial_airspeed, thrust)
+    }
+
+    fn induced_velocity_cold(&self, airspeed: f64, axial_airspeed: f64, thrust: f64) -> f64 {
         let denom = 2.0 * self.air_density * self.prop_disc_area;
         if thrust <= 0.0 || denom <= 0.0 || !thrust.is_finite() {
             return 0.0;
@@ -248,6 +303,20 @@ impl Airframe {
         thrust: f64,
         surfaces: &Surfaces,
     ) -> ForcesMoments {
+        self.forces_moments_from(v_air_body, omega_body, thrust, surfaces, f64::NAN)
+    }
+
+    /// [`Airframe::forces_moments`] with the induced-velocity solve warm-started from
+    /// `w_start` ([`Airframe::induced_velocity_from`]; NaN for a cold start).
+    #[inline]
+    pub fn forces_moments_from(
+        &self,
+        v_air_body: &Vector3<f64>,
+        omega_body: &Vector3<f64>,
+        thrust: f64,
+        surfaces: &Surfaces,
+        w_start: f64,
+    ) -> ForcesMoments {
         let va = v_air_body;
         let speed = va.norm();
         let (alpha, beta) = if speed < AIRSPEED_EPS {
@@ -270,7 +339,7 @@ impl Airframe {
         let kr = 0.25 * rho * speed * s; // q̄ S / V̄ · ½ (rate terms)
 
         // Slip-stream.
-        let wi = self.induced_velocity(speed, va.x, thrust);
+        let wi = self.induced_velocity_from(speed, va.x, thrust, w_start);
         let vs = speed + 2.0 * wi;
         let qss = 0.5 * rho * vs * vs * s; // q̄_s S
         let v_wake = Vector3::new(va.x + 2.0 * wi, va.y, va.z);

@@ -265,7 +265,7 @@ impl Airframe {
     /// The derivatives interpolated linearly in α between the α = 0 column (`_a0`) and the
     /// α = `alpha_1` column (`_a1`) of Tables C.3/C.4; α is clamped to ±`alpha_interp_limit`
     /// first so the straight line is not extrapolated without bound.
-    #[inline]
+    #[inline(always)]
     pub fn coefficients(&self, alpha: f64) -> Coefficients {
         let a = alpha.clamp(-self.alpha_interp_limit, self.alpha_interp_limit);
         let s = if self.alpha_1 != 0.0 { a / self.alpha_1 } else { 0.0 };

@@ -541,6 +541,21 @@ impl GlobalAero {
         thrust: f64,
         surfaces: &Surfaces,
     ) -> (ForcesMoments, AeroDiagnostics) {
+        self.forces_moments_from(a, v_air_body, omega_body, thrust, surfaces, f64::NAN)
+    }
+
+    /// [`GlobalAero::forces_moments`] with the induced-velocity solve warm-started from
+    /// `w_start` ([`Airframe::induced_velocity_from`]; NaN for a cold start).
+    #[inline(always)]
+    pub fn forces_moments_from(
+        &self,
+        a: &Airframe,
+        v_air_body: &Vector3<f64>,
+        omega_body: &Vector3<f64>,
+        thrust: f64,
+        surfaces: &Surfaces,
+        w_start: f64,
+    ) -> (ForcesMoments, AeroDiagnostics) {
         let fr = Flow::of(*v_air_body);
         let c = a.coefficients(self.coefficient_alpha(a, fr.alpha));
         let d = surfaces;
@@ -551,7 +566,7 @@ impl GlobalAero {
         let qs = 0.5 * rho * fr.speed * fr.speed * s;
 
         // Slip-stream flow over the immersed part and the surfaces behind the propellers.
-        let wi = a.induced_velocity(fr.speed, fr.v.x, thrust);
+        let wi = a.induced_velocity_from(fr.speed, fr.v.x, thrust, w_start);
         let vs = fr.speed + 2.0 * wi;
         let qss = 0.5 * rho * vs * vs * s;
         let v_wake = Vector3::new(fr.v.x + 2.0 * wi, fr.v.y, fr.v.z);

@@ -163,16 +163,26 @@ impl Ground {
 
     /// Contact force and moment about the CG in body axes (N, N m) at a state, given its
     /// DCM^BE `c` (module docs). Zero without contact; does not allocate.
-    #[inline]
+    #[inline(always)]
     pub fn contact(&self, a: &Airframe, x: &StateVector, c: &Matrix3<f64>) -> (Vector3<f64>, Vector3<f64>) {
-        let mut force = Vector3::zeros();
-        let mut moment = Vector3::zeros();
         // Cheap test first (no square root): gear_length + max(half span, half height) bounds
         // the gear's reach, so this returns only where the exact test below returns too.
+        // Inlined into the caller (no result through memory on the hot, airborne path).
         let bound = (self.gear_length + self.gear_half_span.max(self.gear_half_height))
             .max(self.nose_length)
             .max(0.5 * a.wing_span);
-        if x[POS_D] + bound <= self.height || x[POS_D] + self.reach(a) <= self.height || x[POS_D].is_nan() {
+        if x[POS_D] + bound <= self.height || x[POS_D].is_nan() {
+            return (Vector3::zeros(), Vector3::zeros());
+        }
+        self.contact_near(a, x, c)
+    }
+
+    /// [`Ground::contact`] once the cheap bound no longer rules contact out.
+    #[inline(never)]
+    fn contact_near(&self, a: &Airframe, x: &StateVector, c: &Matrix3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+        let mut force = Vector3::zeros();
+        let mut moment = Vector3::zeros();
+        if x[POS_D] + self.reach(a) <= self.height {
             return (force, moment);
         }
         let pos = Vector3::new(x[POS_N], x[POS_E], x[POS_D]);

@@ -144,18 +144,31 @@ impl Plant {
     /// Forces/moments and DCM at a state.
     #[inline]
     fn eval(&self, x: &StateVector, wind_ned: &Vector3<f64>) -> (ForcesMoments, nalgebra::Matrix3<f64>) {
+        self.eval_from(x, wind_ned, f64::NAN)
+    }
+
+    /// [`Plant::eval`] with the induced velocity warm-started from `w_start` (NaN: cold).
+    /// Inlined into [`Plant::derivatives`] so the forces do not return through memory.
+    #[inline(always)]
+    fn eval_from(
+        &self,
+        x: &StateVector,
+        wind_ned: &Vector3<f64>,
+        w_start: f64,
+    ) -> (ForcesMoments, nalgebra::Matrix3<f64>) {
         let q = Vector4::new(x[Q1], x[Q2], x[Q3], x[Q4]);
         let c = dcm_earth_to_body(&q);
         let v = Vector3::new(x[U], x[V], x[W]);
         let omega = Vector3::new(x[P], x[Q], x[R]);
         let v_air = v - c * wind_ned;
         let fm = match self.aero.model {
-            AeroModel::Thesis => self
-                .airframe
-                .forces_moments(&v_air, &omega, x[THRUST], &Self::surfaces(x)),
+            AeroModel::Thesis => {
+                self.airframe
+                    .forces_moments_from(&v_air, &omega, x[THRUST], &Self::surfaces(x), w_start)
+            }
             AeroModel::Global => {
                 self.aero
-                    .forces_moments(&self.airframe, &v_air, &omega, x[THRUST], &Self::surfaces(x))
+                    .forces_moments_from(&self.airframe, &v_air, &omega, x[THRUST], &Self::surfaces(x), w_start)
                     .0
             }
         };
@@ -176,8 +189,17 @@ impl Plant {
     /// Air-relative velocity = inertial velocity − DCM^BE·wind_ned. Pure: no allocation.
     #[inline]
     pub fn derivatives(&self, x: &StateVector, u: &InputVector, wind_ned: &Vector3<f64>) -> StateVector {
+        let mut w = f64::NAN;
+        self.derivatives_from(x, u, wind_ned, &mut w)
+    }
+
+    /// [`Plant::derivatives`] with the induced velocity warm-started from `*w` (NaN: cold),
+    /// which is then set to this evaluation's induced velocity (the start of the next stage).
+    #[inline(always)]
+    fn derivatives_from(&self, x: &StateVector, u: &InputVector, wind_ned: &Vector3<f64>, w: &mut f64) -> StateVector {
         let a = &self.airframe;
-        let (fm, c) = self.eval(x, wind_ned);
+        let (fm, c) = self.eval_from(x, wind_ned, *w);
+        *w = fm.induced_velocity;
         let v = Vector3::new(x[U], x[V], x[W]);
         let omega = Vector3::new(x[P], x[Q], x[R]);
         let q = Vector4::new(x[Q1], x[Q2], x[Q3], x[Q4]);
@@ -221,7 +243,9 @@ impl Plant {
     /// communication steps give the same trajectory to rounding when h is a multiple of the
     /// step). After each substep: quaternion renormalised, thrust clamped to its limits and
     /// deflections to ±deflection_limit, every state checked finite and inside the
-    /// [`Envelope`]. On error `x` keeps the last good substep. Does not allocate.
+    /// [`Envelope`]. On error `x` keeps the last good substep. Does not allocate. Each
+    /// stage's induced-velocity solve starts at the previous stage's value
+    /// ([`Airframe::induced_velocity_from`]): the same root to rounding, fewer iterations.
     pub fn advance(
         &self,
         x: &mut StateVector,
@@ -277,11 +301,13 @@ impl Plant {
         let n = n as u64;
         let dt = h / n as f64;
         let mut s = *x;
+        // Induced velocity of the previous stage: the next stage's solve starts there.
+        let mut w = f64::NAN;
         for _ in 0..n {
-            let k1 = self.derivatives(&s, u, wind_ned);
-            let k2 = self.derivatives(&(s + k1 * (0.5 * dt)), u, wind_ned);
-            let k3 = self.derivatives(&(s + k2 * (0.5 * dt)), u, wind_ned);
-            let k4 = self.derivatives(&(s + k3 * dt), u, wind_ned);
+            let k1 = self.derivatives_from(&s, u, wind_ned, &mut w);
+            let k2 = self.derivatives_from(&(s + k1 * (0.5 * dt)), u, wind_ned, &mut w);
+            let k3 = self.derivatives_from(&(s + k2 * (0.5 * dt)), u, wind_ned, &mut w);
+            let k4 = self.derivatives_from(&(s + k3 * dt), u, wind_ned, &mut w);
             s += (k1 + (k2 + k3) * 2.0 + k4) * (dt / 6.0);
             self.project(&mut s);
             self.check(&s, wind_ned)?;
@@ -377,10 +403,25 @@ impl Plant {
     /// Outputs at a state. The commands `u` are not used (no direct feedthrough) but are
     /// part of the signature for symmetry with [`Plant::derivatives`].
     pub fn outputs(&self, x: &StateVector, _u: &InputVector, wind_ned: &Vector3<f64>) -> Outputs {
-        let (fm, c) = self.eval(x, wind_ned);
         let q = Vector4::new(x[Q1], x[Q2], x[Q3], x[Q4]);
+        let c = dcm_earth_to_body(&q);
         let v_air = Vector3::new(x[U], x[V], x[W]) - c * wind_ned;
-        let stall_fraction = self.aero.diagnostics(&self.airframe, &v_air, x[THRUST]).stall_fraction;
+        let omega = Vector3::new(x[P], x[Q], x[R]);
+        // The global model's evaluation carries its stall fraction; the thesis's model gets
+        // it from the diagnostics (the same quantities, evaluated once).
+        let (fm, stall_fraction) = match self.aero.model {
+            AeroModel::Thesis => (
+                self.airframe
+                    .forces_moments(&v_air, &omega, x[THRUST], &Self::surfaces(x)),
+                self.aero.diagnostics(&self.airframe, &v_air, x[THRUST]).stall_fraction,
+            ),
+            AeroModel::Global => {
+                let (fm, d) = self
+                    .aero
+                    .forces_moments(&self.airframe, &v_air, &omega, x[THRUST], &Self::surfaces(x));
+                (fm, d.stall_fraction)
+            }
+        };
         let (f_ground, _) = self.ground.contact(&self.airframe, x, &c);
         Outputs {
             vel_ned: c.tr_mul(&Vector3::new(x[U], x[V], x[W])),

@@ -390,6 +390,32 @@ fn induced_velocity_is_the_root_to_rounding() {
     }
 }
 
+#[test]
+fn warm_started_induced_velocity_is_the_same_root() {
+    // Starts from 0.5 % to 4× the root, and in steep axial descent (several positive roots:
+    // the warm start must not pick another branch), give the cold solve's root to rounding.
+    let a = Airframe::default();
+    for v in [0.7, 3.0, 12.0, 25.0, 45.0] {
+        for c in [0.99, 0.9, 0.5, 0.0, -0.3, -0.8, -0.97, -0.999] {
+            for t in [0.05, 2.0, 9.3, 40.0, 88.3, 150.0] {
+                let vx = v * c;
+                let cold = a.induced_velocity(v, vx, t);
+                let exact = induced_velocity_by_bisection(&a, v, vx, t);
+                let terms = exact * exact * (exact * exact + 2.0 * vx.abs() * exact + v * v);
+                let der = (4.0 * exact.powi(3) + 6.0 * vx * exact * exact + 2.0 * v * v * exact).abs();
+                let tol = 4e-15 * exact + 16.0 * f64::EPSILON * terms / der;
+                for f in [0.25, 0.9, 0.995, 1.0, 1.005, 1.1, 4.0] {
+                    let warm = a.induced_velocity_from(v, vx, t, f * cold);
+                    assert!(
+                        (warm - exact).abs() <= tol,
+                        "V = {v}, V_x = {vx}, T = {t}, start {f} w: {warm} vs {exact} (cold {cold})"
+                    );
+                }
+            }
+        }
+    }
+}
+
 proptest::proptest! {
     #[test]
     fn induced_velocity_any_condition(v in 0.0f64..80.0, c in -1.0f64..1.0, t in 0.01f64..150.0) {

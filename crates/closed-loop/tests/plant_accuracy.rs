@@ -1,0 +1,106 @@
+//! Guard of the plant's speed work (issue 17): the LQR flying the default mission and a
+//! violent manoeuvre on the plant with the global aerodynamic model (the plant FMU's
+//! default) must reproduce the trajectories stored from the plant before that work
+//! (`tests/reference/plant_accuracy_{default,violent}_ref.csv`: t, N, E, D, q₁…q₄ every
+//! 5th communication point) to a stated tolerance.
+//!
+//! Tolerance: 1e-7 m in position and 1e-7 in each quaternion component (≈ 2e-7 rad of
+//! attitude). That is below the 2 ms RK4 step's own integration error on these flights
+//! (≈ 4e-9 m default, ≈ 5e-7 m violent against a 0.25 ms step, docs/PERFORMANCE.md),
+//! so a faster plant that stays inside it changes nothing the integrator resolves. The
+//! maximum differences are printed (`cargo test -p closed-loop --test plant_accuracy -- --nocapture`).
+//!
+//! Regenerate only after a deliberate change of the plant's behaviour (and review the
+//! diff) with `TAILSIM_REGEN_REFERENCE=1 cargo test -p closed-loop --test plant_accuracy`.
+
+use std::path::PathBuf;
+
+use closed_loop::{fly, Scenario, Wind};
+use flight_mission::MissionParams;
+use lqr_control::{LqrController, LqrParams};
+use nalgebra::Vector3;
+use tailsitter_physics::{AeroModel, Airframe, Plant};
+
+const DECIMATION: usize = 5;
+const POSITION_TOLERANCE: f64 = 1e-7;
+const QUATERNION_TOLERANCE: f64 = 1e-7;
+
+/// The fast mission (T1 = 3 s, T2 = 4 s, α up to ≈ 44°) with a 1 − cos gust of 6 m/s
+/// (north, up) over 2 s at t = 12 s and 5 m reference steps at 20 s and 23 s.
+fn violent() -> Scenario {
+    let m = MissionParams {
+        t_transition_1: 3.0,
+        t_transition_2: 4.0,
+        ..MissionParams::default()
+    };
+    let mut s = Scenario::mission(m);
+    s.wind = Wind::OneMinusCosine {
+        t_start: 12.0,
+        duration: 2.0,
+        amplitude: Vector3::new(6.0, 0.0, -6.0),
+    };
+    s.ref_offset_steps = vec![
+        (20.0, Vector3::new(0.0, 5.0, 0.0)),
+        (23.0, Vector3::new(5.0, 5.0, -5.0)),
+    ];
+    s
+}
+
+fn fly_rows(s: &Scenario) -> Vec<[f64; 8]> {
+    let mut plant = Plant::new(Airframe::default());
+    plant.aero.model = AeroModel::Global;
+    let x0 = plant.trim_vertical_climb(s.mission.v_vertical).unwrap().state;
+    let mut c = LqrController::new(Airframe::default(), s.mission, LqrParams::default()).unwrap();
+    let trace = fly(&plant, x0, &mut c, s);
+    assert!(trace.completed(), "{:?}", trace.failure);
+    trace
+        .samples
+        .iter()
+        .step_by(DECIMATION)
+        .map(|s| [s.t, s.x[0], s.x[1], s.x[2], s.x[6], s.x[7], s.x[8], s.x[9]])
+        .collect()
+}
+
+fn check(name: &str, rows: &[[f64; 8]]) {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../tests/reference")
+        .join(format!("plant_accuracy_{name}_ref.csv"));
+    if std::env::var_os("TAILSIM_REGEN_REFERENCE").is_some() {
+        let mut text = String::from("t,N,E,D,q1,q2,q3,q4\n");
+        for r in rows {
+            text.push_str(&r.iter().map(|v| format!("{v:?}")).collect::<Vec<_>>().join(","));
+            text.push('\n');
+        }
+        std::fs::write(&path, text).unwrap();
+    }
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let stored: Vec<Vec<f64>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(stored.len(), rows.len(), "rows of {}", path.display());
+    let (mut dp, mut dq) = (0.0f64, 0.0f64);
+    for (got, want) in rows.iter().zip(&stored) {
+        assert_eq!(got[0], want[0], "time column");
+        for k in 1..4 {
+            dp = dp.max((got[k] - want[k]).abs());
+        }
+        for k in 4..8 {
+            dq = dq.max((got[k] - want[k]).abs());
+        }
+    }
+    println!("{name}: max position difference {dp:.2e} m, max quaternion difference {dq:.2e}");
+    assert!(dp <= POSITION_TOLERANCE, "{name}: position differs by {dp:e} m");
+    assert!(dq <= QUATERNION_TOLERANCE, "{name}: quaternion differs by {dq:e}");
+}
+
+#[test]
+fn default_mission_global_aero_matches_stored_plant() {
+    check("default", &fly_rows(&Scenario::mission(MissionParams::default())));
+}
+
+#[test]
+fn violent_manoeuvre_global_aero_matches_stored_plant() {
+    check("violent", &fly_rows(&violent()));
+}
