@@ -38,7 +38,7 @@ pub mod gains;
 pub mod params;
 pub mod trajectory;
 
-pub use params::TsdParams;
+pub use params::{TsdParams, GUIDANCE_FEEDBACK_LIMIT, TABLE_4_3_GUIDANCE_LEVEL};
 pub use trajectory::{Reference, Trajectory};
 
 use flight_mission::{
@@ -110,6 +110,14 @@ pub struct LoopDesign {
     pub mixing: (f64, f64),
     /// Guidance (K_P, K_V) (4.3.24).
     pub guidance: (f64, f64),
+    /// Guidance (K_P, K_V) across the reference path (along t̂ × k̂ of the path, the earth's
+    /// east axis on the mission's northbound path): equal to `guidance` except in the tuned
+    /// configuration off the hover, where the level-flight pair is Table 4.3's (README,
+    /// "Robustness on uncertain plants").
+    pub guidance_lateral: (f64, f64),
+    /// Largest norm of the guidance feedback −K_P e_P − K_V e_V (m/s²): unbounded in the
+    /// thesis configuration.
+    pub guidance_feedback_limit: f64,
     /// Axial (K_A, K_E) (4.2.8).
     pub axial: (f64, f64),
     /// Normal loop model (A, B) in (C_W, Q′, E_C) ([`gains::normal_model`]).
@@ -373,6 +381,22 @@ impl TsdController {
             lerp(p.guidance_pole_re_vertical, p.guidance_pole_re_level, sched_path),
             lerp(p.guidance_pole_im_vertical, p.guidance_pole_im_level, sched_path),
         );
+        // Tuned configuration, off the hover: across the path the level-flight guidance pair is
+        // Table 4.3's. In the transitions the lateral part of Σ is flown as sideslip by the
+        // directional loop (prescribed normal vector), and the faster pair (retuned for the
+        // front transition's height, a motion in the plane of the path) drove the rudder into
+        // saturation and β beyond 60° in steady crosswinds ≥ 4 m/s (README, "Robustness on
+        // uncertain plants"). In the hover both horizontal directions are alike (thrust tilt).
+        let tuned = p.configuration == 0;
+        let guidance_lateral = if tuned && fc.reference_airspeed > vv + 1.0 {
+            gains::guidance_gains(
+                lerp(p.guidance_pole_re_vertical, TABLE_4_3_GUIDANCE_LEVEL.0, sched_path),
+                lerp(p.guidance_pole_im_vertical, TABLE_4_3_GUIDANCE_LEVEL.1, sched_path),
+            )
+        } else {
+            guidance
+        };
+        let guidance_feedback_limit = if tuned { GUIDANCE_FEEDBACK_LIMIT } else { f64::INFINITY };
         let axial = gains::axial_gains(
             m,
             af.tau_thrust,
@@ -428,9 +452,19 @@ impl TsdController {
         let directional_gains =
             gains::place_3(&directional_model.0, &directional_model.1, directional_poly).ok_or("directional")?;
 
-        let finite = [guidance.0, guidance.1, axial.0, axial.1, b2, b21, b32]
-            .iter()
-            .all(|x| x.is_finite());
+        let finite = [
+            guidance.0,
+            guidance.1,
+            guidance_lateral.0,
+            guidance_lateral.1,
+            axial.0,
+            axial.1,
+            b2,
+            b21,
+            b32,
+        ]
+        .iter()
+        .all(|x| x.is_finite());
         if !finite {
             return Err("scheduled");
         }
@@ -440,6 +474,8 @@ impl TsdController {
             v,
             mixing: (rn, rv),
             guidance,
+            guidance_lateral,
+            guidance_feedback_limit,
             axial,
             normal_model,
             normal_poly,
@@ -657,7 +693,24 @@ impl SampledUnit for TsdController {
         } else {
             reference.specific_accel
         };
-        let sigma = -pos_error_vec * kp_g - vel_error * kv_g + sigma_ff;
+        // (4.3.24), with the lateral pair across the path (t̂ × k̂: the path's own lateral axis,
+        // independent of the weathervane's heading) and the feedback bounded in norm: for the
+        // small errors the poles were placed for it is the linear law; a large error (a gust,
+        // a wind step, an uncertain plant) is recovered at GUIDANCE_FEEDBACK_LIMIT instead of
+        // commanding accelerations that saturate thrust and surfaces (README, "Robustness on
+        // uncertain plants").
+        let lateral = reference.tangent().cross(&reference.prescribed_normal());
+        let (kp_l, kv_l) = d.guidance_lateral;
+        let mut feedback = -pos_error_vec * kp_g - vel_error * kv_g;
+        if (kp_l, kv_l) != (kp_g, kv_g) {
+            feedback -=
+                lateral * ((kp_l - kp_g) * lateral.dot(&pos_error_vec) + (kv_l - kv_g) * lateral.dot(&vel_error));
+        }
+        let size = feedback.norm();
+        if size > d.guidance_feedback_limit {
+            feedback *= d.guidance_feedback_limit / size;
+        }
+        let sigma = feedback + sigma_ff;
 
         // ---- Decomposition (4.3.27–4.3.30) and prescribed normal vector (§4.3.2.1) ---
         let a_cmd = sigma.dot(&iw);
@@ -997,6 +1050,60 @@ mod tests {
             // Low-speed frame in vertical flight, wind axes in level flight.
             assert_eq!(d.kappa, if lvl { 1.0 } else { 0.0 });
         }
+    }
+
+    /// Tuned configuration: across the path, off the hover, the guidance has Table 4.3's
+    /// level-flight pair; along it (and everywhere in the hover) the tuned pair; the
+    /// thesis configuration has one pair and no feedback bound.
+    #[test]
+    fn lateral_guidance_and_feedback_bound_of_the_tuned_configuration() {
+        let level = FlightCondition {
+            airspeed: 25.0,
+            alpha: 0.092,
+            thrust: 9.3,
+            induced_velocity: 0.6,
+            axial_airspeed: 25.0 * 0.092f64.cos(),
+            reference_airspeed: 25.0,
+        };
+        let hover = FlightCondition {
+            airspeed: 3.0,
+            alpha: 0.0,
+            thrust: 88.3,
+            induced_velocity: 10.4,
+            axial_airspeed: 3.0,
+            reference_airspeed: 3.0,
+        };
+        let p = TsdParams::default();
+        let tuned = TsdController::with_mission(MissionParams::default()).unwrap();
+        let d = tuned.design(&level).unwrap();
+        // (s − re)² + im² = s² + K_V s + K_P.
+        let pair = |re: f64, im: f64| (re * re + im * im, -2.0 * re);
+        let close = |a: (f64, f64), b: (f64, f64)| (a.0 - b.0).abs() < 1e-12 && (a.1 - b.1).abs() < 1e-12;
+        assert!(close(
+            d.guidance,
+            pair(p.guidance_pole_re_level, p.guidance_pole_im_level)
+        ));
+        assert!(close(d.guidance_lateral, pair(-0.75, 0.45)), "{:?}", d.guidance_lateral);
+        assert_eq!(d.guidance_feedback_limit, GUIDANCE_FEEDBACK_LIMIT);
+        let d = tuned.design(&hover).unwrap();
+        assert_eq!(d.guidance, d.guidance_lateral);
+        assert!(close(
+            d.guidance,
+            pair(p.guidance_pole_re_vertical, p.guidance_pole_im_vertical)
+        ));
+        let thesis = TsdController::new(
+            Airframe::default(),
+            MissionParams::default(),
+            TsdParams {
+                configuration: 1,
+                ..TsdParams::default()
+            },
+        )
+        .unwrap();
+        let d = thesis.design(&level).unwrap();
+        assert_eq!(d.guidance, d.guidance_lateral);
+        assert!(close(d.guidance, pair(-0.75, 0.45)));
+        assert_eq!(d.guidance_feedback_limit, f64::INFINITY);
     }
 
     #[test]

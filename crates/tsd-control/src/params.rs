@@ -2,6 +2,16 @@
 
 use flight_mission::ParamError;
 
+/// Guidance pair of Table 4.3 for level flight, (re, im) (1/s): the thesis configuration's
+/// level-flight guidance, and in the tuned configuration the guidance *across* the path
+/// outside the hover (README, "Robustness on uncertain plants").
+pub const TABLE_4_3_GUIDANCE_LEVEL: (f64, f64) = (-0.75, 0.45);
+
+/// Largest guidance feedback acceleration of the tuned configuration, ‖−K_P e_P − K_V e_V‖ of
+/// (4.3.24) (m/s²): half a g on top of the profile's feed-forward (README, "Robustness on
+/// uncertain plants").
+pub const GUIDANCE_FEEDBACK_LIMIT: f64 = 5.0;
+
 /// Every tuning parameter of the controller. Field names are the FMU parameter names
 /// (group `tsd` of `modelDescription/tailsitter_tsd.json`).
 ///
@@ -195,8 +205,8 @@ impl TsdParams {
                 wind_frame_speed_high: 1e-6,
                 feedforward_lead: 0.0,
                 // Table 4.3, level-flight guidance (the tuned default is faster, issue 16).
-                guidance_pole_re_level: -0.75,
-                guidance_pole_im_level: 0.45,
+                guidance_pole_re_level: TABLE_4_3_GUIDANCE_LEVEL.0,
+                guidance_pole_im_level: TABLE_4_3_GUIDANCE_LEVEL.1,
                 ..*self
             }),
             c => Err(ParamError(format!(

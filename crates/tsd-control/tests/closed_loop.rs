@@ -275,3 +275,42 @@ fn thesis_configuration_fails_in_vertical_flight_as_documented() {
     assert!(!check.passed());
     assert!(check.final_pitch_error > 10f64.to_radians(), "{check}");
 }
+
+/// The guidance feedback of the tuned configuration is bounded by GUIDANCE_FEEDBACK_LIMIT; the
+/// thesis configuration's is the linear law K_P e_P (4.3.24). A 20 m offset of the reference at
+/// the trimmed climb (zero velocity error, still air): Σ − Σ_ff has norm 5 m/s² (tuned) and
+/// K_P·20 m with K_P = 0.5² + 0.2² = 0.29 1/s² (thesis, vertical-flight pair of Table 4.3).
+#[test]
+fn guidance_feedback_is_bounded_in_the_tuned_configuration() {
+    use flight_mission::{ControllerInput, SampledUnit};
+    use tsd_control::{TsdParams, GUIDANCE_FEEDBACK_LIMIT};
+    let plant = plant();
+    let mission = MissionParams::default();
+    let x0 = climb_trim(&plant, mission.v_vertical);
+    let meas = closed_loop::measure(
+        &plant,
+        &x0,
+        &tailsitter_physics::InputVector::zeros(),
+        &Vector3::zeros(),
+    );
+    for (configuration, want) in [(0, GUIDANCE_FEEDBACK_LIMIT), (1, 0.29 * 20.0)] {
+        let params = TsdParams {
+            configuration,
+            ..TsdParams::default()
+        };
+        let mut ctl = TsdController::new(Airframe::default(), mission, params).unwrap();
+        let lead = ctl.params().feedforward_lead;
+        let sigma_ff = ctl.trajectory().at(lead).specific_accel;
+        ctl.sample(&ControllerInput {
+            t: 0.0,
+            measurement: meas,
+            ref_offset_ned: Vector3::new(20.0, 0.0, 0.0),
+        })
+        .unwrap();
+        let feedback = ctl.internals().sigma_cmd - sigma_ff;
+        assert!(
+            (feedback.norm() - want).abs() < 1e-9 && feedback.x > 0.0,
+            "configuration {configuration}: {feedback:?}"
+        );
+    }
+}
