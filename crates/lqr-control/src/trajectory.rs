@@ -36,9 +36,13 @@ use std::sync::Arc;
 
 use flight_mission::{HeadingRef, MissionParams, Phase, PointMass, Profile, ProfileLimits};
 use nalgebra::{Matrix3, Vector3, Vector4};
-use tailsitter_physics::{quat_from_euler_321, Airframe};
+use tailsitter_physics::{quat_from_euler_321, Airframe, Surfaces};
 
-use crate::model::{derivatives, ix, EulerRep, U, X};
+#[cfg(test)]
+use crate::model::derivatives;
+#[cfg(test)]
+use crate::model::ix;
+use crate::model::{EulerRep, U, X};
 
 /// Table step (s).
 pub const TABLE_STEP: f64 = 0.01;
@@ -253,7 +257,9 @@ fn turn_rate(m: &MissionParams, t: f64, radius: f64) -> (f64, f64) {
     }
 }
 
-/// The model state and input of a longitudinal point for the force-balance solve.
+/// The model state and input of a longitudinal point for the force-balance solve (the
+/// slow reference of the tests).
+#[cfg(test)]
 #[allow(clippy::too_many_arguments)]
 fn point_state(
     v: f64,
@@ -279,6 +285,70 @@ fn point_state(
     u[0] = thrust;
     u[1] = de;
     (x, u)
+}
+
+/// The force balance of one reference point (`ForceBalance` mode): the residual
+/// (V̇, α̇, q̇) − target of the model for control ([`crate::model::derivatives`], E321, β = 0,
+/// p, q, r from the 3-2-1 kinematics of the path) as a function of z = (α, T, δe), only the
+/// three rows it needs, the induced velocity warm-started from the previous residual's.
+struct Balance<'a> {
+    af: &'a Airframe,
+    /// V (m/s).
+    v: f64,
+    /// γ (rad).
+    gamma: f64,
+    /// sin φ, cos φ of the bank.
+    sincos_phi: (f64, f64),
+    /// θ̇ (rad/s).
+    theta_dot: f64,
+    /// Heading rate ψ̇ (rad/s).
+    turn_rate: f64,
+    /// φ̇ (rad/s).
+    phi_dot: f64,
+    /// Target (V̇, α̇, q̇) (m/s², rad/s, rad/s²).
+    target: Vector3<f64>,
+}
+
+impl Balance<'_> {
+    /// Body rates (3-2-1: p = φ̇ − ψ̇ sθ, q = θ̇ cφ + ψ̇ sφ cθ, r = −θ̇ sφ + ψ̇ cφ cθ) and
+    /// (sin θ, cos θ) at θ = γ + α.
+    #[inline]
+    fn rates(&self, alpha: f64) -> (Vector3<f64>, f64, f64) {
+        let (sf, cf) = self.sincos_phi;
+        let (st, ct) = (self.gamma + alpha).sin_cos();
+        let (w, td) = (self.turn_rate, self.theta_dot);
+        (
+            Vector3::new(self.phi_dot - w * st, td * cf + w * sf * ct, -td * sf + w * cf * ct),
+            st,
+            ct,
+        )
+    }
+
+    /// (V̇, α̇, q̇) − target at z = (α, T, δe); `w_start` is the induced velocity to start
+    /// from (NaN: cold) and receives this one's.
+    #[inline]
+    fn residual(&self, z: &[f64; 3], w_start: &mut f64) -> Vector3<f64> {
+        let af = self.af;
+        let (alpha, thrust) = (z[0], z[1]);
+        let (w, st, ct) = self.rates(alpha);
+        let (sa, ca) = alpha.sin_cos();
+        // body_velocity(V, α, β = 0) and DCM^BE (0, 0, g) = g (−sθ, sφ cθ, cφ cθ) (A.2.7).
+        let vb = Vector3::new(self.v * ca, 0.0, self.v * sa);
+        let surfaces = Surfaces {
+            elevator: z[2],
+            ..Surfaces::default()
+        };
+        let fm = af.forces_moments_from(&vb, &w, thrust, &surfaces, *w_start);
+        *w_start = fm.induced_velocity;
+        let (sf, cf) = self.sincos_phi;
+        let g_body = Vector3::new(-st, sf * ct, cf * ct) * af.gravity;
+        let a = fm.force_body / af.mass + g_body - w.cross(&vb);
+        let vdot = vb.dot(&a) / self.v;
+        let alpha_dot = (vb.x * a.z - vb.z * a.x) / (vb.x * vb.x + vb.z * vb.z);
+        // q̇ = (M_y − (ω × Iω)_y) / I_yy, (ω × Iω)_y = r I_xx p − p I_zz r.
+        let qdot = (fm.moment_body.y - (w.z * af.i_xx * w.x - w.x * af.i_zz * w.z)) / af.i_yy;
+        Vector3::new(vdot, alpha_dot, qdot) - self.target
+    }
 }
 
 impl Trajectory {
@@ -333,8 +403,15 @@ impl Trajectory {
         // Passes: body rates from θ̇, ψ̇, φ̇; then α, T, δe; twice for the force balance
         // (the second pass uses α̇, α̈ of the first).
         let passes = if opt.mode == TrajectoryMode::ForceBalance { 2 } else { 1 };
-        let mut z_prev = [0.0, af.mass * g, 0.0];
+        // Force-balance solutions (α, T, δe) of this pass and the previous one; the induced
+        // velocity of the last residual (warm start of the next).
+        let mut z_hist = vec![[0.0; 3]; if passes > 1 { n } else { 0 }];
+        let mut z_prev_pass = z_hist.clone();
+        let mut w_start = f64::NAN;
         for pass in 0..passes {
+            if pass > 0 {
+                z_prev_pass.copy_from_slice(&z_hist);
+            }
             // α̇ has kinks where γ̈ of the cosine blends steps (phase boundaries); a
             // 0.2 s moving average keeps α̈ (→ q̇ → δe) free of finite-difference spikes.
             let alpha_dot = smooth(&derivative(&alphas), 10);
@@ -387,32 +464,49 @@ impl Trajectory {
                         p.euler_321 = Vector3::new(phi, gamma + alpha, psi);
                     }
                     TrajectoryMode::ForceBalance => {
-                        let target = Vector3::new(vdot, alpha_dot[i], theta_ddot);
-                        let resid = |z: &[f64; 3]| {
-                            let rates = rates_of(z[0]);
-                            let (x, u) = point_state(v, z[0], gamma, phi, psi, &rates, z[1], z[2]);
-                            let d = derivatives(af, EulerRep::E321, &x, &u);
-                            Vector3::new(d[ix::V], d[ix::ALPHA], d[ix::Q]) - target
+                        let bal = Balance {
+                            af,
+                            v,
+                            gamma,
+                            sincos_phi: phi.sin_cos(),
+                            theta_dot,
+                            turn_rate: w,
+                            phi_dot,
+                            target: Vector3::new(vdot, alpha_dot[i], theta_ddot),
                         };
-                        let mut z = if i == 0 || pass > 0 {
-                            [alphas[i], pts[i].thrust.max(1.0), pts[i].u[1]]
+                        // Predictor: pass 0 extrapolates the previous points' solutions
+                        // (quadratically), later passes add the extrapolated correction of
+                        // the previous points to this point's previous-pass solution.
+                        let mut z = if pass == 0 {
+                            match i {
+                                0 => [0.0, af.mass * g, 0.0],
+                                1 | 2 => z_hist[i - 1],
+                                _ => core::array::from_fn(|k| {
+                                    3.0 * z_hist[i - 1][k] - 3.0 * z_hist[i - 2][k] + z_hist[i - 3][k]
+                                }),
+                            }
                         } else {
-                            z_prev
+                            let base = z_prev_pass[i];
+                            match i {
+                                0 => base,
+                                1 => core::array::from_fn(|k| base[k] + z_hist[0][k] - z_prev_pass[0][k]),
+                                _ => core::array::from_fn(|k| {
+                                    base[k] + 2.0 * (z_hist[i - 1][k] - z_prev_pass[i - 1][k])
+                                        - (z_hist[i - 2][k] - z_prev_pass[i - 2][k])
+                                }),
+                            }
                         };
-                        if pass == 0 && i == 0 {
-                            z = [0.0, af.mass * g, 0.0];
-                        }
                         let mut ok = false;
                         let mut r_last = f64::INFINITY;
                         for _ in 0..50 {
-                            let r = resid(&z);
+                            let r = bal.residual(&z, &mut w_start);
                             if r.amax() < 1e-10 {
                                 ok = true;
                                 break;
                             }
-                            // Chord iteration: the Jacobian of the previous point (10 ms earlier)
-                            // or iterate is kept while it still reduces the residual tenfold per
-                            // step, and refreshed by central differences otherwise.
+                            // Chord iteration: the Jacobian of an earlier point or iterate is
+                            // kept while it still reduces the residual tenfold per step, and
+                            // refreshed by central differences otherwise.
                             if r.amax() > 0.1 * r_last {
                                 chord = None;
                             }
@@ -427,7 +521,11 @@ impl Trajectory {
                                         let mut zm = z;
                                         zp[j] += h;
                                         zm[j] -= h;
-                                        jac.set_column(j, &((resid(&zp) - resid(&zm)) / (2.0 * h)));
+                                        let mut ws = w_start;
+                                        let rp = bal.residual(&zp, &mut ws);
+                                        let mut ws = w_start;
+                                        let rm = bal.residual(&zm, &mut ws);
+                                        jac.set_column(j, &((rp - rm) / (2.0 * h)));
                                     }
                                     let lu = jac.lu();
                                     chord = Some(lu);
@@ -443,9 +541,10 @@ impl Trajectory {
                             }
                         }
                         if !ok {
-                            return Err(format!("trajectory force balance did not converge at t = {t:.2} s (pass {pass}, z = {z:?}, residual {:?})", resid(&z)));
+                            let r = bal.residual(&z, &mut f64::NAN.clone());
+                            return Err(format!("trajectory force balance did not converge at t = {t:.2} s (pass {pass}, z = {z:?}, residual {r:?})"));
                         }
-                        z_prev = z;
+                        z_hist[i] = z;
                         alphas[i] = z[0];
                         let p = &mut pts[i];
                         p.alpha = z[0];
