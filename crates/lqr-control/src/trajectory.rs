@@ -416,7 +416,7 @@ impl Trajectory {
             // 0.2 s moving average keeps α̈ (→ q̇ → δe) free of finite-difference spikes.
             let alpha_dot = smooth(&derivative(&alphas), 10);
             let alpha_ddot = smooth(&derivative(&alpha_dot), 10);
-            let mut chord: Option<nalgebra::LU<f64, nalgebra::U3, nalgebra::U3>> = None;
+            let mut chord: Option<Matrix3<f64>> = None;
             for i in 0..n {
                 let t = pts[i].t;
                 let (_, [v, vdot, gamma, gdot, gddot]) = path(mission, profile, t);
@@ -498,21 +498,29 @@ impl Trajectory {
                         };
                         let mut ok = false;
                         let mut r_last = f64::INFINITY;
+                        // The last step and its residual (Broyden update of the Jacobian).
+                        let mut last: Option<(Vector3<f64>, Vector3<f64>)> = None;
                         for _ in 0..50 {
                             let r = bal.residual(&z, &mut w_start);
                             if r.amax() < 1e-10 {
                                 ok = true;
                                 break;
                             }
-                            // Chord iteration: the Jacobian of an earlier point or iterate is
-                            // kept while it still reduces the residual tenfold per step, and
-                            // refreshed by central differences otherwise.
+                            // Quasi-Newton: the Jacobian of an earlier point or iterate,
+                            // corrected along every step by Broyden's rank-one update, is kept
+                            // while it still reduces the residual tenfold per step, and refreshed
+                            // by central differences otherwise.
                             if r.amax() > 0.1 * r_last {
                                 chord = None;
+                            } else if let (Some(j), Some((dz, r_prev))) = (chord.as_mut(), last) {
+                                let dd = dz.norm_squared();
+                                if dd > 0.0 {
+                                    *j += (r - r_prev - *j * dz) * dz.transpose() / dd;
+                                }
                             }
                             r_last = r.amax();
-                            let lu = match chord {
-                                Some(lu) => lu,
+                            let jac = match chord {
+                                Some(j) => j,
                                 None => {
                                     let mut jac = Matrix3::zeros();
                                     for j in 0..3 {
@@ -527,18 +535,19 @@ impl Trajectory {
                                         let rm = bal.residual(&zm, &mut ws);
                                         jac.set_column(j, &((rp - rm) / (2.0 * h)));
                                     }
-                                    let lu = jac.lu();
-                                    chord = Some(lu);
-                                    lu
+                                    chord = Some(jac);
+                                    jac
                                 }
                             };
-                            let dz = lu
+                            let dz = jac
+                                .lu()
                                 .solve(&r)
                                 .ok_or_else(|| format!("singular trajectory solve at t = {t}"))?;
                             let scale = (0.1 / dz[0].abs().max(dz[2].abs()).max(1e-300)).min(1.0);
                             for k in 0..3 {
                                 z[k] -= scale * dz[k];
                             }
+                            last = Some((-scale * dz, r));
                         }
                         if !ok {
                             let r = bal.residual(&z, &mut f64::NAN.clone());
