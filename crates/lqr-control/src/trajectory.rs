@@ -475,25 +475,29 @@ impl Trajectory {
                             target: Vector3::new(vdot, alpha_dot[i], theta_ddot),
                         };
                         // Predictor: pass 0 extrapolates the previous points' solutions
-                        // (quadratically), later passes add the extrapolated correction of
-                        // the previous points to this point's previous-pass solution.
+                        // (cubic), later passes add the correction of the previous points
+                        // over their previous-pass solutions, extrapolated (quadratic), to
+                        // this point's previous-pass solution. From there one quasi-Newton
+                        // step usually meets the tolerance.
                         let mut z = if pass == 0 {
                             match i {
                                 0 => [0.0, af.mass * g, 0.0],
-                                1 | 2 => z_hist[i - 1],
+                                1..=3 => z_hist[i - 1],
                                 _ => core::array::from_fn(|k| {
-                                    3.0 * z_hist[i - 1][k] - 3.0 * z_hist[i - 2][k] + z_hist[i - 3][k]
+                                    4.0 * (z_hist[i - 1][k] + z_hist[i - 3][k])
+                                        - 6.0 * z_hist[i - 2][k]
+                                        - z_hist[i - 4][k]
                                 }),
                             }
                         } else {
+                            let d = |j: usize, k: usize| z_hist[j][k] - z_prev_pass[j][k];
                             let base = z_prev_pass[i];
                             match i {
                                 0 => base,
-                                1 => core::array::from_fn(|k| base[k] + z_hist[0][k] - z_prev_pass[0][k]),
-                                _ => core::array::from_fn(|k| {
-                                    base[k] + 2.0 * (z_hist[i - 1][k] - z_prev_pass[i - 1][k])
-                                        - (z_hist[i - 2][k] - z_prev_pass[i - 2][k])
-                                }),
+                                1 | 2 => core::array::from_fn(|k| base[k] + d(i - 1, k)),
+                                _ => {
+                                    core::array::from_fn(|k| base[k] + 3.0 * (d(i - 1, k) - d(i - 2, k)) + d(i - 3, k))
+                                }
                             }
                         };
                         let mut ok = false;
@@ -506,21 +510,26 @@ impl Trajectory {
                                 ok = true;
                                 break;
                             }
-                            // Quasi-Newton: the Jacobian of an earlier point or iterate,
+                            // Quasi-Newton: the inverse Jacobian of an earlier point or iterate,
                             // corrected along every step by Broyden's rank-one update, is kept
                             // while it still reduces the residual tenfold per step, and refreshed
                             // by central differences otherwise.
                             if r.amax() > 0.1 * r_last {
                                 chord = None;
-                            } else if let (Some(j), Some((dz, r_prev))) = (chord.as_mut(), last) {
-                                let dd = dz.norm_squared();
-                                if dd > 0.0 {
-                                    *j += (r - r_prev - *j * dz) * dz.transpose() / dd;
+                            } else if let (Some(b), Some((dz, r_prev))) = (chord.as_mut(), last) {
+                                // Broyden's update J += (Δr − J Δz) Δzᵀ / ΔzᵀΔz applied to
+                                // B = J⁻¹ by Sherman–Morrison:
+                                // B += (Δz − B Δr) Δzᵀ B / (Δzᵀ B Δr).
+                                let dr = r - r_prev;
+                                let bdr = *b * dr;
+                                let den = dz.dot(&bdr);
+                                if den.abs() > 1e-12 * dz.norm() * bdr.norm() {
+                                    *b += (dz - bdr) * (dz.transpose() * *b) / den;
                                 }
                             }
                             r_last = r.amax();
-                            let jac = match chord {
-                                Some(j) => j,
+                            let binv = match chord {
+                                Some(b) => b,
                                 None => {
                                     let mut jac = Matrix3::zeros();
                                     for j in 0..3 {
@@ -535,14 +544,14 @@ impl Trajectory {
                                         let rm = bal.residual(&zm, &mut ws);
                                         jac.set_column(j, &((rp - rm) / (2.0 * h)));
                                     }
-                                    chord = Some(jac);
-                                    jac
+                                    let b = jac
+                                        .try_inverse()
+                                        .ok_or_else(|| format!("singular trajectory solve at t = {t}"))?;
+                                    chord = Some(b);
+                                    b
                                 }
                             };
-                            let dz = jac
-                                .lu()
-                                .solve(&r)
-                                .ok_or_else(|| format!("singular trajectory solve at t = {t}"))?;
+                            let dz = binv * r;
                             let scale = (0.1 / dz[0].abs().max(dz[2].abs()).max(1e-300)).min(1.0);
                             for k in 0..3 {
                                 z[k] -= scale * dz[k];
