@@ -295,8 +295,8 @@ struct Balance<'a> {
     af: &'a Airframe,
     /// V (m/s).
     v: f64,
-    /// γ (rad).
-    gamma: f64,
+    /// sin γ, cos γ of the path.
+    sincos_gamma: (f64, f64),
     /// sin φ, cos φ of the bank.
     sincos_phi: (f64, f64),
     /// θ̇ (rad/s).
@@ -311,11 +311,13 @@ struct Balance<'a> {
 
 impl Balance<'_> {
     /// Body rates (3-2-1: p = φ̇ − ψ̇ sθ, q = θ̇ cφ + ψ̇ sφ cθ, r = −θ̇ sφ + ψ̇ cφ cθ) and
-    /// (sin θ, cos θ) at θ = γ + α.
+    /// (sin θ, cos θ) at θ = γ + α, given (sin α, cos α) (angle addition: one sine and
+    /// cosine per residual instead of two).
     #[inline]
-    fn rates(&self, alpha: f64) -> (Vector3<f64>, f64, f64) {
+    fn rates(&self, (sa, ca): (f64, f64)) -> (Vector3<f64>, f64, f64) {
         let (sf, cf) = self.sincos_phi;
-        let (st, ct) = (self.gamma + alpha).sin_cos();
+        let (sg, cg) = self.sincos_gamma;
+        let (st, ct) = (sg * ca + cg * sa, cg * ca - sg * sa);
         let (w, td) = (self.turn_rate, self.theta_dot);
         (
             Vector3::new(self.phi_dot - w * st, td * cf + w * sf * ct, -td * sf + w * cf * ct),
@@ -330,8 +332,8 @@ impl Balance<'_> {
     fn residual(&self, z: &[f64; 3], w_start: &mut f64) -> Vector3<f64> {
         let af = self.af;
         let (alpha, thrust) = (z[0], z[1]);
-        let (w, st, ct) = self.rates(alpha);
         let (sa, ca) = alpha.sin_cos();
+        let (w, st, ct) = self.rates((sa, ca));
         // body_velocity(V, α, β = 0) and DCM^BE (0, 0, g) = g (−sθ, sφ cθ, cφ cθ) (A.2.7).
         let vb = Vector3::new(self.v * ca, 0.0, self.v * sa);
         let surfaces = Surfaces {
@@ -467,7 +469,7 @@ impl Trajectory {
                         let bal = Balance {
                             af,
                             v,
-                            gamma,
+                            sincos_gamma: gamma.sin_cos(),
                             sincos_phi: phi.sin_cos(),
                             theta_dot,
                             turn_rate: w,
