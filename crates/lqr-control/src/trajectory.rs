@@ -480,18 +480,18 @@ impl Trajectory {
                             target: Vector3::new(vdot, alpha_dot[i], theta_ddot),
                         };
                         // Predictor: pass 0 extrapolates the previous points' solutions
-                        // (cubic), later passes add the correction of the previous points
-                        // over their previous-pass solutions, extrapolated (quadratic), to
+                        // (quartic), later passes add the correction of the previous points
+                        // over their previous-pass solutions, extrapolated (cubic), to
                         // this point's previous-pass solution. From there one quasi-Newton
                         // step usually meets the tolerance.
                         let mut z = if pass == 0 {
                             match i {
                                 0 => [0.0, af.mass * g, 0.0],
-                                1..=3 => z_hist[i - 1],
+                                1..=4 => z_hist[i - 1],
                                 _ => core::array::from_fn(|k| {
-                                    4.0 * (z_hist[i - 1][k] + z_hist[i - 3][k])
-                                        - 6.0 * z_hist[i - 2][k]
-                                        - z_hist[i - 4][k]
+                                    5.0 * (z_hist[i - 1][k] - z_hist[i - 4][k])
+                                        - 10.0 * (z_hist[i - 2][k] - z_hist[i - 3][k])
+                                        + z_hist[i - 5][k]
                                 }),
                             }
                         } else {
@@ -499,10 +499,10 @@ impl Trajectory {
                             let base = z_prev_pass[i];
                             match i {
                                 0 => base,
-                                1 | 2 => core::array::from_fn(|k| base[k] + d(i - 1, k)),
-                                _ => {
-                                    core::array::from_fn(|k| base[k] + 3.0 * (d(i - 1, k) - d(i - 2, k)) + d(i - 3, k))
-                                }
+                                1..=3 => core::array::from_fn(|k| base[k] + d(i - 1, k)),
+                                _ => core::array::from_fn(|k| {
+                                    base[k] + 4.0 * (d(i - 1, k) + d(i - 3, k)) - 6.0 * d(i - 2, k) - d(i - 4, k)
+                                }),
                             }
                         };
                         let mut ok = false;
