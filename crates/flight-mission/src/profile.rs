@@ -264,39 +264,38 @@ impl Profile {
             (q * cl, q * (pm.c_d0 + pm.k_induced * cl * cl), q)
         };
         let back_start = mission.phase_starts()[Phase::TransitionToVertical as usize];
-        // Controls of the guidance law at (t, x), bounded.
-        let commands = |t: f64, x: &PState| -> (f64, f64) {
+        // Controls of the guidance law at (t, x), bounded; `aero` = (q̄ S, D) and `trig` =
+        // (sin γ, cos γ, cos α) of the state, computed once per rate evaluation.
+        let commands = |t: f64, x: &PState, (q, drag): (f64, f64), (sg, cg, ca): (f64, f64, f64)| -> (f64, f64) {
             let [mut vd, mut vd_dot, gd, gd_dot] = desired(mission, t);
             // After the back transition began, the speed is shed only as the path nears
             // vertical (V_d ≥ V_L √cos γ): the pull-up needs the speed for its normal force.
             if t >= back_start {
-                let floor = mission.v_level * x[1].cos().max(0.0).sqrt();
+                let floor = mission.v_level * cg.max(0.0).sqrt();
                 if floor > vd {
                     vd = floor;
                     vd_dot = 0.0;
                 }
             }
-            let (v, gamma, alpha, thrust) = (x[0], x[1], x[2], x[3]);
+            let (v, gamma, thrust) = (x[0], x[1], x[3]);
             let gamma_dot_c = gd_dot + K_GAMMA * (gd - gamma);
-            let (_, _, q) = lift_drag(v, alpha);
-            let fn_req = pm.mass * (v * gamma_dot_c + pm.gravity * gamma.cos());
+            let fn_req = pm.mass * (v * gamma_dot_c + pm.gravity * cg);
             let alpha_c = (fn_req / (thrust + q * pm.c_l_alpha))
                 .clamp(-limits.push_over_fraction * limits.alpha_max, limits.alpha_max);
             let v_dot_c = vd_dot + K_SPEED * (vd - v);
-            let (_, drag, _) = lift_drag(v, alpha);
             // The floor keeps the slip-stream from the back transition on; before it the level
             // phase may cut the thrust below its trim (9.3 N ≈ the floor) to shed the speed
             // overshoot of a thrust-limited front transition.
             let floor = if t >= back_start { t_lo } else { 0.0 };
-            let thrust_c = ((pm.mass * (v_dot_c + pm.gravity * gamma.sin()) + drag) / alpha.cos()).clamp(floor, t_hi);
+            let thrust_c = ((pm.mass * (v_dot_c + pm.gravity * sg) + drag) / ca).clamp(floor, t_hi);
             (alpha_c, thrust_c)
         };
         let rates = |t: f64, x: &PState| -> PState {
             let (v, gamma, alpha, thrust) = (x[0], x[1], x[2], x[3]);
-            let (lift, drag, _) = lift_drag(v, alpha);
-            let (alpha_c, thrust_c) = commands(t, x);
+            let (lift, drag, q) = lift_drag(v, alpha);
             let (sa, ca) = alpha.sin_cos();
             let (sg, cg) = gamma.sin_cos();
+            let (alpha_c, thrust_c) = commands(t, x, (q, drag), (sg, cg, ca));
             [
                 (thrust * ca - drag) / pm.mass - pm.gravity * sg,
                 (thrust * sa + lift - weight * cg) / (pm.mass * v),
