@@ -356,9 +356,176 @@ impl Balance<'_> {
     }
 }
 
+/// One reference point's force balance (`ForceBalance` mode), as a [`BalanceSolver`] sees it.
+struct PointProblem<'a> {
+    /// The residual (V̇, α̇, q̇) − target of z = (α, T, δe).
+    bal: Balance<'a>,
+    /// Mission time (s) and table index.
+    t: f64,
+    i: usize,
+    /// Pass (0: on the kinematic α; 1: on α̇, α̈ of pass 0).
+    pass: usize,
+    /// γ, φ, ψ of the point (rad) (read by the tests' slow reference only).
+    #[cfg_attr(not(test), allow(dead_code))]
+    gamma: f64,
+    #[cfg_attr(not(test), allow(dead_code))]
+    phi: f64,
+    #[cfg_attr(not(test), allow(dead_code))]
+    psi: f64,
+    /// (α, T, δe) in the table before this pass's solve (read by the tests' slow reference
+    /// only).
+    #[cfg_attr(not(test), allow(dead_code))]
+    table: [f64; 3],
+}
+
+/// A solver of the per-point force balance: the construction's [`QuasiNewton`] or the
+/// tests' slow reference.
+trait BalanceSolver {
+    /// A pass over the `n` table points begins.
+    fn start_pass(&mut self, pass: usize, n: usize);
+    /// z = (α, T, δe) with residual < 1e-10, or why not.
+    fn solve(&mut self, p: &PointProblem) -> Result<[f64; 3], String>;
+}
+
+/// The construction's solver (issue 17): each point started from the previous points'
+/// solutions extrapolated, one quasi-Newton (Broyden) iteration; the induced velocity of
+/// the last residual warm-starts the next.
+#[derive(Default)]
+struct QuasiNewton {
+    /// Solutions of this pass and of the previous one.
+    z_hist: Vec<[f64; 3]>,
+    z_prev_pass: Vec<[f64; 3]>,
+    /// Induced velocity of the last residual (m/s) (NaN: cold).
+    w_start: f64,
+    /// Inverse Jacobian kept between points.
+    chord: Option<Matrix3<f64>>,
+}
+
+impl BalanceSolver for QuasiNewton {
+    fn start_pass(&mut self, pass: usize, n: usize) {
+        if pass == 0 {
+            self.z_hist = vec![[0.0; 3]; n];
+            self.z_prev_pass = vec![[0.0; 3]; n];
+            self.w_start = f64::NAN;
+        } else {
+            self.z_prev_pass.copy_from_slice(&self.z_hist);
+        }
+        self.chord = None;
+    }
+
+    fn solve(&mut self, p: &PointProblem) -> Result<[f64; 3], String> {
+        let (bal, t, i, pass) = (&p.bal, p.t, p.i, p.pass);
+        let af = bal.af;
+        let g = af.gravity;
+        // Predictor: pass 0 extrapolates the previous points' solutions
+        // (quartic), later passes add the correction of the previous points
+        // over their previous-pass solutions, extrapolated (cubic), to
+        // this point's previous-pass solution. From there one quasi-Newton
+        // step usually meets the tolerance.
+        let mut z = if pass == 0 {
+            match i {
+                0 => [0.0, af.mass * g, 0.0],
+                1..=4 => self.z_hist[i - 1],
+                _ => core::array::from_fn(|k| {
+                    5.0 * (self.z_hist[i - 1][k] - self.z_hist[i - 4][k])
+                        - 10.0 * (self.z_hist[i - 2][k] - self.z_hist[i - 3][k])
+                        + self.z_hist[i - 5][k]
+                }),
+            }
+        } else {
+            let d = |j: usize, k: usize| self.z_hist[j][k] - self.z_prev_pass[j][k];
+            let base = self.z_prev_pass[i];
+            match i {
+                0 => base,
+                1..=3 => core::array::from_fn(|k| base[k] + d(i - 1, k)),
+                _ => core::array::from_fn(|k| {
+                    base[k] + 4.0 * (d(i - 1, k) + d(i - 3, k)) - 6.0 * d(i - 2, k) - d(i - 4, k)
+                }),
+            }
+        };
+        let mut ok = false;
+        let mut r_last = f64::INFINITY;
+        // The last step and its residual (Broyden update of the Jacobian).
+        let mut last: Option<(Vector3<f64>, Vector3<f64>)> = None;
+        for _ in 0..50 {
+            let r = bal.residual(&z, &mut self.w_start);
+            if r.amax() < 1e-10 {
+                ok = true;
+                break;
+            }
+            // Quasi-Newton: the inverse Jacobian of an earlier point or iterate,
+            // corrected along every step by Broyden's rank-one update, is kept
+            // while it still reduces the residual tenfold per step, and refreshed
+            // by central differences otherwise.
+            if r.amax() > 0.1 * r_last {
+                self.chord = None;
+            } else if let (Some(b), Some((dz, r_prev))) = (self.chord.as_mut(), last) {
+                // Broyden's update J += (Δr − J Δz) Δzᵀ / ΔzᵀΔz applied to
+                // B = J⁻¹ by Sherman–Morrison:
+                // B += (Δz − B Δr) Δzᵀ B / (Δzᵀ B Δr).
+                let dr = r - r_prev;
+                let bdr = *b * dr;
+                let den = dz.dot(&bdr);
+                if den.abs() > 1e-12 * dz.norm() * bdr.norm() {
+                    *b += (dz - bdr) * (dz.transpose() * *b) / den;
+                }
+            }
+            r_last = r.amax();
+            let binv = match self.chord {
+                Some(b) => b,
+                None => {
+                    let mut jac = Matrix3::zeros();
+                    for j in 0..3 {
+                        let h = 1e-7 * (1.0 + z[j].abs());
+                        let mut zp = z;
+                        let mut zm = z;
+                        zp[j] += h;
+                        zm[j] -= h;
+                        let mut ws = self.w_start;
+                        let rp = bal.residual(&zp, &mut ws);
+                        let mut ws = self.w_start;
+                        let rm = bal.residual(&zm, &mut ws);
+                        jac.set_column(j, &((rp - rm) / (2.0 * h)));
+                    }
+                    let b = jac
+                        .try_inverse()
+                        .ok_or_else(|| format!("singular trajectory solve at t = {t}"))?;
+                    self.chord = Some(b);
+                    b
+                }
+            };
+            let dz = binv * r;
+            let scale = (0.1 / dz[0].abs().max(dz[2].abs()).max(1e-300)).min(1.0);
+            for k in 0..3 {
+                z[k] -= scale * dz[k];
+            }
+            last = Some((-scale * dz, r));
+        }
+        if !ok {
+            let mut cold = f64::NAN;
+            let r = bal.residual(&z, &mut cold);
+            return Err(format!(
+                "trajectory force balance did not converge at t = {t:.2} s (pass {pass}, z = {z:?}, residual {r:?})"
+            ));
+        }
+        self.z_hist[i] = z;
+        Ok(z)
+    }
+}
+
 impl Trajectory {
     /// Build the table for `mission` with the controller's airframe `af`.
     pub fn new(af: &Airframe, mission: &MissionParams, opt: &TrajectoryOptions) -> Result<Self, String> {
+        Self::build(af, mission, opt, &mut QuasiNewton::default())
+    }
+
+    /// Build the table, each `ForceBalance` point solved by `solver`.
+    fn build(
+        af: &Airframe,
+        mission: &MissionParams,
+        opt: &TrajectoryOptions,
+        solver: &mut dyn BalanceSolver,
+    ) -> Result<Self, String> {
         mission.validate().map_err(|e| e.0)?;
         let end = mission.end_time() + 1.0;
         let n = (end / TABLE_STEP).ceil() as usize + 2;
@@ -408,20 +575,12 @@ impl Trajectory {
         // Passes: body rates from θ̇, ψ̇, φ̇; then α, T, δe; twice for the force balance
         // (the second pass uses α̇, α̈ of the first).
         let passes = if opt.mode == TrajectoryMode::ForceBalance { 2 } else { 1 };
-        // Force-balance solutions (α, T, δe) of this pass and the previous one; the induced
-        // velocity of the last residual (warm start of the next).
-        let mut z_hist = vec![[0.0; 3]; if passes > 1 { n } else { 0 }];
-        let mut z_prev_pass = z_hist.clone();
-        let mut w_start = f64::NAN;
         for pass in 0..passes {
-            if pass > 0 {
-                z_prev_pass.copy_from_slice(&z_hist);
-            }
+            solver.start_pass(pass, n);
             // α̇ has kinks where γ̈ of the cosine blends steps (phase boundaries); a
             // 0.2 s moving average keeps α̈ (→ q̇ → δe) free of finite-difference spikes.
             let alpha_dot = smooth(&derivative(&alphas), 10);
             let alpha_ddot = smooth(&derivative(&alpha_dot), 10);
-            let mut chord: Option<Matrix3<f64>> = None;
             for i in 0..n {
                 let t = pts[i].t;
                 let (_, [v, vdot, gamma, gdot, gddot]) = path(mission, profile, t);
@@ -479,96 +638,16 @@ impl Trajectory {
                             phi_dot,
                             target: Vector3::new(vdot, alpha_dot[i], theta_ddot),
                         };
-                        // Predictor: pass 0 extrapolates the previous points' solutions
-                        // (quartic), later passes add the correction of the previous points
-                        // over their previous-pass solutions, extrapolated (cubic), to
-                        // this point's previous-pass solution. From there one quasi-Newton
-                        // step usually meets the tolerance.
-                        let mut z = if pass == 0 {
-                            match i {
-                                0 => [0.0, af.mass * g, 0.0],
-                                1..=4 => z_hist[i - 1],
-                                _ => core::array::from_fn(|k| {
-                                    5.0 * (z_hist[i - 1][k] - z_hist[i - 4][k])
-                                        - 10.0 * (z_hist[i - 2][k] - z_hist[i - 3][k])
-                                        + z_hist[i - 5][k]
-                                }),
-                            }
-                        } else {
-                            let d = |j: usize, k: usize| z_hist[j][k] - z_prev_pass[j][k];
-                            let base = z_prev_pass[i];
-                            match i {
-                                0 => base,
-                                1..=3 => core::array::from_fn(|k| base[k] + d(i - 1, k)),
-                                _ => core::array::from_fn(|k| {
-                                    base[k] + 4.0 * (d(i - 1, k) + d(i - 3, k)) - 6.0 * d(i - 2, k) - d(i - 4, k)
-                                }),
-                            }
-                        };
-                        let mut ok = false;
-                        let mut r_last = f64::INFINITY;
-                        // The last step and its residual (Broyden update of the Jacobian).
-                        let mut last: Option<(Vector3<f64>, Vector3<f64>)> = None;
-                        for _ in 0..50 {
-                            let r = bal.residual(&z, &mut w_start);
-                            if r.amax() < 1e-10 {
-                                ok = true;
-                                break;
-                            }
-                            // Quasi-Newton: the inverse Jacobian of an earlier point or iterate,
-                            // corrected along every step by Broyden's rank-one update, is kept
-                            // while it still reduces the residual tenfold per step, and refreshed
-                            // by central differences otherwise.
-                            if r.amax() > 0.1 * r_last {
-                                chord = None;
-                            } else if let (Some(b), Some((dz, r_prev))) = (chord.as_mut(), last) {
-                                // Broyden's update J += (Δr − J Δz) Δzᵀ / ΔzᵀΔz applied to
-                                // B = J⁻¹ by Sherman–Morrison:
-                                // B += (Δz − B Δr) Δzᵀ B / (Δzᵀ B Δr).
-                                let dr = r - r_prev;
-                                let bdr = *b * dr;
-                                let den = dz.dot(&bdr);
-                                if den.abs() > 1e-12 * dz.norm() * bdr.norm() {
-                                    *b += (dz - bdr) * (dz.transpose() * *b) / den;
-                                }
-                            }
-                            r_last = r.amax();
-                            let binv = match chord {
-                                Some(b) => b,
-                                None => {
-                                    let mut jac = Matrix3::zeros();
-                                    for j in 0..3 {
-                                        let h = 1e-7 * (1.0 + z[j].abs());
-                                        let mut zp = z;
-                                        let mut zm = z;
-                                        zp[j] += h;
-                                        zm[j] -= h;
-                                        let mut ws = w_start;
-                                        let rp = bal.residual(&zp, &mut ws);
-                                        let mut ws = w_start;
-                                        let rm = bal.residual(&zm, &mut ws);
-                                        jac.set_column(j, &((rp - rm) / (2.0 * h)));
-                                    }
-                                    let b = jac
-                                        .try_inverse()
-                                        .ok_or_else(|| format!("singular trajectory solve at t = {t}"))?;
-                                    chord = Some(b);
-                                    b
-                                }
-                            };
-                            let dz = binv * r;
-                            let scale = (0.1 / dz[0].abs().max(dz[2].abs()).max(1e-300)).min(1.0);
-                            for k in 0..3 {
-                                z[k] -= scale * dz[k];
-                            }
-                            last = Some((-scale * dz, r));
-                        }
-                        if !ok {
-                            let mut cold = f64::NAN;
-                            let r = bal.residual(&z, &mut cold);
-                            return Err(format!("trajectory force balance did not converge at t = {t:.2} s (pass {pass}, z = {z:?}, residual {r:?})"));
-                        }
-                        z_hist[i] = z;
+                        let z = solver.solve(&PointProblem {
+                            bal,
+                            t,
+                            i,
+                            pass,
+                            gamma,
+                            phi,
+                            psi,
+                            table: [alphas[i], pts[i].thrust, pts[i].u[1]],
+                        })?;
                         alphas[i] = z[0];
                         let p = &mut pts[i];
                         p.alpha = z[0];
@@ -672,216 +751,112 @@ fn derivative(y: &[f64]) -> Vec<f64> {
 mod tests {
     use super::*;
 
-    /// The table as built before the construction was made fast (issue 17): every point's
-    /// force balance solved from the previous point's solution by a chord iteration with
-    /// central-difference Jacobians, cold induced-velocity solves. Kept verbatim as the
-    /// slow reference the fast construction is compared against.
-    #[allow(clippy::needless_range_loop)]
+    /// The force-balance solver as it was before the construction was made fast (issue
+    /// 17): each point started from the previous point's solution, a chord iteration with
+    /// central-difference Jacobians of the full model for control
+    /// ([`crate::model::derivatives`]), cold induced-velocity solves. The slow reference
+    /// the fast construction is compared against.
+    struct SlowChord {
+        z_prev: [f64; 3],
+        chord: Option<nalgebra::LU<f64, nalgebra::U3, nalgebra::U3>>,
+    }
+
+    impl SlowChord {
+        fn new(af: &Airframe) -> Self {
+            Self {
+                z_prev: [0.0, af.mass * af.gravity, 0.0],
+                chord: None,
+            }
+        }
+    }
+
+    impl BalanceSolver for SlowChord {
+        fn start_pass(&mut self, _pass: usize, _n: usize) {
+            self.chord = None;
+        }
+
+        fn solve(&mut self, p: &PointProblem) -> Result<[f64; 3], String> {
+            let (b, t, i, pass) = (&p.bal, p.t, p.i, p.pass);
+            let af = b.af;
+            let rates_of = |alpha: f64| {
+                let th = p.gamma + alpha;
+                let (sf, cf) = p.phi.sin_cos();
+                let (st, ct) = th.sin_cos();
+                let (w, td) = (b.turn_rate, b.theta_dot);
+                Vector3::new(b.phi_dot - w * st, td * cf + w * sf * ct, -td * sf + w * cf * ct)
+            };
+            let resid = |z: &[f64; 3]| {
+                let rates = rates_of(z[0]);
+                let (x, u) = point_state(b.v, z[0], p.gamma, p.phi, p.psi, &rates, z[1], z[2]);
+                let d = derivatives(af, EulerRep::E321, &x, &u);
+                Vector3::new(d[ix::V], d[ix::ALPHA], d[ix::Q]) - b.target
+            };
+            let mut z = if i == 0 || pass > 0 {
+                [p.table[0], p.table[1].max(1.0), p.table[2]]
+            } else {
+                self.z_prev
+            };
+            if pass == 0 && i == 0 {
+                z = [0.0, af.mass * af.gravity, 0.0];
+            }
+            let mut ok = false;
+            let mut r_last = f64::INFINITY;
+            for _ in 0..50 {
+                let r = resid(&z);
+                if r.amax() < 1e-10 {
+                    ok = true;
+                    break;
+                }
+                // Chord iteration: the Jacobian of the previous point (10 ms earlier)
+                // or iterate is kept while it still reduces the residual tenfold per
+                // step, and refreshed by central differences otherwise.
+                if r.amax() > 0.1 * r_last {
+                    self.chord = None;
+                }
+                r_last = r.amax();
+                let lu = match self.chord {
+                    Some(lu) => lu,
+                    None => {
+                        let mut jac = Matrix3::zeros();
+                        for j in 0..3 {
+                            let h = 1e-7 * (1.0 + z[j].abs());
+                            let mut zp = z;
+                            let mut zm = z;
+                            zp[j] += h;
+                            zm[j] -= h;
+                            jac.set_column(j, &((resid(&zp) - resid(&zm)) / (2.0 * h)));
+                        }
+                        let lu = jac.lu();
+                        self.chord = Some(lu);
+                        lu
+                    }
+                };
+                let dz = lu
+                    .solve(&r)
+                    .ok_or_else(|| format!("singular trajectory solve at t = {t}"))?;
+                let scale = (0.1 / dz[0].abs().max(dz[2].abs()).max(1e-300)).min(1.0);
+                for k in 0..3 {
+                    z[k] -= scale * dz[k];
+                }
+            }
+            if !ok {
+                return Err(format!(
+                    "trajectory force balance did not converge at t = {t:.2} s (pass {pass}, z = {z:?}, residual {:?})",
+                    resid(&z)
+                ));
+            }
+            self.z_prev = z;
+            Ok(z)
+        }
+    }
+
+    /// The table built with the slow reference solver.
     fn slow_reference(
         af: &Airframe,
         mission: &MissionParams,
         opt: &TrajectoryOptions,
     ) -> Result<Vec<TrajPoint>, String> {
-        mission.validate().map_err(|e| e.0)?;
-        let end = mission.end_time() + 1.0;
-        let n = (end / TABLE_STEP).ceil() as usize + 2;
-        let g = af.gravity;
-        // Level trim α for the thesis mode (and the solve's initial guesses).
-        let level = tailsitter_physics::Plant::new(*af)
-            .trim_level(mission.v_level)
-            .map_err(|e| format!("level trim at v_level = {} failed: {e}", mission.v_level))?;
-
-        let profile = if opt.limited_path {
-            let pm = PointMass::from_level_trim(af, mission.v_level).map_err(|e| e.0)?;
-            Some(Profile::new(mission, &pm, &ProfileLimits::of(mission)).map_err(|e| e.0)?)
-        } else {
-            None
-        };
-        let profile = profile.as_ref();
-        // Pass 0: kinematic path, heading, bank.
-        let mut pts: Vec<TrajPoint> = Vec::with_capacity(n);
-        let mut psi = 0.0;
-        let mut alphas = Vec::with_capacity(n);
-        for i in 0..n {
-            let t = i as f64 * TABLE_STEP;
-            let (_, [v, _, gamma, _, _]) = path(mission, profile, t);
-            if i > 0 {
-                let (w0, _) = turn_rate(mission, t - TABLE_STEP, opt.turn_radius);
-                let (w1, _) = turn_rate(mission, t, opt.turn_radius);
-                psi += 0.5 * (w0 + w1) * TABLE_STEP;
-            }
-            let alpha = match opt.mode {
-                TrajectoryMode::Thesis => alpha_thesis(mission, t, level.alpha, opt.alpha_max),
-                TrajectoryMode::ForceBalance => 0.0,
-            };
-            alphas.push(alpha);
-            pts.push(TrajPoint {
-                t,
-                v,
-                alpha,
-                gamma,
-                euler_321: Vector3::new(0.0, gamma + alpha, psi),
-                rates: Vector3::zeros(),
-                pos_neh: Vector3::zeros(),
-                thrust: 0.0,
-                u: U::zeros(),
-            });
-        }
-
-        // Passes: body rates from θ̇, ψ̇, φ̇; then α, T, δe; twice for the force balance
-        // (the second pass uses α̇, α̈ of the first).
-        let passes = if opt.mode == TrajectoryMode::ForceBalance { 2 } else { 1 };
-        let mut z_prev = [0.0, af.mass * g, 0.0];
-        for pass in 0..passes {
-            // α̇ has kinks where γ̈ of the cosine blends steps (phase boundaries); a
-            // 0.2 s moving average keeps α̈ (→ q̇ → δe) free of finite-difference spikes.
-            let alpha_dot = smooth(&derivative(&alphas), 10);
-            let alpha_ddot = smooth(&derivative(&alpha_dot), 10);
-            let mut chord: Option<nalgebra::LU<f64, nalgebra::U3, nalgebra::U3>> = None;
-            for i in 0..n {
-                let t = pts[i].t;
-                let (_, [v, vdot, gamma, gdot, gddot]) = path(mission, profile, t);
-                let (w, wdot) = turn_rate(mission, t, opt.turn_radius);
-                let phi = (v * w / g).atan(); // (3.3.18)
-                let psi = pts[i].euler_321.z;
-                let theta_dot = gdot + alpha_dot[i];
-                let theta_ddot = gddot + alpha_ddot[i];
-                // φ̇ from the derivative of atan(V ω / g).
-                let k = v * w / g;
-                let phi_dot = (vdot * w + v * wdot) / g / (1.0 + k * k);
-                let rates_of = |alpha: f64| {
-                    let th = gamma + alpha;
-                    let (sf, cf) = phi.sin_cos();
-                    let (st, ct) = th.sin_cos();
-                    // 3-2-1: p = φ̇ − ψ̇ sθ, q = θ̇ cφ + ψ̇ sφ cθ, r = −θ̇ sφ + ψ̇ cφ cθ.
-                    Vector3::new(
-                        phi_dot - w * st,
-                        theta_dot * cf + w * sf * ct,
-                        -theta_dot * sf + w * cf * ct,
-                    )
-                };
-                match opt.mode {
-                    TrajectoryMode::Thesis => {
-                        let alpha = alphas[i];
-                        let rates = rates_of(alpha);
-                        // (3.3.13–3.3.14).
-                        let thrust = af.mass * vdot
-                            + af.mass * g * gamma.sin()
-                            + 0.5 * af.air_density * v * v * af.wing_area * af.c_D0;
-                        // (3.3.15–3.3.17) with the slip-stream scaling.
-                        let c = af.coefficients(alpha);
-                        let wi = af.induced_velocity(v, v * alpha.cos(), thrust);
-                        let qbar = 0.5 * af.air_density * v * v * af.wing_area * af.mean_chord;
-                        let de = (af.i_yy * theta_ddot / qbar
-                            - af.c_m0
-                            - c.c_m_alpha * alpha
-                            - af.mean_chord / (2.0 * v) * c.c_m_q * rates.y)
-                            / c.c_m_de
-                            * (v / (v + 2.0 * wi)).powi(2);
-                        let p = &mut pts[i];
-                        p.rates = rates;
-                        p.thrust = thrust;
-                        p.u[1] = de;
-                        p.euler_321 = Vector3::new(phi, gamma + alpha, psi);
-                    }
-                    TrajectoryMode::ForceBalance => {
-                        let target = Vector3::new(vdot, alpha_dot[i], theta_ddot);
-                        let resid = |z: &[f64; 3]| {
-                            let rates = rates_of(z[0]);
-                            let (x, u) = point_state(v, z[0], gamma, phi, psi, &rates, z[1], z[2]);
-                            let d = derivatives(af, EulerRep::E321, &x, &u);
-                            Vector3::new(d[ix::V], d[ix::ALPHA], d[ix::Q]) - target
-                        };
-                        let mut z = if i == 0 || pass > 0 {
-                            [alphas[i], pts[i].thrust.max(1.0), pts[i].u[1]]
-                        } else {
-                            z_prev
-                        };
-                        if pass == 0 && i == 0 {
-                            z = [0.0, af.mass * g, 0.0];
-                        }
-                        let mut ok = false;
-                        let mut r_last = f64::INFINITY;
-                        for _ in 0..50 {
-                            let r = resid(&z);
-                            if r.amax() < 1e-10 {
-                                ok = true;
-                                break;
-                            }
-                            // Chord iteration: the Jacobian of the previous point (10 ms earlier)
-                            // or iterate is kept while it still reduces the residual tenfold per
-                            // step, and refreshed by central differences otherwise.
-                            if r.amax() > 0.1 * r_last {
-                                chord = None;
-                            }
-                            r_last = r.amax();
-                            let lu = match chord {
-                                Some(lu) => lu,
-                                None => {
-                                    let mut jac = Matrix3::zeros();
-                                    for j in 0..3 {
-                                        let h = 1e-7 * (1.0 + z[j].abs());
-                                        let mut zp = z;
-                                        let mut zm = z;
-                                        zp[j] += h;
-                                        zm[j] -= h;
-                                        jac.set_column(j, &((resid(&zp) - resid(&zm)) / (2.0 * h)));
-                                    }
-                                    let lu = jac.lu();
-                                    chord = Some(lu);
-                                    lu
-                                }
-                            };
-                            let dz = lu
-                                .solve(&r)
-                                .ok_or_else(|| format!("singular trajectory solve at t = {t}"))?;
-                            let scale = (0.1 / dz[0].abs().max(dz[2].abs()).max(1e-300)).min(1.0);
-                            for k in 0..3 {
-                                z[k] -= scale * dz[k];
-                            }
-                        }
-                        if !ok {
-                            return Err(format!("trajectory force balance did not converge at t = {t:.2} s (pass {pass}, z = {z:?}, residual {:?})", resid(&z)));
-                        }
-                        z_prev = z;
-                        alphas[i] = z[0];
-                        let p = &mut pts[i];
-                        p.alpha = z[0];
-                        p.rates = rates_of(z[0]);
-                        p.thrust = z[1];
-                        p.u[1] = z[2];
-                        p.euler_321 = Vector3::new(phi, gamma + z[0], psi);
-                    }
-                }
-            }
-        }
-        // Thrust command leads the state by the lag (2.3.16); positions (3.3.9–3.3.12).
-        let thrusts: Vec<f64> = pts.iter().map(|p| p.thrust).collect();
-        let tdot = derivative(&thrusts);
-        let mut pos = Vector3::zeros();
-        for i in 0..n {
-            if i > 0 {
-                let vel = |p: &TrajPoint| {
-                    let (sg, cg) = p.gamma.sin_cos();
-                    let (sp, cp) = p.euler_321.z.sin_cos();
-                    Vector3::new(p.v * cg * cp, p.v * cg * sp, p.v * sg)
-                };
-                pos += 0.5 * (vel(&pts[i - 1]) + vel(&pts[i])) * TABLE_STEP;
-            }
-            let p = &mut pts[i];
-            p.pos_neh = pos;
-            p.u[0] = (p.thrust + af.tau_thrust * tdot[i]).clamp(af.thrust_min, af.thrust_max);
-            if opt.mode == TrajectoryMode::Thesis {
-                p.alpha = alphas[i];
-            }
-        }
-        if pts
-            .iter()
-            .any(|p| !(p.v.is_finite() && p.u.iter().all(|x| x.is_finite()) && p.pos_neh.iter().all(|x| x.is_finite())))
-        {
-            return Err("non-finite trajectory".into());
-        }
-        Ok(pts)
+        Trajectory::build(af, mission, opt, &mut SlowChord::new(af)).map(|t| t.points().to_vec())
     }
 
     /// Every component of a table point, for comparisons.
