@@ -226,6 +226,27 @@ impl Scenario {
         }
     }
 
+    /// A violent manoeuvre for accuracy and speed checks: the fast mission of the
+    /// thesis-era timings (T1 = 3 s, T2 = 4 s, α up to ≈ 44° on the LQR) with a 1 − cos
+    /// gust of 6 m/s (north, up) over 2 s at t = 12 s and 5 m reference steps at 20 s and 23 s.
+    pub fn violent_manoeuvre() -> Self {
+        let mut s = Self::mission(MissionParams {
+            t_transition_1: 3.0,
+            t_transition_2: 4.0,
+            ..MissionParams::default()
+        });
+        s.wind = Wind::OneMinusCosine {
+            t_start: 12.0,
+            duration: 2.0,
+            amplitude: Vector3::new(6.0, 0.0, -6.0),
+        };
+        s.ref_offset_steps = vec![
+            (20.0, Vector3::new(0.0, 5.0, 0.0)),
+            (23.0, Vector3::new(5.0, 5.0, -5.0)),
+        ];
+        s
+    }
+
     /// Reference offset at time `t`.
     pub fn ref_offset(&self, t: f64) -> Vector3<f64> {
         let mut offset = Vector3::zeros();

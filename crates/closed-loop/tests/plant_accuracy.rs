@@ -15,36 +15,14 @@
 
 use std::path::PathBuf;
 
-use closed_loop::{fly, Scenario, Wind};
+use closed_loop::{fly, Scenario};
 use flight_mission::MissionParams;
 use lqr_control::{LqrController, LqrParams};
-use nalgebra::Vector3;
 use tailsitter_physics::{AeroModel, Airframe, Plant};
 
 const DECIMATION: usize = 5;
 const POSITION_TOLERANCE: f64 = 1e-7;
 const QUATERNION_TOLERANCE: f64 = 1e-7;
-
-/// The fast mission (T1 = 3 s, T2 = 4 s, α up to ≈ 44°) with a 1 − cos gust of 6 m/s
-/// (north, up) over 2 s at t = 12 s and 5 m reference steps at 20 s and 23 s.
-fn violent() -> Scenario {
-    let m = MissionParams {
-        t_transition_1: 3.0,
-        t_transition_2: 4.0,
-        ..MissionParams::default()
-    };
-    let mut s = Scenario::mission(m);
-    s.wind = Wind::OneMinusCosine {
-        t_start: 12.0,
-        duration: 2.0,
-        amplitude: Vector3::new(6.0, 0.0, -6.0),
-    };
-    s.ref_offset_steps = vec![
-        (20.0, Vector3::new(0.0, 5.0, 0.0)),
-        (23.0, Vector3::new(5.0, 5.0, -5.0)),
-    ];
-    s
-}
 
 fn fly_rows(s: &Scenario) -> Vec<[f64; 8]> {
     let mut plant = Plant::new(Airframe::default());
@@ -102,5 +80,5 @@ fn default_mission_global_aero_matches_stored_plant() {
 
 #[test]
 fn violent_manoeuvre_global_aero_matches_stored_plant() {
-    check("violent", &fly_rows(&violent()));
+    check("violent", &fly_rows(&Scenario::violent_manoeuvre()));
 }

@@ -7,10 +7,9 @@
 //! `violent`: the fast mission (T1 = 3 s, T2 = 4 s, α up to ≈ 44°) with a 1 − cos gust of
 //! 6 m/s (north, up) over 2 s at t = 12 s and 5 m position steps at 20 s and 23 s (the mission ends at 27 s).
 
-use closed_loop::{fly, Scenario, Trace, Wind};
+use closed_loop::{fly, Scenario, Trace};
 use flight_mission::MissionParams;
 use lqr_control::{LqrController, LqrParams};
-use nalgebra::Vector3;
 use std::io::Write;
 use tailsitter_physics::{Airframe, Plant};
 
@@ -24,24 +23,7 @@ fn thread_cpu_time() -> f64 {
 fn scenario(name: &str) -> Scenario {
     match name {
         "default" => Scenario::mission(MissionParams::default()),
-        "violent" => {
-            let m = MissionParams {
-                t_transition_1: 3.0,
-                t_transition_2: 4.0,
-                ..MissionParams::default()
-            };
-            let mut s = Scenario::mission(m);
-            s.wind = Wind::OneMinusCosine {
-                t_start: 12.0,
-                duration: 2.0,
-                amplitude: Vector3::new(6.0, 0.0, -6.0),
-            };
-            s.ref_offset_steps = vec![
-                (20.0, Vector3::new(0.0, 5.0, 0.0)),
-                (23.0, Vector3::new(5.0, 5.0, -5.0)),
-            ];
-            s
-        }
+        "violent" => Scenario::violent_manoeuvre(),
         other => panic!("unknown scenario {other} (default | violent)"),
     }
 }
