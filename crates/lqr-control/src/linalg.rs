@@ -378,6 +378,27 @@ pub mod dense {
         }
     }
 
+    /// Two columns of `A B` at once (each column of A loaded once per pair), rows
+    /// `first_row..R` (the rows above are left 0); `b_pair(k)` gives row k of the two
+    /// columns of B. Multiply-adds fused when `F` ([`madd`]).
+    #[inline(always)]
+    fn column_pair<const R: usize, const K: usize, const F: bool>(
+        a: &[[f64; R]; K],
+        first_row: usize,
+        b_pair: impl Fn(usize) -> (f64, f64),
+    ) -> ([f64; R], [f64; R]) {
+        let mut acc0 = [0.0; R];
+        let mut acc1 = [0.0; R];
+        for (k, ak) in a.iter().enumerate() {
+            let (s0, s1) = b_pair(k);
+            for i in first_row..R {
+                acc0[i] = madd::<F>(acc0[i], ak[i], s0);
+                acc1[i] = madd::<F>(acc1[i], ak[i], s1);
+            }
+        }
+        (acc0, acc1)
+    }
+
     /// `A B`, two result columns at a time (each column of A loaded once per pair);
     /// multiply-adds fused when `F` ([`madd`]).
     #[inline(always)]
@@ -389,18 +410,7 @@ pub mod dense {
         let mut j = 0;
         while j + 1 < C {
             let (b0, b1) = (&b[j], &b[j + 1]);
-            let mut acc0 = [0.0; R];
-            let mut acc1 = [0.0; R];
-            for k in 0..K {
-                let (s0, s1) = (b0[k], b1[k]);
-                let ak = &a[k];
-                for i in 0..R {
-                    acc0[i] = madd::<F>(acc0[i], ak[i], s0);
-                    acc1[i] = madd::<F>(acc1[i], ak[i], s1);
-                }
-            }
-            c[j] = acc0;
-            c[j + 1] = acc1;
+            (c[j], c[j + 1]) = column_pair::<R, K, F>(a, 0, |k| (b0[k], b1[k]));
             j += 2;
         }
         if j < C {
@@ -425,18 +435,7 @@ pub mod dense {
         let mut c = [[0.0; R]; C];
         let mut j = 0;
         while j + 1 < C {
-            let mut acc0 = [0.0; R];
-            let mut acc1 = [0.0; R];
-            for k in 0..K {
-                let (s0, s1) = (b[k][j], b[k][j + 1]);
-                let ak = &a[k];
-                for i in 0..R {
-                    acc0[i] = madd::<F>(acc0[i], ak[i], s0);
-                    acc1[i] = madd::<F>(acc1[i], ak[i], s1);
-                }
-            }
-            c[j] = acc0;
-            c[j + 1] = acc1;
+            (c[j], c[j + 1]) = column_pair::<R, K, F>(a, 0, |k| (b[k][j], b[k][j + 1]));
             j += 2;
         }
         if j < C {
@@ -467,35 +466,13 @@ pub mod dense {
         let mut j = 0;
         while j + 1 < lo {
             let (b0, b1) = (&b[j], &b[j + 1]);
-            let mut acc0 = [0.0; N];
-            let mut acc1 = [0.0; N];
-            for k in 0..K {
-                let (s0, s1) = (b0[k], b1[k]);
-                let ak = &a[k];
-                for i in 0..N {
-                    acc0[i] = madd::<F>(acc0[i], ak[i], s0);
-                    acc1[i] = madd::<F>(acc1[i], ak[i], s1);
-                }
-            }
-            c[j] = acc0;
-            c[j + 1] = acc1;
+            (c[j], c[j + 1]) = column_pair::<N, K, F>(a, 0, |k| (b0[k], b1[k]));
             j += 2;
         }
         while j < N {
             let j1 = (j + 1).min(N - 1);
             let (b0, b1) = (&b[j], &b[j1]);
-            let mut acc0 = [0.0; N];
-            let mut acc1 = [0.0; N];
-            for k in 0..K {
-                let (s0, s1) = (b0[k], b1[k]);
-                let ak = &a[k];
-                for i in lo..N {
-                    acc0[i] = madd::<F>(acc0[i], ak[i], s0);
-                    acc1[i] = madd::<F>(acc1[i], ak[i], s1);
-                }
-            }
-            c[j] = acc0;
-            c[j1] = acc1;
+            (c[j], c[j1]) = column_pair::<N, K, F>(a, lo, |k| (b0[k], b1[k]));
             j += 2;
         }
         for (cj, dj) in c.iter_mut().zip(d.iter()) {
