@@ -38,7 +38,9 @@ pub mod gains;
 pub mod params;
 pub mod trajectory;
 
-pub use params::{TsdParams, GUIDANCE_FEEDBACK_LIMIT, TABLE_4_3_GUIDANCE_LEVEL};
+pub use params::{
+    TsdParams, GUIDANCE_FEEDBACK_LIMIT, HOVER_WIND_CROSSFLOW, HOVER_WIND_DESIGN_SPEED_FACTOR, TABLE_4_3_GUIDANCE_LEVEL,
+};
 pub use trajectory::{Reference, Trajectory};
 
 use flight_mission::{
@@ -664,10 +666,28 @@ impl SampledUnit for TsdController {
         // In the take-off and landing phases (vertical, slow, the air possibly from behind
         // in the descent, α → π) the loops are designed for hover at the axial airspeed:
         // the attached-flow models of (4.2.x) at α ≈ π would reverse the surfaces' sign.
+        // Tuned configuration, hover (the reference at the vertical speed) in wind: the loops
+        // are designed at α = 0 and HOVER_WIND_DESIGN_SPEED_FACTOR × V̄, blended in with the
+        // crossflow (README, "Hover in a wind step"). At the measured condition (a wind step
+        // puts α at ±60° or β at ±65°, V̄ at 5–10 m/s) the elevator and flaps went into a
+        // bang-bang pitch limit cycle (q ≈ ±8 rad/s) that the Jacobi master's extra sample
+        // turned into a tumble from 5 m/s on.
+        let crossflow = (meas.airspeed * meas.airspeed - axial_airspeed * axial_airspeed)
+            .max(0.0)
+            .sqrt();
+        let hover_wind = if p.configuration == 0 && reference.airspeed <= self.mission.v_vertical + 1.0 {
+            let (lo, hi) = HOVER_WIND_CROSSFLOW;
+            ((crossflow - lo) / (hi - lo)).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
         let (fc_airspeed, fc_alpha) = if sigma_ground.is_some() {
             (axial_airspeed.max(0.0), 0.0)
         } else {
-            (meas.airspeed, meas.alpha)
+            (
+                meas.airspeed * lerp(1.0, HOVER_WIND_DESIGN_SPEED_FACTOR, hover_wind),
+                meas.alpha * (1.0 - hover_wind),
+            )
         };
         let d = self
             .design(&FlightCondition {

@@ -12,6 +12,16 @@ pub const TABLE_4_3_GUIDANCE_LEVEL: (f64, f64) = (-0.75, 0.45);
 /// uncertain plants").
 pub const GUIDANCE_FEEDBACK_LIMIT: f64 = 5.0;
 
+/// Hover in wind, tuned configuration: the loops are designed at α = 0 and at this multiple of
+/// the measured airspeed V̄ once the air flows across the nose (README, "Hover in a wind
+/// step"). Found by a scan of the issue-16 hover steps: 1.25–1.4 hold the same cases.
+pub const HOVER_WIND_DESIGN_SPEED_FACTOR: f64 = 1.3;
+
+/// Crossflow V̄ √(1 − cos²α cos²β) (the air-velocity component across the nose, m/s) over
+/// which the hover-in-wind design condition is blended in: none at the first value (still air,
+/// the calm missions unchanged), fully at the second.
+pub const HOVER_WIND_CROSSFLOW: (f64, f64) = (1.0, 3.0);
+
 /// Every tuning parameter of the controller. Field names are the FMU parameter names
 /// (group `tsd` of `modelDescription/tailsitter_tsd.json`).
 ///
