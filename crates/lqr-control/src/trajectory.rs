@@ -387,6 +387,20 @@ trait BalanceSolver {
     fn solve(&mut self, p: &PointProblem) -> Result<[f64; 3], String>;
 }
 
+/// Central-difference Jacobian of `f` at `z` (steps 1e-7 (1 + |z_j|)).
+fn central_jacobian(z: &[f64; 3], f: impl Fn(&[f64; 3]) -> Vector3<f64>) -> Matrix3<f64> {
+    let mut jac = Matrix3::zeros();
+    for j in 0..3 {
+        let h = 1e-7 * (1.0 + z[j].abs());
+        let mut zp = *z;
+        let mut zm = *z;
+        zp[j] += h;
+        zm[j] -= h;
+        jac.set_column(j, &((f(&zp) - f(&zm)) / (2.0 * h)));
+    }
+    jac
+}
+
 /// The construction's solver (issue 17): each point started from the previous points'
 /// solutions extrapolated, one quasi-Newton (Broyden) iteration; the induced velocity of
 /// the last residual warm-starts the next.
@@ -474,20 +488,8 @@ impl BalanceSolver for QuasiNewton {
             let binv = match self.chord {
                 Some(b) => b,
                 None => {
-                    let mut jac = Matrix3::zeros();
-                    for j in 0..3 {
-                        let h = 1e-7 * (1.0 + z[j].abs());
-                        let mut zp = z;
-                        let mut zm = z;
-                        zp[j] += h;
-                        zm[j] -= h;
-                        let mut ws = self.w_start;
-                        let rp = bal.residual(&zp, &mut ws);
-                        let mut ws = self.w_start;
-                        let rm = bal.residual(&zm, &mut ws);
-                        jac.set_column(j, &((rp - rm) / (2.0 * h)));
-                    }
-                    let b = jac
+                    let w_start = self.w_start;
+                    let b = central_jacobian(&z, |zz| bal.residual(zz, &mut { w_start }))
                         .try_inverse()
                         .ok_or_else(|| format!("singular trajectory solve at t = {t}"))?;
                     self.chord = Some(b);
@@ -817,16 +819,7 @@ mod tests {
                 let lu = match self.chord {
                     Some(lu) => lu,
                     None => {
-                        let mut jac = Matrix3::zeros();
-                        for j in 0..3 {
-                            let h = 1e-7 * (1.0 + z[j].abs());
-                            let mut zp = z;
-                            let mut zm = z;
-                            zp[j] += h;
-                            zm[j] -= h;
-                            jac.set_column(j, &((resid(&zp) - resid(&zm)) / (2.0 * h)));
-                        }
-                        let lu = jac.lu();
+                        let lu = central_jacobian(&z, resid).lu();
                         self.chord = Some(lu);
                         lu
                     }

@@ -1002,28 +1002,38 @@ mod tests {
         }
     }
 
-    /// At the vertical climb (3 m/s, T = mg, w ≈ 10.4 m/s) and in level flight (25 m/s), every
-    /// scheduled loop closed on its own model has exactly the poles of Table 4.3.
-    #[test]
-    fn scheduled_loops_have_the_poles_of_table_4_3() {
-        let ctl = TsdController::with_mission(MissionParams::default()).unwrap();
-        let p = TsdParams::default();
-        let vertical = FlightCondition {
+    /// The 3 m/s vertical climb (T ≈ mg, w ≈ 10.4 m/s) as the loops' design sees it.
+    fn vertical_climb_condition() -> FlightCondition {
+        FlightCondition {
             airspeed: 3.0,
             alpha: 0.0,
             thrust: 88.3,
             induced_velocity: 10.4,
             axial_airspeed: 3.0,
             reference_airspeed: 3.0,
-        };
-        let level = FlightCondition {
+        }
+    }
+
+    /// Level flight at 25 m/s (α ≈ 5.3°, T ≈ 9.3 N) as the loops' design sees it.
+    fn level_flight_condition() -> FlightCondition {
+        FlightCondition {
             airspeed: 25.0,
             alpha: 0.092,
             thrust: 9.3,
             induced_velocity: 0.6,
             axial_airspeed: 25.0 * 0.092f64.cos(),
             reference_airspeed: 25.0,
-        };
+        }
+    }
+
+    /// At the vertical climb (3 m/s, T = mg, w ≈ 10.4 m/s) and in level flight (25 m/s), every
+    /// scheduled loop closed on its own model has exactly the poles of Table 4.3.
+    #[test]
+    fn scheduled_loops_have_the_poles_of_table_4_3() {
+        let ctl = TsdController::with_mission(MissionParams::default()).unwrap();
+        let p = TsdParams::default();
+        let vertical = vertical_climb_condition();
+        let level = level_flight_condition();
         for (fc, lvl) in [(vertical, false), (level, true)] {
             let d = ctl.design(&fc).unwrap();
             assert_eq!(d.schedule, if lvl { 1.0 } else { 0.0 });
@@ -1077,22 +1087,8 @@ mod tests {
     /// thesis configuration has one pair and no feedback bound.
     #[test]
     fn lateral_guidance_and_feedback_bound_of_the_tuned_configuration() {
-        let level = FlightCondition {
-            airspeed: 25.0,
-            alpha: 0.092,
-            thrust: 9.3,
-            induced_velocity: 0.6,
-            axial_airspeed: 25.0 * 0.092f64.cos(),
-            reference_airspeed: 25.0,
-        };
-        let hover = FlightCondition {
-            airspeed: 3.0,
-            alpha: 0.0,
-            thrust: 88.3,
-            induced_velocity: 10.4,
-            axial_airspeed: 3.0,
-            reference_airspeed: 3.0,
-        };
+        let level = level_flight_condition();
+        let hover = vertical_climb_condition();
         let p = TsdParams::default();
         let tuned = TsdController::with_mission(MissionParams::default()).unwrap();
         let d = tuned.design(&level).unwrap();
