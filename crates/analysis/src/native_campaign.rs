@@ -280,16 +280,9 @@ pub fn metrics(plant: &Plant, samples: &[Sample]) -> BTreeMap<String, Option<f64
     for s in samples {
         let c = &s.command;
         let t = c.thrust <= THRUST_LIMITS.0 || c.thrust >= THRUST_LIMITS.1 * (1.0 - 1e-9);
-        let surf = [
-            c.elevator,
-            c.aileron,
-            c.rudder,
-            c.flap_collective,
-            c.flap_differential,
-            c.vertical_flap,
-        ]
-        .iter()
-        .any(|d| d.abs() >= DEFLECTION_LIMIT * (1.0 - 1e-9));
+        let surf = c.to_array()[1..]
+            .iter()
+            .any(|d| d.abs() >= DEFLECTION_LIMIT * (1.0 - 1e-9));
         sat += usize::from(t || surf);
         sat_thrust += usize::from(t);
     }

@@ -324,8 +324,8 @@ pub struct Command {
 }
 
 impl Command {
-    /// Whether every command is finite.
-    pub fn is_finite(&self) -> bool {
+    /// `[T_c, δe, δa, δr, δfc, δfd, δv]` (N, rad).
+    pub fn to_array(&self) -> [f64; 7] {
         [
             self.thrust,
             self.elevator,
@@ -335,8 +335,25 @@ impl Command {
             self.flap_differential,
             self.vertical_flap,
         ]
-        .iter()
-        .all(|x| x.is_finite())
+    }
+
+    /// The command of `[T_c, δe, δa, δr, δfc, δfd, δv]` (N, rad).
+    pub fn from_array(c: [f64; 7]) -> Self {
+        let [thrust, elevator, aileron, rudder, flap_collective, flap_differential, vertical_flap] = c;
+        Self {
+            thrust,
+            elevator,
+            aileron,
+            rudder,
+            flap_collective,
+            flap_differential,
+            vertical_flap,
+        }
+    }
+
+    /// Whether every command is finite.
+    pub fn is_finite(&self) -> bool {
+        self.to_array().iter().all(|x| x.is_finite())
     }
 }
 
@@ -404,23 +421,15 @@ impl HeldOutput for ControllerOutput {
 
     /// Command and diagnostics (the notice is transient and not saved).
     fn save(&self, out: &mut impl FnMut(f64)) {
-        let c = &self.command;
         let d = &self.diagnostics;
-        for x in [
-            c.thrust,
-            c.elevator,
-            c.aileron,
-            c.rudder,
-            c.flap_collective,
-            c.flap_differential,
-            c.vertical_flap,
+        for x in self.command.to_array().into_iter().chain([
             d.ref_pos_ned.x,
             d.ref_pos_ned.y,
             d.ref_pos_ned.z,
             d.ref_airspeed,
             d.pos_error,
             f64::from(d.phase.code()),
-        ] {
+        ]) {
             out(x);
         }
     }
@@ -437,15 +446,7 @@ impl HeldOutput for ControllerOutput {
             return None;
         };
         Some(Self {
-            command: Command {
-                thrust: v[0],
-                elevator: v[1],
-                aileron: v[2],
-                rudder: v[3],
-                flap_collective: v[4],
-                flap_differential: v[5],
-                vertical_flap: v[6],
-            },
+            command: Command::from_array([v[0], v[1], v[2], v[3], v[4], v[5], v[6]]),
             diagnostics: Diagnostics {
                 ref_pos_ned: Vector3::new(v[7], v[8], v[9]),
                 ref_airspeed: v[10],

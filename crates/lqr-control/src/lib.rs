@@ -1055,15 +1055,7 @@ impl SampledUnit for LqrController {
             phase: ground_ref.map_or(self.mission.phase_at(t).0, |v| v.phase),
             pos_error: flight_mission::distance(&pos, &ref_neh),
         };
-        let command = Command {
-            thrust: u[0],
-            elevator: u[1],
-            aileron: u[2],
-            rudder: u[3],
-            flap_collective: u[4],
-            flap_differential: u[5],
-            vertical_flap: u[6],
-        };
+        let command = Command::from_array(u.into());
         Ok(ControllerOutput {
             command,
             diagnostics,
