@@ -15,6 +15,12 @@ PHASES = ["vertical 1", "transition 1", "level", "transition 2", "vertical 2"]
 ORDERINGS = ["Gauss-Seidel", "Jacobi"]
 
 
+
+def _controller_ordering_header(first: tuple[str, ...], controllers) -> list[str]:
+    """Header and rule of a table with the `first` columns, then one per controller × ordering."""
+    cols = list(first) + [f"{k} {o}" for k in controllers for o in ORDERINGS]
+    return ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
+
 def _cell(r: dict | None, key: str = "max_pos_error") -> str:
     """`✓ 2.99 m` for a hold, `✗ 131 m` otherwise (the largest position error)."""
     if r is None:
@@ -80,12 +86,7 @@ def section(d: dict) -> list[str]:
         "Bearing the wind comes from (0° = north; at the start the belly faces north and the span east–west).",
         "",
     ]
-    header, rule = "| speed | from |", "|---|---|"
-    for k in controllers:
-        for o in ORDERINGS:
-            header += f" {k} {o} |"
-            rule += "---|"
-    out += [header, rule]
+    out += _controller_ordering_header(("speed", "from"), controllers)
     for v in st["speeds"]:
         for b in st["bearings_deg"]:
             line = f"| {shortest(v)} m/s | {shortest(b)}° |"
@@ -113,12 +114,7 @@ def section(d: dict) -> list[str]:
         "",
     ]
     gby = {(r["controller"], r["ordering"], r["phase"], r["axis"]): r for r in gu["rows"]}
-    header, rule = "| phase | axis |", "|---|---|"
-    for k in controllers:
-        for o in ORDERINGS:
-            header += f" {k} {o} |"
-            rule += "---|"
-    out += [header, rule]
+    out += _controller_ordering_header(("phase", "axis"), controllers)
     for ph in range(5):
         for axis in ["N", "E", "D"]:
             line = f"| {PHASES[ph]} | {axis} |"
