@@ -7,8 +7,20 @@
 # enough: Debian's libclang-cpp<v> (shipped by the base image) is the C++ library, named
 # libclang-cpp.so.<v>, without the C API. So every candidate must also export
 # clang_createIndex. Override the searched directories with FIND_LIBCLANG_DIRS
-# (colon-separated; used by the test suite).
+# (colon-separated) and the symbol lister with FIND_LIBCLANG_NM (a command line; both
+# used by the test suite).
 set -uo pipefail
+
+read -r -a nm <<<"${FIND_LIBCLANG_NM:-nm}"
+
+# Whether library $1 exports clang_createIndex. nm's whole listing is read before it is
+# searched: piping it into `grep -q` under pipefail lost the race whenever grep exited at
+# the match while nm was still writing (nm killed by SIGPIPE, the pipeline "failed").
+exports_c_api() {
+    local symbols
+    symbols=$("${nm[@]}" -D --defined-only "$1" 2>/dev/null) || return 1
+    grep -qw clang_createIndex <<<"$symbols"
+}
 
 dirs=()
 if [ -n "${FIND_LIBCLANG_DIRS:-}" ]; then
@@ -24,7 +36,7 @@ fi
 for d in "${dirs[@]}"; do
     for f in "$d"/libclang.so "$d"/libclang-*.so "$d"/libclang.so.* "$d"/libclang-*.so.*; do
         [ -e "$f" ] || continue
-        if nm -D --defined-only "$f" 2>/dev/null | grep -qw clang_createIndex; then
+        if exports_c_api "$f"; then
             echo "$f"
             exit 0
         fi

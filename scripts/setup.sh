@@ -28,7 +28,7 @@ if ! command -v x86_64-w64-mingw32-gcc >/dev/null || ! command -v x86_64-w64-min
     echo "== installing gcc-mingw-w64-x86-64 (links the win64 DLLs)"
     apt_install gcc-mingw-w64-x86-64
 fi
-if ! rustup target list --installed | grep -qx x86_64-pc-windows-gnu; then
+if ! grep -qx x86_64-pc-windows-gnu <<<"$(rustup target list --installed)"; then
     echo "== adding the Rust target x86_64-pc-windows-gnu"
     rustup target add x86_64-pc-windows-gnu
 fi

@@ -50,6 +50,21 @@ def test_the_real_cpp_library_is_not_taken(tmp_path):
     assert find_libclang([tmp_path]).returncode == 1
 
 
+def test_a_long_symbol_listing_after_the_match_is_still_found(tmp_path):
+    # Regression test (CI failure): the check piped nm into `grep -q` under pipefail, so it
+    # failed at random when grep exited at the match while nm was still writing (SIGPIPE).
+    # A stand-in nm prints the symbol first and then far more than a pipe holds.
+    fake_nm = tmp_path / "fake_nm.sh"
+    fake_nm.write_text('echo "0000000000001000 T clang_createIndex@@LLVM_13"\nyes "0000000000002000 T clang_other" | head -c 4000000\n')
+    libdir = tmp_path / "lib"
+    libdir.mkdir()
+    (libdir / "libclang-14.so.1").write_bytes(b"")
+    env = dict(os.environ, FIND_LIBCLANG_DIRS=str(libdir), FIND_LIBCLANG_NM=f"bash {fake_nm}")
+    result = subprocess.run([str(FIND)], env=env, capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip() == str(libdir / "libclang-14.so.1")
+
+
 def test_set_up_leaves_a_libclang_that_bindgen_can_load():
     # After scripts/setup.sh (which the test command runs first) the default search
     # finds a library exporting libclang's C API.
