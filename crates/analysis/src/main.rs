@@ -63,7 +63,7 @@ enum Cmd {
     /// Only the thesis-vs-global aerodynamic model comparison (aero_models.json), which
     /// `all` and `nonlinear` also write.
     Aero(Common),
-    /// The Monte-Carlo campaign's jobs flown natively (`python -m tailsim.campaign --native`
+    /// The Monte-Carlo campaign's jobs flown natively (`python -m tailsim.campaign_native`
     /// writes them): one JSON job per line in, one JSON row per line out, in job order.
     CampaignJobs(CampaignJobs),
 }
