@@ -23,8 +23,8 @@ use flight_mission::{
     Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, GroundMode, GroundPhases, MissionParams,
     Notice, ParamError, SampledUnit, VerticalReference, Weathervane, WeathervaneParams,
 };
-use nalgebra::{SMatrix, SVector, Vector3};
-use tailsitter_physics::Airframe;
+use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
+use tailsitter_physics::{Airframe, Surfaces};
 
 use linalg::{
     dare_residual, dare_sda, discretise_zoh, lqr_gain, riccati_backward, spectral_radius_bound, RiccatiError,
@@ -42,6 +42,11 @@ pub const MAX_WIND_ESTIMATE: f64 = 20.0;
 /// |α| or |β| beyond which vertical flight counts as flight in wind (rad): the gains are then
 /// computed about the reference instead of the measured state (README, "Hover in wind").
 pub const HOVER_WIND_AIR_ANGLE: f64 = 0.5235987755982988; // 30°
+
+/// Largest pitch rotation of the wind trim (rad) (README, "Gusts").
+pub const WIND_TRIM_MAX_PITCH: f64 = 0.3490658503988659; // 20°
+/// Wind estimates below this leave the reference untrimmed (m/s): still air stays bit-identical.
+pub const WIND_TRIM_MIN_WIND: f64 = 1e-3;
 
 /// Time constant τ_s of the integral action on the horizontal position in wind (s).
 pub const HOVER_SHIFT_TIME: f64 = 3.0;
@@ -200,6 +205,9 @@ pub struct LqrController {
     pos_integrator: Vector3<f64>,
     /// Low-pass wind estimate, NED (m/s); NaN before the first sample.
     wind: Vector3<f64>,
+    /// Rate of the wind estimate of the last sample, (raw − ŵ)/τ_w (m/s²); recomputed every
+    /// sample before it is used (not part of the saved state).
+    wind_rate: Vector3<f64>,
     gain: Gain,
     have_gain: bool,
     rep: EulerRep,
@@ -352,6 +360,7 @@ impl LqrController {
             integrator: 0.0,
             pos_integrator: Vector3::zeros(),
             wind: Vector3::new(f64::NAN, f64::NAN, f64::NAN),
+            wind_rate: Vector3::zeros(),
             gain: Gain::zeros(),
             have_gain: false,
             rep: EulerRep::E231,
@@ -540,7 +549,98 @@ impl LqrController {
         }
         if w.iter().all(|v| v.is_finite()) {
             self.wind = w;
+            let rate = (raw - w) / self.params.wind_filter_time;
+            self.wind_rate = if rate.iter().all(|v| v.is_finite()) {
+                rate
+            } else {
+                Vector3::zeros()
+            };
         }
+    }
+
+    /// Sideways weight of the wind in the air-data reference, max(sin²θ_ref, (V_t/V_L)²).
+    fn lateral_wind_weight(&self, p: &TrajPoint) -> f64 {
+        p.euler_321
+            .y
+            .sin()
+            .powi(2)
+            .max((p.v / self.mission.v_level).powi(2).min(1.0))
+    }
+
+    /// The reference point trimmed for the estimated wind (README, "Gusts"), weighted by the
+    /// lift-borne fraction (V_t/V_L)²: pitch θ_t + δ with α_t + δ (the same ground velocity),
+    /// the pitch rate δ̇ added to the body rates (through the wind estimate's rate), thrust and
+    /// elevator changed. None without wind compensation, in still air or where the trim fails.
+    fn trimmed(&self, p: &TrajPoint) -> Option<TrajPoint> {
+        if self.params.wind_compensation == 0 || !(self.wind.norm() >= WIND_TRIM_MIN_WIND) {
+            return None;
+        }
+        let lift = (p.v / self.mission.v_level).powi(2).min(1.0);
+        let s_lat = self.lateral_wind_weight(p);
+        let z = self.wind_trim(p, &self.wind, s_lat)?;
+        let h = self.mission.sample_time;
+        let z_next = self.wind_trim(p, &(self.wind + h * self.wind_rate), s_lat)?;
+        let rate = lift * (z_next.x - z.x) / h;
+        let mut q = *p;
+        q.euler_321.y += lift * z.x;
+        q.alpha += lift * z.x;
+        let (sphi, cphi) = p.euler_321.x.sin_cos();
+        q.rates += rate * Vector3::new(0.0, cphi, -sphi);
+        q.thrust += lift * z.y;
+        q.u[0] += lift * z.y;
+        q.u[1] += lift * z.z;
+        Some(q)
+    }
+
+    /// Lift-borne wind trim of a reference point (README, "Gusts"): the pitch rotation δ, the
+    /// thrust change ΔT and the elevator change Δδe that keep the reference's force and
+    /// pitching moment — hence its ground-path acceleration (2.2.19–2.2.21) and q̇
+    /// (2.2.22–2.2.24) — in the wind `wind` (NED, m/s): with C(δ) the reference attitude
+    /// pitched by δ and v_a = v_g,t − ŵ, solve
+    /// C(δ)ᵀ F(C(δ) v_a, T_t + ΔT, δe_t + Δδe) = C_tᵀ F(v_b,t, T_t, δe_t) (in-plane x, z) and
+    /// M_y(…) = M_y,t by Newton's method on the model for control. None where it does not
+    /// converge or leaves the limits (the untrimmed reference is then used).
+    fn wind_trim(&self, p: &TrajPoint, wind: &Vector3<f64>, s_lat: f64) -> Option<Vector3<f64>> {
+        let af = &self.airframe;
+        let surfaces = |dde: f64| Surfaces::from_array([p.u[1] + dde, p.u[2], p.u[3], p.u[4], p.u[5], p.u[6]]);
+        let c_t = model::dcm_of_quat(&p.quat());
+        let vb_t = model::body_velocity(p.v, p.alpha, 0.0);
+        let fm_t = af.forces_moments(&vb_t, &p.rates, p.thrust, &surfaces(0.0));
+        let f_e = c_t.transpose() * fm_t.force_body;
+        let v_g = c_t.transpose() * vb_t;
+        let (v_a, v_lat) = (v_g - wind, v_g - s_lat * wind);
+        let residual = |z: &Vector3<f64>| -> Vector3<f64> {
+            let mut q = *p;
+            q.euler_321.y += z.x;
+            let c = model::dcm_of_quat(&q.quat());
+            let mut vb = c * v_a;
+            vb.y = (c * v_lat).y;
+            let fm = af.forces_moments(&vb, &p.rates, p.thrust + z.y, &surfaces(z.z));
+            let df = c_t * (c.transpose() * fm.force_body - f_e);
+            Vector3::new(df.x, df.z, fm.moment_body.y - fm_t.moment_body.y)
+        };
+        let steps = Vector3::new(1e-6, 1e-4, 1e-6);
+        let mut z = Vector3::zeros();
+        for _ in 0..8 {
+            let r = residual(&z);
+            if !r.iter().all(|v| v.is_finite()) {
+                return None;
+            }
+            if r.xy().norm() < 1e-6 * af.mass * af.gravity && r.z.abs() < 1e-7 {
+                let in_limits = z.x.abs() <= WIND_TRIM_MAX_PITCH
+                    && (af.thrust_min..=af.thrust_max).contains(&(p.thrust + z.y))
+                    && (p.u[1] + z.z).abs() <= af.deflection_limit;
+                return in_limits.then_some(z);
+            }
+            let mut jac = Matrix3::zeros();
+            for j in 0..3 {
+                let mut zj = z;
+                zj[j] += steps[j];
+                jac.set_column(j, &((residual(&zj) - r) / steps[j]));
+            }
+            z -= jac.lu().solve(&r)?;
+        }
+        None
     }
 
     /// Reference (V, α, β): with wind compensation, those of the air velocity
@@ -559,12 +659,7 @@ impl LqrController {
         if self.params.wind_compensation == 0 || !self.wind.iter().all(|v| v.is_finite()) {
             return plain;
         }
-        let s_lat = p
-            .euler_321
-            .y
-            .sin()
-            .powi(2)
-            .max((p.v / self.mission.v_level).powi(2).min(1.0));
+        let s_lat = self.lateral_wind_weight(p);
         let c = model::dcm_of_quat(&p.quat());
         let (sa, ca) = p.alpha.sin_cos();
         let v_g = c.transpose() * (p.v * Vector3::new(ca, 0.0, sa));
@@ -921,6 +1016,11 @@ impl SampledUnit for LqrController {
         }
         let ctrl_neh = ref_neh - self.wind_shift;
 
+        self.estimate_wind(m);
+        let reference = match ground_ref {
+            None => self.trimmed(&reference).unwrap_or(reference),
+            Some(_) => reference,
+        };
         let mut x = state_of(
             rep, m.airspeed, m.alpha, m.beta, &m.rates, &m.quat, &m.pos_ned, m.thrust,
         );
@@ -928,7 +1028,6 @@ impl SampledUnit for LqrController {
         xt[ix::N] = ctrl_neh.x;
         xt[ix::E] = ctrl_neh.y;
         xt[ix::H] = ctrl_neh.z;
-        self.estimate_wind(m);
         let air_ref = self.air_reference(&reference);
         xt[ix::V] = air_ref.x;
         xt[ix::ALPHA] = air_ref.y;
@@ -947,7 +1046,19 @@ impl SampledUnit for LqrController {
             // the measured state, whose tilt into the wind and α, β of 30–90° put the linear
             // model far outside its range (gains that over-tilted and lost the aircraft
             // from 7 m/s). In still air the weathervane is never engaged: unchanged.
-            let mut x_lin = if in_wind { xt } else { x };
+            // After the back transition (vertical 2, before the weathervane is free) a wind
+            // across the slowing climb shows as air angles of 30–70° too: relinearise about the
+            // reference there as well (README, "Gusts"; about the measured β of −66° the gains
+            // of a 5 m/s east gust cut the thrust to zero and then saturated it: 2.15 m added
+            // under Jacobi, 1.71 m now).
+            let lin_ref = in_wind
+                || ground_ref.is_none()
+                    && self.params.configuration == 0
+                    && self.mission.phase_at(t).0 == flight_mission::Phase::Vertical2
+                    && (m.alpha.abs() > HOVER_WIND_AIR_ANGLE || m.beta.abs() > HOVER_WIND_AIR_ANGLE)
+                    && flight_mission::weathervane::air_data_wind(m).xy().norm()
+                        >= self.weathervane.params().engage_speed;
+            let mut x_lin = if lin_ref { xt } else { x };
             // In the take-off and landing phases linearise at α = β = 0: x carries the body
             // air velocity there (`hover_air_data`), exact at α = β = 0 for any w/V_e.
             if ground_ref.is_some() {
