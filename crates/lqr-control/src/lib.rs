@@ -544,13 +544,15 @@ impl LqrController {
             raw
         };
         let n = w.norm();
-        if n > MAX_WIND_ESTIMATE {
+        let bounded = n > MAX_WIND_ESTIMATE;
+        if bounded {
             w *= MAX_WIND_ESTIMATE / n;
         }
         if w.iter().all(|v| v.is_finite()) {
             self.wind = w;
+            // The filter's own rate, dŵ/dt = (raw − ŵ)/τ_w; none while the bound holds ŵ.
             let rate = (raw - w) / self.params.wind_filter_time;
-            self.wind_rate = if rate.iter().all(|v| v.is_finite()) {
+            self.wind_rate = if !bounded && rate.iter().all(|v| v.is_finite()) {
                 rate
             } else {
                 Vector3::zeros()
@@ -572,7 +574,8 @@ impl LqrController {
     /// the pitch rate δ̇ added to the body rates (through the wind estimate's rate), thrust and
     /// elevator changed. None without wind compensation, in still air or where the trim fails.
     fn trimmed(&self, p: &TrajPoint) -> Option<TrajPoint> {
-        if self.params.wind_compensation == 0 || !(self.wind.norm() >= WIND_TRIM_MIN_WIND) {
+        let wind = self.wind.norm();
+        if self.params.wind_compensation == 0 || wind.is_nan() || wind < WIND_TRIM_MIN_WIND {
             return None;
         }
         let lift = (p.v / self.mission.v_level).powi(2).min(1.0);
@@ -1172,5 +1175,77 @@ impl SampledUnit for LqrController {
             diagnostics,
             notice,
         })
+    }
+}
+
+#[cfg(test)]
+mod wind_trim_tests {
+    use super::*;
+
+    /// Earth-frame force (N) and pitching moment (N m) of the model for control at reference
+    /// point `p` in the wind `w`, its ground velocity being that of (V_t, α_t, attitude).
+    fn loads(af: &Airframe, p: &TrajPoint, w: &Vector3<f64>) -> (Vector3<f64>, f64) {
+        let c = model::dcm_of_quat(&p.quat());
+        let v_g = c.transpose() * model::body_velocity(p.v, p.alpha, 0.0);
+        let s = Surfaces::from_array([p.u[1], p.u[2], p.u[3], p.u[4], p.u[5], p.u[6]]);
+        let fm = af.forces_moments(&(c * (v_g - w)), &p.rates, p.thrust, &s);
+        (c.transpose() * fm.force_body, fm.moment_body.y)
+    }
+
+    fn controller() -> LqrController {
+        LqrController::new(Airframe::default(), MissionParams::default(), LqrParams::default()).unwrap()
+    }
+
+    /// The trimmed level-flight reference in a steady 5 m/s tail- or headwind has the
+    /// still-air reference's force and pitching moment (the same ground-path acceleration and
+    /// q̇, 2.2.19–2.2.24) at the same ground velocity; a tailwind lowers the dynamic pressure,
+    /// so it pitches up to a larger α (lift ∝ V̄² α), a headwind the other way.
+    #[test]
+    fn level_flight_trim_keeps_force_and_moment() {
+        let mut c = controller();
+        let af = Airframe::default();
+        let p = c.trajectory().at(15.0);
+        let (f_still, m_still) = loads(&af, &p, &Vector3::zeros());
+        for sign in [1.0, -1.0] {
+            let w = Vector3::new(5.0 * sign, 0.0, 0.0);
+            c.wind = w;
+            c.wind_rate = Vector3::zeros();
+            let q = c.trimmed(&p).expect("trim converges");
+            let (f, m) = loads(&af, &q, &w);
+            assert!(
+                (f - f_still).norm() < 1e-5 * af.mass * af.gravity,
+                "{sign}: {f} vs {f_still}"
+            );
+            assert!((m - m_still).abs() < 1e-6, "{sign}: {m} vs {m_still}");
+            let dtheta = q.euler_321.y - p.euler_321.y;
+            let alpha_air = c.air_reference(&q).y;
+            assert!(
+                sign * dtheta > 0.0 && sign * (alpha_air - p.alpha) > 0.0,
+                "{sign}: δ {dtheta}, α {alpha_air}"
+            );
+            // Without a wind rate the reference gains no pitch rate.
+            assert_eq!(q.rates, p.rates);
+        }
+    }
+
+    /// In still air (and without wind compensation) the reference is not touched, so the
+    /// still-air flights are bit-identical to the untrimmed controller's.
+    #[test]
+    fn no_trim_in_still_air_or_without_compensation() {
+        let mut c = controller();
+        let p = c.trajectory().at(15.0);
+        c.wind = Vector3::zeros();
+        assert!(c.trimmed(&p).is_none());
+        let mut t = LqrController::new(
+            Airframe::default(),
+            MissionParams::default(),
+            LqrParams {
+                configuration: 1,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        t.wind = Vector3::new(5.0, 0.0, 0.0);
+        assert!(t.trimmed(&p).is_none());
     }
 }
