@@ -45,8 +45,10 @@ pub const HOVER_WIND_AIR_ANGLE: f64 = 0.5235987755982988; // 30°
 
 /// Largest pitch rotation of the wind trim (rad) (README, "Gusts").
 pub const WIND_TRIM_MAX_PITCH: f64 = 0.3490658503988659; // 20°
-/// Wind estimates below this leave the reference untrimmed (m/s): still air stays bit-identical.
-pub const WIND_TRIM_MIN_WIND: f64 = 1e-3;
+/// The wind trim is phased in (smoothstep) as the estimated wind rises between these
+/// speeds (m/s): below the first the reference is untrimmed (still air bit-identical, and
+/// the air-data wind an estimator makes of still air not flown).
+pub const WIND_TRIM_RAMP: (f64, f64) = (0.5, 1.5);
 
 /// Time constant τ_s of the integral action on the horizontal position in wind (s).
 pub const HOVER_SHIFT_TIME: f64 = 3.0;
@@ -574,24 +576,30 @@ impl LqrController {
     /// the pitch rate δ̇ added to the body rates (through the wind estimate's rate), thrust and
     /// elevator changed. None without wind compensation, in still air or where the trim fails.
     fn trimmed(&self, p: &TrajPoint) -> Option<TrajPoint> {
-        let wind = self.wind.norm();
-        if self.params.wind_compensation == 0 || wind.is_nan() || wind < WIND_TRIM_MIN_WIND {
+        let h = self.mission.sample_time;
+        let w_next = self.wind + h * self.wind_rate;
+        let lift = (p.v / self.mission.v_level).powi(2).min(1.0);
+        let (w0, w1) = WIND_TRIM_RAMP;
+        let weight = |w: &Vector3<f64>| {
+            let x = ((w.norm() - w0) / (w1 - w0)).clamp(0.0, 1.0);
+            lift * x * x * (3.0 - 2.0 * x)
+        };
+        let (k, k_next) = (weight(&self.wind), weight(&w_next));
+        if self.params.wind_compensation == 0 || !(k > 0.0 || k_next > 0.0) {
             return None;
         }
-        let lift = (p.v / self.mission.v_level).powi(2).min(1.0);
         let s_lat = self.lateral_wind_weight(p);
         let z = self.wind_trim(p, &self.wind, s_lat)?;
-        let h = self.mission.sample_time;
-        let z_next = self.wind_trim(p, &(self.wind + h * self.wind_rate), s_lat)?;
-        let rate = lift * (z_next.x - z.x) / h;
+        let z_next = self.wind_trim(p, &w_next, s_lat)?;
+        let rate = (k_next * z_next.x - k * z.x) / h;
         let mut q = *p;
-        q.euler_321.y += lift * z.x;
-        q.alpha += lift * z.x;
+        q.euler_321.y += k * z.x;
+        q.alpha += k * z.x;
         let (sphi, cphi) = p.euler_321.x.sin_cos();
         q.rates += rate * Vector3::new(0.0, cphi, -sphi);
-        q.thrust += lift * z.y;
-        q.u[0] += lift * z.y;
-        q.u[1] += lift * z.z;
+        q.thrust += k * z.y;
+        q.u[0] += k * z.y;
+        q.u[1] += k * z.z;
         Some(q)
     }
 
@@ -1228,14 +1236,18 @@ mod wind_trim_tests {
         }
     }
 
-    /// In still air (and without wind compensation) the reference is not touched, so the
-    /// still-air flights are bit-identical to the untrimmed controller's.
+    /// In still air, in an estimated wind below the ramp (what an estimator makes of still
+    /// air) and without wind compensation the reference is not touched, so the still-air
+    /// flights are bit-identical to the untrimmed controller's.
     #[test]
     fn no_trim_in_still_air_or_without_compensation() {
         let mut c = controller();
         let p = c.trajectory().at(15.0);
-        c.wind = Vector3::zeros();
-        assert!(c.trimmed(&p).is_none());
+        c.wind_rate = Vector3::zeros();
+        for w in [0.0, 0.99 * WIND_TRIM_RAMP.0] {
+            c.wind = Vector3::new(w, 0.0, 0.0);
+            assert!(c.trimmed(&p).is_none(), "{w}");
+        }
         let mut t = LqrController::new(
             Airframe::default(),
             MissionParams::default(),
