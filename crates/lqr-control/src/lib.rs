@@ -23,8 +23,8 @@ use flight_mission::{
     Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, GroundMode, GroundPhases, MissionParams,
     Notice, ParamError, SampledUnit, VerticalReference, Weathervane, WeathervaneParams,
 };
-use nalgebra::{SMatrix, SVector, Vector3};
-use tailsitter_physics::Airframe;
+use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
+use tailsitter_physics::{Airframe, Surfaces};
 
 use linalg::{
     dare_residual, dare_sda, discretise_zoh, lqr_gain, riccati_backward, spectral_radius_bound, RiccatiError,
@@ -42,6 +42,13 @@ pub const MAX_WIND_ESTIMATE: f64 = 20.0;
 /// |α| or |β| beyond which vertical flight counts as flight in wind (rad): the gains are then
 /// computed about the reference instead of the measured state (README, "Hover in wind").
 pub const HOVER_WIND_AIR_ANGLE: f64 = 0.5235987755982988; // 30°
+
+/// Largest pitch rotation of the wind trim (rad) (README, "Gusts").
+pub const WIND_TRIM_MAX_PITCH: f64 = 0.3490658503988659; // 20°
+/// The wind trim is phased in (smoothstep) as the estimated wind rises between these
+/// speeds (m/s): below the first the reference is untrimmed (still air bit-identical, and
+/// the air-data wind an estimator makes of still air not flown).
+pub const WIND_TRIM_RAMP: (f64, f64) = (0.5, 1.5);
 
 /// Time constant τ_s of the integral action on the horizontal position in wind (s).
 pub const HOVER_SHIFT_TIME: f64 = 3.0;
@@ -200,6 +207,9 @@ pub struct LqrController {
     pos_integrator: Vector3<f64>,
     /// Low-pass wind estimate, NED (m/s); NaN before the first sample.
     wind: Vector3<f64>,
+    /// Rate of the wind estimate of the last sample, (raw − ŵ)/τ_w (m/s²); recomputed every
+    /// sample before it is used (not part of the saved state).
+    wind_rate: Vector3<f64>,
     gain: Gain,
     have_gain: bool,
     rep: EulerRep,
@@ -352,6 +362,7 @@ impl LqrController {
             integrator: 0.0,
             pos_integrator: Vector3::zeros(),
             wind: Vector3::new(f64::NAN, f64::NAN, f64::NAN),
+            wind_rate: Vector3::zeros(),
             gain: Gain::zeros(),
             have_gain: false,
             rep: EulerRep::E231,
@@ -535,12 +546,112 @@ impl LqrController {
             raw
         };
         let n = w.norm();
-        if n > MAX_WIND_ESTIMATE {
+        let bounded = n > MAX_WIND_ESTIMATE;
+        if bounded {
             w *= MAX_WIND_ESTIMATE / n;
         }
         if w.iter().all(|v| v.is_finite()) {
             self.wind = w;
+            // The filter's own rate, dŵ/dt = (raw − ŵ)/τ_w; none while the bound holds ŵ.
+            let rate = (raw - w) / self.params.wind_filter_time;
+            self.wind_rate = if !bounded && rate.iter().all(|v| v.is_finite()) {
+                rate
+            } else {
+                Vector3::zeros()
+            };
         }
+    }
+
+    /// Sideways weight of the wind in the air-data reference, max(sin²θ_ref, (V_t/V_L)²).
+    fn lateral_wind_weight(&self, p: &TrajPoint) -> f64 {
+        p.euler_321
+            .y
+            .sin()
+            .powi(2)
+            .max((p.v / self.mission.v_level).powi(2).min(1.0))
+    }
+
+    /// The reference point trimmed for the estimated wind (README, "Gusts"), weighted by the
+    /// lift-borne fraction (V_t/V_L)²: pitch θ_t + δ with α_t + δ (the same ground velocity),
+    /// the pitch rate δ̇ added to the body rates (through the wind estimate's rate), thrust and
+    /// elevator changed. None without wind compensation, in still air or where the trim fails.
+    fn trimmed(&self, p: &TrajPoint) -> Option<TrajPoint> {
+        let h = self.mission.sample_time;
+        let w_next = self.wind + h * self.wind_rate;
+        let lift = (p.v / self.mission.v_level).powi(2).min(1.0);
+        let (w0, w1) = WIND_TRIM_RAMP;
+        let weight = |w: &Vector3<f64>| {
+            let x = ((w.norm() - w0) / (w1 - w0)).clamp(0.0, 1.0);
+            lift * x * x * (3.0 - 2.0 * x)
+        };
+        let (k, k_next) = (weight(&self.wind), weight(&w_next));
+        if self.params.wind_compensation == 0 || !(k > 0.0 || k_next > 0.0) {
+            return None;
+        }
+        let s_lat = self.lateral_wind_weight(p);
+        let z = self.wind_trim(p, &self.wind, s_lat)?;
+        let z_next = self.wind_trim(p, &w_next, s_lat)?;
+        let rate = (k_next * z_next.x - k * z.x) / h;
+        let mut q = *p;
+        q.euler_321.y += k * z.x;
+        q.alpha += k * z.x;
+        let (sphi, cphi) = p.euler_321.x.sin_cos();
+        q.rates += rate * Vector3::new(0.0, cphi, -sphi);
+        q.thrust += k * z.y;
+        q.u[0] += k * z.y;
+        q.u[1] += k * z.z;
+        Some(q)
+    }
+
+    /// Lift-borne wind trim of a reference point (README, "Gusts"): the pitch rotation δ, the
+    /// thrust change ΔT and the elevator change Δδe that keep the reference's force and
+    /// pitching moment — hence its ground-path acceleration (2.2.19–2.2.21) and q̇
+    /// (2.2.22–2.2.24) — in the wind `wind` (NED, m/s): with C(δ) the reference attitude
+    /// pitched by δ and v_a = v_g,t − ŵ, solve
+    /// C(δ)ᵀ F(C(δ) v_a, T_t + ΔT, δe_t + Δδe) = C_tᵀ F(v_b,t, T_t, δe_t) (in-plane x, z) and
+    /// M_y(…) = M_y,t by Newton's method on the model for control. None where it does not
+    /// converge or leaves the limits (the untrimmed reference is then used).
+    fn wind_trim(&self, p: &TrajPoint, wind: &Vector3<f64>, s_lat: f64) -> Option<Vector3<f64>> {
+        let af = &self.airframe;
+        let surfaces = |dde: f64| Surfaces::from_array([p.u[1] + dde, p.u[2], p.u[3], p.u[4], p.u[5], p.u[6]]);
+        let c_t = model::dcm_of_quat(&p.quat());
+        let vb_t = model::body_velocity(p.v, p.alpha, 0.0);
+        let fm_t = af.forces_moments(&vb_t, &p.rates, p.thrust, &surfaces(0.0));
+        let f_e = c_t.transpose() * fm_t.force_body;
+        let v_g = c_t.transpose() * vb_t;
+        let (v_a, v_lat) = (v_g - wind, v_g - s_lat * wind);
+        let residual = |z: &Vector3<f64>| -> Vector3<f64> {
+            let mut q = *p;
+            q.euler_321.y += z.x;
+            let c = model::dcm_of_quat(&q.quat());
+            let mut vb = c * v_a;
+            vb.y = (c * v_lat).y;
+            let fm = af.forces_moments(&vb, &p.rates, p.thrust + z.y, &surfaces(z.z));
+            let df = c_t * (c.transpose() * fm.force_body - f_e);
+            Vector3::new(df.x, df.z, fm.moment_body.y - fm_t.moment_body.y)
+        };
+        let steps = Vector3::new(1e-6, 1e-4, 1e-6);
+        let mut z = Vector3::zeros();
+        for _ in 0..8 {
+            let r = residual(&z);
+            if !r.iter().all(|v| v.is_finite()) {
+                return None;
+            }
+            if r.xy().norm() < 1e-6 * af.mass * af.gravity && r.z.abs() < 1e-7 {
+                let in_limits = z.x.abs() <= WIND_TRIM_MAX_PITCH
+                    && (af.thrust_min..=af.thrust_max).contains(&(p.thrust + z.y))
+                    && (p.u[1] + z.z).abs() <= af.deflection_limit;
+                return in_limits.then_some(z);
+            }
+            let mut jac = Matrix3::zeros();
+            for j in 0..3 {
+                let mut zj = z;
+                zj[j] += steps[j];
+                jac.set_column(j, &((residual(&zj) - r) / steps[j]));
+            }
+            z -= jac.lu().solve(&r)?;
+        }
+        None
     }
 
     /// Reference (V, α, β): with wind compensation, those of the air velocity
@@ -559,12 +670,7 @@ impl LqrController {
         if self.params.wind_compensation == 0 || !self.wind.iter().all(|v| v.is_finite()) {
             return plain;
         }
-        let s_lat = p
-            .euler_321
-            .y
-            .sin()
-            .powi(2)
-            .max((p.v / self.mission.v_level).powi(2).min(1.0));
+        let s_lat = self.lateral_wind_weight(p);
         let c = model::dcm_of_quat(&p.quat());
         let (sa, ca) = p.alpha.sin_cos();
         let v_g = c.transpose() * (p.v * Vector3::new(ca, 0.0, sa));
@@ -921,6 +1027,11 @@ impl SampledUnit for LqrController {
         }
         let ctrl_neh = ref_neh - self.wind_shift;
 
+        self.estimate_wind(m);
+        let reference = match ground_ref {
+            None => self.trimmed(&reference).unwrap_or(reference),
+            Some(_) => reference,
+        };
         let mut x = state_of(
             rep, m.airspeed, m.alpha, m.beta, &m.rates, &m.quat, &m.pos_ned, m.thrust,
         );
@@ -928,7 +1039,6 @@ impl SampledUnit for LqrController {
         xt[ix::N] = ctrl_neh.x;
         xt[ix::E] = ctrl_neh.y;
         xt[ix::H] = ctrl_neh.z;
-        self.estimate_wind(m);
         let air_ref = self.air_reference(&reference);
         xt[ix::V] = air_ref.x;
         xt[ix::ALPHA] = air_ref.y;
@@ -947,7 +1057,19 @@ impl SampledUnit for LqrController {
             // the measured state, whose tilt into the wind and α, β of 30–90° put the linear
             // model far outside its range (gains that over-tilted and lost the aircraft
             // from 7 m/s). In still air the weathervane is never engaged: unchanged.
-            let mut x_lin = if in_wind { xt } else { x };
+            // After the back transition (vertical 2, before the weathervane is free) a wind
+            // across the slowing climb shows as air angles of 30–70° too: relinearise about the
+            // reference there as well (README, "Gusts"; about the measured β of −66° the gains
+            // of a 5 m/s east gust cut the thrust to zero and then saturated it: 2.15 m added
+            // under Jacobi, 1.71 m now).
+            let lin_ref = in_wind
+                || ground_ref.is_none()
+                    && self.params.configuration == 0
+                    && self.mission.phase_at(t).0 == flight_mission::Phase::Vertical2
+                    && (m.alpha.abs() > HOVER_WIND_AIR_ANGLE || m.beta.abs() > HOVER_WIND_AIR_ANGLE)
+                    && flight_mission::weathervane::air_data_wind(m).xy().norm()
+                        >= self.weathervane.params().engage_speed;
+            let mut x_lin = if lin_ref { xt } else { x };
             // In the take-off and landing phases linearise at α = β = 0: x carries the body
             // air velocity there (`hover_air_data`), exact at α = β = 0 for any w/V_e.
             if ground_ref.is_some() {
@@ -1061,5 +1183,81 @@ impl SampledUnit for LqrController {
             diagnostics,
             notice,
         })
+    }
+}
+
+#[cfg(test)]
+mod wind_trim_tests {
+    use super::*;
+
+    /// Earth-frame force (N) and pitching moment (N m) of the model for control at reference
+    /// point `p` in the wind `w`, its ground velocity being that of (V_t, α_t, attitude).
+    fn loads(af: &Airframe, p: &TrajPoint, w: &Vector3<f64>) -> (Vector3<f64>, f64) {
+        let c = model::dcm_of_quat(&p.quat());
+        let v_g = c.transpose() * model::body_velocity(p.v, p.alpha, 0.0);
+        let s = Surfaces::from_array([p.u[1], p.u[2], p.u[3], p.u[4], p.u[5], p.u[6]]);
+        let fm = af.forces_moments(&(c * (v_g - w)), &p.rates, p.thrust, &s);
+        (c.transpose() * fm.force_body, fm.moment_body.y)
+    }
+
+    fn controller() -> LqrController {
+        LqrController::new(Airframe::default(), MissionParams::default(), LqrParams::default()).unwrap()
+    }
+
+    /// The trimmed level-flight reference in a steady 5 m/s tail- or headwind has the
+    /// still-air reference's force and pitching moment (the same ground-path acceleration and
+    /// q̇, 2.2.19–2.2.24) at the same ground velocity; a tailwind lowers the dynamic pressure,
+    /// so it pitches up to a larger α (lift ∝ V̄² α), a headwind the other way.
+    #[test]
+    fn level_flight_trim_keeps_force_and_moment() {
+        let mut c = controller();
+        let af = Airframe::default();
+        let p = c.trajectory().at(15.0);
+        let (f_still, m_still) = loads(&af, &p, &Vector3::zeros());
+        for sign in [1.0, -1.0] {
+            let w = Vector3::new(5.0 * sign, 0.0, 0.0);
+            c.wind = w;
+            c.wind_rate = Vector3::zeros();
+            let q = c.trimmed(&p).expect("trim converges");
+            let (f, m) = loads(&af, &q, &w);
+            assert!(
+                (f - f_still).norm() < 1e-5 * af.mass * af.gravity,
+                "{sign}: {f} vs {f_still}"
+            );
+            assert!((m - m_still).abs() < 1e-6, "{sign}: {m} vs {m_still}");
+            let dtheta = q.euler_321.y - p.euler_321.y;
+            let alpha_air = c.air_reference(&q).y;
+            assert!(
+                sign * dtheta > 0.0 && sign * (alpha_air - p.alpha) > 0.0,
+                "{sign}: δ {dtheta}, α {alpha_air}"
+            );
+            // Without a wind rate the reference gains no pitch rate.
+            assert_eq!(q.rates, p.rates);
+        }
+    }
+
+    /// In still air, in an estimated wind below the ramp (what an estimator makes of still
+    /// air) and without wind compensation the reference is not touched, so the still-air
+    /// flights are bit-identical to the untrimmed controller's.
+    #[test]
+    fn no_trim_in_still_air_or_without_compensation() {
+        let mut c = controller();
+        let p = c.trajectory().at(15.0);
+        c.wind_rate = Vector3::zeros();
+        for w in [0.0, 0.99 * WIND_TRIM_RAMP.0] {
+            c.wind = Vector3::new(w, 0.0, 0.0);
+            assert!(c.trimmed(&p).is_none(), "{w}");
+        }
+        let mut t = LqrController::new(
+            Airframe::default(),
+            MissionParams::default(),
+            LqrParams {
+                configuration: 1,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        t.wind = Vector3::new(5.0, 0.0, 0.0);
+        assert!(t.trimmed(&p).is_none());
     }
 }
