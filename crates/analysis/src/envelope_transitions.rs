@@ -436,8 +436,9 @@ mod tests {
 
     /// Issue 16's bounds for the tuned TSD (α ≤ 15°, altitude deviation < 1 m in each
     /// transition, position error < 2 m) on the default, the 3/4 s and the fast mission,
-    /// under both masters. Before the normal loop's steady-state feed-forward the front
-    /// transition lost 1.06 m (3/4 s) and 1.35–1.37 m (fast) (tsd-control README).
+    /// under both masters. Without the normal loop's steady-state feed-forward of the reference
+    /// acceleration the front transition lost 1.06 m (3/4 s) and 1.35–1.37 m (fast)
+    /// (tsd-control README, "Front transition: normal-loop feed-forward").
     #[test]
     fn tuned_tsd_flies_the_fast_and_3_4_s_missions_inside_the_bounds() {
         let f = MissionParams::fast();

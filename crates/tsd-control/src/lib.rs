@@ -803,15 +803,19 @@ impl SampledUnit for TsdController {
         // of Q̇′; equals the printed δmg of (4.2.16) once −K_Q g₁/V̄ is added back.
         let dm_g = (a22_n * g1 - g1_dot) / (v * b2);
         // Tuned configuration, off the hover (and outside the take-off and landing phases): the
-        // steady state (C_Wc, Q′*, δm*) of the loop model at C_W = C_Wc is fed forward and the
-        // state feedback of (4.2.15) acts on the deviation from it (README, "Front transition:
-        // normal-loop feed-forward"). Without it a command reached δm only through the
-        // integrator E_C, ≈ 0.3 s behind at the vertical-flight poles — the height lost in the
-        // pull-out of a fast front transition.
+        // steady state (C*, Q′*, δm*) of the loop model at the normal part of the reference's own
+        // specific acceleration, C* = Σ^RE·k^W (4.3.24, the previewed feed-forward), is fed
+        // forward and the state feedback of (4.2.15) acts on the deviation from it (README,
+        // "Front transition: normal-loop feed-forward"). Without it the trajectory's normal
+        // acceleration reached δm only through the integrator E_C, ≈ 0.3 s behind at the
+        // vertical-flight poles: the height lost in the pull-out of a fast front transition. The
+        // guidance feedback still enters through E_C alone: fed forward as well, it closed a fast
+        // pitch → velocity error → δm path that oscillated in level flight behind the avionics'
+        // latency (Jacobi master with sensors and EKF, pitch ±9°).
         let (c_ff, q_ff, dm_ff) = if p.configuration == 0 && sigma_ground.is_none() {
             let weight = ((reference.airspeed - self.mission.v_vertical) / NORMAL_FEEDFORWARD_RAMP).clamp(0.0, 1.0);
             if weight > 0.0 {
-                let c_ff = weight * c_cmd;
+                let c_ff = weight * sigma_ff.dot(&kw);
                 let (q_ff, dm_ff) = gains::normal_steady_state(&d.normal_model, c_ff);
                 (c_ff, q_ff, dm_ff)
             } else {

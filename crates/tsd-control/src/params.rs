@@ -22,8 +22,8 @@ pub const HOVER_WIND_DESIGN_SPEED_FACTOR: f64 = 1.3;
 /// the calm missions unchanged), fully at the second.
 pub const HOVER_WIND_CROSSFLOW: (f64, f64) = (1.0, 3.0);
 
-/// Tuned configuration: the normal loop's steady-state feed-forward
-/// ([`crate::gains::normal_steady_state`]) is blended in as the reference airspeed rises from
+/// Tuned configuration: the normal loop's steady-state feed-forward of the reference's normal
+/// acceleration ([`crate::gains::normal_steady_state`]) is blended in as the reference airspeed rises from
 /// v_vertical to v_vertical + this (m/s): none in the hover (the hover-in-wind design and the
 /// take-off and landing phases are untouched), full through the transitions and level flight
 /// (README, "Front transition: normal-loop feed-forward").
