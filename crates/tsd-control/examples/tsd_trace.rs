@@ -1,7 +1,7 @@
 //! Print a closed-loop time series of the TSD controller (debugging and tuning aid).
 //!
 //! `cargo run --release -p tsd-control --example tsd_trace -- <case> [every_s]`
-//! with case one of `default`, `fast`, `jacobi`, `vstep-n`, `vstep-e`, `lstep-d`, `lstep-e`, `hover`
+//! with case one of `default`, `fast` (3/4 s), `fast2` / `fast2j` (2/3 s, Gauss-Seidel / Jacobi), `jacobi`, `vstep-n`, `vstep-e`, `lstep-d`, `lstep-e`, `hover`
 //! (40 s of vertical flight); a constant wind with `TSD_WIND=n,e,d` (m/s, NED).
 
 use closed_loop::{measure, pitch, plant_inputs, Ordering, Scenario};
@@ -24,6 +24,13 @@ fn main() {
         "fast" => {
             mission.t_transition_1 = 3.0;
             mission.t_transition_2 = 4.0;
+        }
+        "fast2" | "fast2j" => {
+            mission.t_transition_1 = 2.0;
+            mission.t_transition_2 = 3.0;
+            if case == "fast2j" {
+                ordering = Ordering::Jacobi;
+            }
         }
         "jacobi" => ordering = Ordering::Jacobi,
         "vstep-n" | "vstep-e" => {

@@ -70,6 +70,26 @@ pub fn normal_model(a11: f64, a21: f64, a22: f64, b2: f64, z_alpha: f64) -> (Mat
     (a, Vector3::new(0.0, b2, 0.0))
 }
 
+/// Steady state of the normal loop model ([`normal_model`]) holding C_W = `c`: the pitch rate
+/// Q′* and the mixed deflection δm* with Ċ_W = Q̇′ = 0 in (4.2.9–4.2.10),
+///
+/// ```text
+/// Q′* = −a11 c / Z_α,     δm* = −(a21/Z_α · c + a22 Q′*) / b2.
+/// ```
+///
+/// In the wind axes (a11 = Z_α/V̄) Q′* = −c/V̄, i.e. Q* = −(C_W + g₁)/V̄: the body pitches with
+/// the flight path it is turning (α̇ = 0 in (4.2.9)), at the trim α* = c/Z_α whose pitching
+/// moment a21 α* + a22 Q* the deflection δm* balances (gravity terms: δmg of (4.2.16)).
+/// Fed forward with the state error taken from it, u = δm* − K (x − x*) of (4.2.15) leaves the
+/// integrator E_C nothing to find for a steady command: the closed loop (poles of Table 4.3)
+/// is then driven only by the command's rate, not by the command itself.
+pub fn normal_steady_state(model: &(Matrix3<f64>, Vector3<f64>), c: f64) -> (f64, f64) {
+    let (a, b) = model;
+    let (a11, z_alpha, a21_over_z, a22, b2) = (a[(0, 0)], a[(0, 1)], a[(1, 0)], a[(1, 1)], b[1]);
+    let q = -a11 * c / z_alpha;
+    (q, -(a21_over_z * c + a22 * q) / b2)
+}
+
 /// Model of the directional loop (4.2.27–4.2.31) in the states x = (B_W, R′, E_B),
 /// R′ = R_s − g₂/V̄, with the mixed rudder δR as input:
 ///
@@ -122,6 +142,24 @@ pub fn guidance_gains(re: f64, im: f64) -> (f64, f64) {
 mod tests {
     use super::*;
     use nalgebra::Complex;
+
+    /// The steady state is an equilibrium of the model's (C_W, Q′) rows at C_W = c, and in the
+    /// wind axes the body pitches with the path: Q′* = −c/V̄ (α̇ = 0 in (4.2.9)).
+    #[test]
+    fn normal_steady_state_is_an_equilibrium_turning_with_the_path() {
+        // A 15 m/s transition condition: Z_α = −60 m/s², a21 = −40, a22 = −3 1/s, b2 = −150.
+        let (v, z_alpha) = (15.0, -60.0);
+        let model = normal_model(z_alpha / v, -40.0, -3.0, -150.0, z_alpha);
+        let c = -12.0;
+        let (q, dm) = normal_steady_state(&model, c);
+        let x = Vector3::new(c, q, 0.0);
+        let xdot = model.0 * x + model.1 * dm;
+        assert!(xdot[0].abs() < 1e-12 && xdot[1].abs() < 1e-12, "{xdot:?}");
+        assert!((q + c / v).abs() < 1e-12, "{q}");
+        // Trim α* = c/Z_α = 0.2 rad; the moment −40·0.2 − 3·0.8 = −10.4 rad/s² is balanced by
+        // δm* = −10.4/150.
+        assert!((dm - (-10.4 / 150.0)).abs() < 1e-12, "{dm}");
+    }
 
     fn eig3(m: &Matrix3<f64>) -> Vec<Complex<f64>> {
         let mut e: Vec<_> = m.complex_eigenvalues().iter().copied().collect();

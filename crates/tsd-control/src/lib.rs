@@ -39,7 +39,8 @@ pub mod params;
 pub mod trajectory;
 
 pub use params::{
-    TsdParams, GUIDANCE_FEEDBACK_LIMIT, HOVER_WIND_CROSSFLOW, HOVER_WIND_DESIGN_SPEED_FACTOR, TABLE_4_3_GUIDANCE_LEVEL,
+    TsdParams, GUIDANCE_FEEDBACK_LIMIT, HOVER_WIND_CROSSFLOW, HOVER_WIND_DESIGN_SPEED_FACTOR, NORMAL_FEEDFORWARD_RAMP,
+    TABLE_4_3_GUIDANCE_LEVEL,
 };
 pub use trajectory::{Reference, Trajectory};
 
@@ -801,7 +802,29 @@ impl SampledUnit for TsdController {
         // Feedback linearisation (App. B), in the Q′ coordinates: cancels the gravity terms
         // of Q̇′; equals the printed δmg of (4.2.16) once −K_Q g₁/V̄ is added back.
         let dm_g = (a22_n * g1 - g1_dot) / (v * b2);
-        let dm_p = -k_n[0] * c_w - k_n[1] * q_prime + dm_g;
+        // Tuned configuration, off the hover (and outside the take-off and landing phases): the
+        // steady state (C*, Q′*, δm*) of the loop model at the normal part of the reference's own
+        // specific acceleration, C* = Σ^RE·k^W (4.3.24, the previewed feed-forward), is fed
+        // forward and the state feedback of (4.2.15) acts on the deviation from it (README,
+        // "Front transition: normal-loop feed-forward"). Without it the trajectory's normal
+        // acceleration reached δm only through the integrator E_C, ≈ 0.3 s behind at the
+        // vertical-flight poles: the height lost in the pull-out of a fast front transition. The
+        // guidance feedback still enters through E_C alone: fed forward as well, it closed a fast
+        // pitch → velocity error → δm path that oscillated in level flight behind the avionics'
+        // latency (Jacobi master with sensors and EKF, pitch ±9°).
+        let (c_ff, q_ff, dm_ff) = if p.configuration == 0 && sigma_ground.is_none() {
+            let weight = ((reference.airspeed - self.mission.v_vertical) / NORMAL_FEEDFORWARD_RAMP).clamp(0.0, 1.0);
+            if weight > 0.0 {
+                let c_ff = weight * sigma_ff.dot(&kw);
+                let (q_ff, dm_ff) = gains::normal_steady_state(&d.normal_model, c_ff);
+                (c_ff, q_ff, dm_ff)
+            } else {
+                (0.0, 0.0, 0.0)
+            }
+        } else {
+            (0.0, 0.0, 0.0)
+        };
+        let dm_p = -k_n[0] * (c_w - c_ff) - k_n[1] * (q_prime - q_ff) + dm_ff + dm_g;
 
         // ---- Roll / NVD (4.2.21–4.2.26, 4.3.7–4.3.11) -----------------------------------
         let (a21_r, _, a23_r, b21) = d.roll_model;

@@ -22,6 +22,13 @@ pub const HOVER_WIND_DESIGN_SPEED_FACTOR: f64 = 1.3;
 /// the calm missions unchanged), fully at the second.
 pub const HOVER_WIND_CROSSFLOW: (f64, f64) = (1.0, 3.0);
 
+/// Tuned configuration: the normal loop's steady-state feed-forward of the reference's normal
+/// acceleration ([`crate::gains::normal_steady_state`]) is blended in as the reference airspeed rises from
+/// v_vertical to v_vertical + this (m/s): none in the hover (the hover-in-wind design and the
+/// take-off and landing phases are untouched), full through the transitions and level flight
+/// (README, "Front transition: normal-loop feed-forward").
+pub const NORMAL_FEEDFORWARD_RAMP: f64 = 1.0;
+
 /// Every tuning parameter of the controller. Field names are the FMU parameter names
 /// (group `tsd` of `modelDescription/tailsitter_tsd.json`).
 ///
