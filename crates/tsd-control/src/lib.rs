@@ -850,28 +850,30 @@ impl SampledUnit for TsdController {
         let g2 = kappa * g * e23;
         let g2_dot = kappa * g * (-(b_w + g * e23) / v * e13 + p_s * e33);
         let r_prime = r_s - g2 / v;
-        // Weathercock feed-forward in hover (tuned configuration; README, "Hover in a
-        // span-wise wind"): δR_w = −N̂/(I_zz b32) cancels the yawing moment of the sideslip,
-        // N = q̄Sb C_nβ β of (2.3.11), which the (B_W, R′) model only carries through
-        // B_W = V̄ a11 β (4.2.27) — wrong in a hover in wind, where B_W is mostly the wind's
-        // side force and the moment is set by the crossflow. The side surfaces see the lateral
-        // air velocity v = V̄ sin β (sin β: bounded where β is not small) at the free-stream
-        // speed V̄ over the share 1 − η of the span and at the slip-stream speed V̄ + 2w
-        // ((2.3.18), the speed of q̄_s) over the share η = min(1, 2D/b) the two propellers'
-        // wash covers (D = √(2A/π) each of disc area A/2), so
-        // N̂/I_zz = ½ρSb C_nβ/I_zz · v [(1 − η) V̄ + η (V̄ + 2w)].
-        let weathercock_ff =
-            if p.configuration == 0 && sigma_ground.is_none() && reference.airspeed <= self.mission.v_vertical + 1.0 {
-                let (lo, hi) = HOVER_WEATHERCOCK_CROSSFLOW;
-                let weight = ((crossflow - lo) / (hi - lo)).clamp(0.0, 1.0);
-                let eta = (2.0 * (2.0 * af.prop_disc_area / core::f64::consts::PI).sqrt() / af.wing_span).min(1.0);
-                let v_lat = meas.airspeed * meas.beta.sin();
-                let v_s = meas.airspeed + 2.0 * meas.induced_velocity.max(0.0);
-                let yaw_accel = d.weathercock * v_lat * ((1.0 - eta) * meas.airspeed + eta * v_s);
-                -weight * yaw_accel / b32
-            } else {
-                0.0
-            };
+        // Weathercock feed-forward (tuned configuration, outside the take-off and landing
+        // phases; README, "Hover in a span-wise wind"): δR_w = −N̂/(I_zz b32) cancels the
+        // yawing moment of the sideslip, N = q̄Sb C_nβ β of (2.3.11), which the (B_W, R′)
+        // model only carries through B_W = V̄ a11 β (4.2.27). That holds in the wind axes
+        // (κ = 1) but not in the path frame of the hover, where B_W is mostly the wind's side
+        // force and the moment is set by the crossflow: weight 1 − κ, so it fades out as the
+        // flow comes along the nose (no double count in the transitions and level flight, and
+        // no jump at the phase boundaries). The side surfaces see the lateral air velocity
+        // v = V̄ sin β (sin β: bounded where β is not small) at the free-stream speed V̄ over
+        // the share 1 − η of the span and at the slip-stream speed V̄ + 2w ((2.3.18), the speed
+        // of q̄_s) over the share η = min(1, 2D/b) the two propellers' wash covers
+        // (D = √(2A/π) each of disc area A/2), so
+        // N̂/I_zz = ½ρSb C_nβ/I_zz · v [(1 − η) V̄ + η (V̄ + 2w)]. Zero in still air (β = 0).
+        let weathercock_ff = if p.configuration == 0 && sigma_ground.is_none() {
+            let (lo, hi) = HOVER_WEATHERCOCK_CROSSFLOW;
+            let weight = ((crossflow - lo) / (hi - lo)).clamp(0.0, 1.0) * (1.0 - kappa);
+            let eta = (2.0 * (2.0 * af.prop_disc_area / core::f64::consts::PI).sqrt() / af.wing_span).min(1.0);
+            let v_lat = meas.airspeed * meas.beta.sin();
+            let v_s = meas.airspeed + 2.0 * meas.induced_velocity.max(0.0);
+            let yaw_accel = d.weathercock * v_lat * ((1.0 - eta) * meas.airspeed + eta * v_s);
+            -weight * yaw_accel / b32
+        } else {
+            0.0
+        };
 
         // ---- Bumpless start -------------------------------------------------------------
         let integ = &mut self.integrators;

@@ -42,8 +42,8 @@ pub const HOVER_WIND_NORMAL_POLE_FACTOR: f64 = 0.7;
 pub const HOVER_WIND_NORMAL_CROSSFLOW: (f64, f64) = (2.0, 4.0);
 
 /// Crossflow (m/s) over which the weathercock feed-forward of the directional loop is blended
-/// in in hover (tuned configuration): zero in still air (the calm missions bit-for-bit
-/// unchanged), full from half a metre per second.
+/// in (tuned configuration; times 1 − κ, the share of the path frame): none below a quarter
+/// metre per second, full from half a metre per second (README, "Hover in a span-wise wind").
 pub const HOVER_WEATHERCOCK_CROSSFLOW: (f64, f64) = (0.25, 0.5);
 
 /// Every tuning parameter of the controller. Field names are the FMU parameter names
