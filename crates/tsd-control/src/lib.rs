@@ -1141,6 +1141,59 @@ mod tests {
         }
     }
 
+    /// Hover in a span-wise wind (README): at the full hover-in-wind weight and a strong
+    /// crossflow the roll pair and the normal poles are the vertical ones scaled by their
+    /// factors (the NVD pole and the directional poles unchanged) and the path frame is kept
+    /// even where the axial airspeed alone would blend in the wind axes; at a crossflow inside
+    /// the normal band's lower end the normal poles are the vertical ones.
+    #[test]
+    fn hover_wind_slows_the_roll_pair_and_in_strong_crossflow_the_normal_poles() {
+        let ctl = TsdController::with_mission(MissionParams::default()).unwrap();
+        let p = TsdParams::default();
+        let (rf, nf) = (HOVER_WIND_ROLL_POLE_FACTOR, HOVER_WIND_NORMAL_POLE_FACTOR);
+        for (crossflow, n_scale) in [
+            (HOVER_WIND_NORMAL_CROSSFLOW.1 + 1.0, nf),
+            (HOVER_WIND_NORMAL_CROSSFLOW.0, 1.0),
+        ] {
+            let fc = FlightCondition {
+                axial_airspeed: 7.0,
+                hover_wind: 1.0,
+                crossflow,
+                ..vertical_climb_condition()
+            };
+            let d = ctl.design(&fc).unwrap();
+            assert_eq!(d.kappa, 0.0, "path frame kept");
+            assert!(ctl.frame_weight(7.0) > 0.0);
+            let (a, b) = d.normal_model;
+            let (re, im) = (p.normal_pole_re_vertical * n_scale, p.normal_pole_im_vertical * n_scale);
+            let real = p.normal_pole_real_vertical * n_scale;
+            assert_poles(&(a - b * d.normal_gains), &[(real, 0.0), (re, im), (re, -im)], "normal");
+            let (_, a22, _, b21) = d.roll_model;
+            let (kp, ke, kphi) = d.roll_gains;
+            let (re, im) = (p.roll_pole_re_vertical * rf, p.roll_pole_im_vertical * rf);
+            assert_poles(
+                &gains::roll_nvd_closed_loop(a22, b21, kp, ke, kphi),
+                &[(p.nvd_pole_vertical, 0.0), (re, im), (re, -im)],
+                "roll/NVD",
+            );
+            let (a, b) = d.directional_model;
+            let (re, im) = (p.directional_pole_re_vertical, p.directional_pole_im_vertical);
+            assert_poles(
+                &(a - b * d.directional_gains),
+                &[(p.directional_pole_real_vertical, 0.0), (re, im), (re, -im)],
+                "directional",
+            );
+            // ½ρSb C_nβ / I_zz of (2.3.11).
+            let af = Airframe::default();
+            let want = 0.5 * af.air_density * af.wing_area * af.wing_span * af.coefficients(0.0).c_n_beta / af.i_zz;
+            assert!(
+                (d.weathercock - want).abs() <= 1e-12 * want.abs(),
+                "{} vs {want}",
+                d.weathercock
+            );
+        }
+    }
+
     /// Tuned configuration: across the path, off the hover, the guidance has Table 4.3's
     /// level-flight pair; along it (and everywhere in the hover) the tuned pair; the
     /// thesis configuration has one pair and no feedback bound.
