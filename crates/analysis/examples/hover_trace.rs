@@ -25,10 +25,26 @@ fn main() {
         Ordering::GaussSeidel
     };
     s.wind = Wind::step_from(STEP_TIME, from.to_radians(), speed);
+    if let Ok(g) = std::env::var("GUST") {
+        // GUST=axis,phase: the envelope's gust case (`speed`, `from_deg` unused).
+        let v: Vec<usize> = g.split(',').map(|x| x.parse().unwrap()).collect();
+        let mission = flight_mission::MissionParams::default();
+        let starts = mission.phase_starts();
+        let mid = 0.5 * (starts[v[1]] + starts[v[1] + 1]);
+        s = Scenario::mission(mission);
+        s.stop_time = mission.end_time() + 5.0;
+        s.ordering = if jacobi {
+            Ordering::Jacobi
+        } else {
+            Ordering::GaussSeidel
+        };
+        s.wind = Wind::gust_along(v[0], analysis::envelope_hover::GUST_AMPLITUDE, mid - 1.0, 2.0);
+        eprintln!("gust from {} s", mid - 1.0);
+    }
     let trace = if a[1] == "lqr" {
         let mut c = lqr_control::LqrController::new(
             Airframe::default(),
-            m,
+            s.mission,
             lqr_control::LqrParams {
                 configuration: cfg,
                 ..Default::default()
@@ -39,7 +55,7 @@ fn main() {
     } else {
         let mut c = tsd_control::TsdController::new(
             Airframe::default(),
-            m,
+            s.mission,
             tsd_control::TsdParams {
                 configuration: cfg,
                 ..Default::default()

@@ -39,8 +39,9 @@ pub mod params;
 pub mod trajectory;
 
 pub use params::{
-    TsdParams, GUIDANCE_FEEDBACK_LIMIT, HOVER_WIND_CROSSFLOW, HOVER_WIND_DESIGN_SPEED_FACTOR, NORMAL_FEEDFORWARD_RAMP,
-    TABLE_4_3_GUIDANCE_LEVEL,
+    TsdParams, GUIDANCE_FEEDBACK_LIMIT, HOVER_WEATHERCOCK_CROSSFLOW, HOVER_WIND_CROSSFLOW,
+    HOVER_WIND_DESIGN_SPEED_FACTOR, HOVER_WIND_NORMAL_CROSSFLOW, HOVER_WIND_NORMAL_POLE_FACTOR,
+    HOVER_WIND_ROLL_POLE_FACTOR, NORMAL_FEEDFORWARD_RAMP, TABLE_4_3_GUIDANCE_LEVEL,
 };
 pub use trajectory::{Reference, Trajectory};
 
@@ -98,6 +99,12 @@ pub struct FlightCondition {
     /// Airspeed of the reference path (m/s): where it is the hover's (≤ v_vertical + 1 m/s)
     /// the tuned guidance poles are blended on `axial_airspeed` instead of V̄.
     pub reference_airspeed: f64,
+    /// Weight (0–1) of the hover-in-wind design condition ([`HOVER_WIND_CROSSFLOW`]; 0 off the
+    /// hover and in the thesis configuration): the path frame is kept (κ scaled by 1 − weight)
+    /// and the roll and normal poles are slowed (README, "Hover in a span-wise wind").
+    pub hover_wind: f64,
+    /// Crossflow V̄ √(1 − cos²α cos²β), the air-velocity component across the nose (m/s).
+    pub crossflow: f64,
 }
 
 /// Every loop's linear model and gains at one flight condition (§4.2, §4.3, Table 4.3).
@@ -149,6 +156,8 @@ pub struct LoopDesign {
     pub a33: f64,
     pub b31: f64,
     pub b32: f64,
+    /// Weathercock coefficient ½ρSb C_nβ / I_zz of (2.3.11) (1/m²): a31 = (this) V̄².
+    pub weathercock: f64,
 }
 
 /// Integrator state of the four inner loops: the thrust contribution (N) and, for the
@@ -351,7 +360,9 @@ impl TsdController {
         let (vv, vl) = (self.mission.v_vertical, self.mission.v_level);
         let v = fc.airspeed.max(p.min_airspeed);
         let sched = ((fc.airspeed - vv) / (vl - vv)).clamp(0.0, 1.0);
-        let kappa = self.frame_weight(fc.axial_airspeed);
+        // Tuned configuration, hover in wind: the path frame (README, "Hover in a span-wise
+        // wind"; κ = 0 in still air hover anyway, axial airspeed < 4 m/s).
+        let kappa = self.frame_weight(fc.axial_airspeed) * (1.0 - fc.hover_wind);
         let rho = af.air_density;
         let (s_ref, b_ref, c_ref) = (af.wing_area, af.wing_span, af.mean_chord);
         let qbar = 0.5 * rho * v * v;
@@ -417,10 +428,17 @@ impl TsdController {
         let a22_n = kr * c_ref * c_ref * c.c_m_q / iyy;
         let b2 = qbar_s * s_ref * c_ref * (c.c_m_de + rn * c.c_m_dfc) / iyy;
         let normal_model = gains::normal_model(kappa * a11_n, a21_n, a22_n, b2, z_alpha);
+        // Hover in a strong crossflow (tuned): slower normal poles (README, "Hover in a
+        // span-wise wind"); factor 1 elsewhere.
+        let strong = {
+            let (lo, hi) = HOVER_WIND_NORMAL_CROSSFLOW;
+            fc.hover_wind * ((fc.crossflow - lo) / (hi - lo)).clamp(0.0, 1.0)
+        };
+        let n_scale = lerp(1.0, HOVER_WIND_NORMAL_POLE_FACTOR, strong);
         let normal_poly = gains::char_poly_3(
-            blend(p.normal_pole_real_vertical, p.normal_pole_real_level),
-            blend(p.normal_pole_re_vertical, p.normal_pole_re_level),
-            blend(p.normal_pole_im_vertical, p.normal_pole_im_level),
+            n_scale * blend(p.normal_pole_real_vertical, p.normal_pole_real_level),
+            n_scale * blend(p.normal_pole_re_vertical, p.normal_pole_re_level),
+            n_scale * blend(p.normal_pole_im_vertical, p.normal_pole_im_level),
         );
         let normal_gains =
             gains::place_3(&normal_model.0, &normal_model.1, normal_poly).ok_or("normal-acceleration")?;
@@ -431,10 +449,12 @@ impl TsdController {
         let a22_r = kr * b_ref * b_ref * c.c_l_p / ixx;
         let a23_r = kr * b_ref * b_ref * c.c_l_r / ixx;
         let b21 = s_ref * b_ref * (qbar * c.c_l_da + qbar_s * c.c_l_dfd) / ixx;
+        // Hover in wind (tuned): a slower roll-rate pair (README, "Hover in a span-wise wind").
+        let r_scale = lerp(1.0, HOVER_WIND_ROLL_POLE_FACTOR, fc.hover_wind);
         let roll_poly = gains::char_poly_3(
             blend(p.nvd_pole_vertical, p.nvd_pole_level),
-            blend(p.roll_pole_re_vertical, p.roll_pole_re_level),
-            blend(p.roll_pole_im_vertical, p.roll_pole_im_level),
+            r_scale * blend(p.roll_pole_re_vertical, p.roll_pole_re_level),
+            r_scale * blend(p.roll_pole_im_vertical, p.roll_pole_im_level),
         );
         let roll_gains = gains::roll_nvd_gains(a22_r, b21, roll_poly).ok_or("roll")?;
 
@@ -495,6 +515,7 @@ impl TsdController {
             a33,
             b31,
             b32,
+            weathercock: 0.5 * rho * s_ref * b_ref * c.c_n_beta / izz,
         })
     }
 
@@ -634,7 +655,23 @@ impl SampledUnit for TsdController {
         // their feedback linearisation): at low speed the wind axes turn as fast as the body
         // and the time-scale separation fails.
         let axial_airspeed = meas.airspeed * meas.alpha.cos() * meas.beta.cos();
-        let kappa = self.frame_weight(axial_airspeed);
+        let crossflow = (meas.airspeed * meas.airspeed - axial_airspeed * axial_airspeed)
+            .max(0.0)
+            .sqrt();
+        let hover_wind = if p.configuration == 0 && reference.airspeed <= self.mission.v_vertical + 1.0 {
+            let (lo, hi) = HOVER_WIND_CROSSFLOW;
+            ((crossflow - lo) / (hi - lo)).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        // Tuned configuration, hover in wind: the reference-path frame is kept, κ scaled by
+        // 1 − hover_wind (README, "Hover in a span-wise wind"): with the nose tilted into a
+        // strong wind the air comes along the nose, the axial airspeed passes 4 m/s and the
+        // blend turned the loops to wind axes that pointed 50–75° off the vertical; the axial
+        // command Σ·i^W then fell to nothing (thrust to 0 N) and the aircraft fell.
+        // Not in the take-off and landing phases (their own hover design; unchanged).
+        let hover_wind_loops = if sigma_ground.is_some() { 0.0 } else { hover_wind };
+        let kappa = self.frame_weight(axial_airspeed) * (1.0 - hover_wind_loops);
         let (fa, fb) = {
             let (sa, ca) = meas.alpha.sin_cos();
             let (sb, cb) = meas.beta.sin_cos();
@@ -673,15 +710,6 @@ impl SampledUnit for TsdController {
         // puts α at ±60° or β at ±65°, V̄ at 5–10 m/s) the elevator and flaps went into a
         // bang-bang pitch limit cycle (q ≈ ±8 rad/s) that the Jacobi master's extra sample
         // turned into a tumble from 5 m/s on.
-        let crossflow = (meas.airspeed * meas.airspeed - axial_airspeed * axial_airspeed)
-            .max(0.0)
-            .sqrt();
-        let hover_wind = if p.configuration == 0 && reference.airspeed <= self.mission.v_vertical + 1.0 {
-            let (lo, hi) = HOVER_WIND_CROSSFLOW;
-            ((crossflow - lo) / (hi - lo)).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
         let (fc_airspeed, fc_alpha) = if sigma_ground.is_some() {
             (axial_airspeed.max(0.0), 0.0)
         } else {
@@ -698,6 +726,8 @@ impl SampledUnit for TsdController {
                 induced_velocity: meas.induced_velocity,
                 axial_airspeed,
                 reference_airspeed: reference.airspeed,
+                hover_wind: hover_wind_loops,
+                crossflow,
             })
             .map_err(|what| Self::err(format!("{what} gains not computable at t = {} s", input.t)))?;
         let (v, sched) = (d.v, d.schedule);
@@ -842,13 +872,37 @@ impl SampledUnit for TsdController {
         let g2 = kappa * g * e23;
         let g2_dot = kappa * g * (-(b_w + g * e23) / v * e13 + p_s * e33);
         let r_prime = r_s - g2 / v;
+        // Weathercock feed-forward (tuned configuration, outside the take-off and landing
+        // phases; README, "Hover in a span-wise wind"): δR_w = −N̂/(I_zz b32) cancels the
+        // yawing moment of the sideslip, N = q̄Sb C_nβ β of (2.3.11), which the (B_W, R′)
+        // model only carries through B_W = V̄ a11 β (4.2.27). That holds in the wind axes
+        // (κ = 1) but not in the path frame of the hover, where B_W is mostly the wind's side
+        // force and the moment is set by the crossflow: weight 1 − κ, so it fades out as the
+        // flow comes along the nose (no double count in the transitions and level flight, and
+        // no jump at the phase boundaries). The side surfaces see the lateral air velocity
+        // v = V̄ sin β (sin β: bounded where β is not small) at the free-stream speed V̄ over
+        // the share 1 − η of the span and at the slip-stream speed V̄ + 2w ((2.3.18), the speed
+        // of q̄_s) over the share η = min(1, 2D/b) the two propellers' wash covers
+        // (D = √(2A/π) each of disc area A/2), so
+        // N̂/I_zz = ½ρSb C_nβ/I_zz · v [(1 − η) V̄ + η (V̄ + 2w)]. Zero in still air (β = 0).
+        let weathercock_ff = if p.configuration == 0 && sigma_ground.is_none() {
+            let (lo, hi) = HOVER_WEATHERCOCK_CROSSFLOW;
+            let weight = ((crossflow - lo) / (hi - lo)).clamp(0.0, 1.0) * (1.0 - kappa);
+            let eta = (2.0 * (2.0 * af.prop_disc_area / core::f64::consts::PI).sqrt() / af.wing_span).min(1.0);
+            let v_lat = meas.airspeed * meas.beta.sin();
+            let v_s = meas.airspeed + 2.0 * meas.induced_velocity.max(0.0);
+            let yaw_accel = d.weathercock * v_lat * ((1.0 - eta) * meas.airspeed + eta * v_s);
+            -weight * yaw_accel / b32
+        } else {
+            0.0
+        };
 
         // ---- Bumpless start -------------------------------------------------------------
         let integ = &mut self.integrators;
         if !self.initialized {
             let s = meas.surfaces; // δe, δa, δr, δfc, δfd, δv
             let da_now = s[1];
-            let dr_f0 = -(a32 * p_s + b31 * da_now + a33 * g2 / v - g2_dot / v) / b32;
+            let dr_f0 = -(a32 * p_s + b31 * da_now + a33 * g2 / v - g2_dot / v) / b32 + weathercock_ff;
             integ.thrust = meas.thrust - thrust_p;
             integ.normal = b2 * (s[0] - dm_p);
             integ.roll = b21 * (da_now - da_p);
@@ -863,7 +917,7 @@ impl SampledUnit for TsdController {
         // (4.2.29), derived: δR_f = −(a32 P + b31 δA + a33 g₂/V̄ − ġ₂/V̄)/b32 cancels every
         // term of Ṙ′ outside the (B_W, R′) model.
         let dr_f = -(a32 * p_s + b31 * da.clamp(-lim, lim) + a33 * g2 / v - g2_dot / v) / b32;
-        let dr = -k_d[0] * b_w - k_d[1] * r_prime + integ.directional / b32 + dr_f;
+        let dr = -k_d[0] * b_w - k_d[1] * r_prime + integ.directional / b32 + dr_f + weathercock_ff;
 
         let thrust_sat = thrust_c.clamp(af.thrust_min, af.thrust_max);
         let dm_sat = dm.clamp(-lim, lim);
@@ -1034,6 +1088,8 @@ mod tests {
             induced_velocity: 10.4,
             axial_airspeed: 3.0,
             reference_airspeed: 3.0,
+            hover_wind: 0.0,
+            crossflow: 0.0,
         }
     }
 
@@ -1046,6 +1102,8 @@ mod tests {
             induced_velocity: 0.6,
             axial_airspeed: 25.0 * 0.092f64.cos(),
             reference_airspeed: 25.0,
+            hover_wind: 0.0,
+            crossflow: 0.0,
         }
     }
 
@@ -1102,6 +1160,59 @@ mod tests {
             assert!(d.b2 < -100.0, "b2 = {}", d.b2);
             // Low-speed frame in vertical flight, wind axes in level flight.
             assert_eq!(d.kappa, if lvl { 1.0 } else { 0.0 });
+        }
+    }
+
+    /// Hover in a span-wise wind (README): at the full hover-in-wind weight and a strong
+    /// crossflow the roll pair and the normal poles are the vertical ones scaled by their
+    /// factors (the NVD pole and the directional poles unchanged) and the path frame is kept
+    /// even where the axial airspeed alone would blend in the wind axes; at a crossflow inside
+    /// the normal band's lower end the normal poles are the vertical ones.
+    #[test]
+    fn hover_wind_slows_the_roll_pair_and_in_strong_crossflow_the_normal_poles() {
+        let ctl = TsdController::with_mission(MissionParams::default()).unwrap();
+        let p = TsdParams::default();
+        let (rf, nf) = (HOVER_WIND_ROLL_POLE_FACTOR, HOVER_WIND_NORMAL_POLE_FACTOR);
+        for (crossflow, n_scale) in [
+            (HOVER_WIND_NORMAL_CROSSFLOW.1 + 1.0, nf),
+            (HOVER_WIND_NORMAL_CROSSFLOW.0, 1.0),
+        ] {
+            let fc = FlightCondition {
+                axial_airspeed: 7.0,
+                hover_wind: 1.0,
+                crossflow,
+                ..vertical_climb_condition()
+            };
+            let d = ctl.design(&fc).unwrap();
+            assert_eq!(d.kappa, 0.0, "path frame kept");
+            assert!(ctl.frame_weight(7.0) > 0.0);
+            let (a, b) = d.normal_model;
+            let (re, im) = (p.normal_pole_re_vertical * n_scale, p.normal_pole_im_vertical * n_scale);
+            let real = p.normal_pole_real_vertical * n_scale;
+            assert_poles(&(a - b * d.normal_gains), &[(real, 0.0), (re, im), (re, -im)], "normal");
+            let (_, a22, _, b21) = d.roll_model;
+            let (kp, ke, kphi) = d.roll_gains;
+            let (re, im) = (p.roll_pole_re_vertical * rf, p.roll_pole_im_vertical * rf);
+            assert_poles(
+                &gains::roll_nvd_closed_loop(a22, b21, kp, ke, kphi),
+                &[(p.nvd_pole_vertical, 0.0), (re, im), (re, -im)],
+                "roll/NVD",
+            );
+            let (a, b) = d.directional_model;
+            let (re, im) = (p.directional_pole_re_vertical, p.directional_pole_im_vertical);
+            assert_poles(
+                &(a - b * d.directional_gains),
+                &[(p.directional_pole_real_vertical, 0.0), (re, im), (re, -im)],
+                "directional",
+            );
+            // ½ρSb C_nβ / I_zz of (2.3.11).
+            let af = Airframe::default();
+            let want = 0.5 * af.air_density * af.wing_area * af.wing_span * af.coefficients(0.0).c_n_beta / af.i_zz;
+            assert!(
+                (d.weathercock - want).abs() <= 1e-12 * want.abs(),
+                "{} vs {want}",
+                d.weathercock
+            );
         }
     }
 

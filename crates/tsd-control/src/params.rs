@@ -29,6 +29,30 @@ pub const HOVER_WIND_CROSSFLOW: (f64, f64) = (1.0, 3.0);
 /// (README, "Front transition: normal-loop feed-forward").
 pub const NORMAL_FEEDFORWARD_RAMP: f64 = 1.0;
 
+/// Hover in wind, tuned configuration: factor on the roll-rate pair of the NVD loop (the
+/// rotation about the nose, i.e. the heading in hover) at the hover-in-wind design condition,
+/// blended in with the [`HOVER_WIND_CROSSFLOW`] weight (README, "Hover in a span-wise wind").
+/// Scanned 0.5–0.8: the same cases held; 1 (none) loses Jacobi 7/8 m/s to a roll–yaw limit
+/// cycle.
+pub const HOVER_WIND_ROLL_POLE_FACTOR: f64 = 0.7;
+
+/// Hover in wind, tuned configuration: factor on the poles of the normal-acceleration loop in
+/// a strong crossflow, blended in over [`HOVER_WIND_NORMAL_CROSSFLOW`] (times the
+/// [`HOVER_WIND_CROSSFLOW`] weight). Scanned 0.6–0.85: the same cases held; 1 loses Jacobi
+/// 5 m/s along the belly.
+pub const HOVER_WIND_NORMAL_POLE_FACTOR: f64 = 0.7;
+
+/// Crossflow (m/s) over which [`HOVER_WIND_NORMAL_POLE_FACTOR`] is blended in: from 2 m/s, so
+/// that the pitch-up at the end of the back transition (crossflow ≈ 1 m/s) keeps the full
+/// normal poles (blended in from 1 m/s, a 5 m/s gust from the north there went into a pitch
+/// limit cycle under Jacobi, 8.5 m).
+pub const HOVER_WIND_NORMAL_CROSSFLOW: (f64, f64) = (2.0, 4.0);
+
+/// Crossflow (m/s) over which the weathercock feed-forward of the directional loop is blended
+/// in (tuned configuration; times 1 − κ, the share of the path frame): none below a quarter
+/// metre per second, full from half a metre per second (README, "Hover in a span-wise wind").
+pub const HOVER_WEATHERCOCK_CROSSFLOW: (f64, f64) = (0.25, 0.5);
+
 /// Every tuning parameter of the controller. Field names are the FMU parameter names
 /// (group `tsd` of `modelDescription/tailsitter_tsd.json`).
 ///

@@ -9,6 +9,12 @@
 //! pitch limit cycle. The wind along the belly (from the north) or the back (south) is the
 //! case the weathervane turns every other wind into.
 //!
+//! Along the span (and half-way to it) the tuned TSD held 7 and 8 m/s from none of the six
+//! bearings with a span-wise component under either master before the span-wise measures
+//! (README, "Hover in a span-wise wind": path frame kept, weathercock feed-forward, slower roll
+//! and strong-crossflow normal poles): 8 m/s from the east drifted 23 m (Gauss-Seidel) and 41 m
+//! (Jacobi) before the heading had turned, from the west under Jacobi it tumbled (101 m).
+//!
 //! `cargo test --release -p tsd-control --test hover_wind_step -- --nocapture` prints the numbers.
 
 use closed_loop::{fly, plant_inputs, Ordering, Scenario, Wind};
@@ -69,5 +75,17 @@ fn holds_5_m_s_steps_from_every_bearing_under_the_jacobi_master() {
         let from_deg = 45.0 * k as f64;
         let (held, max, fin) = step(5.0, from_deg, Ordering::Jacobi);
         assert!(held, "5 m/s from {from_deg}°: max {max} m, final {fin} m");
+    }
+}
+
+/// 8 m/s along the span (east, west) and half-way to it (45°, 135°), both masters: none held
+/// before the span-wise measures (15–101 m), the goal of any direction up to 8 m/s.
+#[test]
+fn holds_an_8_m_s_step_along_the_span_under_both_masters() {
+    for ordering in [Ordering::GaussSeidel, Ordering::Jacobi] {
+        for from_deg in [45.0, 90.0, 135.0, 270.0] {
+            let (held, max, fin) = step(8.0, from_deg, ordering);
+            assert!(held, "8 m/s from {from_deg}°, {ordering:?}: max {max} m, final {fin} m");
+        }
     }
 }
