@@ -395,6 +395,15 @@ impl GlobalAero {
         1.0 - (1.0 - sa) * (1.0 - sb)
     }
 
+    /// Stall weight σ of the free stream at the air-relative body velocity `v_air_body`: the
+    /// σ of [`GlobalAero::forces_moments`] and [`GlobalAero::diagnostics`] (0 below
+    /// [`AIRSPEED_EPS`]). The stall fraction is positive only where this is.
+    #[inline]
+    pub fn free_stream_stall_weight(&self, v_air_body: &Vector3<f64>) -> f64 {
+        let fr = Flow::of(*v_air_body);
+        self.stall_weight(fr.alpha, fr.beta)
+    }
+
     /// Span fraction η = min(1, 2D/b) of the wing washed by the two propellers, D = √(2A/π)
     /// the diameter of one disc (A = `prop_disc_area` of both).
     #[inline]
