@@ -322,7 +322,7 @@ impl Airframe {
         let (alpha, beta) = if speed < AIRSPEED_EPS {
             (0.0, 0.0)
         } else {
-            (va.z.atan2(va.x), (va.y / speed).clamp(-1.0, 1.0).asin())
+            (libm::atan2(va.z, va.x), (va.y / speed).clamp(-1.0, 1.0).asin())
         };
         let (xw, yw, zw, sa, ca) = wind_axes(va, speed);
         let c: Coefficients = self.coefficients(alpha);

@@ -320,7 +320,7 @@ impl Flow {
         Self {
             v,
             speed,
-            alpha: v.z.atan2(v.x),
+            alpha: libm::atan2(v.z, v.x),
             beta: (v.y / speed).clamp(-1.0, 1.0).asin(),
             xw,
             yw,

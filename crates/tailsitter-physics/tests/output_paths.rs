@@ -142,3 +142,27 @@ fn clearly_airborne_means_no_contact_point_touches() {
     assert!(airborne > 1000 && near > 1000, "{airborne} / {near}");
     assert!(Ground::none().clearly_airborne(a, &states()[0]));
 }
+
+/// α (2.2.12) is musl's atan2 (the `libm` crate, no rounding-mode switches): within one unit
+/// in the last place of the platform's atan2, over every quadrant, so the change of library
+/// moves trajectories by rounding only.
+#[test]
+fn angle_of_attack_is_atan2_to_one_ulp() {
+    let a = Airframe::default();
+    let mut worst: f64 = 0.0;
+    for i in 0..400 {
+        let ang = -3.1 + 6.2 * i as f64 / 399.0;
+        for speed in [0.3, 7.0, 25.0] {
+            let v = Vector3::new(
+                speed * ang.cos(),
+                0.1 * speed * (0.3 * i as f64).sin(),
+                speed * ang.sin(),
+            );
+            let fm = a.forces_moments(&v, &Vector3::zeros(), 10.0, &Default::default());
+            let reference = v.z.atan2(v.x);
+            let ulp = f64::EPSILON * reference.abs();
+            worst = worst.max((fm.alpha - reference).abs() / ulp);
+        }
+    }
+    assert!(worst <= 1.0, "α differs from atan2 by {worst} ulp");
+}
