@@ -219,10 +219,13 @@ impl Plant {
 
         let g_body = Vector3::new(c[(0, 2)], c[(1, 2)], c[(2, 2)]) * a.gravity;
         let (f_ground, m_ground) = self.ground.contact(a, x, c);
-        let vdot = (fm.force_body + f_ground) / a.mass + g_body - omega.cross(&v);
+        // Parameter-only reciprocals: hoisted out of the RK4 loop by the compiler (a
+        // multiplication per evaluation instead of a division).
+        let vdot = (fm.force_body + f_ground) * (1.0 / a.mass) + g_body - omega.cross(&v);
         let i = Vector3::new(a.i_xx, a.i_yy, a.i_zz);
+        let i_inv = Vector3::new(1.0 / a.i_xx, 1.0 / a.i_yy, 1.0 / a.i_zz);
         let h = omega.component_mul(&i);
-        let wdot = (fm.moment_body + m_ground - omega.cross(&h)).component_div(&i);
+        let wdot = (fm.moment_body + m_ground - omega.cross(&h)).component_mul(&i_inv);
         let qdot = quat_derivative(&q, &omega);
         let pdot = c.tr_mul(&v);
 
@@ -241,12 +244,13 @@ impl Plant {
         dx[Q] = wdot.y;
         dx[R] = wdot.z;
         let tc = u[THRUST_CMD].max(a.thrust_min).min(a.thrust_max);
-        dx[THRUST] = (tc - x[THRUST]) / a.tau_thrust;
+        dx[THRUST] = (tc - x[THRUST]) * (1.0 / a.tau_thrust);
         let lim = a.deflection_limit;
         let rate = a.servo_rate_limit;
+        let servo_inv = 1.0 / a.servo_tau;
         for k in 0..6 {
             let cmd = u[SURFACES_CMD + k].max(-lim).min(lim);
-            dx[SURFACES + k] = ((cmd - x[SURFACES + k]) / a.servo_tau).max(-rate).min(rate);
+            dx[SURFACES + k] = ((cmd - x[SURFACES + k]) * servo_inv).max(-rate).min(rate);
         }
         dx
     }
@@ -464,7 +468,7 @@ impl Plant {
             airspeed: fm.airspeed,
             alpha: fm.alpha,
             beta: fm.beta,
-            specific_force_body: (fm.force_body + f_ground) / self.airframe.mass,
+            specific_force_body: (fm.force_body + f_ground) * (1.0 / self.airframe.mass),
             induced_velocity: fm.induced_velocity,
             slipstream_speed: fm.slipstream_speed,
             stall_fraction,
