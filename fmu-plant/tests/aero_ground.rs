@@ -48,6 +48,12 @@ fn messages_containing(instance: &str, needle: &str) -> usize {
         .count()
 }
 
+/// One 20 ms step and the outputs after it (computed lazily: `LAZY_STEP_OUTPUTS`).
+fn step(model: &mut PlantModel, vars: &mut Variables, t: f64, log: &mut Logger<'_>) {
+    model.do_step(vars, t, 0.02, log).unwrap();
+    model.update_outputs(vars).unwrap();
+}
+
 /// Starts at rest on the ground, stays there, takes off, lands hard: outputs and messages.
 #[test]
 fn ground_start_take_off_and_hard_landing_are_reported() {
@@ -66,7 +72,7 @@ fn ground_start_take_off_and_hard_landing_are_reported() {
     assert!((d0 - (vars.ground_height - vars.gear_length)).abs() < 0.02);
     let mut t = 0.0;
     for _ in 0..250 {
-        model.do_step(&mut vars, t, 0.02, &mut log).unwrap();
+        step(&mut model, &mut vars, t, &mut log);
         t += 0.02;
     }
     assert_eq!(vars.ground_contact_points, 4.0);
@@ -74,7 +80,7 @@ fn ground_start_take_off_and_hard_landing_are_reported() {
     // Take off, climb, cut the motors: it falls back and lands hard (tail first).
     vars.thrust_cmd = 130.0;
     for _ in 0..75 {
-        model.do_step(&mut vars, t, 0.02, &mut log).unwrap();
+        step(&mut model, &mut vars, t, &mut log);
         t += 0.02;
     }
     assert_eq!(vars.ground_contact_points, 0.0);
@@ -82,7 +88,7 @@ fn ground_start_take_off_and_hard_landing_are_reported() {
     vars.thrust_cmd = 0.0;
     let mut landed = false;
     for _ in 0..300 {
-        model.do_step(&mut vars, t, 0.02, &mut log).unwrap();
+        step(&mut model, &mut vars, t, &mut log);
         t += 0.02;
         landed |= vars.ground_contact_points > 0.0;
         assert!(vars.pos_d.is_finite() && vars.accel_x.is_finite());
@@ -111,7 +117,7 @@ fn leaving_attached_flow_is_reported_once() {
         vars.wind_n = 6.0;
         let mut t = 0.0;
         for _ in 0..10 {
-            model.do_step(&mut vars, t, 0.02, &mut log).unwrap();
+            step(&mut model, &mut vars, t, &mut log);
             t += 0.02;
         }
         assert!(vars.stall_fraction > 0.0 && vars.aero_regime >= 1.0);

@@ -598,7 +598,8 @@ impl<M: FmuModel> Instance<M> {
         match self.model.do_step(&mut self.vars, t, h, &mut log) {
             Ok(()) => {
                 self.machine.time = t + h;
-                self.machine.dirty = false;
+                // Lazy models: outputs computed by the next get (`refresh`).
+                self.machine.dirty = M::LAZY_STEP_OUTPUTS;
                 self.machine.state = StepComplete;
                 Ok(())
             }

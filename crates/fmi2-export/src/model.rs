@@ -55,9 +55,17 @@ pub trait FmuModel: Clone + Send + 'static {
     /// happened since the last computation.
     fn update_outputs(&mut self, vars: &mut Self::Vars) -> Result<(), ModelError>;
 
+    /// Outputs are computed lazily after a step: `do_step` need not write them, the export
+    /// layer marks them stale and calls [`Self::update_outputs`] before the next get (as the
+    /// Reference FMUs do behind their dirty flag). A host that steps without reading every
+    /// step then does not pay for outputs it never reads. Default `false`: `do_step` writes
+    /// the outputs.
+    const LAZY_STEP_OUTPUTS: bool = false;
+
     /// Advance from `t` to `t + h`. Inputs in `vars` are those set for `t`;
-    /// on return, `vars` outputs hold values at `t + h`. Must not allocate on
-    /// the success path.
+    /// on return, `vars` outputs hold values at `t + h` (unless
+    /// [`Self::LAZY_STEP_OUTPUTS`]: then [`Self::update_outputs`] computes them on demand).
+    /// Must not allocate on the success path.
     fn do_step(&mut self, vars: &mut Self::Vars, t: f64, h: f64, log: &mut Logger<'_>) -> Result<(), ModelError>;
 
     /// Model Exchange (only for models whose `Vars::CONTINUOUS_STATES` is not empty):

@@ -110,9 +110,14 @@ fn wind_axes(v: &Vector3<f64>, speed: f64) -> (Vector3<f64>, Vector3<f64>, Vecto
     if speed < AIRSPEED_EPS {
         return (Vector3::x(), Vector3::y(), Vector3::z(), 0.0, 1.0);
     }
-    let xw = v / speed;
+    let xw = v * (1.0 / speed);
     let h = (v.x * v.x + v.z * v.z).sqrt();
-    let (sa, ca) = if h > 0.0 { (v.z / h, v.x / h) } else { (0.0, 1.0) };
+    let (sa, ca) = if h > 0.0 {
+        let h_inv = 1.0 / h;
+        (v.z * h_inv, v.x * h_inv)
+    } else {
+        (0.0, 1.0)
+    };
     // z_w = (−sin α, 0, cos α), y_w = z_w × x_w = (−cα sβ, cβ, −sα sβ).
     let zw = Vector3::new(-sa, 0.0, ca);
     let yw = zw.cross(&xw);
@@ -322,7 +327,7 @@ impl Airframe {
         let (alpha, beta) = if speed < AIRSPEED_EPS {
             (0.0, 0.0)
         } else {
-            (va.z.atan2(va.x), (va.y / speed).clamp(-1.0, 1.0).asin())
+            (libm::atan2(va.z, va.x), (va.y / speed).clamp(-1.0, 1.0).asin())
         };
         let (xw, yw, zw, sa, ca) = wind_axes(va, speed);
         let c: Coefficients = self.coefficients(alpha);
@@ -347,7 +352,7 @@ impl Airframe {
 
         // Free-stream wind-axis forces (2.3.6–2.3.8, 2.3.12–2.3.13).
         let cl = self.c_L0 + c.c_L_alpha * alpha + c.c_L_de * d.elevator + c.c_L_dfc * d.flap_collective;
-        let cd = self.c_D0 + cl * cl / (core::f64::consts::PI * self.aspect_ratio * self.oswald_efficiency);
+        let cd = self.c_D0 + cl * cl * (1.0 / (core::f64::consts::PI * self.aspect_ratio * self.oswald_efficiency));
         let lift_fs = qs * (self.c_L0 + c.c_L_alpha * alpha) + kr * cbar * c.c_L_q * q;
         let drag = qs * cd;
         let side_fs = qs * (c.c_Y_beta * beta + c.c_Y_da * d.aileron) + kr * b * (c.c_Y_p * ps + c.c_Y_r * rs);

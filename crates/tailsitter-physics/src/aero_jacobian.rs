@@ -108,7 +108,7 @@ impl Axes {
         let dyw = -xw.cross_matrix() * dzw + zw.cross_matrix() * dxw;
         Some(Self {
             speed,
-            alpha: v.z.atan2(v.x),
+            alpha: libm::atan2(v.z, v.x),
             beta: (v.y / speed).clamp(-1.0, 1.0).asin(),
             sa,
             ca,

@@ -268,7 +268,11 @@ impl Airframe {
     #[inline(always)]
     pub fn coefficients(&self, alpha: f64) -> Coefficients {
         let a = alpha.clamp(-self.alpha_interp_limit, self.alpha_interp_limit);
-        let s = if self.alpha_1 != 0.0 { a / self.alpha_1 } else { 0.0 };
+        let s = if self.alpha_1 != 0.0 {
+            a * (1.0 / self.alpha_1)
+        } else {
+            0.0
+        };
         let lerp = |a0: f64, a1: f64| a0 + (a1 - a0) * s;
         Coefficients {
             c_L_alpha: lerp(self.c_L_alpha_a0, self.c_L_alpha_a1),

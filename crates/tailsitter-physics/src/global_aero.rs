@@ -251,7 +251,7 @@ pub struct AeroDiagnostics {
 /// C¹ smoothstep: 0 for x ≤ x0, 1 for x ≥ x1, 3t² − 2t³ between.
 #[inline]
 fn smoothstep(x: f64, x0: f64, x1: f64) -> f64 {
-    let t = ((x - x0) / (x1 - x0)).clamp(0.0, 1.0);
+    let t = ((x - x0) * (1.0 / (x1 - x0))).clamp(0.0, 1.0);
     t * t * (3.0 - 2.0 * t)
 }
 
@@ -278,9 +278,14 @@ impl Flow {
         if speed < AIRSPEED_EPS {
             return Self::of(v);
         }
-        let xw = v / speed;
+        let xw = v * (1.0 / speed);
         let h = (v.x * v.x + v.z * v.z).sqrt();
-        let (sa, ca) = if h > 0.0 { (v.z / h, v.x / h) } else { (0.0, 1.0) };
+        let (sa, ca) = if h > 0.0 {
+            let h_inv = 1.0 / h;
+            (v.z * h_inv, v.x * h_inv)
+        } else {
+            (0.0, 1.0)
+        };
         let zw = Vector3::new(-sa, 0.0, ca);
         let yw = zw.cross(&xw);
         Self {
@@ -312,16 +317,21 @@ impl Flow {
                 ca: 1.0,
             };
         }
-        let xw = v / speed;
+        let xw = v * (1.0 / speed);
         let h = (v.x * v.x + v.z * v.z).sqrt();
-        let (sa, ca) = if h > 0.0 { (v.z / h, v.x / h) } else { (0.0, 1.0) };
+        let (sa, ca) = if h > 0.0 {
+            let h_inv = 1.0 / h;
+            (v.z * h_inv, v.x * h_inv)
+        } else {
+            (0.0, 1.0)
+        };
         let zw = Vector3::new(-sa, 0.0, ca);
         let yw = zw.cross(&xw);
         Self {
             v,
             speed,
-            alpha: v.z.atan2(v.x),
-            beta: (v.y / speed).clamp(-1.0, 1.0).asin(),
+            alpha: libm::atan2(v.z, v.x),
+            beta: xw.y.clamp(-1.0, 1.0).asin(),
             xw,
             yw,
             zw,
@@ -395,6 +405,15 @@ impl GlobalAero {
         1.0 - (1.0 - sa) * (1.0 - sb)
     }
 
+    /// Stall weight σ of the free stream at the air-relative body velocity `v_air_body`: the
+    /// σ of [`GlobalAero::forces_moments`] and [`GlobalAero::diagnostics`] (0 below
+    /// [`AIRSPEED_EPS`]). The stall fraction is positive only where this is.
+    #[inline]
+    pub fn free_stream_stall_weight(&self, v_air_body: &Vector3<f64>) -> f64 {
+        let fr = Flow::of(*v_air_body);
+        self.stall_weight(fr.alpha, fr.beta)
+    }
+
     /// Span fraction η = min(1, 2D/b) of the wing washed by the two propellers, D = √(2A/π)
     /// the diameter of one disc (A = `prop_disc_area` of both).
     #[inline]
@@ -411,7 +430,7 @@ impl GlobalAero {
         let qs = 0.5 * a.air_density * f.speed * f.speed * a.wing_area;
         let cl_wing = a.c_L0 + c.c_L_alpha * f.alpha;
         let cl = cl_wing + cl_ctrl;
-        let cd = a.c_D0 + cl * cl / (core::f64::consts::PI * a.aspect_ratio * a.oswald_efficiency);
+        let cd = a.c_D0 + cl * cl * (1.0 / (core::f64::consts::PI * a.aspect_ratio * a.oswald_efficiency));
         let force = f.xw * (-qs * cd) + f.yw * (qs * c.c_Y_beta * f.beta) + f.zw * (-qs * cl_wing);
         let moment = f.xw * (qs * a.wing_span * c.c_l_beta * f.beta)
             + f.yw * (qs * a.mean_chord * (a.c_m0 + c.c_m_alpha * f.alpha))
@@ -621,22 +640,15 @@ impl GlobalAero {
         }
 
         // Ailerons (free stream), effectiveness fading with the chordwise flow after stall.
-        let sx = if fr.speed < AIRSPEED_EPS {
-            1.0
-        } else {
-            fr.v.x / fr.speed
-        };
+        // x_w's x component: v_x / V̄ (1 below AIRSPEED_EPS).
+        let sx = fr.xw.x;
         let e_free = 1.0 - sigma + sigma * sx;
         force += fr.yw * (e_free * qs * c.c_Y_da * d.aileron);
         moment += (fr.xw * (c.c_l_da * b) + fr.zw * (c.c_n_da * b)) * (e_free * qs * d.aileron);
 
         // Surfaces in the slip-stream (thesis: q̄_s, slip-stream axes, derivatives at the
         // free-stream α), effectiveness fading with the local chordwise flow after stall.
-        let sxs = if fs.speed < AIRSPEED_EPS {
-            1.0
-        } else {
-            fs.v.x / fs.speed
-        };
+        let sxs = fs.xw.x;
         let e_s = 1.0 - sigma_s + sigma_s * sxs;
         let lift_s = qss * (c.c_L_de * d.elevator + c.c_L_dfc * d.flap_collective);
         let side_s = qss * (c.c_Y_dr * d.rudder + c.c_Y_dv * d.vertical_flap);

@@ -161,6 +161,23 @@ impl Ground {
         g.max(self.nose_length).max(0.5 * a.wing_span)
     }
 
+    /// gear_length + max(half span, half height), the nose and the wing tips: an upper bound
+    /// of every contact point's distance from the CG without a square root (m).
+    #[inline(always)]
+    fn bound(&self, a: &Airframe) -> f64 {
+        (self.gear_length + self.gear_half_span.max(self.gear_half_height))
+            .max(self.nose_length)
+            .max(0.5 * a.wing_span)
+    }
+
+    /// Whether no contact point can touch the ground at `x` (the CG higher above the
+    /// ground than any point reaches, with a margin for rounding): [`Ground::contact_state`]
+    /// would count no touching point. Cheap (no attitude needed).
+    #[inline]
+    pub fn clearly_airborne(&self, a: &Airframe, x: &StateVector) -> bool {
+        x[POS_D] + self.bound(a) * (1.0 + 1e-12) < self.height
+    }
+
     /// Contact force and moment about the CG in body axes (N, N m) at a state, given its
     /// DCM^BE `c` (module docs). Zero without contact; does not allocate.
     #[inline(always)]
@@ -168,10 +185,7 @@ impl Ground {
         // Cheap test first (no square root): gear_length + max(half span, half height) bounds
         // the gear's reach, so this returns only where the exact test below returns too.
         // Inlined into the caller (no result through memory on the hot, airborne path).
-        let bound = (self.gear_length + self.gear_half_span.max(self.gear_half_height))
-            .max(self.nose_length)
-            .max(0.5 * a.wing_span);
-        if x[POS_D] + bound <= self.height || x[POS_D].is_nan() {
+        if x[POS_D] + self.bound(a) <= self.height || x[POS_D].is_nan() {
             return (Vector3::zeros(), Vector3::zeros());
         }
         self.contact_near(a, x, c)

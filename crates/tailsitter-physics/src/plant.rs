@@ -197,19 +197,35 @@ impl Plant {
     /// which is then set to this evaluation's induced velocity (the start of the next stage).
     #[inline(always)]
     fn derivatives_from(&self, x: &StateVector, u: &InputVector, wind_ned: &Vector3<f64>, w: &mut f64) -> StateVector {
-        let a = &self.airframe;
         let (fm, c) = self.eval_from(x, wind_ned, *w);
         *w = fm.induced_velocity;
+        self.assemble(x, u, &fm, &c)
+    }
+
+    /// The right-hand side of [`Plant::derivatives`] from the forces and moments `fm` and the
+    /// DCM^BE `c` at `x` (the ground contact is added here).
+    #[inline(always)]
+    fn assemble(
+        &self,
+        x: &StateVector,
+        u: &InputVector,
+        fm: &ForcesMoments,
+        c: &nalgebra::Matrix3<f64>,
+    ) -> StateVector {
+        let a = &self.airframe;
         let v = Vector3::new(x[U], x[V], x[W]);
         let omega = Vector3::new(x[P], x[Q], x[R]);
         let q = Vector4::new(x[Q1], x[Q2], x[Q3], x[Q4]);
 
         let g_body = Vector3::new(c[(0, 2)], c[(1, 2)], c[(2, 2)]) * a.gravity;
-        let (f_ground, m_ground) = self.ground.contact(a, x, &c);
-        let vdot = (fm.force_body + f_ground) / a.mass + g_body - omega.cross(&v);
+        let (f_ground, m_ground) = self.ground.contact(a, x, c);
+        // Parameter-only reciprocals: hoisted out of the RK4 loop by the compiler (a
+        // multiplication per evaluation instead of a division).
+        let vdot = (fm.force_body + f_ground) * (1.0 / a.mass) + g_body - omega.cross(&v);
         let i = Vector3::new(a.i_xx, a.i_yy, a.i_zz);
+        let i_inv = Vector3::new(1.0 / a.i_xx, 1.0 / a.i_yy, 1.0 / a.i_zz);
         let h = omega.component_mul(&i);
-        let wdot = (fm.moment_body + m_ground - omega.cross(&h)).component_div(&i);
+        let wdot = (fm.moment_body + m_ground - omega.cross(&h)).component_mul(&i_inv);
         let qdot = quat_derivative(&q, &omega);
         let pdot = c.tr_mul(&v);
 
@@ -228,12 +244,13 @@ impl Plant {
         dx[Q] = wdot.y;
         dx[R] = wdot.z;
         let tc = u[THRUST_CMD].max(a.thrust_min).min(a.thrust_max);
-        dx[THRUST] = (tc - x[THRUST]) / a.tau_thrust;
+        dx[THRUST] = (tc - x[THRUST]) * (1.0 / a.tau_thrust);
         let lim = a.deflection_limit;
         let rate = a.servo_rate_limit;
+        let servo_inv = 1.0 / a.servo_tau;
         for k in 0..6 {
             let cmd = u[SURFACES_CMD + k].max(-lim).min(lim);
-            dx[SURFACES + k] = ((cmd - x[SURFACES + k]) / a.servo_tau).max(-rate).min(rate);
+            dx[SURFACES + k] = ((cmd - x[SURFACES + k]) * servo_inv).max(-rate).min(rate);
         }
         dx
     }
@@ -403,6 +420,16 @@ impl Plant {
     /// Outputs at a state. The commands `u` are not used (no direct feedthrough) but are
     /// part of the signature for symmetry with [`Plant::derivatives`].
     pub fn outputs(&self, x: &StateVector, _u: &InputVector, wind_ned: &Vector3<f64>) -> Outputs {
+        let (fm, stall_fraction, c) = self.eval_with_stall(x, wind_ned);
+        self.outputs_from(x, &fm, stall_fraction, &c)
+    }
+
+    /// Forces (cold induced-velocity solve), stall fraction and DCM^BE at a state.
+    fn eval_with_stall(
+        &self,
+        x: &StateVector,
+        wind_ned: &Vector3<f64>,
+    ) -> (ForcesMoments, f64, nalgebra::Matrix3<f64>) {
         let q = Vector4::new(x[Q1], x[Q2], x[Q3], x[Q4]);
         let c = dcm_earth_to_body(&q);
         let v_air = Vector3::new(x[U], x[V], x[W]) - c * wind_ned;
@@ -422,20 +449,78 @@ impl Plant {
                 (fm, d.stall_fraction)
             }
         };
-        let (f_ground, _) = self.ground.contact(&self.airframe, x, &c);
+        (fm, stall_fraction, c)
+    }
+
+    /// [`Plant::outputs`] from the forces `fm`, the stall fraction and the DCM^BE `c` at `x`.
+    fn outputs_from(
+        &self,
+        x: &StateVector,
+        fm: &ForcesMoments,
+        stall_fraction: f64,
+        c: &nalgebra::Matrix3<f64>,
+    ) -> Outputs {
+        let q = Vector4::new(x[Q1], x[Q2], x[Q3], x[Q4]);
+        let (f_ground, _) = self.ground.contact(&self.airframe, x, c);
         Outputs {
             vel_ned: c.tr_mul(&Vector3::new(x[U], x[V], x[W])),
             euler_321: euler_321_from_quat(&q),
             airspeed: fm.airspeed,
             alpha: fm.alpha,
             beta: fm.beta,
-            specific_force_body: (fm.force_body + f_ground) / self.airframe.mass,
+            specific_force_body: (fm.force_body + f_ground) * (1.0 / self.airframe.mass),
             induced_velocity: fm.induced_velocity,
             slipstream_speed: fm.slipstream_speed,
             stall_fraction,
             aero_regime: AeroRegime::of(stall_fraction),
             ground: self.ground.contact_state(&self.airframe, x),
         }
+    }
+
+    /// [`Plant::outputs`] at `x` and [`Plant::derivatives`] at `x` with its quaternion
+    /// normalised (what a Model Exchange host integrates: the attitude the state
+    /// represents), equal to the two calls. When normalising leaves the quaternion
+    /// unchanged or there is no wind (the air-relative velocity then does not depend on the
+    /// attitude), the forces are evaluated once for both (a zero velocity component may then
+    /// carry the other sign of zero, nothing else differs).
+    pub fn outputs_and_derivatives(
+        &self,
+        x: &StateVector,
+        u: &InputVector,
+        wind_ned: &Vector3<f64>,
+    ) -> (Outputs, StateVector) {
+        let (fm, stall_fraction, c) = self.eval_with_stall(x, wind_ned);
+        let y = self.outputs_from(x, &fm, stall_fraction, &c);
+        let mut xn = *x;
+        let n = (x[Q1] * x[Q1] + x[Q2] * x[Q2] + x[Q3] * x[Q3] + x[Q4] * x[Q4]).sqrt();
+        if n > 0.0 && n.is_finite() {
+            for k in Q1..=Q4 {
+                xn[k] /= n;
+            }
+        }
+        let dx = if xn == *x {
+            self.assemble(&xn, u, &fm, &c)
+        } else if *wind_ned == Vector3::zeros() {
+            // Same forces (v_air = v exactly), DCM of the normalised quaternion.
+            let cn = dcm_earth_to_body(&Vector4::new(xn[Q1], xn[Q2], xn[Q3], xn[Q4]));
+            self.assemble(&xn, u, &fm, &cn)
+        } else {
+            self.derivatives(&xn, u, wind_ned)
+        };
+        (y, dx)
+    }
+
+    /// Whether the free stream at `x` is outside the attached-flow band (stall weight σ > 0,
+    /// the same σ as the force models'): only then can the stall fraction of
+    /// [`Plant::outputs`] be positive. Cheaper than the outputs (no forces).
+    pub fn free_stream_separated(&self, x: &StateVector, wind_ned: &Vector3<f64>) -> bool {
+        let v = Vector3::new(x[U], x[V], x[W]);
+        let v_air = if *wind_ned == Vector3::zeros() {
+            v
+        } else {
+            v - dcm_earth_to_body(&Vector4::new(x[Q1], x[Q2], x[Q3], x[Q4])) * wind_ned
+        };
+        self.aero.free_stream_stall_weight(&v_air) > 0.0
     }
 
     /// Jacobians (A, B) of [`Plant::derivatives`] at (x, u) by central differences
