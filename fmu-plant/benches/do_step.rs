@@ -14,9 +14,11 @@ use criterion::measurement::{Measurement, ValueFormatter};
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use fmi2_export::ffi;
 use fmi2_export::fmi_sys::fmi2::*;
-use fmi2_export::{Causality, ValueType, VariableStore};
 use std::hint::black_box;
-use tailsitter_plant::{vr, PlantModel, Variables};
+use tailsitter_plant::PlantModel;
+
+#[path = "support/trimmed.rs"]
+mod trimmed;
 
 /// CPU time of the calling thread (`CLOCK_THREAD_CPUTIME_ID`), in ns.
 struct ThreadCpuTime;
@@ -83,11 +85,7 @@ fn cpu(c: &mut Criterion<ThreadCpuTime>) {
 fn bench<M: Measurement + 'static>(c: &mut Criterion<M>, prefix: &str) {
     // The layer's shared test host (a recording logger; doStep logs nothing here).
     let host = fmi2_export::test_host::Host::new();
-    let outputs: Vec<u32> = Variables::VARIABLES
-        .iter()
-        .filter(|s| s.causality == Causality::Output && s.value_type == ValueType::Real)
-        .map(|s| s.value_reference)
-        .collect();
+    let outputs = trimmed::real_outputs();
     let mut values = vec![0.0; outputs.len()];
     // One fresh instance per benchmark: a run flies for hours of simulated time (the
     // position envelope, 1e6 m, must not be reached).
@@ -96,32 +94,7 @@ fn bench<M: Measurement + 'static>(c: &mut Criterion<M>, prefix: &str) {
         // read (the outputs are computed lazily, on that read).
         for (kind, get) in [("fmi2DoStep", false), ("fmi2DoStep_getReal", true)] {
             // SAFETY: the host outlives the instance, freed below.
-            let inst = unsafe { host.initializing::<PlantModel>("bench") };
-            // SAFETY: live instance in Initialization Mode.
-            unsafe {
-                let ic = [initial_condition];
-                assert_eq!(
-                    ffi::set_integer::<PlantModel>(inst, &vr::initial_condition, 1, ic.as_ptr()),
-                    fmi2Status_fmi2OK
-                );
-                assert_eq!(
-                    ffi::set_real::<PlantModel>(inst, &vr::initial_speed, 1, &speed),
-                    fmi2Status_fmi2OK
-                );
-                assert_eq!(ffi::exit_initialization_mode::<PlantModel>(inst), fmi2Status_fmi2OK);
-                // Hold the trim: set the command inputs to the trim's (trim_thrust, trim_elevator).
-                let mut trim = [0.0; 2];
-                let trim_vrs = [vr::trim_thrust, vr::trim_elevator];
-                assert_eq!(
-                    ffi::get_real::<PlantModel>(inst, trim_vrs.as_ptr(), 2, trim.as_mut_ptr()),
-                    fmi2Status_fmi2OK
-                );
-                let cmd_vrs = [vr::thrust_cmd, vr::elevator_cmd];
-                assert_eq!(
-                    ffi::set_real::<PlantModel>(inst, cmd_vrs.as_ptr(), 2, trim.as_ptr()),
-                    fmi2Status_fmi2OK
-                );
-            }
+            let inst = unsafe { trimmed::trimmed_instance(&host, "bench", initial_condition, speed) };
             let mut t = 0.0;
             let h = 0.02;
             c.bench_function(&format!("{prefix}{kind}_20ms_{label}"), |b| {

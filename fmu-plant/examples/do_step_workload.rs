@@ -11,9 +11,11 @@
 
 use fmi2_export::ffi;
 use fmi2_export::fmi_sys::fmi2::*;
-use fmi2_export::{Causality, ValueType, VariableStore};
 use std::hint::black_box;
-use tailsitter_plant::{vr, PlantModel, Variables};
+use tailsitter_plant::{vr, PlantModel};
+
+#[path = "../benches/support/trimmed.rs"]
+mod trimmed;
 
 fn thread_cpu_time() -> f64 {
     let mut ts = libc::timespec { tv_sec: 0, tv_nsec: 0 };
@@ -31,38 +33,13 @@ fn main() {
     };
     let steps: usize = args.get(2).and_then(|a| a.parse().ok()).unwrap_or(500);
     let get = args.get(3).is_some_and(|a| a == "get");
-    let outputs: Vec<u32> = Variables::VARIABLES
-        .iter()
-        .filter(|s| s.causality == Causality::Output && s.value_type == ValueType::Real)
-        .map(|s| s.value_reference)
-        .collect();
+    let outputs = trimmed::real_outputs();
     let mut values = vec![0.0; outputs.len()];
     let host = fmi2_export::test_host::Host::new();
     // SAFETY: the host outlives the instance, freed below; every call on a live instance
     // in the state it needs.
     unsafe {
-        let inst = host.initializing::<PlantModel>("workload");
-        let ic = [initial_condition];
-        assert_eq!(
-            ffi::set_integer::<PlantModel>(inst, &vr::initial_condition, 1, ic.as_ptr()),
-            fmi2Status_fmi2OK
-        );
-        assert_eq!(
-            ffi::set_real::<PlantModel>(inst, &vr::initial_speed, 1, &speed),
-            fmi2Status_fmi2OK
-        );
-        assert_eq!(ffi::exit_initialization_mode::<PlantModel>(inst), fmi2Status_fmi2OK);
-        let mut trim = [0.0; 2];
-        let trim_vrs = [vr::trim_thrust, vr::trim_elevator];
-        assert_eq!(
-            ffi::get_real::<PlantModel>(inst, trim_vrs.as_ptr(), 2, trim.as_mut_ptr()),
-            fmi2Status_fmi2OK
-        );
-        let cmd_vrs = [vr::thrust_cmd, vr::elevator_cmd];
-        assert_eq!(
-            ffi::set_real::<PlantModel>(inst, cmd_vrs.as_ptr(), 2, trim.as_ptr()),
-            fmi2Status_fmi2OK
-        );
+        let inst = trimmed::trimmed_instance(&host, "workload", initial_condition, speed);
         let h = 0.02;
         let c0 = thread_cpu_time();
         for k in 0..steps {
