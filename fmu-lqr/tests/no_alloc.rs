@@ -19,3 +19,14 @@ fn do_step_does_not_allocate() {
     // The samples ran: the reference now includes the offset (it was 0 at initialisation).
     assert!((vars.ref_pos_e - 5.0).abs() < 1e-9, "{}", vars.ref_pos_e);
 }
+
+#[test]
+fn do_step_in_wind_does_not_allocate() {
+    // A 6 m/s northerly wind in the measurements (ground velocity 6 m/s north at zero
+    // airspeed): the wind estimate, its trim of the reference and the air-data reference
+    // run on every sample.
+    let mut vars = Variables::with_start_values();
+    let n = step_allocations::<LqrModel>(&mut vars, 1000, 0.01, |v| v.vel_n = 6.0, |_, _| {});
+    assert_eq!(n, 0, "allocations on the controller's step path in wind");
+    assert!(vars.ref_pos_e.is_finite());
+}

@@ -368,6 +368,15 @@ fn induced_velocity_by_bisection(a: &Airframe, v: f64, vx: f64, t: f64) -> f64 {
     0.5 * (lo + hi)
 }
 
+/// How closely the induced velocity `exact` at airspeed `v` (axial component `vx`) is
+/// determined in f64: f is evaluated to ≈ ε · (sum of |terms|), so a root is determined to
+/// that over |f'| (ill-conditioned near V' → 0 in descent).
+fn induced_velocity_rounding_limit(exact: f64, v: f64, vx: f64) -> f64 {
+    let terms = exact * exact * (exact * exact + 2.0 * vx.abs() * exact + v * v);
+    let der = (4.0 * exact.powi(3) + 6.0 * vx * exact * exact + 2.0 * v * v * exact).abs();
+    4e-15 * exact + 16.0 * f64::EPSILON * terms / der
+}
+
 #[test]
 fn induced_velocity_is_the_root_to_rounding() {
     // Halley's early stop must not cost accuracy: compare with bisection over forward,
@@ -379,11 +388,7 @@ fn induced_velocity_is_the_root_to_rounding() {
                 let vx = v * c;
                 let w = a.induced_velocity(v, vx, t);
                 let exact = induced_velocity_by_bisection(&a, v, vx, t);
-                // Rounding limit: f is evaluated to ≈ ε · (sum of |terms|), so a root is
-                // determined to that over |f'| (ill-conditioned near V' → 0 in descent).
-                let terms = exact * exact * (exact * exact + 2.0 * vx.abs() * exact + v * v);
-                let der = (4.0 * exact.powi(3) + 6.0 * vx * exact * exact + 2.0 * v * v * exact).abs();
-                let tol = 4e-15 * exact + 16.0 * f64::EPSILON * terms / der;
+                let tol = induced_velocity_rounding_limit(exact, v, vx);
                 assert!((w - exact).abs() <= tol, "V = {v}, V_x = {vx}, T = {t}: {w} vs {exact}");
             }
         }
@@ -401,9 +406,7 @@ fn warm_started_induced_velocity_is_the_same_root() {
                 let vx = v * c;
                 let cold = a.induced_velocity(v, vx, t);
                 let exact = induced_velocity_by_bisection(&a, v, vx, t);
-                let terms = exact * exact * (exact * exact + 2.0 * vx.abs() * exact + v * v);
-                let der = (4.0 * exact.powi(3) + 6.0 * vx * exact * exact + 2.0 * v * v * exact).abs();
-                let tol = 4e-15 * exact + 16.0 * f64::EPSILON * terms / der;
+                let tol = induced_velocity_rounding_limit(exact, v, vx);
                 for f in [0.25, 0.9, 0.995, 1.0, 1.005, 1.1, 4.0] {
                     let warm = a.induced_velocity_from(v, vx, t, f * cold);
                     assert!(
