@@ -200,6 +200,13 @@ fn lerp(a: f64, b: f64, s: f64) -> f64 {
     a + (b - a) * s
 }
 
+/// Linear blend weight of `x` across the band `(lo, hi)`: 0 at or below `lo`, 1 at or above
+/// `hi` (the schedules and the hover-in-wind bands).
+#[inline]
+fn band_weight(x: f64, (lo, hi): (f64, f64)) -> f64 {
+    ((x - lo) / (hi - lo)).clamp(0.0, 1.0)
+}
+
 impl TsdController {
     /// A controller for `mission` with tuning `params`, using `airframe` (its own model of
     /// the aircraft, not necessarily the plant's) for gains and feedback linearisation.
@@ -347,7 +354,7 @@ impl TsdController {
     /// them in and the lateral position diverged after 8 s (README, "Low-speed frame").
     pub fn frame_weight(&self, axial_airspeed: f64) -> f64 {
         let p = &self.params;
-        ((axial_airspeed - p.wind_frame_speed_low) / (p.wind_frame_speed_high - p.wind_frame_speed_low)).clamp(0.0, 1.0)
+        band_weight(axial_airspeed, (p.wind_frame_speed_low, p.wind_frame_speed_high))
     }
 
     /// Design every loop at flight condition `fc` (gain scheduling, §4.2): the models of
@@ -359,7 +366,7 @@ impl TsdController {
         let m = af.mass;
         let (vv, vl) = (self.mission.v_vertical, self.mission.v_level);
         let v = fc.airspeed.max(p.min_airspeed);
-        let sched = ((fc.airspeed - vv) / (vl - vv)).clamp(0.0, 1.0);
+        let sched = band_weight(fc.airspeed, (vv, vl));
         // Tuned configuration, hover in wind: the path frame (README, "Hover in a span-wise
         // wind"; κ = 0 in still air hover anyway, axial airspeed < 4 m/s).
         let kappa = self.frame_weight(fc.axial_airspeed) * (1.0 - fc.hover_wind);
@@ -386,7 +393,7 @@ impl TsdController {
             if fc.reference_airspeed > vv + 1.0 {
                 sched
             } else {
-                ((fc.axial_airspeed - vv) / (vl - vv)).clamp(0.0, 1.0)
+                band_weight(fc.axial_airspeed, (vv, vl))
             }
         } else {
             sched
@@ -430,10 +437,7 @@ impl TsdController {
         let normal_model = gains::normal_model(kappa * a11_n, a21_n, a22_n, b2, z_alpha);
         // Hover in a strong crossflow (tuned): slower normal poles (README, "Hover in a
         // span-wise wind"); factor 1 elsewhere.
-        let strong = {
-            let (lo, hi) = HOVER_WIND_NORMAL_CROSSFLOW;
-            fc.hover_wind * ((fc.crossflow - lo) / (hi - lo)).clamp(0.0, 1.0)
-        };
+        let strong = fc.hover_wind * band_weight(fc.crossflow, HOVER_WIND_NORMAL_CROSSFLOW);
         let n_scale = lerp(1.0, HOVER_WIND_NORMAL_POLE_FACTOR, strong);
         let normal_poly = gains::char_poly_3(
             n_scale * blend(p.normal_pole_real_vertical, p.normal_pole_real_level),
@@ -659,8 +663,7 @@ impl SampledUnit for TsdController {
             .max(0.0)
             .sqrt();
         let hover_wind = if p.configuration == 0 && reference.airspeed <= self.mission.v_vertical + 1.0 {
-            let (lo, hi) = HOVER_WIND_CROSSFLOW;
-            ((crossflow - lo) / (hi - lo)).clamp(0.0, 1.0)
+            band_weight(crossflow, HOVER_WIND_CROSSFLOW)
         } else {
             0.0
         };
@@ -886,8 +889,7 @@ impl SampledUnit for TsdController {
         // (D = √(2A/π) each of disc area A/2), so
         // N̂/I_zz = ½ρSb C_nβ/I_zz · v [(1 − η) V̄ + η (V̄ + 2w)]. Zero in still air (β = 0).
         let weathercock_ff = if p.configuration == 0 && sigma_ground.is_none() {
-            let (lo, hi) = HOVER_WEATHERCOCK_CROSSFLOW;
-            let weight = ((crossflow - lo) / (hi - lo)).clamp(0.0, 1.0) * (1.0 - kappa);
+            let weight = band_weight(crossflow, HOVER_WEATHERCOCK_CROSSFLOW) * (1.0 - kappa);
             let eta = (2.0 * (2.0 * af.prop_disc_area / core::f64::consts::PI).sqrt() / af.wing_span).min(1.0);
             let v_lat = meas.airspeed * meas.beta.sin();
             let v_s = meas.airspeed + 2.0 * meas.induced_velocity.max(0.0);
