@@ -231,6 +231,10 @@ pub struct LqrController {
     ground_active: bool,
     /// The last DARE solution of the 14-state design, in the Euler set `rep` (warm start).
     warm_p: Option<SMatrix<f64, NR, NR>>,
+    /// The two solutions before `warm_p` (same Euler set, consecutive), for extrapolation.
+    warm_hist: [SMatrix<f64, NR, NR>; 2],
+    /// How many of `warm_hist` are valid.
+    warm_len: usize,
     /// Recompute every accepted warm solve cold and record the difference (tests).
     verify_warm: bool,
 }
@@ -257,14 +261,17 @@ pub const NR: usize = 1 + NX;
 /// Size of the augmented ZOH exponential of that design.
 const NRM: usize = NR + NU;
 
-/// Warm start of the DARE (README, "Riccati"): one Newton step from the previous P is tried
-/// only when that P's relative DARE residual on the new model is at most this (a start
-/// close enough for one quadratic step to reach rounding; a farther start goes cold at once).
-pub const WARM_MAX_START_RESIDUAL: f64 = 1e-4;
-/// Newton steps of the warm start before it gives up and solves cold.
-pub const WARM_MAX_NEWTON_STEPS: usize = 2;
+/// Warm start of the DARE (README, "Riccati"): a Newton step from the extrapolated previous
+/// P is tried only when that start's relative DARE residual on the new model is at most this
+/// (close enough for one quadratic step to reach rounding; a farther start goes cold at
+/// once, having cost only the residual).
+pub const WARM_MAX_START_RESIDUAL: f64 = 1e-7;
+/// Newton steps of the warm start before it gives up and solves cold. One: a step (Smith's
+/// doubling of the Stein equation, ≈ 13 doublings like the cold SDA's: the slow closed-loop
+/// poles set both counts) costs ≈ 0.55 of the cold solve, so a second step loses.
+pub const WARM_MAX_NEWTON_STEPS: usize = 1;
 /// A further Newton step is taken only from a residual at most this.
-pub const WARM_MAX_STEP_RESIDUAL: f64 = 1e-6;
+pub const WARM_MAX_STEP_RESIDUAL: f64 = 1e-7;
 /// The warm solution is accepted when its relative DARE residual is at most this (the cold
 /// doubling reaches ≈ 1e-16); otherwise the cold doubling solves again.
 pub const WARM_MAX_RESIDUAL: f64 = 1e-13;
@@ -481,6 +488,8 @@ impl LqrController {
             ground: GroundPhases::new(mission, airframe.mass * airframe.gravity),
             ground_active: false,
             warm_p: None,
+            warm_hist: [SMatrix::zeros(); 2],
+            warm_len: 0,
             verify_warm: false,
         };
         // Initial gains on the trajectory's start point, so a failure shows at construction.
@@ -955,6 +964,10 @@ impl LqrController {
         for v in self.warm_p.unwrap_or_else(SMatrix::zeros).iter() {
             out(*v);
         }
+        out(self.warm_len as f64);
+        for v in self.warm_hist.iter().flat_map(|m| m.iter()) {
+            out(*v);
+        }
     }
 
     /// Positions in the [`Self::save`] layout of the controller's continuous states, with
@@ -1013,6 +1026,16 @@ impl LqrController {
             *v = take()?;
         }
         self.warm_p = has_warm.then_some(p);
+        let len = take()?;
+        if !(0.0..=2.0).contains(&len) || len.fract() != 0.0 {
+            return Err(ControlError(format!("LQR controller state: warm-start history {len}")));
+        }
+        self.warm_len = len as usize;
+        for m in self.warm_hist.iter_mut() {
+            for v in m.iter_mut() {
+                *v = take()?;
+            }
+        }
         Ok(())
     }
 }
@@ -1246,8 +1269,18 @@ impl SampledUnit for LqrController {
                 x_lin[ix::ALPHA] = 0.0;
                 x_lin[ix::BETA] = 0.0;
             }
-            // Warm start from the previous P when it is in the same Euler set.
-            let warm = if rep == self.rep { self.warm_p } else { None };
+            // Warm start: the previous solutions in the same Euler set, extrapolated (quadratic
+            // through the last three, linear through two, else the last).
+            let warm = if rep == self.rep {
+                self.warm_p.map(|p1| match self.warm_len {
+                    0 => p1,
+                    1 => p1 * 2.0 - self.warm_hist[0],
+                    _ => p1 * 3.0 - self.warm_hist[0] * 3.0 + self.warm_hist[1],
+                })
+            } else {
+                self.warm_len = 0;
+                None
+            };
             match self.solve_gain_warm(rep, &x_lin, &reference.u, t, warm.as_ref()) {
                 Ok(sol) => {
                     if sol.warm {
@@ -1264,6 +1297,13 @@ impl SampledUnit for LqrController {
                     self.gain = sol.gain;
                     self.have_gain = true;
                     self.stats.last_spectral_radius = sol.spectral_radius;
+                    if let (Some(_), Some(old)) = (sol.p, self.warm_p) {
+                        self.warm_hist[1] = self.warm_hist[0];
+                        self.warm_hist[0] = old;
+                        self.warm_len = (self.warm_len + 1).min(2);
+                    } else {
+                        self.warm_len = 0;
+                    }
                     self.warm_p = sol.p;
                 }
                 Err(e) => {

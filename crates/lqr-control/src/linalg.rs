@@ -518,7 +518,7 @@ pub fn dare_newton_step<const N: usize, const U: usize>(
     let mut res = ptp * phi - p0 - (ptp * gamma) * k0 + q;
     symmetrise(&mut res);
     let rel_res = res.norm() / p0.norm().max(f64::MIN_POSITIVE);
-    if !(rel_res <= max_residual) {
+    if rel_res.is_nan() || rel_res > max_residual {
         return Err(RiccatiError::Residual(rel_res));
     }
     let ac = phi - gamma * k0;
@@ -1205,6 +1205,36 @@ mod tests {
             if fused_build() { s_fused } else { s_plain }
         );
         assert!((s_fused - s_plain).abs() <= 1e-12 * s_plain);
+    }
+
+    #[test]
+    fn newton_step_converges_quadratically_to_the_doubling_solution() {
+        // A 9-state, 3-input problem: from P perturbed by ε (relative), one Newton step leaves
+        // an error O(ε²); a far start is refused before the doubling.
+        let phi = test_matrix::<9, 9>(6) * 0.4 + SMatrix::<f64, 9, 9>::identity();
+        let gamma = test_matrix::<9, 3>(7);
+        let q = SMatrix::<f64, 9, 9>::from_diagonal(&SVector::<f64, 9>::from_fn(|i, _| 1.0 + i as f64));
+        let r = SVector::<f64, 3>::new(0.5, 2.0, 7.0);
+        let p = dare_sda(&phi, &gamma, &q, &r).unwrap();
+        let d = test_matrix::<9, 9>(8);
+        let sym = (d + d.transpose()) * (0.5 * p.amax() / d.amax());
+        let mut p1 = p;
+        for eps in [1e-3, 1e-4, 1e-5] {
+            let rel;
+            (p1, rel) = dare_newton_step(&phi, &gamma, &q, &r, &(p + sym * eps), 1.0).unwrap();
+            let err = (p1 - p).amax() / p.amax();
+            // Measured: 4.4e2 ε² (this random pair is poorly conditioned).
+            assert!(rel > 0.1 * eps && rel < 10.0 * eps, "{rel} vs {eps}");
+            assert!(err < 1e3 * eps * eps, "ε = {eps}: error {err}");
+            assert_eq!(p1, p1.transpose());
+        }
+        // A second step from the last: at rounding.
+        let (p2, _) = dare_newton_step(&phi, &gamma, &q, &r, &p1, 1.0).unwrap();
+        assert!((p2 - p).amax() < 1e-12 * p.amax(), "{}", (p2 - p).amax() / p.amax());
+        assert!(matches!(
+            dare_newton_step(&phi, &gamma, &q, &r, &(p + sym * 1e-2), 1e-9),
+            Err(RiccatiError::Residual(_))
+        ));
     }
 
     #[test]
