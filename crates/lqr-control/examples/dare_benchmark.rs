@@ -96,7 +96,10 @@ fn main() {
     let warm = c.solve_gain(rep, &prev.state(rep), &prev.u, t - 0.2).expect("gain").p;
     let warm_accepted = c.solve_gain_warm(rep, &x, &p.u, t, warm.as_ref()).expect("gain").warm;
     let (warm_wall, warm_cpu) = time_us(batches, || {
-        black_box(c.solve_gain_warm(rep, black_box(&x), &p.u, t, warm.as_ref()).expect("gain"));
+        black_box(
+            c.solve_gain_warm(rep, black_box(&x), &p.u, t, warm.as_ref())
+                .expect("gain"),
+        );
     });
     let pp = dare_sda(&sol.phi, &sol.gamma, &q, &w.r).expect("dare");
     let k = lqr_gain(&sol.phi, &sol.gamma, &pp, &w.r).expect("gain");

@@ -1278,6 +1278,8 @@ impl SampledUnit for LqrController {
                     _ => p1 * 3.0 - self.warm_hist[0] * 3.0 + self.warm_hist[1],
                 })
             } else {
+                // A P of the other Euler set is no start (nor history) for this one.
+                self.warm_p = None;
                 self.warm_len = 0;
                 None
             };
