@@ -1,7 +1,8 @@
 //! Criterion benchmarks of the LQR's gain computation and of the native LQR mission
 //! (issue 17): DARE + gain on the 17×17 / 17×7 matrices of the default mission at
 //! t = 15 s (level flight) and t = 2 s (vertical flight); one whole relinearisation
-//! (model Jacobians + ZOH + DARE + gain + residual and stability checks); the default
+//! (model Jacobians + ZOH + DARE + gain + residual and stability checks), cold and
+//! warm-started from the previous period's solution (`relinearisation_warm_…`); the default
 //! mission flown natively (plant + LQR through `closed-loop`, Gauss-Seidel, 20 ms).
 //!
 //! `cargo bench -p lqr-control --bench gain`
@@ -38,6 +39,18 @@ fn gain(c: &mut Criterion) {
         });
         c.bench_function(&format!("relinearisation_t{t}"), |b| {
             b.iter(|| ctl.solve_gain(rep, black_box(&x), &p.u, t).unwrap())
+        });
+        // Warm: started from the solution one relinearisation period (0.2 s) earlier on the
+        // reference, as the controller does in a steady segment (one Newton step accepted).
+        let p_prev = ctl.trajectory().at(t - 0.2);
+        let warm = ctl
+            .solve_gain(rep, &p_prev.state(rep), &p_prev.u, t - 0.2)
+            .unwrap()
+            .p
+            .unwrap();
+        assert!(ctl.solve_gain_warm(rep, &x, &p.u, t, Some(&warm)).unwrap().warm);
+        c.bench_function(&format!("relinearisation_warm_t{t}"), |b| {
+            b.iter(|| ctl.solve_gain_warm(rep, black_box(&x), &p.u, t, Some(&warm)).unwrap())
         });
         // The model's Jacobians alone: analytic (the default) against central differences.
         let af = Airframe::default();

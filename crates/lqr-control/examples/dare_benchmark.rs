@@ -90,6 +90,17 @@ fn main() {
         let pp = dare_sda(black_box(&sol.phi), &sol.gamma, &q, &w.r).expect("dare");
         black_box(lqr_gain(&sol.phi, &sol.gamma, &pp, &w.r).expect("gain"));
     });
+    // Warm-started relinearisation from the solution one period (0.2 s) earlier on the
+    // reference (the controller's steady-segment case).
+    let prev = c.trajectory().at(t - 0.2);
+    let warm = c.solve_gain(rep, &prev.state(rep), &prev.u, t - 0.2).expect("gain").p;
+    let warm_accepted = c.solve_gain_warm(rep, &x, &p.u, t, warm.as_ref()).expect("gain").warm;
+    let (warm_wall, warm_cpu) = time_us(batches, || {
+        black_box(
+            c.solve_gain_warm(rep, black_box(&x), &p.u, t, warm.as_ref())
+                .expect("gain"),
+        );
+    });
     let pp = dare_sda(&sol.phi, &sol.gamma, &q, &w.r).expect("dare");
     let k = lqr_gain(&sol.phi, &sol.gamma, &pp, &w.r).expect("gain");
     let r = DMatrix::<f64>::from_diagonal(&nalgebra::DVector::from_column_slice(w.r.as_slice()));
@@ -110,11 +121,14 @@ fn main() {
         "us_dare_and_gain": dare_cpu,
         "us_wall_relinearise_discretise_dare_checks": full_wall,
         "us_wall_dare_and_gain": dare_wall,
+        "us_relinearise_warm": warm_cpu,
+        "us_wall_relinearise_warm": warm_wall,
     });
     let path = out.join(format!("dare_case_{t}.json"));
     std::fs::write(&path, serde_json::to_string_pretty(&json).expect("json")).expect("write");
     println!(
-        "t = {t} s ({rep:?}), medians of {batches} batches, CPU (wall) µs per call: relinearisation + ZOH + DARE + checks {full_cpu:.1} ({full_wall:.1}), DARE + gain {dare_cpu:.1} ({dare_wall:.1}) -> {}",
+        "t = {t} s ({rep:?}), medians of {batches} batches, CPU (wall) µs per call: relinearisation + ZOH + DARE + checks {full_cpu:.1} ({full_wall:.1}), warm-started {warm_cpu:.1} ({warm_wall:.1}, warm start {}), DARE + gain {dare_cpu:.1} ({dare_wall:.1}) -> {}",
+        if warm_accepted { "accepted" } else { "refused: cold" },
         path.display()
     );
 }

@@ -27,7 +27,8 @@ use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 use tailsitter_physics::{Airframe, Surfaces};
 
 use linalg::{
-    dare_residual, dare_sda, discretise_zoh, lqr_gain, riccati_backward, spectral_radius_bound, RiccatiError,
+    dare_newton_step, dare_residual, dare_sda, discretise_zoh, lqr_gain, riccati_backward, spectral_radius_bound,
+    RiccatiError,
 };
 use model::{ix, linearise, state_of, wrap_pi, EulerRep, I_POS, NA, NU, NX, U, X};
 use trajectory::{TrajPoint, Trajectory, TrajectoryMode, TrajectoryOptions};
@@ -188,6 +189,11 @@ pub struct GainStats {
     pub fallbacks: u64,
     /// Spectral-radius bound of the last accepted closed loop Φ − ΓK.
     pub last_spectral_radius: f64,
+    /// Solves whose warm start (one Newton step from the previous P) was accepted.
+    pub warm_solves: u64,
+    /// With [`LqrController::verify_warm_start`]: the largest relative difference
+    /// max|K_warm − K_cold| / max|K_cold| over the accepted warm solves.
+    pub warm_max_gain_error: f64,
 }
 
 /// The LQR flight controller.
@@ -223,6 +229,14 @@ pub struct LqrController {
     ground: GroundPhases,
     /// Whether the last sample flew a take-off / landing reference (position integrators on).
     ground_active: bool,
+    /// The last DARE solution of the 14-state design, in the Euler set `rep` (warm start).
+    warm_p: Option<SMatrix<f64, NR, NR>>,
+    /// The two solutions before `warm_p` (same Euler set, consecutive), for extrapolation.
+    warm_hist: [SMatrix<f64, NR, NR>; 2],
+    /// How many of `warm_hist` are valid.
+    warm_len: usize,
+    /// Recompute every accepted warm solve cold and record the difference (tests).
+    verify_warm: bool,
 }
 
 /// Names of the commands, for [`Notice::Saturated`].
@@ -235,6 +249,107 @@ pub struct GainSolution {
     pub phi: SMatrix<f64, NA, NA>,
     pub gamma: SMatrix<f64, NA, NU>,
     pub spectral_radius: f64,
+    /// The DARE solution of the design on the [∫ΔV; x] block (inert position integrators,
+    /// `riccati_method` 0): the warm start of the next solve. `None` otherwise.
+    pub p: Option<SMatrix<f64, NR, NR>>,
+    /// Whether the warm start was accepted (else the DARE was solved cold).
+    pub warm: bool,
+}
+
+/// Size of the design when the position integrators are inert: integrator + model states.
+pub const NR: usize = 1 + NX;
+/// Size of the augmented ZOH exponential of that design.
+const NRM: usize = NR + NU;
+
+/// Warm start of the DARE (README, "Riccati"): a Newton step from the extrapolated previous
+/// P is tried only when that start's relative DARE residual on the new model is at most this
+/// (close enough for one quadratic step to reach rounding; a farther start goes cold at
+/// once, having cost only the residual).
+pub const WARM_MAX_START_RESIDUAL: f64 = 1e-7;
+/// Newton steps of the warm start before it gives up and solves cold. One: a step (Smith's
+/// doubling of the Stein equation, ≈ 13 doublings like the cold SDA's: the slow closed-loop
+/// poles set both counts) costs ≈ 0.55 of the cold solve, so a second step loses.
+pub const WARM_MAX_NEWTON_STEPS: usize = 1;
+/// A further Newton step is taken only from a residual at most this.
+pub const WARM_MAX_STEP_RESIDUAL: f64 = 1e-7;
+/// The warm solution is accepted when its relative DARE residual is at most this (the cold
+/// doubling reaches ≈ 1e-16); otherwise the cold doubling solves again.
+pub const WARM_MAX_RESIDUAL: f64 = 1e-13;
+
+/// Discretised model, gain and closed-loop spectral-radius bound of one design.
+struct Design<const N: usize> {
+    k: SMatrix<f64, NU, N>,
+    phi: SMatrix<f64, N, N>,
+    gamma: SMatrix<f64, N, NU>,
+    rho: f64,
+    /// The DARE solution (`riccati_method` 0).
+    p: Option<SMatrix<f64, N, N>>,
+    /// Whether the warm start was accepted.
+    warm: bool,
+}
+
+/// ZOH discretisation of (A, B) over `ts` (`M` = N + NU), gain by the DARE (`riccati_method`
+/// 0, residual checked; warm-started by one Newton step from `warm` when given and close
+/// enough, else the cold doubling) or the backward iteration (1), and the stability check of
+/// Φ − ΓK against `limit`.
+#[allow(clippy::too_many_arguments)]
+fn design<const N: usize, const M: usize>(
+    a: &SMatrix<f64, N, N>,
+    b: &SMatrix<f64, N, NU>,
+    q_diag: &SVector<f64, N>,
+    r: &SVector<f64, NU>,
+    ts: f64,
+    params: &LqrParams,
+    limit: f64,
+    warm: Option<&SMatrix<f64, N, N>>,
+) -> Result<Design<N>, RiccatiError> {
+    let (phi, gamma) = discretise_zoh::<N, NU, M>(a, b, ts);
+    let q = SMatrix::<f64, N, N>::from_diagonal(q_diag);
+    let (k, p, warm) = if params.riccati_method == 0 {
+        // Warm: Newton steps from the previous P, accepted on the residual.
+        let warm_solution = warm.and_then(|p0| {
+            let mut p = *p0;
+            let mut max_start = WARM_MAX_START_RESIDUAL;
+            for _ in 0..WARM_MAX_NEWTON_STEPS {
+                p = dare_newton_step(&phi, &gamma, &q, r, &p, max_start).ok()?.0;
+                let k = lqr_gain(&phi, &gamma, &p, r).ok()?;
+                let res = dare_residual(&phi, &gamma, &q, &p, &k);
+                if res <= WARM_MAX_RESIDUAL {
+                    return Some((k, p));
+                }
+                // The next step starts from here: it must converge at once.
+                max_start = WARM_MAX_STEP_RESIDUAL;
+            }
+            None
+        });
+        match warm_solution {
+            Some((k, p)) => (k, Some(p), true),
+            None => {
+                let p = dare_sda(&phi, &gamma, &q, r)?;
+                let k = lqr_gain(&phi, &gamma, &p, r)?;
+                let res = dare_residual(&phi, &gamma, &q, &p, &k);
+                if res.is_nan() || res >= 1e-6 {
+                    return Err(RiccatiError::Residual(res));
+                }
+                (k, Some(p), false)
+            }
+        }
+    } else {
+        let k = riccati_backward(&phi, &gamma, &q, r, params.riccati_horizon as usize, None)?.0;
+        (k, None, false)
+    };
+    let rho = spectral_radius_bound(&(phi - gamma * k));
+    if rho.is_nan() || rho >= limit {
+        return Err(RiccatiError::Unstable(rho));
+    }
+    Ok(Design {
+        k,
+        phi,
+        gamma,
+        rho,
+        p,
+        warm,
+    })
 }
 
 impl LqrController {
@@ -372,6 +487,10 @@ impl LqrController {
             wind_shift: Vector3::zeros(),
             ground: GroundPhases::new(mission, airframe.mass * airframe.gravity),
             ground_active: false,
+            warm_p: None,
+            warm_hist: [SMatrix::zeros(); 2],
+            warm_len: 0,
+            verify_warm: false,
         };
         // Initial gains on the trajectory's start point, so a failure shows at construction.
         let p0 = c.trajectory.at(0.0);
@@ -422,6 +541,13 @@ impl LqrController {
         self.params.position_integral != 0 || self.ground_active && j == 2
     }
 
+    /// With `on`, every accepted warm-started gain is recomputed cold and the largest relative
+    /// difference kept in [`GainStats::warm_max_gain_error`] (a check for tests; doubles the
+    /// cost of those solves).
+    pub fn verify_warm_start(&mut self, on: bool) {
+        self.verify_warm = on;
+    }
+
     /// The position integrators ∫ΔN, ∫ΔE, ∫Δh (m·s) and the wind estimate (NED, m/s).
     pub fn integrator_states(&self) -> (f64, Vector3<f64>, Vector3<f64>) {
         (self.integrator, self.pos_integrator, self.wind)
@@ -464,7 +590,25 @@ impl LqrController {
     /// for λ = 0 `Φ_I ≈ [1 T_s H_I; 0 Φ]`; the printed (3.2.13) has T_s in the (1,1)
     /// position and Γ_I's first row is not zero but O(T_s²). The small leak λ
     /// (`integrator_leak`) makes the augmented pair stabilisable (see [`LqrParams`]).
+    ///
+    /// The DARE is solved cold (structured doubling); [`Self::solve_gain_warm`] starts from a
+    /// previous solution.
     pub fn solve_gain(&self, rep: EulerRep, x: &X, u: &U, t: f64) -> Result<GainSolution, RiccatiError> {
+        self.solve_gain_warm(rep, x, u, t, None)
+    }
+
+    /// [`Self::solve_gain`] with the DARE warm-started from `warm`, the [`GainSolution::p`] of
+    /// an earlier solve (README, "Riccati"): one Newton step, accepted when the residual of its
+    /// result is ≤ [`WARM_MAX_RESIDUAL`], else the cold doubling. Only the design with inert
+    /// position integrators (the default) is warm-started.
+    pub fn solve_gain_warm(
+        &self,
+        rep: EulerRep,
+        x: &X,
+        u: &U,
+        t: f64,
+        warm: Option<&SMatrix<f64, NR, NR>>,
+    ) -> Result<GainSolution, RiccatiError> {
         let mut xl = *x;
         // Keep the linearisation point inside the model's domain (V > 0, away from the
         // Euler singularity the rep choice avoids anyway).
@@ -492,22 +636,8 @@ impl LqrController {
         if !a.iter().chain(b.iter()).all(|v| v.is_finite()) {
             return Err(RiccatiError::NonFinite);
         }
-        let (phi, gamma) = discretise_zoh::<NA, NU, NM>(&a, &b, self.mission.sample_time);
         let w: Weights = self.schedule.at(&self.mission, t);
-        let q = SMatrix::<f64, NA, NA>::from_diagonal(&w.q);
-        let r: SVector<f64, NU> = w.r;
-        let k = if self.params.riccati_method == 0 {
-            let p = dare_sda(&phi, &gamma, &q, &r)?;
-            let k = lqr_gain(&phi, &gamma, &p, &r)?;
-            let res = dare_residual(&phi, &gamma, &q, &p, &k);
-            if res.is_nan() || res >= 1e-6 {
-                return Err(RiccatiError::Residual(res));
-            }
-            k
-        } else {
-            riccati_backward(&phi, &gamma, &q, &r, self.params.riccati_horizon as usize, None)?.0
-        };
-        let rho = spectral_radius_bound(&(phi - gamma * k));
+        let ts = self.mission.sample_time;
         // With the undamped integrator (leak 0, thesis) the integrator-minus-along-track
         // mode sits at z = 1 whatever the gain: accept the marginal bound (a Jordan block at
         // z = 1 raises the 2¹⁶-power bound to at most (2¹⁶)^(1/2¹⁶) ≈ 1 + 1.7e-4).
@@ -516,14 +646,51 @@ impl LqrController {
         } else {
             1.0
         };
-        if rho.is_nan() || rho >= limit {
-            return Err(RiccatiError::Unstable(rho));
+        if (0..3).any(|j| self.position_integral_on(j)) {
+            let d = design::<NA, NM>(&a, &b, &w.q, &w.r, ts, &self.params, limit, None)?;
+            return Ok(GainSolution {
+                gain: d.k,
+                phi: d.phi,
+                gamma: d.gamma,
+                spectral_radius: d.rho,
+                p: None,
+                warm: false,
+            });
         }
+        // Inert position integrators (the default): they are decoupled (ẋ_Ip = −x_Ip, no
+        // input), so Φ, Γ, P are block-diagonal and their gain columns zero. The design runs
+        // on the leading [∫ΔV; x] block alone (NR = 14 states: ≈ 0.56× the cubic work of 17)
+        // and the result is embedded: the same gains to rounding (an inert state only ever
+        // adds exact zeros to the full problem's sums).
+        let d = design::<NR, NRM>(
+            &a.fixed_view::<NR, NR>(0, 0).into_owned(),
+            &b.fixed_view::<NR, NU>(0, 0).into_owned(),
+            &w.q.fixed_rows::<NR>(0).into_owned(),
+            &w.r,
+            ts,
+            &self.params,
+            limit,
+            warm,
+        )?;
+        let mut k = Gain::zeros();
+        k.fixed_view_mut::<NU, NR>(0, 0).copy_from(&d.k);
+        let mut phi = SMatrix::<f64, NA, NA>::zeros();
+        phi.fixed_view_mut::<NR, NR>(0, 0).copy_from(&d.phi);
+        let inert = (-ts).exp();
+        for j in NR..NA {
+            phi[(j, j)] = inert;
+        }
+        let mut gamma = SMatrix::<f64, NA, NU>::zeros();
+        gamma.fixed_view_mut::<NR, NU>(0, 0).copy_from(&d.gamma);
+        // The inert block's eigenvalue e^{−T_s} joins the spectrum of the closed loop.
+        let rho = d.rho.max(inert);
         Ok(GainSolution {
             gain: k,
             phi,
             gamma,
             spectral_radius: rho,
+            p: d.p,
+            warm: d.warm,
         })
     }
 
@@ -792,6 +959,15 @@ impl LqrController {
         }
         self.ground.save(out);
         out(f64::from(u8::from(self.ground_active)));
+        out(self.stats.warm_solves as f64);
+        out(f64::from(u8::from(self.warm_p.is_some())));
+        for v in self.warm_p.unwrap_or_else(SMatrix::zeros).iter() {
+            out(*v);
+        }
+        out(self.warm_len as f64);
+        for v in self.warm_hist.iter().flat_map(|m| m.iter()) {
+            out(*v);
+        }
     }
 
     /// Positions in the [`Self::save`] layout of the controller's continuous states, with
@@ -843,6 +1019,23 @@ impl LqrController {
             .restore(&mut || take().ok())
             .ok_or_else(|| ControlError("truncated LQR controller state".into()))?;
         self.ground_active = take()? != 0.0;
+        self.stats.warm_solves = take()? as u64;
+        let has_warm = take()? != 0.0;
+        let mut p = SMatrix::<f64, NR, NR>::zeros();
+        for v in p.iter_mut() {
+            *v = take()?;
+        }
+        self.warm_p = has_warm.then_some(p);
+        let len = take()?;
+        if !(0.0..=2.0).contains(&len) || len.fract() != 0.0 {
+            return Err(ControlError(format!("LQR controller state: warm-start history {len}")));
+        }
+        self.warm_len = len as usize;
+        for m in self.warm_hist.iter_mut() {
+            for v in m.iter_mut() {
+                *v = take()?;
+            }
+        }
         Ok(())
     }
 }
@@ -1076,11 +1269,44 @@ impl SampledUnit for LqrController {
                 x_lin[ix::ALPHA] = 0.0;
                 x_lin[ix::BETA] = 0.0;
             }
-            match self.solve_gain(rep, &x_lin, &reference.u, t) {
+            // Warm start: the previous solutions in the same Euler set, extrapolated (quadratic
+            // through the last three, linear through two, else the last).
+            let warm = if rep == self.rep {
+                self.warm_p.map(|p1| match self.warm_len {
+                    0 => p1,
+                    1 => p1 * 2.0 - self.warm_hist[0],
+                    _ => p1 * 3.0 - self.warm_hist[0] * 3.0 + self.warm_hist[1],
+                })
+            } else {
+                // A P of the other Euler set is no start (nor history) for this one.
+                self.warm_p = None;
+                self.warm_len = 0;
+                None
+            };
+            match self.solve_gain_warm(rep, &x_lin, &reference.u, t, warm.as_ref()) {
                 Ok(sol) => {
+                    if sol.warm {
+                        self.stats.warm_solves += 1;
+                        if self.verify_warm {
+                            if let Ok(cold) = self.solve_gain(rep, &x_lin, &reference.u, t) {
+                                let e = (sol.gain - cold.gain).amax() / cold.gain.amax();
+                                self.stats.warm_max_gain_error = self.stats.warm_max_gain_error.max(e);
+                            } else {
+                                self.stats.warm_max_gain_error = f64::INFINITY;
+                            }
+                        }
+                    }
                     self.gain = sol.gain;
                     self.have_gain = true;
                     self.stats.last_spectral_radius = sol.spectral_radius;
+                    if let (Some(_), Some(old)) = (sol.p, self.warm_p) {
+                        self.warm_hist[1] = self.warm_hist[0];
+                        self.warm_hist[0] = old;
+                        self.warm_len = (self.warm_len + 1).min(2);
+                    } else {
+                        self.warm_len = 0;
+                    }
+                    self.warm_p = sol.p;
                 }
                 Err(e) => {
                     self.stats.fallbacks += 1;
