@@ -476,7 +476,7 @@ impl Plant {
     /// One internal step of [`Integrator::Dp5Checked`] from `s` (where f = `k1`): the
     /// result and f there (at the projected state: the next step's first stage).
     #[allow(clippy::too_many_arguments)]
-    #[inline(never)]
+    #[inline(always)]
     fn dp5_checked_step(
         &self,
         s: &StateVector,
