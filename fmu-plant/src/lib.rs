@@ -148,7 +148,7 @@ impl PlantModel {
     /// Write every output from the state and the current inputs, and the Model Exchange
     /// derivatives `der_*`: ẋ = f(x, u, wind) ([`Plant::derivatives`]). An ME solver
     /// integrates the quaternion without the renormalisation the CS integrator applies after
-    /// each RK4 step, so f is evaluated at the unit quaternion (the attitude the state
+    /// each internal step, so f is evaluated at the unit quaternion (the attitude the state
     /// represents); its norm drift stays within the solver tolerance. The thrust and servo
     /// derivatives keep those states in range by construction: the targets are saturated (the
     /// state relaxes towards a value inside the range, so at a bound the derivative never

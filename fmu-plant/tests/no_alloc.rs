@@ -1,4 +1,4 @@
-//! The plant's step path (`FmuModel::do_step`: RK4 substeps; the outputs after it) does
+//! The plant's step path (`FmuModel::do_step`: the integrator's internal steps; the outputs after it) does
 //! not allocate; the export layer's own path is proven in crates/fmi2-export.
 
 use fmi2_export::testing::{allocations, CountingAllocator};

@@ -570,6 +570,7 @@ impl Ekf {
             model: {
                 let mut m = Plant::new(params.airframe);
                 m.integration_step = MODEL_STEP;
+                m.integrator = tailsitter_physics::Integrator::Rk4;
                 m.aero.model =
                     tailsitter_physics::AeroModel::from_index(params.prediction.aero_model).unwrap_or_default();
                 m

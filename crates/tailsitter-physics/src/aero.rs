@@ -145,7 +145,7 @@ impl Airframe {
     }
 
     /// [`Airframe::induced_velocity`] warm-started from `start` (a nearby root, e.g. the
-    /// previous RK4 stage's; NaN or ≤ 0 for a cold start). From a warm start Halley's method
+    /// previous integration stage's; NaN or ≤ 0 for a cold start). From a warm start Halley's method
     /// runs without the bracket and stops on the same test (a Halley step ≤ 1e-6 w, after
     /// which the error is O(1e-18) w by cubic convergence: the root to rounding, whatever the
     /// start); if it does not within [`WARM_ITERATIONS`] iterations, or leaves w > 0, the cold,

@@ -4,7 +4,7 @@
 //!
 //! * [`Airframe`]: parameters (App. C, docs/DESIGN.md §4) and the force/moment model
 //!   [`Airframe::forces_moments`] (§2.3) that controllers use for their own models.
-//! * [`Plant`]: the 20-state plant: derivatives, fixed-step RK4 [`Plant::advance`], outputs,
+//! * [`Plant`]: the 20-state plant: derivatives, fixed-step Runge–Kutta [`Plant::advance`], outputs,
 //!   trims ([`Plant::trim_level`], [`Plant::trim_vertical_climb`]) and [`Plant::linearise`].
 //! * [`attitude`]: quaternion (A.2.8, scalar last), DCMs and Euler angles (3-2-1, 2-3-1).
 //!
@@ -34,7 +34,7 @@ pub use attitude::{
 pub use error::PhysicsError;
 pub use global_aero::{AeroDiagnostics, AeroModel, AeroRegime, GlobalAero};
 pub use ground::{ContactState, Ground};
-pub use plant::{Envelope, Outputs, Plant, Trim, MAX_SUBSTEPS};
+pub use plant::{dp5, Envelope, Integrator, Outputs, Plant, Trim, DEFAULT_INTEGRATION_STEP, MAX_SUBSTEPS};
 
 use nalgebra::SVector;
 

@@ -1,5 +1,6 @@
-//! The 20-state plant: state derivatives (§2.2, §2.3, App. D.5), fixed-step RK4, outputs,
-//! trims and linearisation.
+//! The 20-state plant: state derivatives (§2.2, §2.3, App. D.5), fixed-step Runge–Kutta
+//! integration (Dormand–Prince 5 with checked steps, or RK4), outputs, trims and
+//! linearisation.
 
 use crate::numeric::central_differences;
 use nalgebra::{SMatrix, Vector3, Vector4};
@@ -13,7 +14,7 @@ use crate::ground::{ContactState, Ground};
 use crate::idx::{self, *};
 use crate::{InputVector, StateVector, N_INPUTS, N_STATES};
 
-/// Limits of the sane envelope checked by [`Plant::advance`] after every RK4 substep.
+/// Limits of the sane envelope checked by [`Plant::advance`] after every internal step.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Envelope {
     /// Maximum inertial speed |(u, v, w)| and airspeed (m/s).
@@ -34,17 +35,110 @@ impl Default for Envelope {
     }
 }
 
-/// Largest number of RK4 substeps one [`Plant::advance`] takes (2000 s of flight at 2 ms).
+/// Largest number of internal steps one [`Plant::advance`] takes (≈ 6700 s of flight at the
+/// default step).
 pub const MAX_SUBSTEPS: f64 = 1e6;
+
+/// Default internal step of [`Plant::advance`] (s), 20/3 ms: three steps per 20 ms
+/// communication step (the FMU parameter `integration_step`). Chosen with
+/// [`Integrator::default`] by measured error (docs/PERFORMANCE.md, "the integrator").
+pub const DEFAULT_INTEGRATION_STEP: f64 = 0.02 / 3.0;
+
+/// Fixed-step explicit Runge–Kutta method of [`Plant::advance`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Integrator {
+    /// Classical fourth-order Runge–Kutta: 4 right-hand sides per step.
+    Rk4,
+    /// The fifth-order solution of Dormand & Prince's embedded 5(4) pair at fixed step
+    /// ([`dp5`]): 6 right-hand sides per step (the pair's seventh, first-same-as-last stage
+    /// only feeds the embedded error estimate, which a fixed step does not use).
+    Dp5,
+    /// [`Integrator::Dp5`] with its embedded error estimate: a step whose estimate exceeds
+    /// `tolerance` is taken again as two halves, each checked the same way, at most
+    /// `max_halvings` times (a dyadic grid inside the internal step: the result depends only
+    /// on the step's start state, commands and wind).
+    Dp5Checked {
+        /// Largest embedded error estimate accepted for one (sub)step: max over position (m),
+        /// velocity (m/s), quaternion and rates (rad/s).
+        tolerance: f64,
+        /// Deepest halving of the internal step.
+        max_halvings: u32,
+    },
+}
+
+impl Default for Integrator {
+    fn default() -> Self {
+        Integrator::Dp5Checked {
+            tolerance: 1e-9,
+            max_halvings: 4,
+        }
+    }
+}
+
+/// The Butcher tableau of Dormand & Prince's 5(4) pair, fifth-order solution (J.R. Dormand,
+/// P.J. Prince, "A family of embedded Runge–Kutta formulae", J. Comput. Appl. Math. 6(1),
+/// 19–26, 1980, the method RK5(4)7M; also Hairer, Nørsett & Wanner, *Solving Ordinary
+/// Differential Equations I*, Table II.5.2). `A[i][j]` is a_(i+1)(j+1); the stage times
+/// c_i = Σ_j a_ij. Its 17 order conditions up to order 5 are checked in the tests.
+pub mod dp5 {
+    /// Number of stages of the fifth-order solution.
+    pub const STAGES: usize = 6;
+    /// Stage coefficients a_ij (strictly lower triangular).
+    pub const A: [[f64; STAGES]; STAGES] = [
+        [0.0; STAGES],
+        [1.0 / 5.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
+        [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0, 0.0],
+        [
+            19372.0 / 6561.0,
+            -25360.0 / 2187.0,
+            64448.0 / 6561.0,
+            -212.0 / 729.0,
+            0.0,
+            0.0,
+        ],
+        [
+            9017.0 / 3168.0,
+            -355.0 / 33.0,
+            46732.0 / 5247.0,
+            49.0 / 176.0,
+            -5103.0 / 18656.0,
+            0.0,
+        ],
+    ];
+    /// Weights b_i of the fifth-order solution.
+    pub const B: [f64; STAGES] = [
+        35.0 / 384.0,
+        0.0,
+        500.0 / 1113.0,
+        125.0 / 192.0,
+        -2187.0 / 6784.0,
+        11.0 / 84.0,
+    ];
+    /// Weights b̂_i of the embedded fourth-order solution; its seventh stage is f at the
+    /// fifth-order result (a₇ⱼ = b_j).
+    pub const B_HAT: [f64; STAGES + 1] = [
+        5179.0 / 57600.0,
+        0.0,
+        7571.0 / 16695.0,
+        393.0 / 640.0,
+        -92097.0 / 339200.0,
+        187.0 / 2100.0,
+        1.0 / 40.0,
+    ];
+}
 
 /// The nonlinear plant: airframe parameters and the integrator's maximum step.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Plant {
     /// Airframe parameters.
     pub airframe: Airframe,
-    /// Maximum internal RK4 step (s) (default 0.002 s). [`Plant::advance`] splits a
-    /// communication step h into ⌈h / integration_step⌉ equal substeps.
+    /// Maximum internal integration step (s) (default [`DEFAULT_INTEGRATION_STEP`] = 20/3 ms).
+    /// [`Plant::advance`] splits a communication step h into ⌈h / integration_step⌉ equal
+    /// steps.
     pub integration_step: f64,
+    /// The fixed-step method (default: [`Integrator::default`]).
+    pub integrator: Integrator,
     /// Envelope checked after every substep.
     pub envelope: Envelope,
     /// Aerodynamic model selection and global-model parameters. [`Plant::new`] selects the
@@ -107,12 +201,14 @@ pub struct Trim {
 }
 
 impl Plant {
-    /// Plant with `integration_step` = 0.002 s, the default envelope, the thesis's
-    /// aerodynamic model (set `aero.model` for the global one) and no ground.
+    /// Plant with the default integrator and step ([`Integrator::default`],
+    /// [`DEFAULT_INTEGRATION_STEP`]), the default envelope, the thesis's aerodynamic model
+    /// (set `aero.model` for the global one) and no ground.
     pub fn new(airframe: Airframe) -> Self {
         Self {
             airframe,
-            integration_step: 0.002,
+            integration_step: DEFAULT_INTEGRATION_STEP,
+            integrator: Integrator::default(),
             envelope: Envelope::default(),
             aero: GlobalAero {
                 model: AeroModel::Thesis,
@@ -219,7 +315,7 @@ impl Plant {
 
         let g_body = Vector3::new(c[(0, 2)], c[(1, 2)], c[(2, 2)]) * a.gravity;
         let (f_ground, m_ground) = self.ground.contact(a, x, c);
-        // Parameter-only reciprocals: hoisted out of the RK4 loop by the compiler (a
+        // Parameter-only reciprocals: hoisted out of the integration loop by the compiler (a
         // multiplication per evaluation instead of a division).
         let vdot = (fm.force_body + f_ground) * (1.0 / a.mass) + g_body - omega.cross(&v);
         let i = Vector3::new(a.i_xx, a.i_yy, a.i_zz);
@@ -255,12 +351,17 @@ impl Plant {
         dx
     }
 
-    /// Advance the state by `h` seconds with the commands `u` and wind held constant:
-    /// classical RK4 with n = ⌈h / integration_step⌉ equal substeps (so 1, 10 and 20 ms
-    /// communication steps give the same trajectory to rounding when h is a multiple of the
-    /// step). After each substep: quaternion renormalised, thrust clamped to its limits and
+    /// Advance the state by `h` seconds with the commands `u` and wind held constant, in
+    /// n = ⌈h / integration_step⌉ equal internal steps of the [`Integrator`] (default
+    /// [`Integrator::Dp5Checked`]: Dormand–Prince's fifth-order solution; a step whose
+    /// embedded error estimate exceeds 1e-9 is taken again in halves, down to 1/16 of the
+    /// step, which resolves the right-hand side's kinks — stall blending, the thesis's α
+    /// clamp, ground contact). The internal steps, and so the trajectory, depend only on the
+    /// grid: communication steps that are multiples of `integration_step` (20 and 40 ms at the
+    /// default 20/3 ms; 5, 10 and 20 ms at a 5 ms step) give the same trajectory to rounding.
+    /// After each internal step: quaternion renormalised, thrust clamped to its limits and
     /// deflections to ±deflection_limit, every state checked finite and inside the
-    /// [`Envelope`]. On error `x` keeps the last good substep. Does not allocate. Each
+    /// [`Envelope`]. On error `x` keeps the last good internal step. Does not allocate. Each
     /// stage's induced-velocity solve starts at the previous stage's value
     /// ([`Airframe::induced_velocity_from`]): the same root to rounding, fewer iterations.
     pub fn advance(
@@ -269,6 +370,20 @@ impl Plant {
         u: &InputVector,
         wind_ned: &Vector3<f64>,
         h: f64,
+    ) -> Result<(), PhysicsError> {
+        self.advance_counting(x, u, wind_ned, h, &mut 0)
+    }
+
+    /// [`Plant::advance`] that adds to `evals` the number of right-hand-side evaluations it
+    /// made (for measuring the integrator's cost).
+    #[inline]
+    pub fn advance_counting(
+        &self,
+        x: &mut StateVector,
+        u: &InputVector,
+        wind_ned: &Vector3<f64>,
+        h: f64,
+        evals: &mut u64,
     ) -> Result<(), PhysicsError> {
         for k in 0..N_INPUTS {
             if !u[k].is_finite() {
@@ -320,17 +435,140 @@ impl Plant {
         let mut s = *x;
         // Induced velocity of the previous stage: the next stage's solve starts there.
         let mut w = f64::NAN;
+        // f at the start of the step (the previous step's last evaluation), if known.
+        let mut k_start: Option<StateVector> = None;
         for _ in 0..n {
-            let k1 = self.derivatives_from(&s, u, wind_ned, &mut w);
-            let k2 = self.derivatives_from(&(s + k1 * (0.5 * dt)), u, wind_ned, &mut w);
-            let k3 = self.derivatives_from(&(s + k2 * (0.5 * dt)), u, wind_ned, &mut w);
-            let k4 = self.derivatives_from(&(s + k3 * dt), u, wind_ned, &mut w);
-            s += (k1 + (k2 + k3) * 2.0 + k4) * (dt / 6.0);
-            self.project(&mut s);
+            match self.integrator {
+                Integrator::Rk4 => {
+                    *evals += 4;
+                    self.rk4_step(&mut s, u, wind_ned, dt, &mut w);
+                    self.project(&mut s);
+                }
+                Integrator::Dp5 => {
+                    *evals += 6;
+                    let k1 = self.derivatives_from(&s, u, wind_ned, &mut w);
+                    self.dp5_step(&mut s, &k1, u, wind_ned, dt, &mut w);
+                    self.project(&mut s);
+                }
+                Integrator::Dp5Checked {
+                    tolerance,
+                    max_halvings,
+                } => {
+                    let k1 = match k_start {
+                        Some(k) => k,
+                        None => {
+                            *evals += 1;
+                            self.derivatives_from(&s, u, wind_ned, &mut w)
+                        }
+                    };
+                    let (y, k_end) =
+                        self.dp5_checked_step(&s, &k1, u, wind_ned, dt, tolerance, max_halvings.min(30), &mut w, evals);
+                    s = y;
+                    k_start = Some(k_end);
+                }
+            }
             self.check(&s, wind_ned)?;
             *x = s;
         }
         Ok(())
+    }
+
+    /// One internal step of [`Integrator::Dp5Checked`] from `s` (where f = `k1`): the
+    /// result and f there (at the projected state: the next step's first stage).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn dp5_checked_step(
+        &self,
+        s: &StateVector,
+        k1: &StateVector,
+        u: &InputVector,
+        wind_ned: &Vector3<f64>,
+        dt: f64,
+        tolerance: f64,
+        max_halvings: u32,
+        w: &mut f64,
+        evals: &mut u64,
+    ) -> (StateVector, StateVector) {
+        // Position and substep length in units of dt / 2^max_halvings.
+        let total = 1u64 << max_halvings;
+        let (mut done, mut level) = (0u64, 0u32);
+        let (mut y, mut k) = (*s, *k1);
+        while done < total {
+            let h = dt / (1u64 << level) as f64;
+            let mut y_new = y;
+            let e = self.dp5_step(&mut y_new, &k, u, wind_ned, h, w);
+            self.project(&mut y_new);
+            let k_new = self.derivatives_from(&y_new, u, wind_ned, w);
+            *evals += 6;
+            let e = e - k_new * (dp5::B_HAT[6] * h);
+            let estimate = e.rows(POS_N, R + 1 - POS_N).amax();
+            if estimate <= tolerance || level == max_halvings {
+                y = y_new;
+                k = k_new;
+                done += total >> level;
+                // Back to the coarsest level the grid allows from here.
+                while level > 0 && done % (total >> (level - 1)) == 0 {
+                    level -= 1;
+                }
+            } else {
+                level += 1;
+            }
+        }
+        (y, k)
+    }
+
+    /// One classical RK4 step of `dt` from `s`.
+    #[inline(always)]
+    fn rk4_step(&self, s: &mut StateVector, u: &InputVector, wind_ned: &Vector3<f64>, dt: f64, w: &mut f64) {
+        let k1 = self.derivatives_from(s, u, wind_ned, w);
+        let k2 = self.derivatives_from(&(*s + k1 * (0.5 * dt)), u, wind_ned, w);
+        let k3 = self.derivatives_from(&(*s + k2 * (0.5 * dt)), u, wind_ned, w);
+        let k4 = self.derivatives_from(&(*s + k3 * dt), u, wind_ned, w);
+        *s += (k1 + (k2 + k3) * 2.0 + k4) * (dt / 6.0);
+    }
+
+    /// One step of `dt` from `s` (where f = `k1`) with the fifth-order solution of [`dp5`]
+    /// (the commands and the wind are held, so the stage times do not enter). Returns
+    /// dt Σᵢ₌₁⁶ (bᵢ − b̂ᵢ) kᵢ: the embedded error estimate without its seventh stage.
+    #[inline(always)]
+    fn dp5_step(
+        &self,
+        s: &mut StateVector,
+        k1: &StateVector,
+        u: &InputVector,
+        wind_ned: &Vector3<f64>,
+        dt: f64,
+        w: &mut f64,
+    ) -> StateVector {
+        use dp5::{A, B, B_HAT};
+        let k1 = *k1;
+        let k2 = self.derivatives_from(&(*s + k1 * (A[1][0] * dt)), u, wind_ned, w);
+        let k3 = self.derivatives_from(&(*s + (k1 * A[2][0] + k2 * A[2][1]) * dt), u, wind_ned, w);
+        let k4 = self.derivatives_from(
+            &(*s + (k1 * A[3][0] + k2 * A[3][1] + k3 * A[3][2]) * dt),
+            u,
+            wind_ned,
+            w,
+        );
+        let k5 = self.derivatives_from(
+            &(*s + (k1 * A[4][0] + k2 * A[4][1] + k3 * A[4][2] + k4 * A[4][3]) * dt),
+            u,
+            wind_ned,
+            w,
+        );
+        let k6 = self.derivatives_from(
+            &(*s + (k1 * A[5][0] + k2 * A[5][1] + k3 * A[5][2] + k4 * A[5][3] + k5 * A[5][4]) * dt),
+            u,
+            wind_ned,
+            w,
+        );
+        *s += (k1 * B[0] + k3 * B[2] + k4 * B[3] + k5 * B[4] + k6 * B[5]) * dt;
+        (k1 * (B[0] - B_HAT[0])
+            + k3 * (B[2] - B_HAT[2])
+            + k4 * (B[3] - B_HAT[3])
+            + k5 * (B[4] - B_HAT[4])
+            + k6 * (B[5] - B_HAT[5]))
+            * dt
     }
 
     /// Renormalise the quaternion, clamp thrust and deflections.

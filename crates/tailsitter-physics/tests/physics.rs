@@ -242,7 +242,8 @@ fn thrust_lag_matches_first_order_step() {
     for _ in 0..25 {
         p.advance(&mut x, &u, &zero_wind(), 0.02).unwrap();
         t += 0.02;
-        // RK4 with 2 ms steps on a 0.1 s lag: global error ≲ 50·(t/τ)e^(−t/τ)(h/τ)⁴/120 ≈ 3e-8 N.
+        // DP5 with 20/3 ms steps on a 0.1 s lag: one step's error 50·|R(z) − eᶻ| with
+        // R(z) − eᶻ ≈ z⁶/3600 (DP5's stability polynomial has z⁶/600), z = h/τ = 1/15: ≈ 1e-9 N.
         assert_relative_eq!(x[THRUST], 50.0 * (1.0 - (-t / tau).exp()), epsilon = 1e-7);
     }
     // Commands beyond the limits are clamped.
@@ -578,26 +579,35 @@ fn communication_step_independence() {
     u[AILERON_CMD] = 0.05;
     u[THRUST_CMD] += 10.0;
     let wind = Vector3::new(2.0, -1.0, 0.5);
-    let run = |h: f64| {
+    let run = |p: &Plant, h: f64| {
         let mut x = t.state;
-        let n = (1.0 / h).round() as usize;
+        let n = (1.2 / h).round() as usize;
         for _ in 0..n {
             p.advance(&mut x, &u, &wind, h).unwrap();
         }
         x
     };
-    // Communication steps that are multiples of the 2 ms integration step
-    // integrate with the very same substeps: equal up to round-off.
-    let x2 = run(0.002);
-    let x10 = run(0.010);
-    let x20 = run(0.020);
-    assert!((x2 - t.state).amax() > 0.1, "it moved");
-    assert!((x2 - x10).amax() < 1e-9, "{}", (x2 - x10).amax());
-    assert!((x2 - x20).amax() < 1e-9, "{}", (x2 - x20).amax());
-    // Steps that are not multiples (1 ms, 12.5 ms) differ by the RK4 error only.
-    for h in [0.001, 0.0125] {
-        let x = run(h);
-        assert!((x2 - x).amax() < 1e-6, "h = {h}: {}", (x2 - x).amax());
+    // Communication steps that are multiples of the integration step (20/3 ms by default)
+    // integrate with the very same internal steps: equal up to round-off.
+    let step = p.integration_step;
+    let x1 = run(&p, step);
+    let x20 = run(&p, 0.020);
+    let x40 = run(&p, 0.040);
+    assert!((x1 - t.state).amax() > 0.1, "it moved");
+    assert!((x1 - x20).amax() < 1e-9, "{}", (x1 - x20).amax());
+    assert!((x1 - x40).amax() < 1e-9, "{}", (x1 - x40).amax());
+    // With a 5 ms step: 5, 10 and 20 ms communication steps.
+    let mut p5 = p.clone();
+    p5.integration_step = 0.005;
+    let y5 = run(&p5, 0.005);
+    for h in [0.010, 0.020] {
+        let y = run(&p5, h);
+        assert!((y5 - y).amax() < 1e-9, "h = {h}: {}", (y5 - y).amax());
+    }
+    // Steps that are not multiples (1, 2, 10, 12.5 ms) differ by the integration error only.
+    for h in [0.001, 0.002, 0.010, 0.0125] {
+        let x = run(&p, h);
+        assert!((x1 - x).amax() < 1e-6, "h = {h}: {}", (x1 - x).amax());
     }
 }
 
