@@ -45,8 +45,14 @@ pub const K_GAMMA: f64 = 3.0;
 /// vertical climb may use −α_max (thrust tilted over the path), but the pull-out to level
 /// follows at +α_max within a second at low speed, and the controllers then lag the swing
 /// of 2 α_max (TSD: sink of 3.3 m and α 17° in the fast mission; 2.3 m and 6° with 0.3).
-/// With 0.3 gravity does most of the turn-over (γ̇ = −g cos γ / V once the path leans).
-pub const PUSH_OVER_ALPHA_FRACTION: f64 = 0.3;
+/// With a fraction gravity does most of the turn-over (γ̇ = −g cos γ / V once the path leans).
+/// 0.4 (was 0.3): the push-over binds for T1 ≤ 3 s only (the default profile's α stays above
+/// −0.8°, unchanged; at T1 = 3 s it reaches −3.8° instead of −3.6°, rotation unchanged at
+/// 2.38 s); in the fast mission it sets the rotation: the profile's path is within 5° of level 1.82 s after the start of
+/// T1 = 2 s (2.04 s with 0.3), which the LQR follows to 0.02 s; issue 16 asks ≤ 2 s. 0.5 is
+/// faster still (1.68 s) but dips the path 2.3° below level after the pull-out (README,
+/// "Front rotation and the push-over limit").
+pub const PUSH_OVER_ALPHA_FRACTION: f64 = 0.4;
 /// Gain k_V of the speed tracking of the guidance law (1/s).
 pub const K_SPEED: f64 = 1.5;
 const FRAC_PI_2: f64 = core::f64::consts::FRAC_PI_2;
@@ -466,6 +472,28 @@ mod tests {
             (end.v - 3.0).abs() < 0.1 && (end.gamma - FRAC_PI_2).abs() < 0.01,
             "{end:?}"
         );
+    }
+
+    /// Issue 16: the fast mission's front transition (T1 = 2 s) rotates the path to within 5°
+    /// of level in at most 2 s (the controllers follow the profile; the flown figures are in
+    /// `analysis::envelope_transitions`). With the push-over limited to −0.3 α_max it took
+    /// 2.04 s.
+    #[test]
+    fn the_fast_front_transition_rotates_within_two_seconds() {
+        let m = MissionParams::fast();
+        let p = Profile::new(&m, &airframe(), &ProfileLimits::of(&m)).unwrap();
+        let s = m.phase_starts();
+        let rotation = p.settle_time(s[1], s[3], 0.0, 5f64.to_radians()).unwrap();
+        assert!(rotation <= 2.0, "{rotation}");
+        // ... without leaving the α range of the profile or dipping below level by more than
+        // the 5° tolerance.
+        let dip = p
+            .points()
+            .iter()
+            .filter(|q| q.t >= s[1] && q.t <= s[3])
+            .map(|q| q.gamma)
+            .fold(f64::INFINITY, f64::min);
+        assert!(dip > -5f64.to_radians(), "{}", dip.to_degrees());
     }
 
     #[test]

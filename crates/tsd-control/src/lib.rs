@@ -740,12 +740,22 @@ impl SampledUnit for TsdController {
         // ---- Guidance (4.3.24) ---------------------------------------------------------
         let (kp_g, kv_g) = d.guidance;
         let vel_error = meas.vel_ned - reference.vel;
-        let sigma_ff = if let Some(s) = sigma_ground {
-            s
+        // The previewed Σ^RE as read at t + lead (`sigma_ahead`: the normal loop's steady-state
+        // feed-forward below) and resolved in the path axes of t (`sigma_ff`: the guidance
+        // command, (4.3.24)). Read as a vector, the preview also turns the command with the
+        // path by γ̇·lead — 7° of the ≈ 13 m/s² thrust acceleration in the fast push-over became
+        // a normal command the integrator E_C then held: the attitude led the path, gravity
+        // amplified the lead and the TSD sank 0.8 m and climbed back in the fast front
+        // transition (README, "Front transition: preview in path axes").
+        let (sigma_ff, sigma_ahead) = if let Some(s) = sigma_ground {
+            (s, s)
         } else if p.feedforward_lead > 0.0 {
-            self.trajectory.at(t_mission + p.feedforward_lead).specific_accel
+            (
+                self.trajectory.previewed_specific_accel(t_mission, p.feedforward_lead),
+                self.trajectory.at(t_mission + p.feedforward_lead).specific_accel,
+            )
         } else {
-            reference.specific_accel
+            (reference.specific_accel, reference.specific_accel)
         };
         // (4.3.24), with the lateral pair across the path (t̂ × k̂: the path's own lateral axis,
         // independent of the weathervane's heading) and the feedback bounded in norm: for the
@@ -848,7 +858,10 @@ impl SampledUnit for TsdController {
         let (c_ff, q_ff, dm_ff) = if p.configuration == 0 && sigma_ground.is_none() {
             let weight = ((reference.airspeed - self.mission.v_vertical) / NORMAL_FEEDFORWARD_RAMP).clamp(0.0, 1.0);
             if weight > 0.0 {
-                let c_ff = weight * sigma_ff.dot(&kw);
+                // As read at t + lead: the steady state the body must be in by then, so the
+                // attitude leads the path by the preview (the command's own turn stays out of
+                // E_C, which integrates C_W − C_Wc with C_Wc from the path-axes preview).
+                let c_ff = weight * sigma_ahead.dot(&kw);
                 let (q_ff, dm_ff) = gains::normal_steady_state(&d.normal_model, c_ff);
                 (c_ff, q_ff, dm_ff)
             } else {

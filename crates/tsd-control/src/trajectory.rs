@@ -116,6 +116,25 @@ impl Trajectory {
         &self.mission
     }
 
+    /// The feed-forward Σ^RE of (4.3.24) previewed `lead` seconds ahead, **resolved in the
+    /// path axes** (tangent t̂, lateral, normal k̂ = the prescribed normal) of the point it
+    /// is read at and re-expressed in the path axes at `t`: the preview brings forward the
+    /// *magnitudes* of the tangential and normal specific accelerations (thrust and lift the
+    /// inner loops need time to build), not the path's turn over the lead. Read as a vector at
+    /// t + lead, the large tangential part (≈ 13 m/s² of thrust in the fast push-over) turned
+    /// with the path by γ̇·lead (7° at γ̇ = 1.2 rad/s, 0.1 s) became a normal command at t:
+    /// the attitude led the path, gravity amplified the lead, and the TSD sank 0.9 m in the
+    /// fast front transition (README, "Front transition: preview in path axes"). Where γ is
+    /// constant (vertical and level flight) this is the previewed vector itself.
+    pub fn previewed_specific_accel(&self, t: f64, lead: f64) -> Vector3<f64> {
+        let now = self.at(t);
+        let ahead = self.at(t + lead);
+        let s = ahead.specific_accel;
+        now.tangent() * s.dot(&ahead.tangent())
+            + now.prescribed_normal() * s.dot(&ahead.prescribed_normal())
+            + Vector3::new(0.0, s.y, 0.0)
+    }
+
     /// The reference at mission time `t`.
     pub fn at(&self, t: f64) -> Reference {
         let m = &self.mission;
@@ -257,6 +276,51 @@ mod tests {
                 "{end2:?}"
             );
         }
+    }
+
+    /// The preview keeps the path-axes components of the point ahead (the thrust's and the
+    /// lift's share of Σ) and turns them with the path back to `t`: in the turning push-over of
+    /// the fast mission's limited profile the previewed vector read as is would differ from
+    /// this by |Σ|·2 sin(Δγ/2), the path's turn Δγ over the lead; on straight segments the
+    /// two are the same vector.
+    #[test]
+    fn preview_is_resolved_in_the_path_axes() {
+        let m = MissionParams::fast();
+        let pm = flight_mission::PointMass {
+            mass: 9.0,
+            gravity: 9.81,
+            air_density: 1.225,
+            wing_area: 0.5737,
+            c_l_alpha: 3.1,
+            c_d0: 0.0272,
+            k_induced: 1.0 / (core::f64::consts::PI * 0.8 * 4.29),
+            thrust_max: 150.0,
+        };
+        let profile = Profile::new(&m, &pm, &flight_mission::ProfileLimits::of(&m)).unwrap();
+        let tr = Trajectory::limited(m, 9.81, profile);
+        let s = m.phase_starts();
+        let lead = 0.1;
+        // The vertical climb: the previewed vector itself.
+        let p = tr.previewed_specific_accel(1.0, lead);
+        assert!(close(p, tr.at(1.0 + lead).specific_accel, 1e-12));
+        let mut turned = 0.0f64;
+        let mut t = 0.0;
+        while t < m.end_time() {
+            let (now, ahead) = (tr.at(t), tr.at(t + lead));
+            let p = tr.previewed_specific_accel(t, lead);
+            let sa = ahead.specific_accel;
+            assert!((p.dot(&now.tangent()) - sa.dot(&ahead.tangent())).abs() < 1e-9);
+            assert!((p.dot(&now.prescribed_normal()) - sa.dot(&ahead.prescribed_normal())).abs() < 1e-9);
+            assert!((p.norm() - sa.norm()).abs() < 1e-9);
+            let dg = ahead.gamma - now.gamma;
+            assert!(((p - sa).norm() - sa.norm() * 2.0 * (0.5 * dg).sin().abs()).abs() < 1e-9);
+            if t >= s[1] && t < s[2] {
+                turned = turned.max(dg.abs());
+            }
+            t += 0.05;
+        }
+        // The fast push-over turns the path by several degrees over 0.1 s.
+        assert!(turned > 4f64.to_radians(), "{}", turned.to_degrees());
     }
 
     #[test]
