@@ -80,6 +80,68 @@ impl RiccatiError {
     }
 }
 
+/// Coefficients c_k = (2q−k)! q! / ((2q)! k! (q−k)!) of the diagonal [6/6] Padé approximant
+/// of e^X (q = 6).
+const PADE_6: [f64; 7] = [
+    1.0,
+    0.5,
+    5.0 / 44.0,
+    1.0 / 66.0,
+    1.0 / 792.0,
+    1.0 / 15840.0,
+    1.0 / 665280.0,
+];
+
+/// Scaling of the scaling-and-squaring method: the smallest s ≥ 0 with ‖X‖₁ / 2^s ≤ 1/2,
+/// where the [6/6] Padé error is below 1e-16 relative, and the factor 2^-s.
+fn pade_scaling(norm_1: f64) -> (i32, f64) {
+    let s = if norm_1 > 0.5 {
+        (norm_1 / 0.5).log2().ceil() as i32
+    } else {
+        0
+    };
+    (s, 2f64.powi(-s))
+}
+
+/// The top R rows (column-major, C ≥ R columns; the identity occupies the first R columns)
+/// of the Padé even part U = c₀ I + c₂ X² + c₄ X⁴ + c₆ X⁶ and of the odd part's factor
+/// c₁ I + c₃ X² + c₅ X⁴ (V = X times it), from the top rows of X², X⁴, X⁶.
+#[inline(always)]
+fn pade_parts<const R: usize, const C: usize>(
+    x2: &[[f64; R]; C],
+    x4: &[[f64; R]; C],
+    x6: &[[f64; R]; C],
+) -> ([[f64; R]; C], [[f64; R]; C]) {
+    let c = &PADE_6;
+    let mut u = [[0.0; R]; C];
+    let mut vi = [[0.0; R]; C];
+    for j in 0..C {
+        for i in 0..R {
+            u[j][i] = x2[j][i] * c[2] + x4[j][i] * c[4] + x6[j][i] * c[6];
+            vi[j][i] = x2[j][i] * c[3] + x4[j][i] * c[5];
+        }
+    }
+    for i in 0..R {
+        u[i][i] += c[0];
+        vi[i][i] += c[1];
+    }
+    (u, vi)
+}
+
+/// E = D⁻¹ N of the Padé approximant (column-major, C columns; `den` is overwritten by its LU
+/// factors); all NaN when D is singular, which the callers' finiteness checks report.
+#[inline(always)]
+fn pade_solve<const R: usize, const C: usize>(den: &mut [[f64; R]; R], num: &[[f64; R]; C]) -> [[f64; R]; C] {
+    // Row-major right-hand side for the solver: the rows of N.
+    let mut y = dense::transpose(num);
+    let mut none = [[0.0; 0]; R];
+    if dense::lu_solve2(den, &mut y, &mut none) {
+        dense::transpose(&y)
+    } else {
+        [[f64::NAN; R]; C]
+    }
+}
+
 /// Matrix exponential e^A by scaling and squaring with the diagonal [6/6] Padé
 /// approximant: A is scaled by 2^-s so that ‖A/2^s‖₁ ≤ 1/2, where the [6/6] Padé
 /// error is below 1e-16 relative (Moler & Van Loan, "Nineteen dubious ways", method 3).
@@ -91,22 +153,7 @@ fused_wrapper!(expm_fused, expm_impl, [const N: usize], (a: &SMatrix<f64, N, N>)
 
 #[inline(always)]
 fn expm_impl<const N: usize, const F: bool>(a: &SMatrix<f64, N, N>) -> SMatrix<f64, N, N> {
-    // Padé coefficients c_k = (2q−k)! q! / ((2q)! k! (q−k)!), q = 6.
-    const C: [f64; 7] = [
-        1.0,
-        0.5,
-        5.0 / 44.0,
-        1.0 / 66.0,
-        1.0 / 792.0,
-        1.0 / 15840.0,
-        1.0 / 665280.0,
-    ];
-    let norm = a.column_iter().map(|c| c.abs().sum()).fold(0.0, f64::max);
-    let mut s = 0i32;
-    if norm > 0.5 {
-        s = (norm / 0.5).log2().ceil() as i32;
-    }
-    let scale = 2f64.powi(-s);
+    let (s, scale) = pade_scaling(a.column_iter().map(|c| c.abs().sum()).fold(0.0, f64::max));
     let mut x = a.data.0;
     for col in x.iter_mut() {
         for v in col.iter_mut() {
@@ -116,17 +163,8 @@ fn expm_impl<const N: usize, const F: bool>(a: &SMatrix<f64, N, N>) -> SMatrix<f
     let x2 = dense::mul::<_, _, _, F>(&x, &x);
     let x4 = dense::mul::<_, _, _, F>(&x2, &x2);
     let x6 = dense::mul::<_, _, _, F>(&x4, &x2);
-    // Even part U and odd part V: N = U + V, D = U − V.
-    let mut u = [[0.0; N]; N];
-    let mut vi = [[0.0; N]; N];
-    for j in 0..N {
-        for i in 0..N {
-            u[j][i] = x2[j][i] * C[2] + x4[j][i] * C[4] + x6[j][i] * C[6];
-            vi[j][i] = x2[j][i] * C[3] + x4[j][i] * C[5];
-        }
-        u[j][j] += C[0];
-        vi[j][j] += C[1];
-    }
+    // Even part U and odd part V = X·vi: N = U + V, D = U − V.
+    let (u, vi) = pade_parts(&x2, &x4, &x6);
     let v = dense::mul::<_, _, _, F>(&x, &vi);
     let mut den = [[0.0; N]; N];
     let mut num = [[0.0; N]; N];
@@ -136,14 +174,7 @@ fn expm_impl<const N: usize, const F: bool>(a: &SMatrix<f64, N, N>) -> SMatrix<f
             den[j][i] = u[j][i] - v[j][i];
         }
     }
-    // Row-major right-hand side: the rows of N are the columns of Nᵀ.
-    let mut y = dense::transpose(&num);
-    let mut none = [[0.0; 0]; N];
-    let mut e = if dense::lu_solve2(&mut den, &mut y, &mut none) {
-        dense::transpose(&y)
-    } else {
-        [[f64::NAN; N]; N]
-    };
+    let mut e = pade_solve(&mut den, &num);
     for _ in 0..s {
         e = dense::mul::<_, _, _, F>(&e, &e);
     }
@@ -203,26 +234,12 @@ fused_wrapper!(zoh_top_fused, zoh_top_impl, [const NX: usize, const M: usize], (
 /// M columns); see [`discretise_zoh`].
 #[inline(always)]
 fn zoh_top_impl<const NX: usize, const M: usize, const F: bool>(z: &[[f64; NX]; M]) -> [[f64; NX]; M] {
-    // Padé coefficients c_k = (2q−k)! q! / ((2q)! k! (q−k)!), q = 6 (as in `expm_impl`).
-    const C: [f64; 7] = [
-        1.0,
-        0.5,
-        5.0 / 44.0,
-        1.0 / 66.0,
-        1.0 / 792.0,
-        1.0 / 15840.0,
-        1.0 / 665280.0,
-    ];
-    // ‖Z‖₁ (the zero rows add nothing to the column sums); scale by 2^-s to ‖·‖₁ ≤ 1/2.
-    let norm = z
-        .iter()
-        .map(|c| c.iter().map(|v| v.abs()).sum::<f64>())
-        .fold(0.0, f64::max);
-    let mut s = 0i32;
-    if norm > 0.5 {
-        s = (norm / 0.5).log2().ceil() as i32;
-    }
-    let scale = 2f64.powi(-s);
+    // ‖Z‖₁ (the zero rows add nothing to the column sums).
+    let (s, scale) = pade_scaling(
+        z.iter()
+            .map(|c| c.iter().map(|v| v.abs()).sum::<f64>())
+            .fold(0.0, f64::max),
+    );
     let mut x = *z;
     dense::scale(&mut x, scale);
     // Top rows of a product of two block matrices [P₁ P₂; 0 0] [Q₁ Q₂; 0 0] = P₁ [Q₁ Q₂].
@@ -233,23 +250,12 @@ fn zoh_top_impl<const NX: usize, const M: usize, const F: bool>(z: &[[f64; NX]; 
     let x6 = dense::mul::<NX, NX, M, F>(&left(&x4), &x2);
     // Even part U = c₀ I + c₂ Z² + c₄ Z⁴ + c₆ Z⁶, odd part V = Z (c₁ I + c₃ Z² + c₅ Z⁴):
     // top rows; the bottom rows are [0 c₀ I] and 0.
-    let mut u = [[0.0; NX]; M];
-    let mut vi = [[0.0; NX]; M];
-    for j in 0..M {
-        for i in 0..NX {
-            u[j][i] = x2[j][i] * C[2] + x4[j][i] * C[4] + x6[j][i] * C[6];
-            vi[j][i] = x2[j][i] * C[3] + x4[j][i] * C[5];
-        }
-    }
-    for i in 0..NX {
-        u[i][i] += C[0];
-        vi[i][i] += C[1];
-    }
+    let (u, vi) = pade_parts(&x2, &x4, &x6);
     // V's top rows: Z₁ vi_top + Z₂ [0 c₁ I] = Z₁ vi_top + [0 c₁ Z₂].
     let mut v = dense::mul::<NX, NX, M, F>(&x_l, &vi);
     for j in NX..M {
         for i in 0..NX {
-            v[j][i] += C[1] * x[j][i];
+            v[j][i] += PADE_6[1] * x[j][i];
         }
     }
     // D E = N with D = [D₁ D₂; 0 I], N = [N₁ N₂; 0 I]: E's top rows solve
@@ -271,14 +277,7 @@ fn zoh_top_impl<const NX: usize, const M: usize, const F: bool>(z: &[[f64; NX]; 
             rhs[j][i] -= u[j][i] - v[j][i];
         }
     }
-    // Row-major right-hand side for the solver: the rows of [N₁, N₂ − D₂].
-    let mut y = dense::transpose(&rhs);
-    let mut none = [[0.0; 0]; NX];
-    let mut e = if dense::lu_solve2(&mut den, &mut y, &mut none) {
-        dense::transpose(&y)
-    } else {
-        [[f64::NAN; NX]; M]
-    };
+    let mut e = pade_solve(&mut den, &rhs);
     // Squarings: [E₁ E₂; 0 I]² = [E₁ E₁, E₁ E₂ + E₂; 0 I].
     for _ in 0..s {
         let mut sq = dense::mul::<NX, NX, M, F>(&left(&e), &e);
@@ -1171,15 +1170,25 @@ mod tests {
         assert!(!dense::lu_solve2(&mut s, &mut y1, &mut y2));
     }
 
+    /// A 9-state, 3-input DARE problem (Φ, Γ, Q, R diagonal) shared by the build and Newton tests.
+    fn problem_9x3() -> (
+        SMatrix<f64, 9, 9>,
+        SMatrix<f64, 9, 3>,
+        SMatrix<f64, 9, 9>,
+        SVector<f64, 3>,
+    ) {
+        let phi = test_matrix::<9, 9>(6) * 0.4 + SMatrix::<f64, 9, 9>::identity();
+        let gamma = test_matrix::<9, 3>(7);
+        let q = SMatrix::<f64, 9, 9>::from_diagonal(&SVector::<f64, 9>::from_fn(|i, _| 1.0 + i as f64));
+        (phi, gamma, q, SVector::<f64, 3>::new(0.5, 2.0, 7.0))
+    }
+
     #[test]
     fn simd_and_baseline_builds_agree() {
         // The dispatched build equals the `_impl` of its own flavour bit for bit (software
         // `fma` is correctly rounded like the instruction), and the fused and unfused
         // flavours agree to rounding.
-        let phi = test_matrix::<9, 9>(6) * 0.4 + SMatrix::<f64, 9, 9>::identity();
-        let gamma = test_matrix::<9, 3>(7);
-        let q = SMatrix::<f64, 9, 9>::from_diagonal(&SVector::<f64, 9>::from_fn(|i, _| 1.0 + i as f64));
-        let r = SVector::<f64, 3>::new(0.5, 2.0, 7.0);
+        let (phi, gamma, q, r) = problem_9x3();
         let p = dare_sda(&phi, &gamma, &q, &r).unwrap();
         let p_fused = dare_sda_impl::<9, 3, true>(&phi, &gamma, &q, &r).unwrap();
         let p_plain = dare_sda_impl::<9, 3, false>(&phi, &gamma, &q, &r).unwrap();
@@ -1211,10 +1220,7 @@ mod tests {
     fn newton_step_converges_quadratically_to_the_doubling_solution() {
         // A 9-state, 3-input problem: from P perturbed by ε (relative), one Newton step leaves
         // an error O(ε²); a far start is refused before the doubling.
-        let phi = test_matrix::<9, 9>(6) * 0.4 + SMatrix::<f64, 9, 9>::identity();
-        let gamma = test_matrix::<9, 3>(7);
-        let q = SMatrix::<f64, 9, 9>::from_diagonal(&SVector::<f64, 9>::from_fn(|i, _| 1.0 + i as f64));
-        let r = SVector::<f64, 3>::new(0.5, 2.0, 7.0);
+        let (phi, gamma, q, r) = problem_9x3();
         let p = dare_sda(&phi, &gamma, &q, &r).unwrap();
         let d = test_matrix::<9, 9>(8);
         let sym = (d + d.transpose()) * (0.5 * p.amax() / d.amax());
