@@ -222,7 +222,8 @@ type PState = [f64; 7];
 /// The α- and thrust-limited flight-path profile of a mission (module docs).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Profile {
-    points: Arc<[PathPoint]>,
+    /// The table, shared by clones (an `Arc<Vec>`: no copy of the built vector).
+    points: Arc<Vec<PathPoint>>,
 }
 
 impl Profile {
@@ -354,7 +355,7 @@ impl Profile {
             let (a, b) = (i.saturating_sub(1), (i + 1).min(n - 1));
             pts[i].gamma_ddot = (pts[b].gamma_dot - pts[a].gamma_dot) / ((b - a) as f64 * h);
         }
-        Ok(Self { points: pts.into() })
+        Ok(Self { points: Arc::new(pts) })
     }
 
     /// The profile at mission time `t` (linear interpolation; beyond the table the last

@@ -169,7 +169,9 @@ impl TrajPoint {
 /// The precomputed reference trajectory.
 #[derive(Debug, Clone)]
 pub struct Trajectory {
-    points: Arc<[TrajPoint]>,
+    /// The table, shared by clones (an `Arc<Vec>`: taking over the built vector copies
+    /// nothing, where `Arc<[T]>::from(Vec)` would copy the ≈ 0.6 MB table once more).
+    points: Arc<Vec<TrajPoint>>,
     mission: MissionParams,
 }
 
@@ -688,7 +690,7 @@ impl Trajectory {
             return Err("non-finite trajectory".into());
         }
         Ok(Self {
-            points: pts.into(),
+            points: Arc::new(pts),
             mission: *mission,
         })
     }
