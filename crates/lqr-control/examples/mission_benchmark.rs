@@ -7,7 +7,8 @@
 //! After the timed runs three more, instrumented (monotonic clock around each controller
 //! sample), splits the mission into construction, relinearising samples, other samples and
 //! the plant with the loop; the fastest of the three is printed (the instrumentation adds
-//! ≈ 2 × 25 ns per sample).
+//! ≈ 2 × 25 ns per sample). With `runs` = 1 only the one mission is flown (for counting its
+//! instructions: `valgrind --tool=callgrind`).
 //!
 //! `violent`: the fast mission (T1 = 3 s, T2 = 4 s, α up to ≈ 44°) with a 1 − cos gust of
 //! 6 m/s (north, up) over 2 s at t = 12 s and 5 m position steps at 20 s and 23 s (the mission ends at 27 s).
@@ -34,9 +35,9 @@ fn scenario(name: &str) -> Scenario {
     }
 }
 
-/// The flown trace, the number of gain solves and the CPU time (s) of the controller's
-/// construction (reference trajectory + first gain).
-fn fly_once(s: &Scenario, integration_step: Option<f64>) -> (Trace, u64, f64) {
+/// The flown trace, the number of gain solves (all, warm-started) and the CPU time (s) of
+/// the controller's construction (reference trajectory + first gain).
+fn fly_once(s: &Scenario, integration_step: Option<f64>) -> (Trace, (u64, u64), f64) {
     let mut plant = Plant::new(Airframe::default());
     if let Some(step) = integration_step {
         plant.integration_step = step;
@@ -46,7 +47,7 @@ fn fly_once(s: &Scenario, integration_step: Option<f64>) -> (Trace, u64, f64) {
     let mut c = LqrController::new(Airframe::default(), s.mission, LqrParams::default()).expect("controller");
     let construction = thread_cpu_time() - c0;
     let trace = fly(&plant, x0, &mut c, s);
-    (trace, c.stats().solves, construction)
+    (trace, (c.stats().solves, c.stats().warm_solves), construction)
 }
 
 /// The controller with the time spent in its samples, split by whether the sample solved
@@ -158,7 +159,7 @@ fn main() {
         constructions.push(r.2 * 1e3);
         last = Some(r);
     }
-    let (trace, solves, _) = last.expect("one run");
+    let (trace, (solves, warm_solves), _) = last.expect("one run");
     times.sort_by(|a, b| a.total_cmp(b));
     constructions.sort_by(|a, b| a.total_cmp(b));
     if let Some(path) = out.filter(|p| p != "-") {
@@ -169,7 +170,7 @@ fn main() {
         }
     }
     println!(
-        "{name} mission: {} samples, {solves} gain solves, failure {:?}, max position error {:.4} m; CPU time per mission: median {:.2} ms (min {:.2}) over {} runs, of which the controller's construction (reference trajectory + first gain) median {:.2} ms",
+        "{name} mission: {} samples, {solves} gain solves ({warm_solves} warm-started), failure {:?}, max position error {:.4} m; CPU time per mission: median {:.2} ms (min {:.2}) over {} runs, of which the controller's construction (reference trajectory + first gain) median {:.2} ms",
         trace.samples.len(),
         trace.failure,
         trace.max_pos_error(),
@@ -178,5 +179,7 @@ fn main() {
         times.len(),
         constructions[constructions.len() / 2]
     );
-    print_breakdown(&s, integration_step);
+    if runs > 1 {
+        print_breakdown(&s, integration_step);
+    }
 }

@@ -311,7 +311,11 @@ fn design<const N: usize, const M: usize>(
             let mut p = *p0;
             let mut max_start = WARM_MAX_START_RESIDUAL;
             for _ in 0..WARM_MAX_NEWTON_STEPS {
-                p = dare_newton_step(&phi, &gamma, &q, r, &p, max_start).ok()?.0;
+                // A start already converged (the model has not changed: steady flight) is
+                // returned as it is and accepted on the residual below.
+                p = dare_newton_step(&phi, &gamma, &q, r, &p, max_start, WARM_MAX_RESIDUAL)
+                    .ok()?
+                    .0;
                 let k = lqr_gain(&phi, &gamma, &p, r).ok()?;
                 let res = dare_residual(&phi, &gamma, &q, &p, &k);
                 if res <= WARM_MAX_RESIDUAL {

@@ -497,6 +497,10 @@ fn dare_sda_impl<const N: usize, const U: usize, const F: bool>(
 /// rounding of P. Only the correction (small) is iterated, so a step costs three 17×17
 /// products per doubling against SDA's LU solve and five products.
 ///
+/// A start whose relative residual ‖𝓡(P₀)‖_F / ‖P₀‖_F is already at most `converged` is
+/// returned as it is (X = 0, no doubling): a model that has not changed since the last
+/// solve (steady flight) costs only the residual. 0 always takes the step.
+///
 /// Returns P₁ and the relative size ‖X‖_F / ‖P₁‖_F of the correction. `Err` when
 /// ‖𝓡(P₀)‖_F > `max_residual` ‖P₀‖_F (P₀ too far from the solution for one step to reach
 /// rounding: checked before the doubling, so a far start costs only the residual), when K₀ cannot
@@ -510,6 +514,7 @@ pub fn dare_newton_step<const N: usize, const U: usize>(
     r_diag: &SVector<f64, U>,
     p0: &SMatrix<f64, N, N>,
     max_residual: f64,
+    converged: f64,
 ) -> Result<(SMatrix<f64, N, N>, f64), RiccatiError> {
     let k0 = lqr_gain(phi, gamma, p0, r_diag)?;
     let ptp = phi.transpose() * p0;
@@ -519,6 +524,9 @@ pub fn dare_newton_step<const N: usize, const U: usize>(
     let rel_res = res.norm() / p0.norm().max(f64::MIN_POSITIVE);
     if rel_res.is_nan() || rel_res > max_residual {
         return Err(RiccatiError::Residual(rel_res));
+    }
+    if rel_res <= converged {
+        return Ok((*p0, 0.0));
     }
     let ac = phi - gamma * k0;
     if !(all_finite(&res) && all_finite(&ac)) {
@@ -1227,7 +1235,7 @@ mod tests {
         let mut p1 = p;
         for eps in [1e-3, 1e-4, 1e-5] {
             let rel;
-            (p1, rel) = dare_newton_step(&phi, &gamma, &q, &r, &(p + sym * eps), 1.0).unwrap();
+            (p1, rel) = dare_newton_step(&phi, &gamma, &q, &r, &(p + sym * eps), 1.0, 0.0).unwrap();
             let err = (p1 - p).amax() / p.amax();
             // Measured: 4.4e2 ε² (this random pair is poorly conditioned).
             assert!(rel > 0.1 * eps && rel < 10.0 * eps, "{rel} vs {eps}");
@@ -1235,12 +1243,23 @@ mod tests {
             assert_eq!(p1, p1.transpose());
         }
         // A second step from the last: at rounding.
-        let (p2, _) = dare_newton_step(&phi, &gamma, &q, &r, &p1, 1.0).unwrap();
+        let (p2, _) = dare_newton_step(&phi, &gamma, &q, &r, &p1, 1.0, 0.0).unwrap();
         assert!((p2 - p).amax() < 1e-12 * p.amax(), "{}", (p2 - p).amax() / p.amax());
         assert!(matches!(
-            dare_newton_step(&phi, &gamma, &q, &r, &(p + sym * 1e-2), 1e-9),
+            dare_newton_step(&phi, &gamma, &q, &r, &(p + sym * 1e-2), 1e-9, 0.0),
             Err(RiccatiError::Residual(_))
         ));
+        // A converged start (the doubling's P: residual ≈ 1e-16) is returned untouched when
+        // `converged` admits it, and stepped otherwise; a start off by 1e-5 is stepped.
+        assert!(dare_residual(&phi, &gamma, &q, &p, &lqr_gain(&phi, &gamma, &p, &r).unwrap()) < 1e-13);
+        assert_eq!(
+            dare_newton_step(&phi, &gamma, &q, &r, &p, 1.0, 1e-13).unwrap(),
+            (p, 0.0)
+        );
+        let (stepped, rel) = dare_newton_step(&phi, &gamma, &q, &r, &p, 1.0, 0.0).unwrap();
+        assert!(rel > 0.0 && (stepped - p).amax() < 1e-12 * p.amax());
+        let (far, rel) = dare_newton_step(&phi, &gamma, &q, &r, &(p + sym * 1e-5), 1.0, 1e-13).unwrap();
+        assert!(rel > 1e-6 && (far - p).amax() < 1e-7 * p.amax());
     }
 
     #[test]
