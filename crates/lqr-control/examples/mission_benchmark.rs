@@ -2,7 +2,11 @@
 //! writes the trajectory (t, N, E, D, full precision) as CSV for before/after comparisons
 //! and prints the CPU time of one whole mission (median over `runs`).
 //!
-//! `cargo run --release -p lqr-control --example mission_benchmark -- [default|violent] [out.csv|-] [runs=5] [plant integration step (s)]`
+//! `cargo run --release -p lqr-control --example mission_benchmark -- [default|violent] [out.csv|-] [runs=5] [plant integration step (s)|-] [relinearisation period T_l (s)]`
+//!
+//! The last argument overrides the LQR's `relinearisation_period` (default 0.2 s, the
+//! thesis's T_l): e.g. `1e9` relinearises only at the start, which gives the mission's cost
+//! without the periodic gain solves (docs/PERFORMANCE.md, "relinearisation period").
 //!
 //! After the timed runs three more, instrumented (monotonic clock around each controller
 //! sample), splits the mission into construction, relinearising samples, other samples and
@@ -35,16 +39,38 @@ fn scenario(name: &str) -> Scenario {
     }
 }
 
+/// The overrides of the command line: plant integration step and LQR relinearisation period.
+#[derive(Clone, Copy, Default)]
+struct Setup {
+    integration_step: Option<f64>,
+    relinearisation_period: Option<f64>,
+}
+
+impl Setup {
+    fn plant(&self) -> Plant {
+        let mut plant = Plant::new(Airframe::default());
+        if let Some(step) = self.integration_step {
+            plant.integration_step = step;
+        }
+        plant
+    }
+
+    fn params(&self) -> LqrParams {
+        let mut params = LqrParams::default();
+        if let Some(period) = self.relinearisation_period {
+            params.relinearisation_period = period;
+        }
+        params
+    }
+}
+
 /// The flown trace, the number of gain solves (all, warm-started) and the CPU time (s) of
 /// the controller's construction (reference trajectory + first gain).
-fn fly_once(s: &Scenario, integration_step: Option<f64>) -> (Trace, (u64, u64), f64) {
-    let mut plant = Plant::new(Airframe::default());
-    if let Some(step) = integration_step {
-        plant.integration_step = step;
-    }
+fn fly_once(s: &Scenario, setup: Setup) -> (Trace, (u64, u64), f64) {
+    let plant = setup.plant();
     let x0 = plant.trim_vertical_climb(s.mission.v_vertical).expect("trim").state;
     let c0 = thread_cpu_time();
-    let mut c = LqrController::new(Airframe::default(), s.mission, LqrParams::default()).expect("controller");
+    let mut c = LqrController::new(Airframe::default(), s.mission, setup.params()).expect("controller");
     let construction = thread_cpu_time() - c0;
     let trace = fly(&plant, x0, &mut c, s);
     (trace, (c.stats().solves, c.stats().warm_solves), construction)
@@ -100,14 +126,11 @@ impl SampledUnit for Timed {
 type Breakdown = (Duration, Duration, (Duration, u64), (Duration, u64), Duration);
 
 /// One instrumented mission.
-fn breakdown(s: &Scenario, integration_step: Option<f64>) -> Breakdown {
-    let mut plant = Plant::new(Airframe::default());
-    if let Some(step) = integration_step {
-        plant.integration_step = step;
-    }
+fn breakdown(s: &Scenario, setup: Setup) -> Breakdown {
+    let plant = setup.plant();
     let x0 = plant.trim_vertical_climb(s.mission.v_vertical).expect("trim").state;
     let start = Instant::now();
-    let controller = LqrController::new(Airframe::default(), s.mission, LqrParams::default()).expect("controller");
+    let controller = LqrController::new(Airframe::default(), s.mission, setup.params()).expect("controller");
     let construction = start.elapsed();
     let mut timed = Timed {
         controller,
@@ -121,9 +144,9 @@ fn breakdown(s: &Scenario, integration_step: Option<f64>) -> Breakdown {
 }
 
 /// Prints the fastest of three instrumented missions.
-fn print_breakdown(s: &Scenario, integration_step: Option<f64>) {
+fn print_breakdown(s: &Scenario, setup: Setup) {
     let (total, construction, relinearising, other, rest) = (0..3)
-        .map(|_| breakdown(s, integration_step))
+        .map(|_| breakdown(s, setup))
         .min_by_key(|b| b.0)
         .expect("three runs");
     let ms = |d: Duration| d.as_secs_f64() * 1e3;
@@ -147,14 +170,17 @@ fn main() {
     let name = args.first().map(String::as_str).unwrap_or("default");
     let out = args.get(1).cloned();
     let runs: usize = args.get(2).and_then(|a| a.parse().ok()).unwrap_or(5);
-    let integration_step: Option<f64> = args.get(3).and_then(|a| a.parse().ok());
+    let setup = Setup {
+        integration_step: args.get(3).and_then(|a| a.parse().ok()),
+        relinearisation_period: args.get(4).and_then(|a| a.parse().ok()),
+    };
     let s = scenario(name);
     let mut times = Vec::new();
     let mut constructions = Vec::new();
     let mut last = None;
     for _ in 0..runs.max(1) {
         let c0 = thread_cpu_time();
-        let r = fly_once(&s, integration_step);
+        let r = fly_once(&s, setup);
         times.push((thread_cpu_time() - c0) * 1e3);
         constructions.push(r.2 * 1e3);
         last = Some(r);
@@ -180,6 +206,6 @@ fn main() {
         constructions[constructions.len() / 2]
     );
     if runs > 1 {
-        print_breakdown(&s, integration_step);
+        print_breakdown(&s, setup);
     }
 }
