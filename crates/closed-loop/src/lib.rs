@@ -64,12 +64,10 @@ impl Criteria {
     }
 }
 
-/// Time edges (s): a communication point `t` has reached an edge `t_edge` when
-/// `t ≥ t_edge − EDGE_TOLERANCE`, so that `t = k·h` computed in floating point meets an
-/// edge at a multiple of `h`. Used by [`Wind::Step`], [`Scenario::ref_offset`] and
-/// [`Trace::window`], and identically by the Python master (`tailsim.master.step`,
-/// `tailsim.metrics.window`); equal to `edge_tolerance` of the criteria file (tested).
-pub const EDGE_TOLERANCE: f64 = 1e-9;
+/// Time edges (s), the mission's ([`flight_mission::EDGE_TOLERANCE`]): used by
+/// [`Wind::Step`], [`Scenario::ref_offset`] and [`Trace::window`], and identically by the
+/// Python master; equal to `edge_tolerance` of the criteria file (tested).
+pub use flight_mission::EDGE_TOLERANCE;
 
 /// How the master orders the two units within a communication step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

@@ -74,6 +74,14 @@ pub struct MissionParams {
 // modelDescription/fragments/controller_interface.json.
 include!(concat!(env!("OUT_DIR"), "/mission_generated.rs"));
 
+/// Time edges (s): a communication point `t` has reached an edge `t_edge` when
+/// `t ≥ t_edge − EDGE_TOLERANCE`, so that `t = k·h` computed in floating point, by
+/// multiplication or by accumulation, meets an edge at a multiple of `h`: the phase
+/// edges of [`MissionParams::phase_at`], and the wind and reference-offset steps and
+/// metric windows of the closed loops. Equal to `edge_tolerance` of
+/// `modelDescription/fragments/mission_criteria.json` (tested in `closed-loop`).
+pub const EDGE_TOLERANCE: f64 = 1e-9;
+
 /// T1 of the fast mission ([`MissionParams::fast`]) (s).
 pub const FAST_T_TRANSITION_1: f64 = 2.0;
 /// T2 of the fast mission ([`MissionParams::fast`]) (s).
@@ -185,17 +193,22 @@ impl MissionParams {
         self.phase_starts()[5]
     }
 
-    /// The phase flown at mission time `t` and the time since that phase began.
-    /// Before 0 it is the first vertical phase; after the end the last one.
+    /// The phase flown at mission time `t` and the time since that phase began (negative,
+    /// at most [`EDGE_TOLERANCE`], just before a phase edge reached within the tolerance).
+    /// Before 0 it is the first vertical phase; after the end the last one. A phase begins
+    /// at `t ≥ start − EDGE_TOLERANCE`, so a master that accumulates its time
+    /// (4.999999999999981 for 5) switches at the same communication point as one that
+    /// multiplies.
     pub fn phase_at(&self, t: f64) -> (Phase, f64) {
         let s = self.phase_starts();
-        let phase = if t < s[1] {
+        let before = |edge: f64| t < edge - EDGE_TOLERANCE;
+        let phase = if before(s[1]) {
             Phase::Vertical1
-        } else if t < s[2] {
+        } else if before(s[2]) {
             Phase::TransitionToLevel
-        } else if t < s[3] {
+        } else if before(s[3]) {
             Phase::Level
-        } else if t < s[4] {
+        } else if before(s[4]) {
             Phase::TransitionToVertical
         } else {
             Phase::Vertical2
@@ -574,6 +587,23 @@ mod tests {
         assert_eq!(m.phase_at(25.0).0, Phase::TransitionToVertical);
         assert_eq!(m.phase_at(31.0).0, Phase::Vertical2);
         assert_eq!(m.phase_at(100.0).0, Phase::Vertical2);
+    }
+
+    #[test]
+    fn phase_edges_are_met_by_accumulated_time() {
+        let m = MissionParams::default();
+        // 250 steps of 0.02 s summed: 4.999999999999981, one rounding below the edge at 5 s.
+        let t = (0..250).fold(0.0, |t, _| t + 0.02);
+        assert!(t < 5.0 && 5.0 - t < 1e-12, "{t}");
+        let (phase, tau) = m.phase_at(t);
+        assert_eq!(phase, Phase::TransitionToLevel);
+        assert!(tau <= 0.0 && tau > -EDGE_TOLERANCE);
+        // Farther than the tolerance below the edge: still the phase before.
+        assert_eq!(m.phase_at(5.0 - 2.0 * EDGE_TOLERANCE).0, Phase::Vertical1);
+        for (k, edge) in m.phase_starts()[1..5].iter().enumerate() {
+            assert_eq!(m.phase_at(edge - 0.5 * EDGE_TOLERANCE).0 as usize, k + 1);
+            assert_eq!(m.phase_at(edge - 2.0 * EDGE_TOLERANCE).0 as usize, k);
+        }
     }
 
     #[test]
