@@ -33,7 +33,7 @@ pub struct FlightCondition {
     /// Airspeed of the reference path (m/s): where it is the hover's (≤ v_vertical + 1 m/s)
     /// the tuned guidance poles are blended on `axial_airspeed` instead of V̄.
     pub reference_airspeed: f64,
-    /// Weight (0–1) of the hover-in-wind design condition ([`HOVER_WIND_CROSSFLOW`]; 0 off the
+    /// Weight (0–1) of the hover-in-wind design condition ([`crate::HOVER_WIND_CROSSFLOW`]; 0 off the
     /// hover and in the thesis configuration): the path frame is kept (κ scaled by 1 − weight)
     /// and the roll and normal poles are slowed (README, "Hover in a span-wise wind").
     pub hover_wind: f64,

@@ -31,6 +31,13 @@
 //! with the tracking gain (§4.2.1) when a command saturates, and only finite values are
 //! committed. `sample` does not allocate (static nalgebra types only).
 //!
+//! Stages, one module each, in the order `sample` runs them: `reference` (trajectory or
+//! take-off / landing phases, weathervane heading) → `axes` (loop frame, measured specific
+//! accelerations) → `design` (gain schedule of every loop) → `guidance` (4.3.24) → `nvd`
+//! (decomposition 4.3.27–4.3.30, NVD error 4.3.5) → `inner_loops` (axial, normal, roll,
+//! directional laws) → `integrators` (bumpless start, anti-windup) → `mixing` (surface
+//! allocation, saturation); `deviations` holds the thesis-vs-tuned switch of each stage.
+//!
 //! Frames: earth NED, body (x nose, y right wing, z belly), wind axes (x along the air
 //! velocity, z in the plane of symmetry). Units SI, angles rad.
 
@@ -353,7 +360,7 @@ impl SampledUnit for TsdController {
     }
 
     /// One sample of the TSD controller: the stages of Figs. 4.1–4.2 in signal order
-    /// (crate README, "Where each block lives in the code").
+    /// (crate README, "Where each block of Figs. 4.1–4.2 lives in the code").
     fn sample(&mut self, input: &ControllerInput) -> Result<ControllerOutput, ControlError> {
         check_input(input)?;
         let meas = &input.measurement;
@@ -386,8 +393,8 @@ impl SampledUnit for TsdController {
             return Err(Self::err(format!("non-finite command at t = {} s", input.t)));
         }
         let e = integrators::loop_errors(&s.axes, &cmd, &laws);
-        let (ts, kaw) = (self.mission.sample_time, self.params.antiwindup_gain);
-        self.integrators.anti_windup_step(&s.d, e, &u, &u_sat, ts, kaw);
+        let (ts, gain) = (self.mission.sample_time, self.params.antiwindup_gain);
+        self.integrators.anti_windup_step(&s.d, e, &u, &u_sat, ts, gain);
         // Diagnostics.
         let notice = self.saturation_notice(&u, s.d.mixing);
         self.internals = Internals::of(&s, &sigma, &cmd, &u);
