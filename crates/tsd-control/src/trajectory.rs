@@ -58,7 +58,7 @@ impl Reference {
 /// The kinematic trajectory of a mission.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Trajectory {
-    /// The α- and thrust-limited point-mass path ([`flight_mission::profile`], issue 16)
+    /// The α- and thrust-limited point-mass path ([`flight_mission::profile`])
     /// replacing the quarter loops, if set.
     profile: Option<Profile>,
     mission: MissionParams,
@@ -260,7 +260,7 @@ mod tests {
     }
 
     #[test]
-    fn radius_of_the_issue_physics_check() {
+    fn radius_and_pull_up_load_factor() {
         let r = Trajectory::radius(3.0, 25.0, 4.0);
         assert!((r - 35.65).abs() < 0.05, "{r}");
         // Lift at the start of the pull-up: V²/r + g ≈ 2.8 g.
