@@ -58,7 +58,7 @@ impl Reference {
 /// The kinematic trajectory of a mission.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Trajectory {
-    /// The α- and thrust-limited point-mass path ([`flight_mission::profile`], issue 16)
+    /// The α- and thrust-limited point-mass path ([`flight_mission::profile`])
     /// replacing the quarter loops, if set.
     profile: Option<Profile>,
     mission: MissionParams,
@@ -135,94 +135,118 @@ impl Trajectory {
             + Vector3::new(0.0, s.y, 0.0)
     }
 
-    /// The reference at mission time `t`.
+    /// The reference at mission time `t`: the limited profile's point mass if set, else the
+    /// vertical climb, the quarter loops (4.3.31–4.3.40) and level flight.
     pub fn at(&self, t: f64) -> Reference {
-        let m = &self.mission;
         if let Some(profile) = &self.profile {
-            // t̂ = (cos γ, 0, −sin γ), dt̂/dγ = (−sin γ, 0, −cos γ): a = V̇ t̂ + V γ̇ dt̂/dγ.
-            let p = profile.at(t);
-            let (sg, cg) = p.gamma.sin_cos();
-            let tangent = Vector3::new(cg, 0.0, -sg);
-            let turn = Vector3::new(-sg, 0.0, -cg);
-            let a = tangent * p.v_dot + turn * (p.v * p.gamma_dot);
-            return Reference {
-                phase: m.phase_at(t).0,
-                pos: Vector3::new(p.north, 0.0, -p.height),
-                vel: tangent * p.v,
-                specific_accel: a - Vector3::new(0.0, 0.0, self.gravity),
-                airspeed: p.v,
-                gamma: p.gamma,
-            };
+            return self.on_profile(profile, t);
         }
-        let (vv, vl) = (m.v_vertical, m.v_level);
-        let g = Vector3::new(0.0, 0.0, self.gravity);
+        let m = &self.mission;
         let (phase, tau) = m.phase_at(t);
         let tau = tau.max(0.0);
-        let climb = |p0: Vector3<f64>| Reference {
-            phase,
-            pos: p0 + Vector3::new(0.0, 0.0, -vv * tau),
-            vel: Vector3::new(0.0, 0.0, -vv),
-            specific_accel: -g,
-            airspeed: vv,
-            gamma: FRAC_PI_2,
-        };
         match phase {
-            Phase::Vertical1 => climb(self.starts[0]),
-            Phase::Vertical2 => climb(self.starts[4]),
+            Phase::Vertical1 => self.climb(phase, tau, self.starts[0]),
+            Phase::Vertical2 => self.climb(phase, tau, self.starts[4]),
             // Take-off and landing: flown from flight_mission::ground, never a mission time.
             Phase::OnGround | Phase::TakeOff | Phase::Approach | Phase::Descent | Phase::Flare | Phase::Landed => {
-                climb(self.starts[4])
+                self.climb(phase, tau, self.starts[4])
             }
             Phase::Level => Reference {
                 phase,
-                pos: self.starts[2] + Vector3::new(vl * tau, 0.0, 0.0),
-                vel: Vector3::new(vl, 0.0, 0.0),
-                specific_accel: -g,
-                airspeed: vl,
+                pos: self.starts[2] + Vector3::new(m.v_level * tau, 0.0, 0.0),
+                vel: Vector3::new(m.v_level, 0.0, 0.0),
+                specific_accel: -self.gravity_vector(),
+                airspeed: m.v_level,
                 gamma: 0.0,
             },
-            Phase::TransitionToLevel => {
-                // (4.3.31), (4.3.33): push-over, γ = π/2 − φ.
-                let tt = m.t_transition_1;
-                let tau = tau.min(tt);
-                let av = (vl - vv) / tt;
-                let v = vv + av * tau;
-                let s = vv * tau + 0.5 * av * tau * tau;
-                let phi = s / self.r1;
-                let (sp, cp) = phi.sin_cos();
-                let tangent = Vector3::new(sp, 0.0, -cp);
-                let normal = Vector3::new(cp, 0.0, sp); // dt̂/dφ, towards the centre
-                let a = tangent * av + normal * (v * v / self.r1);
-                Reference {
-                    phase,
-                    pos: self.starts[1] + Vector3::new(self.r1 * (1.0 - cp), 0.0, -self.r1 * sp),
-                    vel: tangent * v,
-                    specific_accel: a - g,
-                    airspeed: v,
-                    gamma: FRAC_PI_2 - phi,
-                }
-            }
-            Phase::TransitionToVertical => {
-                // (4.3.32), (4.3.34): pull-up, γ = φ.
-                let tt = m.t_transition_2;
-                let tau = tau.min(tt);
-                let av = (vv - vl) / tt;
-                let v = vl + av * tau;
-                let s = vl * tau + 0.5 * av * tau * tau;
-                let phi = s / self.r2;
-                let (sp, cp) = phi.sin_cos();
-                let tangent = Vector3::new(cp, 0.0, -sp);
-                let normal = Vector3::new(-sp, 0.0, -cp);
-                let a = tangent * av + normal * (v * v / self.r2);
-                Reference {
-                    phase,
-                    pos: self.starts[3] + Vector3::new(self.r2 * sp, 0.0, -self.r2 * (1.0 - cp)),
-                    vel: tangent * v,
-                    specific_accel: a - g,
-                    airspeed: v,
-                    gamma: phi,
-                }
-            }
+            Phase::TransitionToLevel => self.push_over(phase, tau),
+            Phase::TransitionToVertical => self.pull_up(phase, tau),
+        }
+    }
+
+    /// Gravity g = (0, 0, g), NED (m/s²).
+    fn gravity_vector(&self) -> Vector3<f64> {
+        Vector3::new(0.0, 0.0, self.gravity)
+    }
+
+    /// The point mass of the limited profile at `t`: t̂ = (cos γ, 0, −sin γ),
+    /// dt̂/dγ = (−sin γ, 0, −cos γ), a = V̇ t̂ + V γ̇ dt̂/dγ, Σ = a − g.
+    fn on_profile(&self, profile: &Profile, t: f64) -> Reference {
+        let p = profile.at(t);
+        let (sg, cg) = p.gamma.sin_cos();
+        let tangent = Vector3::new(cg, 0.0, -sg);
+        let turn = Vector3::new(-sg, 0.0, -cg);
+        let a = tangent * p.v_dot + turn * (p.v * p.gamma_dot);
+        Reference {
+            phase: self.mission.phase_at(t).0,
+            pos: Vector3::new(p.north, 0.0, -p.height),
+            vel: tangent * p.v,
+            specific_accel: a - Vector3::new(0.0, 0.0, self.gravity),
+            airspeed: p.v,
+            gamma: p.gamma,
+        }
+    }
+
+    /// Vertical climb at V_V from `start`, `tau` into the phase: Σ = −g.
+    fn climb(&self, phase: Phase, tau: f64, start: Vector3<f64>) -> Reference {
+        let vv = self.mission.v_vertical;
+        Reference {
+            phase,
+            pos: start + Vector3::new(0.0, 0.0, -vv * tau),
+            vel: Vector3::new(0.0, 0.0, -vv),
+            specific_accel: -self.gravity_vector(),
+            airspeed: vv,
+            gamma: FRAC_PI_2,
+        }
+    }
+
+    /// First transition (4.3.31), (4.3.33): push-over on the quarter loop of radius r1 with
+    /// the airspeed linear from V_V to V_L, γ = π/2 − φ.
+    fn push_over(&self, phase: Phase, tau: f64) -> Reference {
+        let m = &self.mission;
+        let (vv, vl) = (m.v_vertical, m.v_level);
+        let tt = m.t_transition_1;
+        let tau = tau.min(tt);
+        let av = (vl - vv) / tt;
+        let v = vv + av * tau;
+        let s = vv * tau + 0.5 * av * tau * tau;
+        let phi = s / self.r1;
+        let (sp, cp) = phi.sin_cos();
+        let tangent = Vector3::new(sp, 0.0, -cp);
+        let normal = Vector3::new(cp, 0.0, sp); // dt̂/dφ, towards the centre
+        let a = tangent * av + normal * (v * v / self.r1);
+        Reference {
+            phase,
+            pos: self.starts[1] + Vector3::new(self.r1 * (1.0 - cp), 0.0, -self.r1 * sp),
+            vel: tangent * v,
+            specific_accel: a - self.gravity_vector(),
+            airspeed: v,
+            gamma: FRAC_PI_2 - phi,
+        }
+    }
+
+    /// Second transition (4.3.32), (4.3.34): pull-up on the quarter loop of radius r2 with
+    /// the airspeed linear from V_L to V_V, γ = φ.
+    fn pull_up(&self, phase: Phase, tau: f64) -> Reference {
+        let m = &self.mission;
+        let (vv, vl) = (m.v_vertical, m.v_level);
+        let tt = m.t_transition_2;
+        let tau = tau.min(tt);
+        let av = (vv - vl) / tt;
+        let v = vl + av * tau;
+        let s = vl * tau + 0.5 * av * tau * tau;
+        let phi = s / self.r2;
+        let (sp, cp) = phi.sin_cos();
+        let tangent = Vector3::new(cp, 0.0, -sp);
+        let normal = Vector3::new(-sp, 0.0, -cp);
+        let a = tangent * av + normal * (v * v / self.r2);
+        Reference {
+            phase,
+            pos: self.starts[3] + Vector3::new(self.r2 * sp, 0.0, -self.r2 * (1.0 - cp)),
+            vel: tangent * v,
+            specific_accel: a - self.gravity_vector(),
+            airspeed: v,
+            gamma: phi,
         }
     }
 }
@@ -236,7 +260,7 @@ mod tests {
     }
 
     #[test]
-    fn radius_of_the_issue_physics_check() {
+    fn radius_and_pull_up_load_factor() {
         let r = Trajectory::radius(3.0, 25.0, 4.0);
         assert!((r - 35.65).abs() < 0.05, "{r}");
         // Lift at the start of the pull-up: V²/r + g ≈ 2.8 g.

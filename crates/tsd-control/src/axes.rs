@@ -1,0 +1,134 @@
+//! Measurement stage (Fig. 4.1, the fed-back signals of the inner loop): the frame the specific
+//! accelerations are resolved in — the wind axes of the thesis (A.2.7) above
+//! `wind_frame_speed_high`, the reference-path frame below `wind_frame_speed_low`, blended
+//! between with the weight κ — and the measured A_W, B_W, C_W (2.5.25–2.5.28), the gravity
+//! direction cosines e_i3 (4.2.17) and the stability-axis rates.
+
+use crate::deviations::Deviations;
+use crate::{band_weight, TsdController, HOVER_WIND_CROSSFLOW};
+use flight_mission::Measurement;
+use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+
+/// The air flow over the aircraft as the schedule and the frame blend see it.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Airflow {
+    /// Axial airspeed V̄ cos α cos β (m/s): the variable of the frame blend κ.
+    pub axial_airspeed: f64,
+    /// Crossflow V̄ √(1 − cos²α cos²β) (m/s).
+    pub crossflow: f64,
+    /// Weight (0–1) of the hover-in-wind design condition.
+    pub hover_wind: f64,
+    /// The same for the loops: 0 in the take-off and landing phases (their own hover design).
+    pub hover_wind_loops: f64,
+    /// Weight κ of the wind axes against the reference-path frame.
+    pub kappa: f64,
+}
+
+impl TsdController {
+    /// The air flow of the sample and the frame weight κ. `reference_airspeed` is the
+    /// reference path's airspeed; `ground_phase` the take-off and landing phases.
+    ///
+    /// κ blends the wind axes (thesis) and the reference-path axes in the axial airspeed
+    /// V̄ cos α cos β (not V̄: a crosswind in hover must not blend in wind axes that point along
+    /// the span), and also scales the path-rotation terms of the loop models (a11 C_W, the
+    /// gravity terms g₁/V̄, g₂/V̄ and their feedback linearisation): at low speed the wind axes
+    /// turn as fast as the body and the time-scale separation fails.
+    pub(crate) fn airflow(
+        &self,
+        meas: &Measurement,
+        reference_airspeed: f64,
+        ground_phase: bool,
+        dev: Deviations,
+    ) -> Airflow {
+        let axial_airspeed = meas.airspeed * meas.alpha.cos() * meas.beta.cos();
+        let crossflow = (meas.airspeed * meas.airspeed - axial_airspeed * axial_airspeed)
+            .max(0.0)
+            .sqrt();
+        let hover_wind = if dev.hover_wind_design && reference_airspeed <= self.mission.v_vertical + 1.0 {
+            band_weight(crossflow, HOVER_WIND_CROSSFLOW)
+        } else {
+            0.0
+        };
+        // Tuned configuration, hover in wind: the reference-path frame is kept, κ scaled by
+        // 1 − hover_wind (README, "Hover in a span-wise wind"): with the nose tilted into a
+        // strong wind the air comes along the nose, the axial airspeed passes 4 m/s and the
+        // blend turned the loops to wind axes that pointed 50–75° off the vertical; the axial
+        // command Σ·i^W then fell to nothing (thrust to 0 N) and the aircraft fell.
+        // Not in the take-off and landing phases (their own hover design; unchanged).
+        let hover_wind_loops = if ground_phase { 0.0 } else { hover_wind };
+        let kappa = self.frame_weight(axial_airspeed) * (1.0 - hover_wind_loops);
+        Airflow {
+            axial_airspeed,
+            crossflow,
+            hover_wind,
+            hover_wind_loops,
+            kappa,
+        }
+    }
+}
+
+/// The loop frame (i^W, j^W, k^W) and the signals measured in it.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct LoopAxes {
+    /// Loop-frame axes in earth (NED) components.
+    pub iw: Vector3<f64>,
+    pub jw: Vector3<f64>,
+    pub kw: Vector3<f64>,
+    /// Measured A_W, B_W, C_W (m/s²).
+    pub a_w: f64,
+    pub b_w: f64,
+    pub c_w: f64,
+    /// Gravity direction cosines e_i3 = (axis i)·(down) (4.2.17).
+    pub e13: f64,
+    pub e23: f64,
+    pub e33: f64,
+    /// Stability-axis roll and yaw rates P, R (≈ P_W of (2.5.27) for small β) and the body
+    /// pitch rate Q (rad/s).
+    pub p_s: f64,
+    pub q: f64,
+    pub r_s: f64,
+}
+
+impl LoopAxes {
+    /// The loop frame at weight `kappa` between the measured wind axes and the reference
+    /// path's `tangent`, and the measurements resolved in it (rows of DCM^WB, (A.2.7)).
+    pub fn measure(meas: &Measurement, tangent: &Vector3<f64>, kappa: f64) -> Self {
+        let q = &meas.quat;
+        let att = UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]));
+        // Body → earth.
+        let r_eb = att.to_rotation_matrix();
+        let (fa, fb) = {
+            let (sa, ca) = meas.alpha.sin_cos();
+            let (sb, cb) = meas.beta.sin_cos();
+            let iw_e = r_eb * Vector3::new(ca * cb, sb, sa * cb);
+            let blend = iw_e * kappa + tangent * (1.0 - kappa);
+            let i_f = r_eb.transpose() * (if blend.norm() > 1e-6 { blend.normalize() } else { iw_e });
+            (i_f.z.atan2(i_f.x), i_f.y.clamp(-1.0, 1.0).asin())
+        };
+        let (sa, ca) = fa.sin_cos();
+        let (sb, cb) = fb.sin_cos();
+        // Rows of DCM^WB (A.2.7): wind axes in body components.
+        let iw_b = Vector3::new(ca * cb, sb, sa * cb);
+        let jw_b = Vector3::new(-ca * sb, cb, -sa * sb);
+        let kw_b = Vector3::new(-sa, 0.0, ca);
+        let iw = r_eb * iw_b;
+        let jw = r_eb * jw_b;
+        let kw = r_eb * kw_b;
+        let f = meas.specific_force_body;
+        let (pr, qr, rr) = (meas.rates.x, meas.rates.y, meas.rates.z);
+        Self {
+            iw,
+            jw,
+            kw,
+            a_w: iw_b.dot(&f),
+            b_w: jw_b.dot(&f),
+            c_w: kw_b.dot(&f),
+            e13: iw.z,
+            e23: jw.z,
+            e33: kw.z,
+            p_s: pr * ca + rr * sa,
+            q: qr,
+            r_s: rr * ca - pr * sa,
+        }
+    }
+}

@@ -1,0 +1,113 @@
+//! Reference stage (Fig. 4.2, the trajectory input of the outer loop): the kinematic reference of §4.3.3
+//! (position, velocity, specific acceleration Σ^RE (4.3.35–4.3.36), flight-path angle), or
+//! the take-off and landing phases around it (`flight_mission::ground`), and the heading of
+//! the weathervane that turns the prescribed normal vector of §4.3.2.1.
+
+use crate::trajectory::Reference;
+use crate::TsdController;
+use flight_mission::{Command, ControllerInput, ControllerOutput, Diagnostics, GroundMode, Measurement, Phase};
+use nalgebra::Vector3;
+
+/// The reference signals of one flying sample.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ReferenceSignals {
+    /// Mission time of the trajectory (the FMU time shifted by the take-off; NaN in the
+    /// take-off and landing phases).
+    pub t_mission: f64,
+    /// Reference of §4.3.3 (or the ground phases' vertical reference).
+    pub reference: Reference,
+    /// Reference position with every offset (NED).
+    pub ref_pos: Vector3<f64>,
+    /// Feed-forward Σ = a − g of the vertical reference of the take-off and landing phases;
+    /// `None` on the mission.
+    pub sigma_ground: Option<Vector3<f64>>,
+    /// Weathervane heading ψ_w about the earth's down axis (rad); 0 in still air and in the
+    /// take-off and landing phases.
+    pub heading: f64,
+}
+
+impl ReferenceSignals {
+    /// In the take-off and landing phases (their own vertical reference and loop design).
+    pub fn ground_phase(&self) -> bool {
+        self.sigma_ground.is_some()
+    }
+}
+
+/// What the reference stage found: a flying sample, or on the gear (no loop runs).
+pub(crate) enum ReferenceStage {
+    Flying(ReferenceSignals),
+    OnGear { phase: Phase, thrust: f64 },
+}
+
+impl TsdController {
+    /// Reference (§4.3.3) at the sample, or the take-off / landing phases around it, then
+    /// the weathervane's heading (README, "Weathervaning").
+    pub(crate) fn reference_stage(&mut self, input: &ControllerInput) -> ReferenceStage {
+        let meas = &input.measurement;
+        let g = self.airframe.gravity;
+        let trajectory = &self.trajectory;
+        let origin = self.ground.origin().unwrap_or_else(Vector3::zeros);
+        let mission_ref = |tm: f64| {
+            let r = trajectory.at(tm);
+            (r.pos + input.ref_offset_ned + origin, r.vel)
+        };
+        // Mission time of the trajectory (the FMU time shifted by the take-off), the
+        // reference, its position with every offset, and the feed-forward Σ of a vertical
+        // reference of the ground phases.
+        let (t_mission, reference, ref_pos, sigma_ground) = match self.ground.step(input.t, meas, mission_ref) {
+            GroundMode::Mission { t, offset } => {
+                let r = self.trajectory.at(t);
+                let shift = offset + origin;
+                (t, r, r.pos + input.ref_offset_ned + shift, None)
+            }
+            GroundMode::Vertical(v) => {
+                let r = Reference {
+                    phase: v.phase,
+                    pos: v.pos,
+                    vel: v.vel,
+                    specific_accel: v.accel - Vector3::new(0.0, 0.0, g),
+                    airspeed: v.vel.norm(),
+                    gamma: core::f64::consts::FRAC_PI_2,
+                };
+                (f64::NAN, r, v.pos + input.ref_offset_ned, Some(r.specific_accel))
+            }
+            GroundMode::Idle { phase, thrust } => return ReferenceStage::OnGear { phase, thrust },
+        };
+        // Heading reference (weathervane, README "Weathervaning"): the prescribed normal
+        // vector turned about the earth's down axis by ψ_w; zero in still air and in the
+        // take-off and landing phases (their own vertical reference).
+        let heading = if sigma_ground.is_some() {
+            flight_mission::HeadingRef::default()
+        } else {
+            self.weathervane.update(&self.mission, t_mission, meas)
+        };
+        ReferenceStage::Flying(ReferenceSignals {
+            t_mission,
+            reference,
+            ref_pos,
+            sigma_ground,
+            heading: heading.heading,
+        })
+    }
+
+    /// On the gear: no loop runs (no integrator wind-up); the next flight phase starts
+    /// bumpless from the measured thrust and surfaces.
+    pub(crate) fn on_gear(&mut self, meas: &Measurement, phase: Phase, thrust: f64) -> ControllerOutput {
+        self.initialized = false;
+        self.saturated = 0;
+        let command = Command {
+            thrust: thrust.clamp(self.airframe.thrust_min, self.airframe.thrust_max),
+            ..Command::default()
+        };
+        ControllerOutput {
+            command,
+            diagnostics: Diagnostics {
+                ref_pos_ned: meas.pos_ned,
+                ref_airspeed: 0.0,
+                phase,
+                pos_error: 0.0,
+            },
+            notice: None,
+        }
+    }
+}
