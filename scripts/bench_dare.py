@@ -13,7 +13,7 @@ loaded machine: it excludes the time spent waiting for a core); wall-clock media
 printed beside them. BLAS is limited to one thread so that scipy's CPU time is all on
 this thread (17×17 problems do not profit from threads).
 
-    PYTHONPATH=python .venv/bin/python scripts/bench_dare.py [--t 15] [--batches 15] [--exe BINARY]
+    .venv/bin/python scripts/bench_dare.py [--t 15] [--batches 15] [--exe BINARY]
 """
 
 from __future__ import annotations

@@ -16,7 +16,7 @@ import shutil
 import pytest
 
 from fmu_util import ROOT
-from tailsim import analysis_report
+from tailsim.reports import analysis as analysis_report
 
 DATA = ROOT / "tests" / "data" / "analysis"
 
@@ -162,7 +162,7 @@ def test_aero_models_section_shows_both_models_side_by_side(rendered):
 
 def test_aero_verdicts():
     """The verdict logic on hand-made rows (independent of any run)."""
-    from tailsim.aero_report import verdict
+    from tailsim.reports.aero import verdict
 
     def row(passed, alpha, err, alt, stall, beta=0.0, failure=None):
         return {"passed": passed, "max_alpha_deg": alpha, "max_beta_deg": beta, "max_pos_error_m": err,
@@ -183,7 +183,7 @@ def test_robustness_changes_say_what_changed_and_why():
     fewer and more passing factors on the global model are listed with their counts, the
     largest change of the worst error is named, and the reason depends on whether the
     changed sweeps left attached flow."""
-    from tailsim.aero_report import robustness_changes
+    from tailsim.reports.aero import robustness_changes
 
     d = {"controllers": ["LQR"], "params": [{"id": "CLa", "name": "C_Lα"}, {"id": "Cma", "name": "C_mα"},
                                             {"id": "Cnb", "name": "C_nβ"}]}

@@ -1,5 +1,5 @@
 """Avionics in the loop (issue 14): plant → tailsitter_sensors → tailsitter_ekf →
-controller → plant under fmpy (tailsim.avionics). Both controllers fly the
+controller → plant under fmpy (tailsim.masters.avionics). Both controllers fly the
 default mission on the estimator's outputs; the true position error per phase
 and the estimation errors per phase are printed (pytest -s).
 
@@ -16,8 +16,8 @@ import math
 import numpy as np
 import pytest
 
-from tailsim.avionics import AvionicsLoop, fly_with_avionics, format_phase_errors, phase_errors
-from tailsim.master import pos_error
+from tailsim.masters.avionics import AvionicsLoop, fly_with_avionics, format_phase_errors, phase_errors
+from tailsim.masters import pos_error
 from tailsim.metrics import mission_check
 
 # The thesis's aerodynamics (aero_model 0), as tests/test_closed_loop.py: the controllers'

@@ -13,10 +13,10 @@ import pathlib
 import numpy as np
 import pytest
 
-from tailsim import campaign_runner as R
+from tailsim.campaign import runner as R
 from tailsim.campaign import Store, deterministic, local_cluster, run_campaign
-from tailsim.campaign_report import bootstrap_mean_ci, spearman, wilson_interval, write_report
-from tailsim.campaign_sampling import (
+from tailsim.campaign.report import bootstrap_mean_ci, spearman, wilson_interval, write_report
+from tailsim.campaign.sampling import (
     MISSIONS,
     TABLE_5_1,
     CampaignSpec,
@@ -26,7 +26,7 @@ from tailsim.campaign_sampling import (
     sample_columns,
     wind_function,
 )
-from tailsim.master import ClosedLoop
+from tailsim.masters import ClosedLoop
 
 from conftest import ROOT
 
@@ -203,10 +203,10 @@ def test_thesis_configuration_run_equals_closed_loop_with_configuration_1(fmus):
 
 
 def test_avionics_run_equals_the_avionics_loop_with_the_sample_seed(fmus):
-    """The `avionics` axis flies tailsim.avionics' chain with the sensors' seed = the sample's
+    """The `avionics` axis flies tailsim.masters.avionics' chain with the sensors' seed = the sample's
     noise_seed; errors are the TRUE position against the reference."""
-    from tailsim.avionics import AvionicsLoop
-    from tailsim.master import pos_error
+    from tailsim.masters.avionics import AvionicsLoop
+    from tailsim.masters import pos_error
 
     spec = short_spec(state_sources=("avionics",), controllers=("lqr",))
     dig = R.install_fmus(R.load_fmu_bytes(DIST, ["lqr"], ["avionics"]))
@@ -271,13 +271,22 @@ def test_distributed_equals_serial(client, serial, tmp_path):
 
 def test_existing_cluster_without_tailsim_runs_the_same_campaign(serial, tmp_path):
     """--scheduler: a separately started scheduler and workers (loopback), whose Python
-    cannot import tailsim (no PYTHONPATH, another cwd): the package and the FMUs are sent."""
+    cannot import tailsim (hidden from their sys.path, another cwd): the package and the FMUs are sent."""
     import subprocess
     import sys
     import time
 
     dask_cli = str(pathlib.Path(sys.executable).parent / "dask")
-    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    # The venv has tailsim installed (editable: its folder on sys.path through a .pth);
+    # a sitecustomize drops that entry in the cluster's processes, as on a machine
+    # without the package.
+    hide = tmp_path / "hide"
+    hide.mkdir()
+    (hide / "sitecustomize.py").write_text(
+        "import os, sys\n"
+        "sys.path[:] = [p for p in sys.path if not os.path.isfile(os.path.join(p, 'tailsim', '__init__.py'))]\n"
+    )
+    env = {**os.environ, "PYTHONPATH": str(hide)}
     sched_file = tmp_path / "scheduler.json"
     log = open(tmp_path / "cluster.log", "w")
     common = dict(cwd=tmp_path, env=env, stdout=log, stderr=subprocess.STDOUT)
@@ -429,7 +438,7 @@ def test_native_campaign_flies_identical_jobs_to_the_same_rows(serial, tmp_path)
     """The native Rust loop (`analysis campaign-jobs`) on the campaign's jobs: the same
     outcome for every run (an invalid parameter, a tumble) and the same metrics, to the
     summation order of the RMS values (campaign_native.TOLERANCE), both configurations."""
-    from tailsim.campaign_native import TOLERANCE, compare, run_native
+    from tailsim.campaign.native import TOLERANCE, compare, run_native
 
     faults = {1: {"c_m_q_a0": 30.0, "c_m_q_a1": 30.0}, 3: {"mass": -1.0}}  # a tumble, an invalid value
     spec = short_spec(n_samples=N + 1, configurations=("tuned", "thesis"), overrides=faults)
@@ -467,11 +476,11 @@ def test_resume_refuses_a_different_campaign_unless_replace(serial, tmp_path):
 
 
 def test_comparison_section_is_the_paired_result(serial, tmp_path):
-    """tailsim.campaign_section (the comparison report's first section): Wilson intervals and
+    """tailsim.campaign.section (the comparison report's first section): Wilson intervals and
     paired TSD − LQR differences of the campaign's rows; campaigns of other samples refused."""
     import pyarrow.parquet as pq
 
-    from tailsim import campaign_section as S
+    from tailsim.campaign import section as S
 
     for name, spec in (("a", short_spec()), ("b", dataclasses.replace(short_spec(), seed=8))):
         (tmp_path / name).mkdir()

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from tailsim import ClosedLoop, step
-from tailsim.master import pos_error, settling_time
+from tailsim.masters import pos_error, settling_time
 from tailsim.metrics import mission_check
 
 MISSION = ["t_vertical_1", "t_transition_1", "t_level", "t_transition_2", "t_vertical_2", "v_level"]

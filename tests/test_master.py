@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from tailsim import ClosedLoop, one_minus_cosine_gust, step
-from tailsim.compare import main as compare_main
-from tailsim.master import pos_error, settling_time
+from tailsim.reports.compare import main as compare_main
+from tailsim.masters import pos_error, settling_time
 
 
 def test_wiring_is_by_name(fmus):

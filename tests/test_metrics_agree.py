@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from fmu_util import ROOT
-from tailsim.master import EDGE_TOLERANCE, RunResult, one_minus_cosine_gust, step, wind_from
+from tailsim.masters import EDGE_TOLERANCE, RunResult, one_minus_cosine_gust, step, wind_from
 from tailsim.metrics import CRITERIA, mission_check
 
 DATA = ROOT / "tests" / "data"

@@ -14,7 +14,7 @@ import pytest
 
 from fmu_util import DIST
 from tailsim import ClosedLoop
-from tailsim.report_takeoff import MISSION, PLANT, touchdown
+from tailsim.reports.takeoff import MISSION, PLANT, touchdown
 
 #: Long enough for the mission, the approach and the 2 m/s descent from ≈ 230 m (s).
 STOP = 190.0
@@ -102,7 +102,8 @@ def test_report_section_and_plot_from_the_campaign_data(tmp_path):
     import shutil
 
     from fmu_util import ROOT
-    from tailsim import analysis_report, report_takeoff
+    from tailsim.reports import analysis as analysis_report
+    from tailsim.reports import takeoff as report_takeoff
 
     data = ROOT / "tests" / "data" / "analysis"
     for f in data.iterdir():

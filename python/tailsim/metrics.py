@@ -18,7 +18,8 @@ from typing import Mapping
 
 import numpy as np
 
-from .master import EDGE_TOLERANCE, RunResult, pos_error, settling_time
+from .masters.fmu import RunResult, pos_error, settling_time
+from .masters.profiles import EDGE_TOLERANCE
 
 PHASES = ["vertical 1", "transition 1", "level", "transition 2", "vertical 2"]
 SURFACES = ["elevator", "aileron", "rudder", "flap_collective", "flap_differential", "vertical_flap"]

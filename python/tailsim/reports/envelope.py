@@ -2,14 +2,14 @@
 `report.json` (written by `crates/analysis/src/envelope_transitions.rs`) as a Markdown
 section and a plot of the fastest transitions each controller flies inside α ≤ 15°.
 
-Hooked into `tailsim.analysis_report` (section) and `tailsim.analysis_plots` (plot).
+Hooked into `tailsim.reports.analysis` (section) and `tailsim.reports.analysis_plots` (plot).
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
-from .report import fmt_or_dash, shortest
+from .markdown import fmt_or_dash, shortest
 
 ISSUE_TIMINGS = [(5.0, 10.0), (3.0, 4.0), (2.0, 3.0)]
 

@@ -1,14 +1,14 @@
 """The analysis report, rendered from the data the Rust campaign writes.
 
     cargo run --release -p analysis -- all --out out/analysis
-    PYTHONPATH=python .venv/bin/python -m tailsim.analysis_report out/analysis
+    .venv/bin/python -m tailsim.reports.analysis out/analysis
 
 The campaign (`crates/analysis`) writes data only: `report.json` (every table
 as structured data) and the CSV files of every table and figure. This module
 renders them: `report.md` (everything) and one Markdown file per section
 (`open_loop_modes.md`, `closed_loop_poles.md`, `table_5_1.md`,
 `robustness.md`, `gusts.md`, `aero_models.md`), `report.html` and the plots
-(`tailsim.analysis_plots`, `tailsim.aero_report`). `tailsim.compare` includes the same sections in
+(`tailsim.reports.analysis_plots`, `tailsim.reports.aero`). `tailsim.reports.compare` includes the same sections in
 the comparison report.
 """
 
@@ -18,11 +18,11 @@ import argparse
 import json
 import pathlib
 
-from . import aero_report
-from . import report_hover
-from . import report_envelope
-from . import report_takeoff
-from .report import fmt_or_dash, fmt_pole, markdown_to_html, shortest
+from . import aero as aero_report
+from . import envelope as report_envelope
+from . import hover as report_hover
+from . import takeoff as report_takeoff
+from .markdown import fmt_or_dash, fmt_pole, markdown_to_html, shortest
 
 OPEN_LOOP_NOTES = (
     "Differences from the thesis: the thesis's modes were computed from its AVL-based model with numbers it "
@@ -364,7 +364,7 @@ def write(folder: str | pathlib.Path, with_plots: bool = True) -> pathlib.Path:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="tailsim.analysis_report", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="tailsim.reports.analysis", description=__doc__.split("\n\n")[0])
     ap.add_argument("folder", nargs="?", default="out/analysis", help="output folder of the analysis campaign")
     ap.add_argument("--no-plots", action="store_true", help="tables only")
     args = ap.parse_args(argv)

@@ -12,13 +12,13 @@ Two sources, both shown when present:
 * the documented full run (≥ 1000 samples), summarised once into
   `docs/campaign_full_run.json` by
 
-      python -m tailsim.campaign_section --write docs/campaign_full_run.json FOLDER...
+      python -m tailsim.campaign.section --write docs/campaign_full_run.json FOLDER...
 
   (FOLDERs: campaigns of the same seed and sample space, e.g. one per axis; their rows
   are merged, samples paired by id — a sample's draw does not depend on the axes);
 * the main job's small campaign (`<out>/campaign`, `scripts/main.sh`).
 
-`report_section(out)` is the hook of `tailsim.compare`.
+`report_section(out)` is the hook of `tailsim.reports.compare`.
 """
 
 from __future__ import annotations
@@ -31,10 +31,10 @@ from typing import Any, Iterable, Mapping
 
 import numpy as np
 
-from .campaign_report import arms, bootstrap_mean_ci, paired, wilson_interval, _arm_mask
-from .campaign_sampling import CampaignSpec
+from .report import arms, bootstrap_mean_ci, paired, wilson_interval, _arm_mask
+from .sampling import CampaignSpec
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
+ROOT = pathlib.Path(__file__).resolve().parents[3]
 FULL_RUN = ROOT / "docs" / "campaign_full_run.json"
 #: Spec fields that fix the samples: campaigns merged into one summary must agree on them.
 SAMPLE_SPACE = ("seed", "tau_aero", "tau_mass", "wind_max", "gust_max", "gust_duration", "mission", "aero_model", "step_size")
@@ -163,7 +163,7 @@ def markdown(summary: Mapping[str, Any], title: str) -> list[str]:
 
 
 def report_section(out: str | pathlib.Path) -> list[str]:
-    """The report's comparison section (hook of `tailsim.compare`): the documented full run
+    """The report's comparison section (hook of `tailsim.reports.compare`): the documented full run
     and, when present, the main job's campaign in `<out>/campaign`."""
     md = [
         "",
@@ -186,7 +186,7 @@ def report_section(out: str | pathlib.Path) -> list[str]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m tailsim.campaign_section", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m tailsim.campaign.section", description=__doc__.split("\n\n")[0])
     ap.add_argument("folders", nargs="+", help="campaign folders of one sample space (rows merged, paired by sample)")
     ap.add_argument("--write", help="write the summary JSON here (e.g. docs/campaign_full_run.json)")
     a = ap.parse_args(argv)

@@ -9,7 +9,7 @@ and Jacobi, global aerodynamics.
 
 from __future__ import annotations
 
-from .report import shortest
+from .markdown import shortest
 
 PHASES = ["vertical 1", "transition 1", "level", "transition 2", "vertical 2"]
 ORDERINGS = ["Gauss-Seidel", "Jacobi"]

@@ -1,6 +1,6 @@
 """Plots of the analysis report, from the CSV files the Rust campaign
 (`cargo run --release -p analysis -- all --out DIR`) wrote into DIR; called by
-`python -m tailsim.analysis_report DIR`, which renders the whole report.
+`python -m tailsim.reports.analysis DIR`, which renders the whole report.
 
 Writes PNGs beside the CSVs:
   open_loop_modes.png                 open-loop poles (level, vertical), thesis Tables 3.2/3.3
@@ -22,7 +22,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from tailsim import report_envelope  # noqa: E402
+from tailsim.reports import envelope as report_envelope  # noqa: E402
 
 
 def rows(path):

@@ -22,10 +22,10 @@ import uuid
 import zipfile
 from typing import Any, Callable, Mapping
 
-from .campaign_runner import digest, install_fmus, load_fmu_bytes, metric_columns, run_job
-from .campaign_sampling import MISSIONS, CampaignSpec, jobs, sample_columns
+from .runner import digest, install_fmus, load_fmu_bytes, metric_columns, run_job
+from .sampling import MISSIONS, CampaignSpec, jobs, sample_columns
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
+ROOT = pathlib.Path(__file__).resolve().parents[3]
 #: Columns that depend on where and when a run was executed, not on what was run.
 NONDETERMINISTIC = ("worker", "wall_time_s", "cpu_time_s")
 SORT_KEYS = [("sample_id", "ascending"), ("controller", "ascending"), ("configuration", "ascending"), ("state_source", "ascending")]
@@ -168,11 +168,11 @@ def local_cluster(n_workers: int | None = None):
 
 def _package_zip() -> bytes:
     """The tailsim package as zip bytes, for workers that do not have it."""
-    pkg = pathlib.Path(__file__).resolve().parent
+    pkg = pathlib.Path(__file__).resolve().parents[1]
     buf = io.BytesIO()
     with zipfile.ZipFile(buf, "w") as z:
-        for f in sorted(pkg.glob("*.py")):
-            info = zipfile.ZipInfo(f"tailsim/{f.name}", date_time=(2020, 1, 1, 0, 0, 0))
+        for f in sorted(pkg.rglob("*.py")):
+            info = zipfile.ZipInfo(f"tailsim/{f.relative_to(pkg).as_posix()}", date_time=(2020, 1, 1, 0, 0, 0))
             z.writestr(info, f.read_bytes())
     return buf.getvalue()
 
@@ -246,7 +246,7 @@ def run_campaign(
                 else:
                     cluster = local_cluster(n_workers)
                     own_client = client = Client(cluster)
-            from . import campaign_plugin
+            from . import plugin as campaign_plugin
 
             package = None
             if upload if upload is not None else bool(scheduler):
@@ -404,7 +404,7 @@ def main(argv: list[str] | None = None) -> int:
             + (f"; {stats['not_recorded']} not recorded (run again to resume)" if stats["not_recorded"] else "")
         )
     if not a.no_report:
-        from .campaign_report import write_report
+        from .report import write_report
 
         path = write_report(out, spec)
         print(f"report: {path}")

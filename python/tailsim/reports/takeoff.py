@@ -4,8 +4,8 @@
 take off, fly the thesis's mission and land on a target point, on the global
 aerodynamics, Gauss-Seidel and Jacobi.
 
-`section(d)` gives the Markdown lines (hooked into `tailsim.analysis_report.SECTIONS`);
-`plot(folder)` draws `takeoff_landing.png` (called by `tailsim.analysis_report.write`).
+`section(d)` gives the Markdown lines (hooked into `tailsim.reports.analysis.SECTIONS`);
+`plot(folder)` draws `takeoff_landing.png` (called by `tailsim.reports.analysis.write`).
 """
 
 from __future__ import annotations
@@ -139,7 +139,7 @@ PLANT = {"initial_condition": 2}
 
 
 def touchdown(result, mission: dict | None = None) -> dict:
-    """Touchdown figures of a `tailsim.master.RunResult` of the mission (plant outputs):
+    """Touchdown figures of a `tailsim.masters.RunResult` of the mission (plant outputs):
     first contact after lift-off, the gear's sink rate there (`touchdown_speed`, the larger of
     the plant's output and the CG's sink just before), miss distance from the target at
     touchdown and at the end, tilt from the vertical (|90° − θ|), bounce (contact lost after

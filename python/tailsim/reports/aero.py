@@ -4,14 +4,14 @@ analysis report rendered from `aero_models.json` (+ `aero_coefficients.csv`),
 which `cargo run --release -p analysis -- all|aero --out DIR` writes.
 
     cargo run --release -p analysis -- aero --out out/analysis
-    PYTHONPATH=python .venv/bin/python -m tailsim.analysis_report out/analysis
+    .venv/bin/python -m tailsim.reports.analysis out/analysis
 
 Tables: the flight cases (default and fast mission, hover wind steps) and the
 analysis's gust sweep, each with the thesis / global values side by side and
 what changed; the parameter sweep of Table 5.1 on both models is in the
-robustness section (`tailsim.analysis_report`, rendered with
+robustness section (`tailsim.reports.analysis`, rendered with
 `robustness_changes` from here). Writes `aero_models.md`
-(via `tailsim.analysis_report`) and the plots
+(via `tailsim.reports.analysis`) and the plots
 `aero_coefficients.png` (C_L, C_D, C_m of both models over α = 0…180°) and
 `aero_flights.png` (largest position error of every flight).
 """
@@ -22,7 +22,7 @@ import json
 import math
 import pathlib
 
-from .report import fmt_or_dash, shortest
+from .markdown import fmt_or_dash, shortest
 
 FILE = "aero_models.json"
 

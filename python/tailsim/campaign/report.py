@@ -12,8 +12,8 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
-from .campaign_sampling import TABLE_5_1, CampaignSpec
-from .metrics import PHASES
+from .sampling import TABLE_5_1, CampaignSpec
+from ..metrics import PHASES
 
 Z95 = 1.959963984540054  # standard normal 97.5 % quantile
 COLORS = {"lqr": "tab:blue", "tsd": "tab:red"}

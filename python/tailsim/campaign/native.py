@@ -3,7 +3,7 @@ performance): the same samples, parameters, wind and limits as the fmpy runs, th
 `analysis campaign-jobs` (crates/analysis/src/native_campaign.rs), compared row by row
 with the fmpy campaign's rows and timed side by side.
 
-    python -m tailsim.campaign_native --campaign out/campaign [--threads 1] [--samples N]
+    python -m tailsim.campaign.native --campaign out/campaign [--threads 1] [--samples N]
 
 reads the campaign's specification (`campaign.json`) and rows (`results.parquet`), flies
 the perfect-state runs natively and writes `<campaign>/native/rows.jsonl`,
@@ -33,10 +33,10 @@ from typing import Any, Iterable, Mapping
 
 import numpy as np
 
-from .campaign_runner import FMU_NAMES, metric_columns
-from .campaign_sampling import CONFIGURATION_INDEX, TABLE_5_1, CampaignSpec, jobs, plant_parameters
+from .runner import FMU_NAMES, metric_columns
+from .sampling import CONFIGURATION_INDEX, TABLE_5_1, CampaignSpec, jobs, plant_parameters
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
+ROOT = pathlib.Path(__file__).resolve().parents[3]
 #: Largest |fmpy − native| of a completed run's metric (m, deg, fractions, s). The two
 #: engines fly the same Rust code behind different masters and, with the fmpy master's
 #: timing mirrored (`closed_loop::MeasuredWind::HeldInput`) and the inputs passed as bit
@@ -159,7 +159,7 @@ def compare(fmpy_rows: Iterable[Mapping[str, Any]], native_rows: Iterable[Mappin
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m tailsim.campaign_native", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m tailsim.campaign.native", description=__doc__.split("\n\n")[0])
     ap.add_argument("--campaign", default="out/campaign", help="folder of an fmpy campaign (campaign.json, results.parquet)")
     ap.add_argument("--dist", default=str(ROOT / "dist"))
     ap.add_argument("--threads", type=int, help="native threads (default: all cores)")

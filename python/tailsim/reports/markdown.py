@@ -1,6 +1,6 @@
 """The one rendering layer of the project's reports: number formats and the
 Markdown → self-contained HTML conversion used by the comparison report
-(`tailsim.compare`) and the analysis report (`tailsim.analysis_report`).
+(`tailsim.reports.compare`) and the analysis report (`tailsim.reports.analysis`).
 
 Rust writes data (CSV, JSON); everything a reader sees is formatted here.
 """

@@ -74,7 +74,7 @@ assert len(TABLE_5_1) == 25
 #: (the controller FMUs' `configuration`: 0 = tuned, the default; 1 = the thesis's
 #: configuration as printed, see the parameter's description). A state source is what the
 #: controller flies on: `perfect` = the plant's outputs; `avionics` = the estimate of
-#: `tailsitter_ekf` fed by `tailsitter_sensors` (tailsim.avionics, Gauss-Seidel), the
+#: `tailsitter_ekf` fed by `tailsitter_sensors` (tailsim.masters.avionics, Gauss-Seidel), the
 #: sensors seeded with the sample's `noise_seed`.
 CONTROLLERS = ("lqr", "tsd")
 CONFIGURATIONS: dict[str, dict[str, dict[str, int]]] = {

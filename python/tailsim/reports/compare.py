@@ -1,7 +1,7 @@
 """The comparison product: fly the missions and step tests with each
 controller, write CSVs, plots and a report (Markdown + self-contained HTML).
 
-    python -m tailsim.compare --controller both --out out
+    python -m tailsim.reports.compare --controller both --out out
 """
 
 from __future__ import annotations
@@ -15,10 +15,11 @@ import time
 
 import numpy as np
 
-from . import analysis_report, campaign_section
-from .master import ClosedLoop, Fmu, RunResult, pos_error, step
-from .metrics import CRITERIA, PHASES, mission_metrics, phase_starts, step_settling
-from .report import fmt, markdown_to_html
+from ..campaign import section as campaign_section
+from ..masters import ClosedLoop, Fmu, RunResult, pos_error, step
+from ..metrics import CRITERIA, PHASES, mission_metrics, phase_starts, step_settling
+from . import analysis as analysis_report
+from .markdown import fmt, markdown_to_html
 
 NAMES = {"lqr": "tailsitter_lqr", "tsd": "tailsitter_tsd"}
 COLORS = {"lqr": "tab:blue", "tsd": "tab:red"}
@@ -141,7 +142,7 @@ def analysis_section(out: pathlib.Path) -> list[str]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="tailsim.compare", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="tailsim.reports.compare", description=__doc__.split("\n\n")[0])
     ap.add_argument("--controller", choices=["lqr", "tsd", "both"], default="both")
     ap.add_argument("--dist", default="dist", help="folder with the .fmu files")
     ap.add_argument("--out", default="out", help="output folder")
