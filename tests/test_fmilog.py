@@ -7,7 +7,7 @@ import subprocess
 import sys
 import textwrap
 
-from fmu_util import ROOT, fmu_path
+from fmu_util import fmu_path
 
 SCRIPT = textwrap.dedent(
     """

@@ -26,8 +26,8 @@ import numpy as np
 import pytest
 
 from tailsim import ClosedLoop
-from tailsim.masters.cosim import run_fmus, run_ssp
 from tailsim.masters import pos_error
+from tailsim.masters.cosim import run_fmus, run_ssp
 from tailsim.metrics import CRITERIA, declared_mission, level_window, phase_starts
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent

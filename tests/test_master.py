@@ -11,14 +11,21 @@ import numpy as np
 import pytest
 
 from tailsim import ClosedLoop, one_minus_cosine_gust, step
-from tailsim.reports.compare import main as compare_main
 from tailsim.masters import pos_error, settling_time
+from tailsim.reports.compare import main as compare_main
 
 
 def test_wiring_is_by_name(fmus):
     loop = ClosedLoop(fmus["tailsitter_plant"], fmus["tailsitter_lqr"])
-    commands = ["thrust_cmd", "elevator_cmd", "aileron_cmd", "rudder_cmd", "flap_collective_cmd",
-                "flap_differential_cmd", "vertical_flap_cmd"]
+    commands = [
+        "thrust_cmd",
+        "elevator_cmd",
+        "aileron_cmd",
+        "rudder_cmd",
+        "flap_collective_cmd",
+        "flap_differential_cmd",
+        "vertical_flap_cmd",
+    ]
     assert sorted(loop.to_plant) == sorted(commands)
     plant_outputs = set(fmus["tailsitter_plant"].names("output"))
     assert set(loop.to_controller) == plant_outputs & set(fmus["tailsitter_lqr"].names("input"))
@@ -38,7 +45,7 @@ def test_commands_reach_the_plant(fmus):
     # The plant's actual thrust follows the controller's command through the 0.1 s lag.
     t, cmd, thrust = r.time, r["thrust_cmd"], r["thrust"]
     lagged = np.interp(t - 0.3, t, cmd)
-    steady = (t > 11.0)
+    steady = t > 11.0
     assert np.max(np.abs(thrust[steady] - lagged[steady])) < 2.0
     assert abs(r["elevator"][-1] - r["elevator_cmd"][-2]) < math.radians(1.0)
 
@@ -67,9 +74,7 @@ def test_constant_wind_is_flown_through(fmus):
     # (default, issue 13) β = 34° here is past the sideslip stall band and TSD drifts 0.13 m/s.
     r = ClosedLoop(
         fmus["tailsitter_plant"], fmus["tailsitter_tsd"], plant_params={"aero_model": 0}, controller_params=hover_long
-    ).run(
-        stop_time=10.0, wind=lambda t: wind
-    )
+    ).run(stop_time=10.0, wind=lambda t: wind)
     assert np.all(r["wind_e"] == 2.0)
     # In the vertical climb the controller holds position: the air moves past at 2 m/s sideways.
     k = r.time > 8.0

@@ -80,7 +80,9 @@ def test_ssp_flies_take_off_to_landing():
                     p.name = f"{comp.name}.{name}"
                     params.append(p)
     assert seen == set(MISSION), "the SSD binds every take-off and landing parameter"
-    r = simulate_ssp(str(path), stop_time=STOP, step_size=0.02, parameter_set=ParameterSet(name="tl", parameters=params))
+    r = simulate_ssp(
+        str(path), stop_time=STOP, step_size=0.02, parameter_set=ParameterSet(name="tl", parameters=params)
+    )
     contact = r["plant.ground_contact_points"]
     assert contact[0] > 0, "starts on the gear"
     phases = r["controller.phase"]

@@ -29,7 +29,8 @@ import subprocess
 import sys
 import tempfile
 import time
-from typing import Any, Iterable, Mapping
+from collections.abc import Iterable, Mapping
+from typing import Any
 
 import numpy as np
 
@@ -112,7 +113,14 @@ def run_native(
     tmp = pathlib.Path(workdir or tempfile.mkdtemp(prefix="tailsim-native-"))
     tmp.mkdir(parents=True, exist_ok=True)
     (tmp / "jobs.jsonl").write_text("".join(json.dumps(j) + "\n" for j in js))
-    cmd = [str(analysis_binary(profile)), "campaign-jobs", "--jobs", str(tmp / "jobs.jsonl"), "--out", str(tmp / "rows.jsonl")]
+    cmd = [
+        str(analysis_binary(profile)),
+        "campaign-jobs",
+        "--jobs",
+        str(tmp / "jobs.jsonl"),
+        "--out",
+        str(tmp / "rows.jsonl"),
+    ]
     if threads:
         cmd += ["--threads", str(threads)]
     t0 = time.perf_counter()
@@ -134,7 +142,13 @@ def compare(fmpy_rows: Iterable[Mapping[str, Any]], native_rows: Iterable[Mappin
     Outcomes are compared as (completed, failure); metrics on runs both engines completed,
     NaN equal to NaN."""
     by_key = {r["key"]: r for r in fmpy_rows}
-    out: dict[str, Any] = {"runs": 0, "same_outcome": 0, "outcome_differs": [], "max_abs_diff": {}, "beyond_tolerance": []}
+    out: dict[str, Any] = {
+        "runs": 0,
+        "same_outcome": 0,
+        "outcome_differs": [],
+        "max_abs_diff": {},
+        "beyond_tolerance": [],
+    }
     for n in native_rows:
         f = by_key.get(n["key"])
         if f is None:
@@ -160,7 +174,9 @@ def compare(fmpy_rows: Iterable[Mapping[str, Any]], native_rows: Iterable[Mappin
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m tailsim.campaign.native", description=__doc__.split("\n\n")[0])
-    ap.add_argument("--campaign", default="out/campaign", help="folder of an fmpy campaign (campaign.json, results.parquet)")
+    ap.add_argument(
+        "--campaign", default="out/campaign", help="folder of an fmpy campaign (campaign.json, results.parquet)"
+    )
     ap.add_argument("--dist", default=str(ROOT / "dist"))
     ap.add_argument("--threads", type=int, help="native threads (default: all cores)")
     ap.add_argument("--samples", type=int, help="only the first N samples")
@@ -194,7 +210,8 @@ def main(argv: list[str] | None = None) -> int:
         + ", ".join(f"{k} {v[0]:.2e}" for k, v in sorted(cmp["max_abs_diff"].items()))
     )
     print(
-        f"CPU per run: fmpy {t['fmpy_cpu_s_per_run_mean'] * 1e3:.1f} ms, native {t['native_cpu_s_per_run_mean'] * 1e3:.1f} ms "
+        f"CPU per run: fmpy {t['fmpy_cpu_s_per_run_mean'] * 1e3:.1f} ms, native "
+        f"{t['native_cpu_s_per_run_mean'] * 1e3:.1f} ms "
         f"({t['speed_ratio']:.1f}×); native wall {wall:.1f} s"
     )
     return 0 if not cmp["outcome_differs"] and not cmp["beyond_tolerance"] else 1

@@ -12,7 +12,7 @@ import importlib
 import os
 import sys
 import tempfile
-from typing import Mapping
+from collections.abc import Mapping
 
 from distributed import WorkerPlugin
 

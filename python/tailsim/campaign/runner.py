@@ -24,13 +24,13 @@ import socket
 import tempfile
 import threading
 import time
-from typing import Any, Mapping
+from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
-
 from fmpy.fmi1 import FMICallException
 
-from .. import fmilog
+from .. import declarations, fmilog
 from ..masters import AvionicsLoop, ClosedLoop, Fmu, NonFinite, pos_error
 from .sampling import CONFIGURATIONS, CampaignSpec, plant_parameters, wind_function
 
@@ -43,19 +43,13 @@ FMU_NAMES = {
 }
 #: The FMUs a state source needs beside the plant and the controllers.
 STATE_SOURCE_FMUS = {"perfect": (), "avionics": ("sensors", "ekf")}
-N_PHASES = 5
-#: Command limits of the saturation metric: thrust 0 / 150 N, surfaces ±25° (plant defaults).
-THRUST_LIMITS = (0.0, 150.0)
-DEFLECTION_LIMIT = math.radians(25.0)
-COMMANDS = [
-    "thrust_cmd",
-    "elevator_cmd",
-    "aileron_cmd",
-    "rudder_cmd",
-    "flap_collective_cmd",
-    "flap_differential_cmd",
-    "vertical_flap_cmd",
-]
+N_PHASES = len(declarations.PHASES)
+#: Command limits of the saturation metric: the plant's declared thrust limits and surface
+#: deflection limit (its parameters' defaults).
+THRUST_LIMITS = declarations.THRUST_LIMITS
+DEFLECTION_LIMIT = declarations.DEFLECTION_LIMIT
+#: The commands, thrust first.
+COMMANDS = list(declarations.COMMANDS)
 FAILURES = ("fmi_error", "divergence", "timeout", "exception")
 
 
@@ -68,7 +62,7 @@ def digest(data: bytes) -> str:
 _lock = threading.Lock()
 _fmus: dict[str, Fmu] = {}  # by sha256 of the .fmu bytes
 _dirs: list[str] = []
-_slaves: dict[tuple[int, str], "_Slave"] = {}  # (thread id, digest) -> instance
+_slaves: dict[tuple[int, str], _Slave] = {}  # (thread id, digest) -> instance
 
 
 class _Slave:
@@ -236,7 +230,7 @@ def run_metrics(sig: Mapping[str, np.ndarray]) -> dict[str, float]:
     run; altitude loss in transition 1 and 2 = largest height below the reference
     (pos_d − ref_pos_d, ≥ 0) in phase 1 / 3; max α over phases 1–3 (α is not
     meaningful in the near-hover vertical phases); saturation = fraction of samples
-    with any command at its limit (thrust ≤ 0 or ≥ 150 N, a surface at ±25°).
+    with any command at its limit (thrust at `THRUST_LIMITS`, a surface at ±`DEFLECTION_LIMIT`).
     """
     out: dict[str, float] = {}
     err, phase = sig["pos_error"], sig["phase"]
@@ -341,7 +335,11 @@ def run_job(job: Mapping[str, Any], spec_json: Mapping[str, Any], digests: Mappi
 
 
 def _run_avionics(
-    job: Mapping[str, Any], spec: CampaignSpec, digests: Mapping[str, str], pp: Mapping[str, float], cp: Mapping[str, Any]
+    job: Mapping[str, Any],
+    spec: CampaignSpec,
+    digests: Mapping[str, str],
+    pp: Mapping[str, float],
+    cp: Mapping[str, Any],
 ) -> dict[str, Any]:
     """Metrics and outcome of one run with avionics in the loop (`tailsim.masters.AvionicsLoop`,
     Gauss-Seidel, fresh instances): the sensors seeded with the sample's `noise_seed`. Position
@@ -394,7 +392,8 @@ def _run_avionics(
             k = int(over[0])
             failure = "divergence"
             detail = (
-                f"true position error {sig['pos_error'][k]:.1f} m > {spec.divergence_m:g} m at t = {sig['time'][k]:.2f} s"
+                f"true position error {sig['pos_error'][k]:.1f} m > {spec.divergence_m:g} m "
+                f"at t = {sig['time'][k]:.2f} s"
             )
             sig = {n: v[: k + 1] for n, v in sig.items()}
         out = run_metrics(sig)

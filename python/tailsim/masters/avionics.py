@@ -75,6 +75,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import declarations
 from .closed_loop import commands_driven, int_outputs, real_outputs, ref_offset_external, wind_external
 from .fmu import Fmu, RunResult, pos_error
 from .profiles import TimeFunction
@@ -93,7 +94,7 @@ SHARED_PARAMETERS = (
 )
 
 #: Phase names by the controller's `phase` output.
-PHASES = ["vertical 1", "transition 1", "level", "transition 2", "vertical 2"]
+PHASES = list(declarations.PHASES)
 
 #: Estimation errors recorded (signal name, unit).
 ERRORS = [
@@ -198,8 +199,7 @@ class AvionicsLoop:
         return System(
             [
                 Unit("sensors", S, self.sensors_params, sampler=True, minor=True),
-                Unit("controller", C, self.controller_params, sampler=True,
-                     record=real_outputs(C) + int_outputs(C)),
+                Unit("controller", C, self.controller_params, sampler=True, record=real_outputs(C) + int_outputs(C)),
                 Unit("ekf", E, ekf_params, record=real_outputs(E) + int_outputs(E), prefix="est_"),
                 Unit("plant", P, self.plant_params, minor=True, record=real_outputs(P)),
             ],
@@ -290,7 +290,8 @@ def format_phase_errors(result: RunResult, title: str = "") -> str:
     lines = [
         title
         or f"{result.controller} with avionics ({result.ordering}): max position error {pos_error(result).max():.2f} m",
-        f"  {'phase':>12} {'max |x-ref|':>11} | RMS est. error: {'pos':>6} {'vel':>6} {'att':>6} {'V':>6} {'alpha':>6} {'beta':>6}",
+        f"  {'phase':>12} {'max |x-ref|':>11} | RMS est. error: {'pos':>6} {'vel':>6} {'att':>6} {'V':>6} "
+        f"{'alpha':>6} {'beta':>6}",
     ]
     for pe in phase_errors(result):
         r = pe.rms

@@ -85,11 +85,22 @@ class ClosedLoop:
         c = self.controller
         return System(
             [
-                Unit("controller", c, self.controller_params, sampler=True,
-                     record=list(record_controller if record_controller is not None
-                                 else real_outputs(c) + int_outputs(c))),
-                Unit("plant", self.plant, self.plant_params, minor=True,
-                     record=list(record_plant if record_plant is not None else self.plant.names("output"))),
+                Unit(
+                    "controller",
+                    c,
+                    self.controller_params,
+                    sampler=True,
+                    record=list(
+                        record_controller if record_controller is not None else real_outputs(c) + int_outputs(c)
+                    ),
+                ),
+                Unit(
+                    "plant",
+                    self.plant,
+                    self.plant_params,
+                    minor=True,
+                    record=list(record_plant if record_plant is not None else self.plant.names("output")),
+                ),
             ],
             [Link("plant", "controller", self.to_controller), Link("controller", "plant", self.to_plant)],
             [wind_external(wind), ref_offset_external(ref_offset)],

@@ -36,7 +36,7 @@ import pathlib
 import tempfile
 import time as wall
 import zipfile
-from typing import Mapping
+from collections.abc import Mapping
 
 import numpy as np
 from fmpy import read_model_description
@@ -57,9 +57,16 @@ def _import_libcosim():
     from libcosimpy.CosimObserver import CosimObserver
     from libcosimpy.CosimSlave import CosimLocalSlave
 
-    return CosimExecution, CosimObserver, CosimLocalSlave, CosimVariableType, CosimVariableCausality, (
-        CosimLogLevel,
-        log_output_level,
+    return (
+        CosimExecution,
+        CosimObserver,
+        CosimLocalSlave,
+        CosimVariableType,
+        CosimVariableCausality,
+        (
+            CosimLogLevel,
+            log_output_level,
+        ),
     )
 
 
@@ -206,7 +213,9 @@ def run_fmus(
         for x in controller.names(causality.OUTPUT)
         if x in plant.names(causality.INPUT) and controller.vars[x].type == plant.vars[x].type == real
     ]
-    undriven = [x for x in plant.names(causality.INPUT) if x.endswith("_cmd") and not any(link[2] == x for link in links)]
+    undriven = [
+        x for x in plant.names(causality.INPUT) if x.endswith("_cmd") and not any(link[2] == x for link in links)
+    ]
     if undriven:
         raise ValueError(f"{controller_fmu.name} does not drive plant inputs {undriven}")
     for src, dst, x in links:

@@ -6,8 +6,8 @@ import math
 import pathlib
 import shutil
 import tempfile
+from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Mapping
 
 import numpy as np
 from fmpy import extract, read_model_description

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from typing import Callable
+from collections.abc import Callable
 
 Vector3 = tuple[float, float, float]
 TimeFunction = Callable[[float], Vector3]

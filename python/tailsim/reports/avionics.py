@@ -9,6 +9,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from .. import declarations
 from ..masters import Fmu, RunResult, pos_error
 from ..masters.avionics import PHASES, fly_with_avionics, phase_errors
 from ..metrics import mission_check
@@ -47,9 +48,11 @@ def avionics_section(
             for k in keys:
                 try:
                     r = fly_with_avionics(
-                        fmus, f"tailsitter_{k}", ordering=ordering, controller_params=dict(params),
-                        stop_time=sum(float(params[d]) for d in ("t_vertical_1", "t_transition_1", "t_level",
-                                                                  "t_transition_2", "t_vertical_2")),
+                        fmus,
+                        f"tailsitter_{k}",
+                        ordering=ordering,
+                        controller_params=dict(params),
+                        stop_time=declarations.stop_time(dict(params)),
                     )
                     runs[k] = r
                     if out is not None:
@@ -57,8 +60,13 @@ def avionics_section(
                 except Exception as e:  # noqa: BLE001 - a failed run is a result
                     runs[k] = f"failed: {e}"[:80]
             header = ["quantity"] + [f"{k.upper()} {w}" for k in keys for w in ("perfect state", "avionics")]
-            md += ["", f"### {m} mission: perfect state vs avionics", "", "| " + " | ".join(header) + " |",
-                   "|" + "---|" * len(header)]
+            md += [
+                "",
+                f"### {m} mission: perfect state vs avionics",
+                "",
+                "| " + " | ".join(header) + " |",
+                "|" + "---|" * len(header),
+            ]
 
             def cell(run, f):
                 if isinstance(run, str):
@@ -67,16 +75,18 @@ def avionics_section(
                     return "–"
                 return f(run)
 
-            def completed(r):
+            def completed(r, params=params):
                 mc = mission_check(r, {**params}, theta_trim)
                 return "yes" if mc.passed() else "no: " + "; ".join(mc.failures())[:60]
 
             rows = [("mission criteria met", completed)]
             for i, ph in enumerate(PHASES):
-                rows.append((
-                    f"max position error, {ph} [m]",
-                    lambda r, i=i: f"{float(np.max(pos_error(r)[r['phase'] == i], initial=0.0)):.2f}",
-                ))
+                rows.append(
+                    (
+                        f"max position error, {ph} [m]",
+                        lambda r, i=i: f"{float(np.max(pos_error(r)[r['phase'] == i], initial=0.0)):.2f}",
+                    )
+                )
             for label, f in rows:
                 vals = []
                 for k in keys:
@@ -86,15 +96,20 @@ def avionics_section(
                 r = runs[k]
                 if isinstance(r, str):
                     continue
-                md += ["", f"Estimation errors, {k.upper()} {m} mission (RMS per phase; α, β weakly observable "
-                       "in vertical flight):", "",
-                       "| phase | position [m] | velocity [m/s] | attitude [deg] | airspeed [m/s] | α [deg] | β [deg] |",
-                       "|---|---|---|---|---|---|---|"]
+                md += [
+                    "",
+                    f"Estimation errors, {k.upper()} {m} mission (RMS per phase; α, β weakly observable "
+                    "in vertical flight):",
+                    "",
+                    "| phase | position [m] | velocity [m/s] | attitude [deg] | airspeed [m/s] | α [deg] | β [deg] |",
+                    "|---|---|---|---|---|---|---|",
+                ]
                 for pe in phase_errors(r):
                     q = pe.rms
                     md.append(
                         f"| {pe.phase} | {q['err_pos']:.2f} | {q['err_vel']:.2f} | {math.degrees(q['err_att']):.2f} | "
-                        f"{q['err_airspeed']:.2f} | {math.degrees(q['err_alpha']):.2f} | {math.degrees(q['err_beta']):.2f} |"
+                        f"{q['err_airspeed']:.2f} | {math.degrees(q['err_alpha']):.2f} | "
+                        f"{math.degrees(q['err_beta']):.2f} |"
                     )
     finally:
         for f in fmus.values():

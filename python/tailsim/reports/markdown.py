@@ -11,7 +11,7 @@ import base64
 import html
 import math
 import pathlib
-from typing import Iterable
+from collections.abc import Iterable
 
 STYLE = (
     "body{font-family:sans-serif;max-width:80em;margin:2em auto}table{border-collapse:collapse}"

@@ -14,11 +14,10 @@ import json
 import math
 import pathlib
 
+from .. import declarations
+
 #: Phase codes of the controllers' `phase` output (modelDescription/fragments/controller_interface.json).
-PHASE_NAMES = {
-    0: "vertical 1", 1: "transition 1", 2: "level", 3: "transition 2", 4: "vertical 2",
-    5: "on ground", 6: "take-off", 7: "approach", 8: "descent", 9: "flare", 10: "landed",
-}
+PHASE_NAMES = declarations.PHASE_NAMES
 
 
 def _f(x, digits=2) -> str:
@@ -124,16 +123,8 @@ def plot(folder: str | pathlib.Path) -> pathlib.Path | None:
 
 
 #: The take-off-to-landing mission of the report (the Rust `analysis::takeoff_landing::mission`):
-#: controller parameters on top of the declared defaults.
-MISSION = {
-    "takeoff_spinup_time": 2.0,
-    "takeoff_time": 2.0,
-    "landing_descent_rate": 2.0,
-    "landing_target_n": 460.0,
-    "landing_target_e": 0.0,
-    "landing_target_d": 0.0,
-    "landing_approach_speed": 3.0,
-}
+#: controller parameters on top of the declared defaults (the declared preset `takeoff_landing`).
+MISSION = dict(declarations.PRESETS["takeoff_landing"])
 #: The plant at rest on the gear (global aerodynamics and the ground are its defaults).
 PLANT = {"initial_condition": 2}
 
