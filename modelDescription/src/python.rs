@@ -50,7 +50,11 @@ pub fn declarations_module(dir: &Path, version: &str) -> Result<String, DeclErro
 /// A Python string literal, quoted as `ruff format` quotes it (double quotes unless
 /// the text holds more double than single quotes).
 fn py_str(s: &str) -> String {
-    let quote = if s.matches('"').count() > s.matches('\'').count() { '\'' } else { '"' };
+    let quote = if s.matches('"').count() > s.matches('\'').count() {
+        '\''
+    } else {
+        '"'
+    };
     let mut out = String::with_capacity(s.len() + 2);
     out.push(quote);
     for c in s.chars() {
@@ -117,7 +121,10 @@ fn start_of(model: &Model, name: &str) -> Result<f64, DeclError> {
         .ok_or_else(|| DeclError(format!("{}: no variable '{name}'", model.model_identifier)))?;
     match v.decl.start {
         Some(Start::Number(x)) => Ok(x),
-        _ => Err(DeclError(format!("{}: '{name}' has no numeric start", model.model_identifier))),
+        _ => Err(DeclError(format!(
+            "{}: '{name}' has no numeric start",
+            model.model_identifier
+        ))),
     }
 }
 
@@ -233,7 +240,10 @@ pub fn render(models: &[Model], interface: &DeclFile) -> Result<String, DeclErro
     let mission_phases: Vec<_> = interface.phases.iter().filter(|p| p.duration.is_some()).collect();
     for (i, p) in mission_phases.iter().enumerate() {
         if p.code != i as i64 {
-            return Err(DeclError(format!("phase '{}': the mission's phases must be codes 0, 1, ...", p.name)));
+            return Err(DeclError(format!(
+                "phase '{}': the mission's phases must be codes 0, 1, ...",
+                p.name
+            )));
         }
     }
     let mission: Vec<_> = iface
@@ -267,9 +277,17 @@ pub fn render(models: &[Model], interface: &DeclFile) -> Result<String, DeclErro
     for v in &mission {
         let _ = writeln!(out, "    {}: {},", py_str(&v.name), py_start(VarType::Real, &v.start));
     }
-    out.push_str("}\n\n#: Their declared ranges (min, max).\nMISSION_RANGES: dict[str, tuple[float | None, float | None]] = {\n");
+    out.push_str(
+        "}\n\n#: Their declared ranges (min, max).\nMISSION_RANGES: dict[str, tuple[float | None, float | None]] = {\n",
+    );
     for v in &mission {
-        let _ = writeln!(out, "    {}: ({}, {}),", py_str(&v.name), py_opt_float(v.min), py_opt_float(v.max));
+        let _ = writeln!(
+            out,
+            "    {}: ({}, {}),",
+            py_str(&v.name),
+            py_opt_float(v.min),
+            py_opt_float(v.max)
+        );
     }
     out.push_str("}\n\n");
 

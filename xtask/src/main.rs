@@ -167,8 +167,9 @@ fn regen() -> Result<(), String> {
     }
     let root = workspace_root();
     let path = root.join(model_description::python::MODULE_PATH);
-    let text = model_description::python::declarations_module(&root.join("modelDescription"), env!("CARGO_PKG_VERSION"))
-        .map_err(|e| e.to_string())?;
+    let text =
+        model_description::python::declarations_module(&root.join("modelDescription"), env!("CARGO_PKG_VERSION"))
+            .map_err(|e| e.to_string())?;
     std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))?;
     println!("wrote {}", path.display());
     Ok(())

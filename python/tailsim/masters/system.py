@@ -125,31 +125,22 @@ class _Transfer:
 
 
 class _Instance:
-    """A unit's slave with its FMI functions bound once (fmpy's low-level calls,
-    status-checked by fmpy) and its prepared transfers."""
+    """A unit's slave with its prepared calls: fmpy's low-level FMI functions
+    (status-checked by fmpy) bound once, on ctypes arrays prepared once."""
 
     def __init__(self, unit: Unit, slave):
         self.unit, self.slave, self.comp = unit, slave, slave.component
         self.get = {t: getattr(slave, f) for t, f in _GET.items()}
         self.set = {t: getattr(slave, f) for t, f in _SET.items()}
         self.do_step = slave.fmi2DoStep
-        self.links_in: list[tuple[str, list[_Transfer]]] = []  # (source unit, transfers)
-        self.externals: list[tuple[External, ctypes.Array, ctypes.Array]] = []
-        self.records: list[tuple[_Transfer, np.ndarray]] = []  # (buffer, columns)
+        # (source name, get, source component, vrs, n, buffer, view to check or None)
+        self.reads: list[tuple] = []
+        self.writes: list[tuple] = []  # (set, component, vrs, n, buffer)
+        self.ext: list[tuple] = []  # (external index, buffer, offset, n)
+        self.inits: list[tuple] = []  # per link / external: what initialisation sets
+        self.buffers: list = []
+        self.records: list[tuple] = []  # (get, component, vrs, n, buffer, view or None, columns)
         self.wall = 0.0
-
-    def read(self, src: _Instance, tr: _Transfer) -> None:
-        src.get[tr.type](src.comp, tr.src, tr.n, tr.buf)
-
-    def write(self, tr: _Transfer) -> None:
-        self.set[tr.type](self.comp, tr.dst, tr.n, tr.buf)
-
-    def set_externals(self, values: Mapping[int, tuple]) -> None:
-        for e, vrs, buf in self.externals:
-            v = values[id(e)]
-            for j, x in enumerate(v):
-                buf[j] = x
-            self.set["Real"](self.comp, vrs, len(v), buf)
 
     def step(self, t: float, h: float, clock=wall.perf_counter) -> None:
         t0 = clock()
@@ -258,6 +249,16 @@ class System:
                 inst[u.name] = _Instance(u, s)
             self._prepare(inst, names)
             self._initialise(inst)
+            self._order = [inst[u.name] for u in self.units]
+            self._minor = [i for i in self._order if i.unit.minor]
+            self._recorded = [inst[u.name] for u in self.recorded]
+            self._jacobi = self.ordering == "jacobi"
+            self._functions = [e.function for e in self.externals]
+            col = len(names) - sum(len(e.signals) for e in self.externals)
+            self._ext_cols = []
+            for e in self.externals:
+                self._ext_cols.append(slice(col, col + len(e.signals)))
+                col += len(e.signals)
             iterator = range(n + 1)
             if progress:
                 from tqdm import tqdm
@@ -291,75 +292,120 @@ class System:
     # --- the steps ---------------------------------------------------------------------
 
     def _prepare(self, inst: Mapping[str, _Instance], names: list[str]) -> None:
-        col = {name: i for i, name in enumerate(names)}
+        """Per unit: its inputs (links and externals) in as few arrays as possible, one
+        per type (a new one where a later link sets an input again), each set with one
+        call; a link is read straight into its slice of the array."""
+        segments: dict[str, list[tuple]] = {u.name: [] for u in self.units}
         for link in self.links:
-            src, dst = inst[link.src], inst[link.dst]
-            dst.links_in.append((link.src, _transfers(src.unit.fmu, dst.unit.fmu, link.names)))
-        for e in self.externals:
-            i = inst[e.unit]
-            vrs = [i.unit.fmu.variables[x].valueReference for x in e.inputs]
-            i.externals.append((e, (ctypes.c_uint * len(vrs))(*vrs), (ctypes.c_double * len(vrs))()))
+            src = inst[link.src]
+            for tr in _transfers(src.unit.fmu, inst[link.dst].unit.fmu, link.names):
+                segments[link.dst].append((link.src, tr.type, list(tr.src), list(tr.dst)))
+        for k, e in enumerate(self.externals):
+            vrs = [inst[e.unit].unit.fmu.variables[x].valueReference for x in e.inputs]
+            segments[e.unit].append((k, "Real", None, vrs))
+        for name, segs in segments.items():
+            i = inst[name]
+            groups: list[dict] = []
+            for seg in segs:
+                type_, dst = seg[1], seg[3]
+                g = groups[-1] if groups else None
+                if g is None or g["type"] != type_ or g["set"] & set(dst):
+                    g = {"type": type_, "vrs": [], "set": set(), "segs": []}
+                    groups.append(g)
+                g["segs"].append((seg, len(g["vrs"])))
+                g["vrs"] += dst
+                g["set"] |= set(dst)
+            for g in groups:
+                type_, n_all = g["type"], len(g["vrs"])
+                ct, setter = _CTYPES[type_], i.set[type_]
+                buf = (ct * n_all)()
+                i.buffers.append(buf)
+                i.writes.append((setter, i.comp, (ctypes.c_uint * n_all)(*g["vrs"]), n_all, buf))
+                view = np.ctypeslib.as_array(buf) if type_ == "Real" else None
+                for (source, _, src_vrs, dst), off in g["segs"]:
+                    n = len(dst)
+                    ptr = ctypes.cast(ctypes.byref(buf, off * ctypes.sizeof(ct)), ctypes.POINTER(ct))
+                    dst_vrs = (ctypes.c_uint * n)(*dst)
+                    if isinstance(source, str):
+                        s = inst[source]
+                        check = view[off : off + n] if source in self.finite_sources and view is not None else None
+                        read = (source, s.get[type_], s.comp, (ctypes.c_uint * n)(*src_vrs), n, ptr, check)
+                        i.reads.append(read)
+                        i.inits.append((read, None, buf, off, setter, dst_vrs))
+                    else:
+                        i.ext.append((source, buf, off, n))
+                        i.inits.append((None, source, buf, off, setter, dst_vrs))
+        col = {name: c for c, name in enumerate(names)}
         for u in self.units:
             i = inst[u.name]
+            by_vr = {u.fmu.variables[x].valueReference: x for x in u.record}
             for tr in _transfers(u.fmu, u.fmu, list(u.record)):
-                by_vr = {u.fmu.variables[x].valueReference: x for x in u.record}
-                cols = np.array([col[u.signal(by_vr[vr])] for vr in tr.src], dtype=np.intp)
-                i.records.append((tr, cols))
+                cols = [col[u.signal(by_vr[vr])] for vr in tr.src]
+                contiguous = cols == list(range(cols[0], cols[0] + len(cols)))
+                where = slice(cols[0], cols[0] + len(cols)) if contiguous else np.array(cols, dtype=np.intp)
+                i.records.append((i.get[tr.type], i.comp, tr.src, tr.n, tr.buf, tr.view, where))
 
     def _initialise(self, inst: Mapping[str, _Instance]) -> None:
         for name in self.init_order:
             s = inst[name].slave
             s.setupExperiment(startTime=0.0)
             s.enterInitializationMode()
-        values = {id(e): tuple(e.function(0.0)) for e in self.externals}
+        values = [tuple(e.function(0.0)) for e in self.externals]
         done: set[str] = set()
         for name in self.init_order:
             i = inst[name]
             i.unit.fmu.set(i.slave, i.unit.params)
-            for src, transfers in i.links_in:
-                if src in done:
-                    for tr in transfers:
-                        i.read(inst[src], tr)
-                        i.write(tr)
-            i.set_externals(values)
+            # Links from the units already initialised, then the external inputs at 0.
+            for read, _, _, _, setter, dst_vrs in i.inits:
+                if read is not None and read[0] in done:
+                    _, get, comp, src_vrs, n, ptr, _ = read
+                    get(comp, src_vrs, n, ptr)
+                    setter(i.comp, dst_vrs, n, ptr)
+            for read, k, buf, off, setter, dst_vrs in i.inits:
+                if read is None:
+                    n = len(values[k])
+                    buf[off : off + n] = values[k]
+                    setter(i.comp, dst_vrs, n, ctypes.cast(ctypes.byref(buf, off * 8), ctypes.POINTER(ctypes.c_double)))
             i.slave.exitInitializationMode()
             done.add(name)
 
-    def _read_links(self, i: _Instance, inst: Mapping[str, _Instance], t: float) -> None:
-        for src, transfers in i.links_in:
-            for tr in transfers:
-                i.read(inst[src], tr)
-                if src in self.finite_sources and tr.view is not None and not np.isfinite(tr.view).all():
-                    raise NonFinite(f"non-finite {src} output at t = {t:.2f} s")
+    @staticmethod
+    def _read_links(i: _Instance, t: float) -> None:
+        for src, get, comp, vrs, n, ptr, check in i.reads:
+            get(comp, vrs, n, ptr)
+            if check is not None and not np.isfinite(check).all():
+                raise NonFinite(f"non-finite {src} output at t = {t:.2f} s")
+
+    @staticmethod
+    def _write_inputs(i: _Instance, values: Sequence[tuple]) -> None:
+        """The external inputs of `values` into their slices, then every input array."""
+        for k, buf, off, n in i.ext:
+            buf[off : off + n] = values[k]
+        for set_, comp, vrs, n, buf in i.writes:
+            set_(comp, vrs, n, buf)
 
     def _communication_point(self, inst, k, t, h, hs, m, n, data, monitor) -> None:
-        values = {id(e): tuple(e.function(t)) for e in self.externals}
-        order = [inst[u.name] for u in self.units]
-        jacobi = self.ordering == "jacobi"
+        functions = self._functions
+        values = [tuple(f(t)) for f in functions]
+        order = self._order
+        jacobi = self._jacobi
         if jacobi:
             for i in order:
-                self._read_links(i, inst, t)
+                self._read_links(i, t)
         for i in order:
             if not jacobi:
-                self._read_links(i, inst, t)
-            for _, transfers in i.links_in:
-                for tr in transfers:
-                    i.write(tr)
-            i.set_externals(values)
+                self._read_links(i, t)
+            self._write_inputs(i, values)
             if i.unit.sampler:
                 i.step(t, hs if i.unit.minor else h)
         row = data[k]
         row[0] = t
-        for u in self.recorded:
-            i = inst[u.name]
-            for tr, cols in i.records:
-                i.get[tr.type](i.comp, tr.src, tr.n, tr.buf)
-                row[cols] = tr.view if tr.view is not None else list(tr.buf)
-        col = len(row) - sum(len(e.signals) for e in self.externals)
-        for e in self.externals:
-            v = values[id(e)]
-            row[col : col + len(v)] = v
-            col += len(v)
+        for i in self._recorded:
+            for get, comp, vrs, nv, buf, view, where in i.records:
+                get(comp, vrs, nv, buf)
+                row[where] = view if view is not None else list(buf)
+        for where, v in zip(self._ext_cols, values, strict=True):
+            row[where] = v
         if monitor is not None:
             monitor(k, t, row)
         if k >= n:
@@ -367,19 +413,15 @@ class System:
         for i in order:
             if not i.unit.sampler and not i.unit.minor:
                 i.step(t, h)
-        minor = [i for i in order if i.unit.minor]
         for j in range(m):
             tj = t + j * hs
             if j > 0:
-                values = {id(e): tuple(e.function(tj)) for e in self.externals}
-            for i in minor:
+                values = [tuple(f(tj)) for f in functions]
+            for i in self._minor:
                 if j > 0:
                     if i.unit.sampler:
-                        self._read_links(i, inst, tj)
-                        for _, transfers in i.links_in:
-                            for tr in transfers:
-                                i.write(tr)
-                    i.set_externals(values)
+                        self._read_links(i, tj)
+                    self._write_inputs(i, values)
                 if not i.unit.sampler or j > 0:
                     i.step(tj, hs)
 
