@@ -219,6 +219,9 @@ class AvionicsLoop:
         ref_offset: TimeFunction | None = None,
     ) -> RunResult:
         h = default_step(self.controller, self.controller_params, step_size)
+        hs = float(self.plant_step or h)
+        if round(h / hs) < 1 or abs(round(h / hs) * hs - h) > 1e-12 * h:
+            raise ValueError(f"plant_step {hs} s must divide the controller step {h} s")
         system = self.system(h, wind, ref_offset)
         try:
             result = system.run(

@@ -206,10 +206,12 @@ class System:
         return names
 
     def units_of_signals(self) -> dict[str, str]:
+        """Units of the recorded Real signals (Integer and Boolean ones have none)."""
         units = {"time": "s"}
         for u in self.recorded:
             for n in u.record:
-                units[u.signal(n)] = u.fmu.variables[n].unit or ""
+                if u.fmu.variables[n].type == "Real":
+                    units[u.signal(n)] = u.fmu.variables[n].unit or ""
         for e in self.externals:
             for s in e.signals:
                 units[s] = e.unit_name
