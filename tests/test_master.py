@@ -136,3 +136,46 @@ def test_report_numbers_come_from_the_csvs(tmp_path):
         assert m["completed"] is True
         text = (out / "report.md").read_text()
         assert f"{m['max_error'][2]:.2f}" in text
+
+
+def test_one_engine_a_system_wired_by_hand_flies_as_closed_loop(fmus):
+    """ClosedLoop is a configuration of tailsim.masters.system.System: the same units,
+    links and external inputs declared by hand fly the same trajectory bit for bit, and
+    a run stopped by its monitor hands back the record flown so far."""
+    from tailsim.masters import External, Link, System, Unit, wire
+
+    plant, ctrl = fmus["tailsitter_plant"], fmus["tailsitter_tsd"]
+    gust = one_minus_cosine_gust(1.0, 1.0, (2.0, 0.0, -1.0))
+    offset = step(1.5, (0.0, 1.0, 0.0))
+    ref = ClosedLoop(plant, ctrl).run(stop_time=3.0, wind=gust, ref_offset=offset)
+    system = System(
+        [
+            Unit("controller", ctrl, sampler=True, record=["pos_error", "thrust_cmd", "phase"]),
+            Unit("plant", plant, record=["pos_n", "alpha"]),
+        ],
+        [Link("plant", "controller", wire(plant, ctrl)), Link("controller", "plant", wire(ctrl, plant))],
+        [
+            External("plant", ("wind_n", "wind_e", "wind_d"), gust, ("wind_n", "wind_e", "wind_d")),
+            External(
+                "controller", ("ref_offset_n", "ref_offset_e", "ref_offset_d"), offset, ("off_n", "off_e", "off_d")
+            ),
+        ],
+        init_order=["plant", "controller"],
+    )
+    r = system.run(3.0, 0.02)
+    for name in ["time", "pos_error", "thrust_cmd", "phase", "pos_n", "alpha", "wind_n", "wind_d"]:
+        assert np.array_equal(r[name], ref[name]), name
+    assert np.array_equal(r["off_e"], ref["ref_offset_e"])
+
+    class Stop(Exception):
+        pass
+
+    def monitor(k, t, row):
+        if t >= 1.0:
+            raise Stop
+
+    with pytest.raises(Stop) as info:
+        system.run(3.0, 0.02, monitor=monitor)
+    partial = info.value.partial_result
+    assert info.value.t == pytest.approx(1.0) and partial.time[-1] == pytest.approx(0.98)
+    assert np.array_equal(partial["pos_n"], ref["pos_n"][: len(partial.time)])

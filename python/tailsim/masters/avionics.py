@@ -59,7 +59,10 @@ and sensors at 5 ms; with it both controllers fly Gauss-Seidel and Jacobi at
 
 The chain is a configuration of `tailsim.masters.system.System`: the sensors and
 the controller are samplers, the estimator and the plant state units, the plant and
-the sensors minor units. The result is a `tailsim.masters.RunResult` whose signals hold the plant's
+the sensors minor units. As in every configuration the truth recorded at t is the
+plant's outputs with its inputs of t set (the command and the wind of t).
+
+The result is a `tailsim.masters.RunResult` whose signals hold the plant's
 outputs (the truth) under their names, the controller's outputs, the
 estimator's outputs as `est_<name>` (its diagnostics `est_std_*` as they are),
 and the estimation errors against the truth: `err_pos` (m), `err_vel` (m/s),
