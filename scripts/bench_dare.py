@@ -13,7 +13,7 @@ loaded machine: it excludes the time spent waiting for a core); wall-clock media
 printed beside them. BLAS is limited to one thread so that scipy's CPU time is all on
 this thread (17×17 problems do not profit from threads).
 
-    PYTHONPATH=python .venv/bin/python scripts/bench_dare.py [--t 15] [--batches 15] [--exe BINARY]
+    .venv/bin/python scripts/bench_dare.py [--t 15] [--batches 15] [--exe BINARY]
 """
 
 from __future__ import annotations
@@ -69,7 +69,8 @@ def main() -> int:
     ap.add_argument("--no-build", action="store_true", help="use the already built example binary")
     ap.add_argument(
         "--exe",
-        help="run this dare_benchmark binary instead (e.g. a base commit's build, for before/after runs; implies --no-build)",
+        help="run this dare_benchmark binary instead (e.g. a base commit's build, for before/after runs; "
+        "implies --no-build)",
     )
     a = ap.parse_args()
 
@@ -103,7 +104,10 @@ def main() -> int:
     print(f"matrices: Φ {phi.shape}, Γ {gamma.shape}, t = {a.t} s ({case['euler']}); scipy {scipy.__version__}")
     print(f"gains: max |K_ours − K_scipy| / max |K| = {k_rel:.2e}; P: {p_rel:.2e}")
     print(f"DARE relative residual: ours {residual(p_ours):.2e}, scipy {residual(p_sp):.2e}")
-    print(f"DARE + gain, median CPU (wall) µs per call: ours {ours_cpu:.1f} ({ours_wall:.1f}), scipy {sp_cpu:.1f} ({sp_wall:.1f})")
+    print(
+        f"DARE + gain, median CPU (wall) µs per call: ours {ours_cpu:.1f} ({ours_wall:.1f}), scipy {sp_cpu:.1f} "
+        f"({sp_wall:.1f})"
+    )
     print(f"ratio scipy / ours: {sp_cpu / ours_cpu:.1f}× (CPU time), {sp_wall / ours_wall:.1f}× (wall)")
     print(f"one whole relinearisation + gain (ours): {case['us_relinearise_discretise_dare_checks']:.1f} µs CPU")
     if not k_rel <= 1e-8:

@@ -6,7 +6,7 @@ and model-description parsing excluded), median and best of the CPU time of this
 and of the wall-clock time, and the share spent inside the controller's and the plant's
 fmi2DoStep.
 
-    PYTHONPATH=python .venv/bin/python scripts/bench_fmpy.py [--dist dist] [--runs 5]
+    .venv/bin/python scripts/bench_fmpy.py [--dist dist] [--runs 5]
 """
 
 from __future__ import annotations
@@ -18,10 +18,9 @@ import time
 
 import numpy as np
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT / "python"))
+from tailsim import ClosedLoop, Fmu
 
-from tailsim import ClosedLoop, Fmu  # noqa: E402
+ROOT = pathlib.Path(__file__).resolve().parent.parent
 
 
 def main() -> int:

@@ -20,10 +20,10 @@ cargo xtask dist
 if [ "$analysis" = 1 ]; then
     echo "== analysis campaign (out/analysis)"
     cargo run --release --locked -p analysis -- all --out out/analysis
-    PYTHONPATH=python .venv/bin/python -m tailsim.analysis_report out/analysis
+    .venv/bin/python -m tailsim.reports.analysis out/analysis
 fi
 # Before the missions: the comparison report's first section is the paired Monte-Carlo result.
 echo "== Monte-Carlo campaign (out/campaign; the full run: docs/CAMPAIGN.md)"
-PYTHONPATH=python .venv/bin/python -m tailsim.campaign --samples 16 --seed 1 --out out/campaign --replace --no-progress
+.venv/bin/python -m tailsim.campaign --samples 16 --seed 1 --out out/campaign --replace --no-progress
 echo "== flying the missions"
-PYTHONPATH=python .venv/bin/python -m tailsim.compare --out out "${runner_args[@]+"${runner_args[@]}"}"
+.venv/bin/python -m tailsim.reports.compare --out out "${runner_args[@]+"${runner_args[@]}"}"

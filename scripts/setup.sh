@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Set up a fresh machine: system packages (libclang for fmi-sys' bindgen; MinGW-w64
 # and Wine for the win64 binaries), the Rust target x86_64-pc-windows-gnu, the Rust
-# crates (fetched by cargo on first build) and the pinned Python venv.
+# crates (fetched by cargo on first build), the pinned Python venv and the tailsim package
+# (pyproject.toml; installed editable into the venv, so no PYTHONPATH is needed).
 # Idempotent and non-interactive: re-running only checks.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -47,4 +48,10 @@ if [ ! -x .venv/bin/python ] || ! cmp -s tests/requirements.txt .venv/requiremen
     .venv/bin/pip install -q --upgrade pip
     .venv/bin/pip install -q -r tests/requirements.txt
     cp tests/requirements.txt .venv/requirements.installed
+fi
+# The tailsim package (python/tailsim), editable: the venv imports the checkout's sources.
+if ! (root=$PWD; cd / && "$root/.venv/bin/python" -c "import tailsim" 2>/dev/null) || ! cmp -s pyproject.toml .venv/pyproject.installed; then
+    echo "== installing the tailsim package into .venv (pip install -e .)"
+    .venv/bin/pip install -q --no-deps -e .
+    cp pyproject.toml .venv/pyproject.installed
 fi

@@ -13,6 +13,9 @@ echo "== build and package the FMUs (dist/)"
 cargo xtask dist
 echo "== Rust tests"
 cargo test --workspace --locked
+echo "== ruff check / ruff format --check (python/, tests/, scripts/)"
+.venv/bin/ruff check python tests scripts
+.venv/bin/ruff format --check python tests scripts
 echo "== Python tests (fmpy)"
 .venv/bin/python -m pytest tests -q --ignore=tests/test_win64.py
 # The win64 FMUs under Wine through fmpy's remoting client, in a process of their own:

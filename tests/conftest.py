@@ -5,7 +5,6 @@ import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tests"))
-sys.path.insert(0, str(ROOT / "python"))
 
 from fmu_util import Unpacked  # noqa: E402
 from tailsim import Fmu, fmilog  # noqa: E402

@@ -16,7 +16,7 @@ import shutil
 import pytest
 
 from fmu_util import ROOT
-from tailsim import analysis_report
+from tailsim.reports import analysis as analysis_report
 
 DATA = ROOT / "tests" / "data" / "analysis"
 
@@ -84,7 +84,9 @@ def test_tables_hold_the_data(rendered):
     assert set(by) == {(k, m) for k in d["controllers"] for m in (0, 1)}
     for i, k in enumerate(d["controllers"]):
         t, g = by[k, 0], by[k, 1]
-        assert cells[1 + 3 * i] == f"{t['range'][0]:.3f} … {t['range'][1]:.3f} / {g['range'][0]:.3f} … {g['range'][1]:.3f}"
+        assert (
+            cells[1 + 3 * i] == f"{t['range'][0]:.3f} … {t['range'][1]:.3f} / {g['range'][0]:.3f} … {g['range'][1]:.3f}"
+        )
         assert cells[2 + 3 * i] == f"{t['passes']}/{t['points']} / {g['passes']}/{g['points']}"
         assert cells[3 + 3 * i] == f"{t['worst_pos_error']:.2f} / {g['worst_pos_error']:.2f}"
     # The generated comparison: one line per controller with its nominal flight on both models.
@@ -100,7 +102,11 @@ def test_tables_hold_the_data(rendered):
     assert len(gu) == 9
     # Transitions (issue 16): one row per tuned run, the thesis configuration on the issue's timings.
     env = d["envelope_transitions"]
-    tr = [line for line in lines_of(folder, "envelope_transitions.md") if line.startswith("| LQR") or line.startswith("| TSD")]
+    tr = [
+        line
+        for line in lines_of(folder, "envelope_transitions.md")
+        if line.startswith("| LQR") or line.startswith("| TSD")
+    ]
     assert len(tr) == len(env["rows"])
     fast = next(r for r in env["rows"] if r["controller"] == "LQR" and r["configuration"] == 0 and r["t1"] == 2.0)
     assert f"| {fast['max_alpha_deg']:.1f} | {fast['alt_dev_t1']:.2f} / {fast['alt_dev_t2']:.2f} |" in "\n".join(tr)
@@ -155,18 +161,25 @@ def test_aero_models_section_shows_both_models_side_by_side(rendered):
     # Coefficient curves: both models over 0…180°, identical in attached flow.
     c = a["coefficients"]
     assert c["alpha_deg"][0] == 0 and c["alpha_deg"][-1] == 180
-    for al, t, g in zip(c["alpha_deg"], c["thesis"]["c_L"], c["global"]["c_L"]):
+    for al, t, g in zip(c["alpha_deg"], c["thesis"]["c_L"], c["global"]["c_L"], strict=False):
         if al <= c["alpha_attached_deg"]:
             assert abs(t - g) < 1e-12
 
 
 def test_aero_verdicts():
     """The verdict logic on hand-made rows (independent of any run)."""
-    from tailsim.aero_report import verdict
+    from tailsim.reports.aero import verdict
 
     def row(passed, alpha, err, alt, stall, beta=0.0, failure=None):
-        return {"passed": passed, "max_alpha_deg": alpha, "max_beta_deg": beta, "max_pos_error_m": err,
-                "max_alt_dev_m": alt, "max_stall_fraction": stall, "failure": failure}
+        return {
+            "passed": passed,
+            "max_alpha_deg": alpha,
+            "max_beta_deg": beta,
+            "max_pos_error_m": err,
+            "max_alt_dev_m": alt,
+            "max_stall_fraction": stall,
+            "failure": failure,
+        }
 
     assert verdict(row(True, 8, 0.5, 0.3, 0.0), row(True, 8, 0.5, 0.3, 0.0)) == "unchanged: attached flow throughout"
     v = verdict(row(True, 22, 0.4, 0.2, 0.5), row(False, 170, 80, 79, 1.0, failure="touched the ground"))
@@ -183,21 +196,35 @@ def test_robustness_changes_say_what_changed_and_why():
     fewer and more passing factors on the global model are listed with their counts, the
     largest change of the worst error is named, and the reason depends on whether the
     changed sweeps left attached flow."""
-    from tailsim.aero_report import robustness_changes
+    from tailsim.reports.aero import robustness_changes
 
-    d = {"controllers": ["LQR"], "params": [{"id": "CLa", "name": "C_Lα"}, {"id": "Cma", "name": "C_mα"},
-                                            {"id": "Cnb", "name": "C_nβ"}]}
+    d = {
+        "controllers": ["LQR"],
+        "params": [{"id": "CLa", "name": "C_Lα"}, {"id": "Cma", "name": "C_mα"}, {"id": "Cnb", "name": "C_nβ"}],
+    }
 
     def row(pid, model, passes, worst, alpha, stall, rng=(0.8, 1.2)):
         nominal = {"passed": True, "max_pos_error": 0.4 + model, "max_alpha_deg": 11.0, "max_stall_fraction": 0.01}
-        return {"param": pid, "controller": "LQR", "aero_model": model, "passes": passes, "points": 50,
-                "range": list(rng), "worst_pos_error": worst, "max_alpha_deg": alpha,
-                "max_stall_fraction": stall, "nominal": nominal}
+        return {
+            "param": pid,
+            "controller": "LQR",
+            "aero_model": model,
+            "passes": passes,
+            "points": 50,
+            "range": list(rng),
+            "worst_pos_error": worst,
+            "max_alpha_deg": alpha,
+            "max_stall_fraction": stall,
+            "nominal": nominal,
+        }
 
     rows = [
-        row("CLa", 0, 50, 0.5, 22, 0.4), row("CLa", 1, 44, 3.5, 60, 1.0, (0.9, 1.2)),  # fewer, stalled
-        row("Cma", 0, 40, 2.0, 30, 0.5, (0.9, 1.2)), row("Cma", 1, 46, 2.0, 35, 0.6),  # more, stalled
-        row("Cnb", 0, 50, 0.7, 8, 0.0), row("Cnb", 1, 50, 0.7, 8, 0.0),  # attached, identical
+        row("CLa", 0, 50, 0.5, 22, 0.4),
+        row("CLa", 1, 44, 3.5, 60, 1.0, (0.9, 1.2)),  # fewer, stalled
+        row("Cma", 0, 40, 2.0, 30, 0.5, (0.9, 1.2)),
+        row("Cma", 1, 46, 2.0, 35, 0.6),  # more, stalled
+        row("Cnb", 0, 50, 0.7, 8, 0.0),
+        row("Cnb", 1, 50, 0.7, 8, 0.0),  # attached, identical
     ]
     out = robustness_changes(d, rows)
     line = next(x for x in out if x.startswith("- **LQR**"))

@@ -1,5 +1,5 @@
 """Avionics in the loop (issue 14): plant → tailsitter_sensors → tailsitter_ekf →
-controller → plant under fmpy (tailsim.avionics). Both controllers fly the
+controller → plant under fmpy (tailsim.masters.avionics). Both controllers fly the
 default mission on the estimator's outputs; the true position error per phase
 and the estimation errors per phase are printed (pytest -s).
 
@@ -16,8 +16,8 @@ import math
 import numpy as np
 import pytest
 
-from tailsim.avionics import AvionicsLoop, fly_with_avionics, format_phase_errors, phase_errors
-from tailsim.master import pos_error
+from tailsim.masters import pos_error
+from tailsim.masters.avionics import AvionicsLoop, fly_with_avionics, format_phase_errors, phase_errors
 from tailsim.metrics import mission_check
 
 # The thesis's aerodynamics (aero_model 0), as tests/test_closed_loop.py: the controllers'
@@ -70,8 +70,14 @@ def test_tsd_default_mission_with_avionics_jacobi(fmus, level_trim_theta):
     """Formerly diverged (the TSD's ≈ 4.5 Hz normal-acceleration loop had no margin for the
     two extra communication steps): the estimator now predicts its outputs over the
     measurement latency and the lead with its aircraft model (set by the master)."""
-    loop = AvionicsLoop(fmus["tailsitter_plant"], fmus["tailsitter_sensors"], fmus["tailsitter_ekf"],
-                        fmus["tailsitter_tsd"], ordering="jacobi", plant_params=PLANT)
+    loop = AvionicsLoop(
+        fmus["tailsitter_plant"],
+        fmus["tailsitter_sensors"],
+        fmus["tailsitter_ekf"],
+        fmus["tailsitter_tsd"],
+        ordering="jacobi",
+        plant_params=PLANT,
+    )
     assert loop._jacobi_defaults == ["measurement_latency", "prediction_lead"]
     r = loop.run()
     check(r, fmus, "tailsitter_tsd", level_trim_theta)
@@ -83,8 +89,9 @@ def test_tsd_jacobi_without_the_model_prediction_is_the_known_limit(fmus, level_
     from fmpy.fmi1 import FMICallException
 
     try:
-        r = fly_with_avionics(fmus, "tailsitter_tsd", ordering="jacobi", ekf_params={"model_prediction": False},
-                              plant_params=PLANT)
+        r = fly_with_avionics(
+            fmus, "tailsitter_tsd", ordering="jacobi", ekf_params={"model_prediction": False}, plant_params=PLANT
+        )
     except FMICallException as e:  # the plant left its envelope: lost
         print(f"\nTSD Jacobi without the model prediction: {e}")
         return
@@ -113,8 +120,15 @@ def test_wiring_by_name_and_shared_parameters(fmus):
     assert loop.ekf_params == {"mag_declination": -0.4}
     # The two FMUs declare the shared parameters with the same defaults.
     s, e = fmus["tailsitter_sensors"], fmus["tailsitter_ekf"]
-    for name in ["ref_latitude", "ref_longitude", "ref_height", "mag_field_total", "mag_declination",
-                 "mag_inclination", "filter_bandwidth"]:
+    for name in [
+        "ref_latitude",
+        "ref_longitude",
+        "ref_height",
+        "mag_field_total",
+        "mag_declination",
+        "mag_inclination",
+        "filter_bandwidth",
+    ]:
         assert s.start(name) == pytest.approx(e.start(name), rel=1e-12), name
         assert s.variables[name].unit == e.variables[name].unit, name
     for name in ["mag_x", "mag_y", "mag_z"]:
@@ -122,7 +136,10 @@ def test_wiring_by_name_and_shared_parameters(fmus):
     # The estimator's magnetometer σ is the sensors' σ through their 8 Hz filter at 50 Hz.
     assert e.start("sigma_mag") == pytest.approx(s.start("mag_std") * 0.5764)
     bad = AvionicsLoop(
-        fmus["tailsitter_plant"], fmus["tailsitter_sensors"], fmus["tailsitter_ekf"], fmus["tailsitter_lqr"],
+        fmus["tailsitter_plant"],
+        fmus["tailsitter_sensors"],
+        fmus["tailsitter_ekf"],
+        fmus["tailsitter_lqr"],
         plant_step=0.003,
     )
     with pytest.raises(ValueError, match="plant_step"):
@@ -142,6 +159,7 @@ def test_estimation_errors_are_against_the_truth(fmus):
     assert pos_error(r).max() < 20.0
     # In the reference point's NED frame the estimate at t = 0 is the first GPS fix: within
     # 5σ (Table D.1: 4 m per axis).
-    a = fly_with_avionics(fmus, "tailsitter_lqr", stop_time=1.0, plant_params=PLANT,
-                          ekf_params={"position_relative_to_start": False})
+    a = fly_with_avionics(
+        fmus, "tailsitter_lqr", stop_time=1.0, plant_params=PLANT, ekf_params={"position_relative_to_start": False}
+    )
     assert 0.0 < a["err_pos"][0] < 5 * 4.0 * math.sqrt(3)

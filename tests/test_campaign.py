@@ -13,10 +13,11 @@ import pathlib
 import numpy as np
 import pytest
 
-from tailsim import campaign_runner as R
+from conftest import ROOT
 from tailsim.campaign import Store, deterministic, local_cluster, run_campaign
-from tailsim.campaign_report import bootstrap_mean_ci, spearman, wilson_interval, write_report
-from tailsim.campaign_sampling import (
+from tailsim.campaign import runner as R
+from tailsim.campaign.report import bootstrap_mean_ci, spearman, wilson_interval, write_report
+from tailsim.campaign.sampling import (
     MISSIONS,
     TABLE_5_1,
     CampaignSpec,
@@ -26,9 +27,7 @@ from tailsim.campaign_sampling import (
     sample_columns,
     wind_function,
 )
-from tailsim.master import ClosedLoop
-
-from conftest import ROOT
+from tailsim.masters import ClosedLoop
 
 DIST = ROOT / "dist"
 N = 3  # samples of the campaign tests: 6 runs of the short (11 s) mission
@@ -126,7 +125,12 @@ def test_axes_multiply_runs_without_changing_the_draws():
 
 def test_wilson_interval_matches_newcombe_1998():
     # Newcombe, Stat. Med. 17 (1998) 857, Table I, method 3 (score, no continuity correction).
-    for k, n, lo, hi in [(81, 263, 0.2553, 0.3662), (15, 148, 0.0624, 0.1605), (0, 20, 0.0, 0.1611), (1, 29, 0.0061, 0.1718)]:
+    for k, n, lo, hi in [
+        (81, 263, 0.2553, 0.3662),
+        (15, 148, 0.0624, 0.1605),
+        (0, 20, 0.0, 0.1611),
+        (1, 29, 0.0061, 0.1718),
+    ]:
         assert wilson_interval(k, n) == pytest.approx((lo, hi), abs=6e-5)
 
 
@@ -140,7 +144,9 @@ def test_spearman_and_bootstrap():
     d = np.random.default_rng(0).normal(1.0, 1.0, 400)
     lo, hi = bootstrap_mean_ci(d)
     half = 1.96 * d.std() / math.sqrt(d.size)  # normal-theory interval of the mean
-    assert lo == pytest.approx(d.mean() - half, abs=0.25 * half) and hi == pytest.approx(d.mean() + half, abs=0.25 * half)
+    assert lo == pytest.approx(d.mean() - half, abs=0.25 * half) and hi == pytest.approx(
+        d.mean() + half, abs=0.25 * half
+    )
 
 
 # --- the runner ---------------------------------------------------------------------------
@@ -166,7 +172,9 @@ def test_reset_and_reuse_run_equals_closed_loop(fmus):
     assert ps.used and cs.used
     ps.slave.reset()
     cs.slave.reset()
-    sig, failure, _ = R.fly(ps.fmu, ps.slave, cs.fmu, cs.slave, pp, dict(spec.mission), wind_function(j), spec.stop_time, spec.step_size)
+    sig, failure, _ = R.fly(
+        ps.fmu, ps.slave, cs.fmu, cs.slave, pp, dict(spec.mission), wind_function(j), spec.stop_time, spec.step_size
+    )
     assert failure == ""
     for name, v in sig.items():
         assert np.array_equal(v, ref[name]), name  # bit for bit
@@ -195,7 +203,9 @@ def test_thesis_configuration_run_equals_closed_loop_with_configuration_1(fmus):
             stop_time=spec.stop_time, step_size=spec.step_size, wind=wind_function(j)
         )
         row = R.run_job(j, spec.to_json(), dig)
-        want = R.run_metrics({k: ref[k] for k in ("time", "phase", "pos_d", "alpha", "ref_pos_d", "pos_error", *R.COMMANDS)})
+        want = R.run_metrics(
+            {k: ref[k] for k in ("time", "phase", "pos_d", "alpha", "ref_pos_d", "pos_error", *R.COMMANDS)}
+        )
         for k, v in want.items():
             assert row[k] == v or (math.isnan(v) and math.isnan(row[k])), (j["key"], k)
         # and the configuration changes the flight (the parameter reached the controller)
@@ -203,10 +213,10 @@ def test_thesis_configuration_run_equals_closed_loop_with_configuration_1(fmus):
 
 
 def test_avionics_run_equals_the_avionics_loop_with_the_sample_seed(fmus):
-    """The `avionics` axis flies tailsim.avionics' chain with the sensors' seed = the sample's
+    """The `avionics` axis flies tailsim.masters.avionics' chain with the sensors' seed = the sample's
     noise_seed; errors are the TRUE position against the reference."""
-    from tailsim.avionics import AvionicsLoop
-    from tailsim.master import pos_error
+    from tailsim.masters import pos_error
+    from tailsim.masters.avionics import AvionicsLoop
 
     spec = short_spec(state_sources=("avionics",), controllers=("lqr",))
     dig = R.install_fmus(R.load_fmu_bytes(DIST, ["lqr"], ["avionics"]))
@@ -221,9 +231,15 @@ def test_avionics_run_equals_the_avionics_loop_with_the_sample_seed(fmus):
     sensors, ekf = fmus["tailsitter_sensors"], fmus["tailsitter_ekf"]
 
     def metrics(seed):
-        r = AvionicsLoop(plant, sensors, ekf, fmus["tailsitter_lqr"], plant_params=pp, sensors_params={"seed": seed},
-                         controller_params=dict(spec.mission)).run(
-            stop_time=spec.stop_time, step_size=spec.step_size, wind=wind_function(j))
+        r = AvionicsLoop(
+            plant,
+            sensors,
+            ekf,
+            fmus["tailsitter_lqr"],
+            plant_params=pp,
+            sensors_params={"seed": seed},
+            controller_params=dict(spec.mission),
+        ).run(stop_time=spec.stop_time, step_size=spec.step_size, wind=wind_function(j))
         sig = {k: r[k] for k in ("time", "phase", "pos_d", "alpha", "ref_pos_d", *R.COMMANDS)}
         sig["phase"] = sig["phase"].astype(np.int64)
         sig["pos_error"] = pos_error(r)
@@ -246,13 +262,20 @@ def test_embedded_cluster_listens_on_loopback_only(client):
     pids = set(client.run(os.getpid).values())
     assert len(pids) == 2 and os.getpid() not in pids
     listening = [
-        c.laddr.ip for pid in pids for c in psutil.Process(pid).net_connections(kind="inet") if c.status == psutil.CONN_LISTEN
+        c.laddr.ip
+        for pid in pids
+        for c in psutil.Process(pid).net_connections(kind="inet")
+        if c.status == psutil.CONN_LISTEN
     ]
     # the scheduler and the nannies (in this process): their comm and HTTP ports
     sched = client.cluster.scheduler
     ports = {int(sched.address.rsplit(":", 1)[1]), sched.http_server.port}
     ports |= {int(w["nanny"].rsplit(":", 1)[1]) for w in client.scheduler_info()["workers"].values()}
-    mine = [c for c in psutil.Process().net_connections(kind="inet") if c.status == psutil.CONN_LISTEN and c.laddr.port in ports]
+    mine = [
+        c
+        for c in psutil.Process().net_connections(kind="inet")
+        if c.status == psutil.CONN_LISTEN and c.laddr.port in ports
+    ]
     assert len(mine) == len(ports) == 4
     listening += [c.laddr.ip for c in mine]
     assert len(listening) >= 6 and set(listening) == {"127.0.0.1"}, listening
@@ -271,20 +294,39 @@ def test_distributed_equals_serial(client, serial, tmp_path):
 
 def test_existing_cluster_without_tailsim_runs_the_same_campaign(serial, tmp_path):
     """--scheduler: a separately started scheduler and workers (loopback), whose Python
-    cannot import tailsim (no PYTHONPATH, another cwd): the package and the FMUs are sent."""
+    cannot import tailsim (hidden from their sys.path, another cwd): the package and the FMUs are sent."""
     import subprocess
     import sys
     import time
 
     dask_cli = str(pathlib.Path(sys.executable).parent / "dask")
-    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    # The venv has tailsim installed (editable: its folder on sys.path through a .pth);
+    # a sitecustomize drops that entry in the cluster's processes, as on a machine
+    # without the package.
+    hide = tmp_path / "hide"
+    hide.mkdir()
+    (hide / "sitecustomize.py").write_text(
+        "import os, sys\n"
+        "sys.path[:] = [p for p in sys.path if not os.path.isfile(os.path.join(p, 'tailsim', '__init__.py'))]\n"
+    )
+    env = {**os.environ, "PYTHONPATH": str(hide)}
     sched_file = tmp_path / "scheduler.json"
     log = open(tmp_path / "cluster.log", "w")
     common = dict(cwd=tmp_path, env=env, stdout=log, stderr=subprocess.STDOUT)
     procs = [
         subprocess.Popen(
-            [dask_cli, "scheduler", "--host", "127.0.0.1", "--port", "0", "--dashboard-address", "127.0.0.1:0",
-             "--scheduler-file", str(sched_file)],
+            [
+                dask_cli,
+                "scheduler",
+                "--host",
+                "127.0.0.1",
+                "--port",
+                "0",
+                "--dashboard-address",
+                "127.0.0.1:0",
+                "--scheduler-file",
+                str(sched_file),
+            ],
             **common,
         )
     ]
@@ -294,8 +336,20 @@ def test_existing_cluster_without_tailsim_runs_the_same_campaign(serial, tmp_pat
             time.sleep(0.2)
         procs.append(
             subprocess.Popen(
-                [dask_cli, "worker", "--scheduler-file", str(sched_file), "--host", "127.0.0.1", "--nthreads", "1",
-                 "--nworkers", "2", "--dashboard-address", "127.0.0.1:0"],
+                [
+                    dask_cli,
+                    "worker",
+                    "--scheduler-file",
+                    str(sched_file),
+                    "--host",
+                    "127.0.0.1",
+                    "--nthreads",
+                    "1",
+                    "--nworkers",
+                    "2",
+                    "--dashboard-address",
+                    "127.0.0.1:0",
+                ],
                 **common,
             )
         )
@@ -328,7 +382,9 @@ def test_interrupted_campaign_resumes_to_the_same_content(client, serial, tmp_pa
     kept = Store(tmp_path).done_keys()
     assert set(seen) <= kept and len(kept) < 2 * N
     again = []
-    table = run_campaign(short_spec(), tmp_path, DIST, client=client, progress=False, on_row=lambda r, c: again.append(r["key"]))
+    table = run_campaign(
+        short_spec(), tmp_path, DIST, client=client, progress=False, on_row=lambda r, c: again.append(r["key"])
+    )
     assert not set(again) & kept  # completed runs are skipped
     assert deterministic(table).equals(deterministic(serial))
 
@@ -429,7 +485,7 @@ def test_native_campaign_flies_identical_jobs_to_the_same_rows(serial, tmp_path)
     """The native Rust loop (`analysis campaign-jobs`) on the campaign's jobs: the same
     outcome for every run (an invalid parameter, a tumble) and the same metrics, to the
     summation order of the RMS values (campaign_native.TOLERANCE), both configurations."""
-    from tailsim.campaign_native import TOLERANCE, compare, run_native
+    from tailsim.campaign.native import TOLERANCE, compare, run_native
 
     faults = {1: {"c_m_q_a0": 30.0, "c_m_q_a1": 30.0}, 3: {"mass": -1.0}}  # a tumble, an invalid value
     spec = short_spec(n_samples=N + 1, configurations=("tuned", "thesis"), overrides=faults)
@@ -467,11 +523,11 @@ def test_resume_refuses_a_different_campaign_unless_replace(serial, tmp_path):
 
 
 def test_comparison_section_is_the_paired_result(serial, tmp_path):
-    """tailsim.campaign_section (the comparison report's first section): Wilson intervals and
+    """tailsim.campaign.section (the comparison report's first section): Wilson intervals and
     paired TSD − LQR differences of the campaign's rows; campaigns of other samples refused."""
     import pyarrow.parquet as pq
 
-    from tailsim import campaign_section as S
+    from tailsim.campaign import section as S
 
     for name, spec in (("a", short_spec()), ("b", dataclasses.replace(short_spec(), seed=8))):
         (tmp_path / name).mkdir()

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from tailsim import ClosedLoop, step
-from tailsim.master import pos_error, settling_time
+from tailsim.masters import pos_error, settling_time
 from tailsim.metrics import mission_check
 
 MISSION = ["t_vertical_1", "t_transition_1", "t_level", "t_transition_2", "t_vertical_2", "v_level"]
@@ -104,16 +104,35 @@ def test_controllers_are_interchangeable(fmus, controller):
     """Same ports and mission parameters in both controllers (docs/DESIGN.md, "Ports and timing")."""
     a, b = fmus["tailsitter_lqr"], fmus["tailsitter_tsd"]
     shared = {"input", "output"}
-    ports = lambda f: {(v.name, v.causality, v.type, v.unit) for v in f.md.modelVariables if v.causality in shared}
+
+    def ports(f):
+        return {(v.name, v.causality, v.type, v.unit) for v in f.md.modelVariables if v.causality in shared}
+
     assert ports(a) == ports(b)
-    mission = ["t_vertical_1", "t_transition_1", "t_level", "t_transition_2", "t_vertical_2", "v_level", "v_vertical", "sample_time"]
+    mission = [
+        "t_vertical_1",
+        "t_transition_1",
+        "t_level",
+        "t_transition_2",
+        "t_vertical_2",
+        "v_level",
+        "v_vertical",
+        "sample_time",
+    ]
     for name in mission:
         assert a.variables[name].start == b.variables[name].start, name
     plant_inputs = set(fmus["tailsitter_plant"].names("input"))
     plant_outputs = set(fmus["tailsitter_plant"].names("output"))
     c = fmus[controller]
     for name in c.names("output"):
-        assert name in plant_inputs or name in {"ref_pos_n", "ref_pos_e", "ref_pos_d", "ref_airspeed", "phase", "pos_error"}, name
+        assert name in plant_inputs or name in {
+            "ref_pos_n",
+            "ref_pos_e",
+            "ref_pos_d",
+            "ref_airspeed",
+            "phase",
+            "pos_error",
+        }, name
     for name in c.names("input"):
         assert name in plant_outputs or name.startswith("ref_offset_"), name
 
@@ -123,8 +142,9 @@ def test_fast_mission_tsd(fmus):
     params = {"t_transition_1": 3.0, "t_transition_2": 4.0}
     # The thesis's result, on the thesis's (linear) aerodynamics: with the global model
     # (aero_model = 1, issue 13) this transition stalls the wing (alpha up to about 80 deg).
-    result = fly(fmus, "tailsitter_tsd", controller_params=params, plant_params={"aero_model": 0},
-                 stop_time=5 + 3 + 10 + 4 + 5)
+    result = fly(
+        fmus, "tailsitter_tsd", controller_params=params, plant_params={"aero_model": 0}, stop_time=5 + 3 + 10 + 4 + 5
+    )
     report(result, "tailsitter_tsd fast mission")
     for name, values in result.signals.items():
         assert np.all(np.isfinite(values)), f"{name} not finite"

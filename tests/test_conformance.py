@@ -49,8 +49,12 @@ def test_fmutool_check_passes(model):
 def test_archive_holds_binary_and_documentation(model):
     with zipfile.ZipFile(fmu_path(model)) as z:
         names = set(z.namelist())
-        assert {"modelDescription.xml", f"binaries/linux64/{model}.so", f"binaries/win64/{model}.dll",
-                "documentation/index.html"} <= names
+        assert {
+            "modelDescription.xml",
+            f"binaries/linux64/{model}.so",
+            f"binaries/win64/{model}.dll",
+            "documentation/index.html",
+        } <= names
         doc = z.read("documentation/index.html").decode()
     md = read_model_description(str(fmu_path(model)))
     assert doc.lstrip().lower().startswith("<!doctype html>")

@@ -7,12 +7,11 @@ import subprocess
 import sys
 import textwrap
 
-from fmu_util import ROOT, fmu_path
+from fmu_util import fmu_path
 
 SCRIPT = textwrap.dedent(
     """
     import gc, math, sys
-    sys.path.insert(0, {python!r})
     from fmpy import simulate_fmu
     from tailsim import Fmu, fmilog
 
@@ -39,7 +38,6 @@ SCRIPT = textwrap.dedent(
 
 def test_an_fmu_logging_after_simulate_fmu_reaches_a_live_logger(tmp_path):
     script = SCRIPT.format(
-        python=str(ROOT / "python"),
         plant=str(fmu_path("tailsitter_plant")),
         sensors=str(fmu_path("tailsitter_sensors")),
         tmp=str(tmp_path),

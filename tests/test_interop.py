@@ -9,14 +9,13 @@ Run with `-s` to see the printed matrix (also written to target/interop-matrix.m
 
 from __future__ import annotations
 
-import math
 import os
 
 import numpy as np
 import pytest
-from fmpy import read_model_description, simulate_fmu
+from fmpy import simulate_fmu
 
-from fmu_util import ROOT, LogRecorder, Unpacked, fmu_path
+from fmu_util import ROOT, LogRecorder, Unpacked
 
 ALL = ["tailsitter_plant", "tailsitter_lqr", "tailsitter_tsd"]
 MODELS = [m.strip() for m in os.environ.get("TAILSITTER_FMUS", "").split(",") if m.strip()] or ALL

@@ -1,5 +1,5 @@
 """The closed loop under a second master, libcosim (libcosimpy 0.0.6), compared with the fmpy
-master of tailsim.master (Gauss-Seidel reference and Jacobi).
+master of tailsim.masters (Gauss-Seidel reference and Jacobi).
 
 libcosim steps both FMUs from t on the values transferred after the previous step: the
 controller samples the plant at t (as in Gauss-Seidel) but the plant flies the previous
@@ -26,8 +26,8 @@ import numpy as np
 import pytest
 
 from tailsim import ClosedLoop
-from tailsim.cosim import run_fmus, run_ssp
-from tailsim.master import pos_error
+from tailsim.masters import pos_error
+from tailsim.masters.cosim import run_fmus, run_ssp
 from tailsim.metrics import CRITERIA, declared_mission, level_window, phase_starts
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -185,15 +185,15 @@ def test_unloadable_fmu_is_an_error_not_a_crash(tmp_path):
         run_fmus(tmp_path / "missing.fmu", fmu("tailsitter_tsd"))
     # In a subprocess: if the check ever failed, a segfault must not take pytest down.
     code = (
-        "import sys; sys.path.insert(0, sys.argv[3])\n"
-        "from tailsim.cosim import run_fmus\n"
+        "import sys\n"
+        "from tailsim.masters.cosim import run_fmus\n"
         "try:\n"
         "    run_fmus(sys.argv[1], sys.argv[2], stop_time=0.1)\n"
         "except RuntimeError as e:\n"
         "    print('RuntimeError', e); sys.exit(3)\n"
     )
     proc = subprocess.run(
-        [sys.executable, "-c", code, str(broken), str(fmu("tailsitter_tsd")), str(ROOT / "python")],
+        [sys.executable, "-c", code, str(broken), str(fmu("tailsitter_tsd"))],
         capture_output=True,
         text=True,
         timeout=120,

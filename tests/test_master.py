@@ -11,14 +11,21 @@ import numpy as np
 import pytest
 
 from tailsim import ClosedLoop, one_minus_cosine_gust, step
-from tailsim.compare import main as compare_main
-from tailsim.master import pos_error, settling_time
+from tailsim.masters import pos_error, settling_time
+from tailsim.reports.compare import main as compare_main
 
 
 def test_wiring_is_by_name(fmus):
     loop = ClosedLoop(fmus["tailsitter_plant"], fmus["tailsitter_lqr"])
-    commands = ["thrust_cmd", "elevator_cmd", "aileron_cmd", "rudder_cmd", "flap_collective_cmd",
-                "flap_differential_cmd", "vertical_flap_cmd"]
+    commands = [
+        "thrust_cmd",
+        "elevator_cmd",
+        "aileron_cmd",
+        "rudder_cmd",
+        "flap_collective_cmd",
+        "flap_differential_cmd",
+        "vertical_flap_cmd",
+    ]
     assert sorted(loop.to_plant) == sorted(commands)
     plant_outputs = set(fmus["tailsitter_plant"].names("output"))
     assert set(loop.to_controller) == plant_outputs & set(fmus["tailsitter_lqr"].names("input"))
@@ -38,7 +45,7 @@ def test_commands_reach_the_plant(fmus):
     # The plant's actual thrust follows the controller's command through the 0.1 s lag.
     t, cmd, thrust = r.time, r["thrust_cmd"], r["thrust"]
     lagged = np.interp(t - 0.3, t, cmd)
-    steady = (t > 11.0)
+    steady = t > 11.0
     assert np.max(np.abs(thrust[steady] - lagged[steady])) < 2.0
     assert abs(r["elevator"][-1] - r["elevator_cmd"][-2]) < math.radians(1.0)
 
@@ -67,9 +74,7 @@ def test_constant_wind_is_flown_through(fmus):
     # (default, issue 13) β = 34° here is past the sideslip stall band and TSD drifts 0.13 m/s.
     r = ClosedLoop(
         fmus["tailsitter_plant"], fmus["tailsitter_tsd"], plant_params={"aero_model": 0}, controller_params=hover_long
-    ).run(
-        stop_time=10.0, wind=lambda t: wind
-    )
+    ).run(stop_time=10.0, wind=lambda t: wind)
     assert np.all(r["wind_e"] == 2.0)
     # In the vertical climb the controller holds position: the air moves past at 2 m/s sideways.
     k = r.time > 8.0
@@ -131,3 +136,46 @@ def test_report_numbers_come_from_the_csvs(tmp_path):
         assert m["completed"] is True
         text = (out / "report.md").read_text()
         assert f"{m['max_error'][2]:.2f}" in text
+
+
+def test_one_engine_a_system_wired_by_hand_flies_as_closed_loop(fmus):
+    """ClosedLoop is a configuration of tailsim.masters.system.System: the same units,
+    links and external inputs declared by hand fly the same trajectory bit for bit, and
+    a run stopped by its monitor hands back the record flown so far."""
+    from tailsim.masters import External, Link, System, Unit, wire
+
+    plant, ctrl = fmus["tailsitter_plant"], fmus["tailsitter_tsd"]
+    gust = one_minus_cosine_gust(1.0, 1.0, (2.0, 0.0, -1.0))
+    offset = step(1.5, (0.0, 1.0, 0.0))
+    ref = ClosedLoop(plant, ctrl).run(stop_time=3.0, wind=gust, ref_offset=offset)
+    system = System(
+        [
+            Unit("controller", ctrl, sampler=True, record=["pos_error", "thrust_cmd", "phase"]),
+            Unit("plant", plant, record=["pos_n", "alpha"]),
+        ],
+        [Link("plant", "controller", wire(plant, ctrl)), Link("controller", "plant", wire(ctrl, plant))],
+        [
+            External("plant", ("wind_n", "wind_e", "wind_d"), gust, ("wind_n", "wind_e", "wind_d")),
+            External(
+                "controller", ("ref_offset_n", "ref_offset_e", "ref_offset_d"), offset, ("off_n", "off_e", "off_d")
+            ),
+        ],
+        init_order=["plant", "controller"],
+    )
+    r = system.run(3.0, 0.02)
+    for name in ["time", "pos_error", "thrust_cmd", "phase", "pos_n", "alpha", "wind_n", "wind_d"]:
+        assert np.array_equal(r[name], ref[name]), name
+    assert np.array_equal(r["off_e"], ref["ref_offset_e"])
+
+    class Stop(Exception):
+        pass
+
+    def monitor(k, t, row):
+        if t >= 1.0:
+            raise Stop
+
+    with pytest.raises(Stop) as info:
+        system.run(3.0, 0.02, monitor=monitor)
+    partial = info.value.partial_result
+    assert info.value.t == pytest.approx(1.0) and partial.time[-1] == pytest.approx(0.98)
+    assert np.array_equal(partial["pos_n"], ref["pos_n"][: len(partial.time)])

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from fmu_util import ROOT
-from tailsim.master import EDGE_TOLERANCE, RunResult, one_minus_cosine_gust, step, wind_from
+from tailsim.masters import EDGE_TOLERANCE, RunResult, one_minus_cosine_gust, step, wind_from
 from tailsim.metrics import CRITERIA, mission_check
 
 DATA = ROOT / "tests" / "data"
@@ -33,7 +33,9 @@ def trajectory() -> RunResult:
     path = DATA / "mission_metrics_trajectory.csv"
     names = [h.split(" ")[0] for h in path.read_text().splitlines()[0].split(",")]
     data = np.loadtxt(path, delimiter=",", skiprows=1)
-    return RunResult(signals={n: data[:, i] for i, n in enumerate(names)}, units={}, plant="", controller="", ordering="")
+    return RunResult(
+        signals={n: data[:, i] for i, n in enumerate(names)}, units={}, plant="", controller="", ordering=""
+    )
 
 
 def test_criteria_are_read_from_the_same_file(rust):

@@ -24,8 +24,25 @@ from tailsim import ClosedLoop
 
 CONTROLLERS = ["tailsitter_lqr", "tailsitter_tsd"]
 RTOL = 1e-9
-COMPARED = ["pos_n", "pos_e", "pos_d", "u", "v", "w", "quat_1", "quat_2", "quat_3", "quat_4",
-            "p", "q", "r", "thrust", "elevator", "aileron", "rudder"]
+COMPARED = [
+    "pos_n",
+    "pos_e",
+    "pos_d",
+    "u",
+    "v",
+    "w",
+    "quat_1",
+    "quat_2",
+    "quat_3",
+    "quat_4",
+    "p",
+    "q",
+    "r",
+    "thrust",
+    "elevator",
+    "aileron",
+    "rudder",
+]
 # ME (CVode, rtol 1e-9) vs CS (RK4, 2 ms): both integrate the same right-hand side over
 # the same 20 ms sample intervals with the same held commands. RK4's local error
 # ~ (2 ms)^5 f^(5) and CVode's tolerance-controlled error are both far below 1e-6 per
@@ -54,8 +71,12 @@ def fly_model_exchange(plant_fmu, controller, stop_time=None):
     assert md.numberOfEventIndicators == 0
     nx = len(md.derivatives)
     pv = {v.name: v for v in md.modelVariables}
-    plant = FMU2Model(guid=md.guid, unzipDirectory=plant_fmu.dir,
-                      modelIdentifier=md.modelExchange.modelIdentifier, instanceName="plant_me")
+    plant = FMU2Model(
+        guid=md.guid,
+        unzipDirectory=plant_fmu.dir,
+        modelIdentifier=md.modelExchange.modelIdentifier,
+        instanceName="plant_me",
+    )
     plant.instantiate()
     c = controller.instantiate("controller")
     cv = controller.variables
@@ -81,10 +102,20 @@ def fly_model_exchange(plant_fmu, controller, stop_time=None):
     c.setReal(c_in_vr, plant.getReal(p_out_vr))
     c.exitInitializationMode()
 
-    solver = CVodeSolver(nx=nx, nz=0, get_x=plant.getContinuousStates, set_x=plant.setContinuousStates,
-                         get_dx=plant.getDerivatives, get_z=plant.getEventIndicators,
-                         get_nominals=plant.getNominalsOfContinuousStates, set_time=plant.setTime,
-                         input=_NoInput(), startTime=0.0, maxStep=h, relativeTolerance=RTOL)
+    solver = CVodeSolver(
+        nx=nx,
+        nz=0,
+        get_x=plant.getContinuousStates,
+        set_x=plant.setContinuousStates,
+        get_dx=plant.getDerivatives,
+        get_z=plant.getEventIndicators,
+        get_nominals=plant.getNominalsOfContinuousStates,
+        set_time=plant.setTime,
+        input=_NoInput(),
+        startTime=0.0,
+        maxStep=h,
+        relativeTolerance=RTOL,
+    )
     time = np.arange(n + 1) * h
     data = np.full((n + 1, len(COMPARED)), np.nan)
     for k in range(n + 1):
@@ -121,8 +152,10 @@ def test_model_exchange_cvode_closed_loop_agrees_with_co_simulation(controller, 
     worst = {n: float(np.max(np.abs(me[n] - cs[n]))) for n in COMPARED}
     name, err = max(worst.items(), key=lambda kv: kv[1])
     pos = max(worst[k] for k in ("pos_n", "pos_e", "pos_d"))
-    print(f"\n{controller}: ME (CVode, rtol {RTOL:g}) vs CS (RK4 2 ms) over {time[-1]:.0f} s: "
-          f"max |Δ| = {err:.3g} ({name}), position {pos:.3g} m")
+    print(
+        f"\n{controller}: ME (CVode, rtol {RTOL:g}) vs CS (RK4 2 ms) over {time[-1]:.0f} s: "
+        f"max |Δ| = {err:.3g} ({name}), position {pos:.3g} m"
+    )
     # The mission really flew: level flight at 25 m/s reached (θ well below 90°).
     assert np.max(np.hypot(me["u"], me["w"])) > 20.0
     assert err < ME_TOL, worst
@@ -150,8 +183,9 @@ def test_me_derivatives_saturate_at_the_bounds(fmus):
     plant = fmus["tailsitter_plant"]
     md = plant.md
     pv = plant.variables
-    s = FMU2Model(guid=md.guid, unzipDirectory=plant.dir, modelIdentifier=md.modelExchange.modelIdentifier,
-                  instanceName="bounds")
+    s = FMU2Model(
+        guid=md.guid, unzipDirectory=plant.dir, modelIdentifier=md.modelExchange.modelIdentifier, instanceName="bounds"
+    )
     s.instantiate()
     s.setupExperiment(startTime=0.0)
     s.enterInitializationMode()
@@ -180,6 +214,7 @@ def test_me_derivatives_saturate_at_the_bounds(fmus):
 
 def _get_x(s, nx):
     from ctypes import c_double
+
     buf = (c_double * nx)()
     s.getContinuousStates(buf, nx)
     return list(buf)
@@ -187,12 +222,14 @@ def _get_x(s, nx):
 
 def _set_x(s, x):
     from ctypes import c_double
+
     buf = (c_double * len(x))(*x)
     s.setContinuousStates(buf, len(x))
 
 
 def _get_dx(s, nx):
     from ctypes import c_double
+
     buf = (c_double * nx)()
     s.getDerivatives(buf, nx)
     return list(buf)
@@ -207,8 +244,9 @@ def test_model_exchange_state_machine_guards(fmus):
     plant = fmus["tailsitter_plant"]
     md = plant.md
     rec = LogRecorder()
-    s = FMU2Model(guid=md.guid, unzipDirectory=plant.dir, modelIdentifier=md.modelExchange.modelIdentifier,
-                  instanceName="guards")
+    s = FMU2Model(
+        guid=md.guid, unzipDirectory=plant.dir, modelIdentifier=md.modelExchange.modelIdentifier, instanceName="guards"
+    )
     s.instantiate(callbacks=rec.callbacks)
     nx = len(md.derivatives)
 

@@ -50,5 +50,7 @@ def test_default_mission_matches_reference(fmus, controller):
         i = int(np.argmax(err))
         if err[i] > worst[0]:
             worst = (float(err[i]), name, float(ref["time"][i]))
-    print(f"\n{controller}: worst relative deviation from the native loop {worst[0]:.1e} ({worst[1]} at t = {worst[2]})")
+    print(
+        f"\n{controller}: worst relative deviation from the native loop {worst[0]:.1e} ({worst[1]} at t = {worst[2]})"
+    )
     assert worst[0] <= TOLERANCE, f"{worst[1]} at t = {worst[2]} deviates by {worst[0]:.3e}"

@@ -18,13 +18,38 @@ from fmu_util import LogRecorder, Unpacked
 ID = "tailsitter_sensors"
 H = 0.02
 ANALOG = [
-    "imu_accel_x", "imu_accel_y", "imu_accel_z", "imu_gyro_p", "imu_gyro_q", "imu_gyro_r",
-    "mag_x", "mag_y", "mag_z", "pitot_airspeed",
+    "imu_accel_x",
+    "imu_accel_y",
+    "imu_accel_z",
+    "imu_gyro_p",
+    "imu_gyro_q",
+    "imu_gyro_r",
+    "mag_x",
+    "mag_y",
+    "mag_z",
+    "pitot_airspeed",
 ]
 GPS = ["gps_latitude", "gps_longitude", "gps_height", "gps_vel_n", "gps_vel_e", "gps_vel_d"]
 TRUTH = [
-    "pos_n", "pos_e", "pos_d", "vel_n", "vel_e", "vel_d", "p", "q", "r",
-    "quat_1", "quat_2", "quat_3", "quat_4", "airspeed", "alpha", "beta", "accel_x", "accel_y", "accel_z",
+    "pos_n",
+    "pos_e",
+    "pos_d",
+    "vel_n",
+    "vel_e",
+    "vel_d",
+    "p",
+    "q",
+    "r",
+    "quat_1",
+    "quat_2",
+    "quat_3",
+    "quat_4",
+    "airspeed",
+    "alpha",
+    "beta",
+    "accel_x",
+    "accel_y",
+    "accel_z",
 ]
 
 
@@ -65,11 +90,7 @@ def test_every_variable_as_declared(fmus, monkeypatch):
 
 # ----------------------------------------------------------------- its own behaviour
 def outputs(f: Unpacked, s) -> list:
-    return (
-        f.get(s, *ANALOG, *GPS)
-        + s.getInteger([f.vr["gps_fix_count"]])
-        + s.getBoolean([f.vr["gps_valid"]])
-    )
+    return f.get(s, *ANALOG, *GPS) + s.getInteger([f.vr["gps_fix_count"]]) + s.getBoolean([f.vr["gps_valid"]])
 
 
 def test_plant_to_sensors_by_name(plant, sensors):
@@ -80,14 +101,16 @@ def test_plant_to_sensors_by_name(plant, sensors):
     s = sensors.slave("sensors", log, init=False)
     s.setupExperiment(startTime=0.0)
     s.enterInitializationMode()
-    sensors.set(s, **dict(zip(TRUTH, plant.get(p, *TRUTH))))
+    sensors.set(s, **dict(zip(TRUTH, plant.get(p, *TRUTH), strict=False)))
     s.exitInitializationMode()
-    gains = dict(zip(["a", "g", "m"], sensors.get(s, "accel_noise_gain", "gyro_noise_gain", "mag_noise_gain")))
+    gains = dict(
+        zip(["a", "g", "m"], sensors.get(s, "accel_noise_gain", "gyro_noise_gain", "mag_noise_gain"), strict=False)
+    )
     accel_std, gps_h_std = sensors.get(s, "accel_std", "gps_height_std")
     fixes = []
     for k in range(250):
         t = k * H
-        truth = dict(zip(TRUTH, plant.get(p, *TRUTH)))
+        truth = dict(zip(TRUTH, plant.get(p, *TRUTH), strict=False))
         sensors.set(s, **truth)
         s.doStep(t, H)
         p.doStep(t, H)

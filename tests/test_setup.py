@@ -30,7 +30,9 @@ def exports_c_api(path):
 def test_a_library_named_like_libclang_without_the_c_api_is_not_taken(tmp_path):
     # Stand-ins named as clang-sys would match them, but without clang_createIndex:
     # the C++ library's name from the base image and a plain libclang.so name.
-    libm = next(p for p in ("/lib/x86_64-linux-gnu/libm.so.6", "/usr/lib/x86_64-linux-gnu/libm.so.6") if os.path.exists(p))
+    libm = next(
+        p for p in ("/lib/x86_64-linux-gnu/libm.so.6", "/usr/lib/x86_64-linux-gnu/libm.so.6") if os.path.exists(p)
+    )
     shutil.copy(libm, tmp_path / "libclang-cpp.so.14")
     shutil.copy(libm, tmp_path / "libclang.so.1")
     result = find_libclang([tmp_path])
@@ -55,7 +57,9 @@ def test_a_long_symbol_listing_after_the_match_is_still_found(tmp_path):
     # failed at random when grep exited at the match while nm was still writing (SIGPIPE).
     # A stand-in nm prints the symbol first and then far more than a pipe holds.
     fake_nm = tmp_path / "fake_nm.sh"
-    fake_nm.write_text('echo "0000000000001000 T clang_createIndex@@LLVM_13"\nyes "0000000000002000 T clang_other" | head -c 4000000\n')
+    fake_nm.write_text(
+        'echo "0000000000001000 T clang_createIndex@@LLVM_13"\nyes "0000000000002000 T clang_other" | head -c 4000000\n'
+    )
     libdir = tmp_path / "lib"
     libdir.mkdir()
     (libdir / "libclang-14.so.1").write_bytes(b"")

@@ -27,6 +27,7 @@ import zipfile
 import numpy as np
 import pytest
 from lxml import etree
+
 from tailsim.metrics import CRITERIA, declared_mission, level_window, phase_starts
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -163,7 +164,9 @@ def test_design_model_is_bound_to_the_plants_declared_airframe(controller):
     with zipfile.ZipFile(ssp_path(controller)) as z:
         plant_md = model_description(z.read("resources/tailsitter_plant.fmu"))
         ctrl_md = model_description(z.read(f"resources/{controller}.fmu"))
-    ctrl_params = {v.get("name") for v in ctrl_md.iterfind("ModelVariables/ScalarVariable") if v.get("causality") == "parameter"}
+    ctrl_params = {
+        v.get("name") for v in ctrl_md.iterfind("ModelVariables/ScalarVariable") if v.get("causality") == "parameter"
+    }
     airframe = {
         v.get("name"): float(v.find("Real").get("start"))
         for v in plant_md.iterfind("ModelVariables/ScalarVariable")
@@ -237,8 +240,10 @@ def test_fmpy_simulate_ssp_flies_the_default_mission(controller):
     window = level_window(t_end, MISSION)
     level_error = np.max(np.abs(airspeed[window] - MISSION["v_level"]))
     final_pitch = abs(math.degrees(theta[-1]) - 90.0)
-    print(f"\n{controller} under fmpy simulate_ssp: level airspeed error {level_error:.3f} m/s, "
-          f"final pitch {final_pitch:.2f} deg from vertical, max pos_error {r['controller.pos_error'].max():.3f} m")
+    print(
+        f"\n{controller} under fmpy simulate_ssp: level airspeed error {level_error:.3f} m/s, "
+        f"final pitch {final_pitch:.2f} deg from vertical, max pos_error {r['controller.pos_error'].max():.3f} m"
+    )
     assert level_error <= CRITERIA["level_airspeed_error_max"]
     assert final_pitch <= CRITERIA["final_pitch_error_max"]
     assert r["controller.phase"][-1] == 4

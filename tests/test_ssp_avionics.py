@@ -14,6 +14,7 @@ import zipfile
 import numpy as np
 import pytest
 from lxml import etree
+
 from tailsim.metrics import CRITERIA, declared_mission, level_window
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -46,7 +47,9 @@ def variables(fmu_bytes: bytes) -> dict[str, tuple[str, str]]:
 
     with zipfile.ZipFile(io.BytesIO(fmu_bytes)) as z:
         md = etree.fromstring(z.read("modelDescription.xml"))
-    return {sv.get("name"): (sv.get("causality", "local"), sv[0].tag) for sv in md.iterfind("ModelVariables/ScalarVariable")}
+    return {
+        sv.get("name"): (sv.get("causality", "local"), sv[0].tag) for sv in md.iterfind("ModelVariables/ScalarVariable")
+    }
 
 
 @pytest.mark.parametrize("controller", CONTROLLERS)
@@ -77,7 +80,9 @@ def test_avionics_ssd_is_valid_and_wires_every_input_by_name(controller):
                 assert (elem, n) in wired, (elem, n)
     assert {("plant", n) for n, (caus, _) in vars_["plant"].items() if caus == "input" and n.endswith("_cmd")} <= wired
     ekf_out = {n for n, (caus, _) in vars_["estimator"].items() if caus == "output"}
-    assert {("controller", n) for n, (caus, _) in vars_["controller"].items() if caus == "input" and n in ekf_out} <= wired
+    assert {
+        ("controller", n) for n, (caus, _) in vars_["controller"].items() if caus == "input" and n in ekf_out
+    } <= wired
     # No controller input reads the plant directly: the controller flies the estimate.
     assert not any(c.startElement == "plant" and c.endElement == "controller" for c in ssd.system.connections)
 
@@ -117,8 +122,10 @@ def test_fmpy_simulate_ssp_flies_the_avionics_system(controller):
     window = level_window(t_end, MISSION)
     level_error = float(np.max(np.abs(r["plant.airspeed"][window] - MISSION["v_level"])))
     final_pitch = abs(math.degrees(r["plant.theta"][-1]) - 90.0)
-    print(f"\n{controller} avionics under fmpy simulate_ssp: level airspeed error {level_error:.3f} m/s, "
-          f"final pitch {final_pitch:.2f} deg, max pos_error {r['controller.pos_error'].max():.2f} m")
+    print(
+        f"\n{controller} avionics under fmpy simulate_ssp: level airspeed error {level_error:.3f} m/s, "
+        f"final pitch {final_pitch:.2f} deg, max pos_error {r['controller.pos_error'].max():.2f} m"
+    )
     assert r["controller.phase"][-1] == 4
     assert final_pitch <= CRITERIA["final_pitch_error_max"]
     assert level_error <= CRITERIA["level_airspeed_error_max"]
@@ -155,7 +162,10 @@ def test_libcosim_flies_the_avionics_system(controller):
     t, v = np.array(times) / 1e9, np.array(speeds)
     window = level_window(t, MISSION)
     level_error = float(np.max(np.abs(v[window] - MISSION["v_level"])))
-    print(f"\n{controller} avionics under libcosim: level airspeed error {level_error:.3f} m/s, final pitch {final_pitch:.2f} deg")
+    print(
+        f"\n{controller} avionics under libcosim: level airspeed error {level_error:.3f} m/s, final pitch "
+        f"{final_pitch:.2f} deg"
+    )
     assert last.last_integer_values(ctrl, [cv["phase"]]) == [4]
     assert final_pitch <= CRITERIA["final_pitch_error_max"]
     assert level_error <= CRITERIA["level_airspeed_error_max"]

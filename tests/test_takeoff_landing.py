@@ -14,7 +14,7 @@ import pytest
 
 from fmu_util import DIST
 from tailsim import ClosedLoop
-from tailsim.report_takeoff import MISSION, PLANT, touchdown
+from tailsim.reports.takeoff import MISSION, PLANT, touchdown
 
 #: Long enough for the mission, the approach and the 2 m/s descent from ≈ 230 m (s).
 STOP = 190.0
@@ -80,7 +80,9 @@ def test_ssp_flies_take_off_to_landing():
                     p.name = f"{comp.name}.{name}"
                     params.append(p)
     assert seen == set(MISSION), "the SSD binds every take-off and landing parameter"
-    r = simulate_ssp(str(path), stop_time=STOP, step_size=0.02, parameter_set=ParameterSet(name="tl", parameters=params))
+    r = simulate_ssp(
+        str(path), stop_time=STOP, step_size=0.02, parameter_set=ParameterSet(name="tl", parameters=params)
+    )
     contact = r["plant.ground_contact_points"]
     assert contact[0] > 0, "starts on the gear"
     phases = r["controller.phase"]
@@ -102,7 +104,8 @@ def test_report_section_and_plot_from_the_campaign_data(tmp_path):
     import shutil
 
     from fmu_util import ROOT
-    from tailsim import analysis_report, report_takeoff
+    from tailsim.reports import analysis as analysis_report
+    from tailsim.reports import takeoff as report_takeoff
 
     data = ROOT / "tests" / "data" / "analysis"
     for f in data.iterdir():

@@ -11,11 +11,15 @@ FMUS = ["tailsitter_plant", "tailsitter_lqr", "tailsitter_tsd", "tailsitter_sens
 
 
 def getter(slave, v):
-    return {"Real": slave.getReal, "Integer": slave.getInteger, "Boolean": slave.getBoolean, "String": slave.getString}[v.type]
+    return {"Real": slave.getReal, "Integer": slave.getInteger, "Boolean": slave.getBoolean, "String": slave.getString}[
+        v.type
+    ]
 
 
 def setter(slave, v):
-    return {"Real": slave.setReal, "Integer": slave.setInteger, "Boolean": slave.setBoolean, "String": slave.setString}[v.type]
+    return {"Real": slave.setReal, "Integer": slave.setInteger, "Boolean": slave.setBoolean, "String": slave.setString}[
+        v.type
+    ]
 
 
 def start_of(v):

@@ -52,8 +52,16 @@ fmi2GetStatus fmi2GetRealStatus fmi2GetIntegerStatus fmi2GetBooleanStatus fmi2Ge
 # DLLs every Windows 10/11 has in System32 (api-ms-win-* are API-set names the
 # loader resolves itself). Rust >= 1.78 needs Windows 10: bcryptprimitives.dll
 # (ProcessPrng) is part of it.
-WINDOWS_SYSTEM_DLLS = {"kernel32.dll", "ntdll.dll", "msvcrt.dll", "userenv.dll", "ws2_32.dll",
-                       "bcryptprimitives.dll", "advapi32.dll", "bcrypt.dll"}
+WINDOWS_SYSTEM_DLLS = {
+    "kernel32.dll",
+    "ntdll.dll",
+    "msvcrt.dll",
+    "userenv.dll",
+    "ws2_32.dll",
+    "bcryptprimitives.dll",
+    "advapi32.dll",
+    "bcrypt.dll",
+}
 
 OBJDUMP = "x86_64-w64-mingw32-objdump"
 MINGW_GCC = "x86_64-w64-mingw32-gcc"
@@ -120,8 +128,19 @@ def _prng_shim(tmp: pathlib.Path) -> pathlib.Path:
     out = tmp / "bcryptprimitives.dll"
     if shutil.which(MINGW_GCC) is None:
         pytest.fail(f"{MINGW_GCC} not found: run scripts/setup.sh")
-    subprocess.run([MINGW_GCC, "-O2", "-shared", "-static-libgcc", "-o", str(out),
-                    str(ROOT / "tests/wine/bcryptprimitives.c"), "-ladvapi32"], check=True)
+    subprocess.run(
+        [
+            MINGW_GCC,
+            "-O2",
+            "-shared",
+            "-static-libgcc",
+            "-o",
+            str(out),
+            str(ROOT / "tests/wine/bcryptprimitives.c"),
+            "-ladvapi32",
+        ],
+        check=True,
+    )
     return out
 
 
@@ -178,32 +197,57 @@ def win64_fmus(tmp_path_factory):
 # model the LQR's back transition stalls (α ≈ 52°), a far more sensitive flight: 1.0e-8
 # (u, m/s). 1e-7 in SI units keeps a 10× margin, far below anything physical.
 WIN64_TOL = 1e-7
-COMPARED = ["pos_n", "pos_e", "pos_d", "u", "v", "w", "p", "q", "r",
-            "quat_1", "quat_2", "quat_3", "quat_4", "thrust", "elevator", "aileron", "rudder"]
+COMPARED = [
+    "pos_n",
+    "pos_e",
+    "pos_d",
+    "u",
+    "v",
+    "w",
+    "p",
+    "q",
+    "r",
+    "quat_1",
+    "quat_2",
+    "quat_3",
+    "quat_4",
+    "thrust",
+    "elevator",
+    "aileron",
+    "rudder",
+]
 
 
 # fmpy's TCP remoting server listens on one fixed port: one remoted FMU per host at a
 # time (a second one in the same loop fails to instantiate). So each win64 FMU flies
 # in turn with its partner on linux64: (plant binary, controller binary, controller).
-PAIRINGS = [("win64", "linux64", "tailsitter_lqr"), ("win64", "linux64", "tailsitter_tsd"),
-            ("linux64", "win64", "tailsitter_lqr"), ("linux64", "win64", "tailsitter_tsd")]
+PAIRINGS = [
+    ("win64", "linux64", "tailsitter_lqr"),
+    ("win64", "linux64", "tailsitter_tsd"),
+    ("linux64", "win64", "tailsitter_lqr"),
+    ("linux64", "win64", "tailsitter_tsd"),
+]
 
 
 @pytest.mark.parametrize("plant_platform,controller_platform,controller", PAIRINGS)
-def test_win64_mission_under_wine_agrees_with_linux64(plant_platform, controller_platform, controller,
-                                                      fmus, win64_fmus):
+def test_win64_mission_under_wine_agrees_with_linux64(
+    plant_platform, controller_platform, controller, fmus, win64_fmus
+):
     stop = MISSION_SECONDS
     pick = {"linux64": fmus, "win64": win64_fmus}
     t0 = time.perf_counter()
     win = ClosedLoop(pick[plant_platform]["tailsitter_plant"], pick[controller_platform][controller]).run(
-        stop_time=stop)
+        stop_time=stop
+    )
     wall = time.perf_counter() - t0
     lin = ClosedLoop(fmus["tailsitter_plant"], fmus[controller]).run(stop_time=stop)
     worst = {n: float(np.max(np.abs(win[n] - lin[n]))) for n in COMPARED}
     name, err = max(worst.items(), key=lambda kv: kv[1])
-    print(f"\nplant {plant_platform} + {controller} {controller_platform} vs all linux64 over {stop} s "
-          f"({len(lin.time)} samples): max |Δ| = {err:.3g} ({name}); "
-          f"position {max(worst[k] for k in ('pos_n', 'pos_e', 'pos_d')):.3g} m; wine run {wall:.1f} s")
+    print(
+        f"\nplant {plant_platform} + {controller} {controller_platform} vs all linux64 over {stop} s "
+        f"({len(lin.time)} samples): max |Δ| = {err:.3g} ({name}); "
+        f"position {max(worst[k] for k in ('pos_n', 'pos_e', 'pos_d')):.3g} m; wine run {wall:.1f} s"
+    )
     assert np.all(np.isfinite(win["pos_d"]))
     assert win.time[-1] == pytest.approx(stop)
     assert err < WIN64_TOL, worst

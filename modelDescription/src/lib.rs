@@ -17,6 +17,7 @@
 //! `modelDescription/generated/` and a test fails when it drifts.
 
 pub mod html;
+pub mod python;
 pub mod rust;
 pub mod units;
 pub mod xml;
@@ -249,6 +250,33 @@ pub struct DeclFile {
     /// interface this way, so wiring by name carries each value into the same field.
     #[serde(default)]
     pub connect_groups: Vec<GroupLink>,
+    /// The codes of the controllers' `phase` output with their names and, for the five
+    /// phases of the mission, the parameter of their duration (read by [`python`]).
+    #[serde(default)]
+    pub phases: Vec<PhaseDecl>,
+    /// Named missions: values of mission parameters over their declared starts (read by
+    /// [`python`]).
+    #[serde(default)]
+    pub presets: BTreeMap<String, Preset>,
+}
+
+/// One code of the `phase` output.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PhaseDecl {
+    pub code: i64,
+    pub name: String,
+    /// The mission parameter of the phase's duration (the five phases of the mission).
+    #[serde(default)]
+    pub duration: Option<String>,
+}
+
+/// A named mission: parameter values over the declared starts.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Preset {
+    pub description: String,
+    pub values: BTreeMap<String, f64>,
 }
 
 /// The groups of another declaration whose ports this file's variables connect to.

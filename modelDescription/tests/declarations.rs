@@ -299,3 +299,16 @@ fn nested_fields_need_a_group_built_on_default() {
     assert!(rust.contains("let mut value = <T>::default();"), "{rust}");
     assert!(rust.contains("value.x.y[2] = self.a;"), "{rust}");
 }
+
+#[test]
+fn python_declarations_module_matches_generated() {
+    let generated = model_description::python::declarations_module(&dir(), env!("CARGO_PKG_VERSION")).unwrap();
+    let path = dir().join("..").join(model_description::python::MODULE_PATH);
+    let committed =
+        std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e} (run `cargo xtask regen`)", path.display()));
+    assert!(
+        generated == committed,
+        "{} drifted from the declarations: run `cargo xtask regen` and commit it",
+        path.display()
+    );
+}

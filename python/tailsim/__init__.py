@@ -1,11 +1,14 @@
 """tailsim: fly the tail-sitter FMUs from Python.
 
-`ClosedLoop` is a small co-simulation master (fmpy underneath) that wires a
-plant FMU and any controller FMU by port name (docs/DESIGN.md, "Ports and
-timing"): every controller input gets the plant output of the same name,
-every controller output goes to the plant input of the same name.
+`tailsim.masters` holds the co-simulation engine (a system of FMUs wired by port
+name, docs/DESIGN.md "Ports and timing") and its configurations: `ClosedLoop`
+(plant + controller: every controller input gets the plant output of the same name,
+every controller output goes to the plant input of the same name) and
+`AvionicsLoop` (plant, sensors, estimator, controller). `tailsim.campaign` is the
+Monte-Carlo campaign, `tailsim.reports` the reports, `tailsim.metrics` the
+measures of a run, `tailsim.declarations` the FMUs' declared interfaces (generated).
 """
 
-from .master import ClosedLoop, Fmu, RunResult, one_minus_cosine_gust, step
+from .masters import ClosedLoop, Fmu, RunResult, one_minus_cosine_gust, step
 
 __all__ = ["ClosedLoop", "Fmu", "RunResult", "one_minus_cosine_gust", "step"]

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import ctypes
 import threading
-from typing import Callable
+from collections.abc import Callable
 
 from fmpy.fmi2 import (
     calloc,

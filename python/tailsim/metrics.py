@@ -13,15 +13,18 @@ from __future__ import annotations
 import json
 import math
 import pathlib
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Mapping
 
 import numpy as np
 
-from .master import EDGE_TOLERANCE, RunResult, pos_error, settling_time
+from . import declarations
+from .masters.fmu import RunResult, pos_error, settling_time
+from .masters.profiles import EDGE_TOLERANCE
 
-PHASES = ["vertical 1", "transition 1", "level", "transition 2", "vertical 2"]
-SURFACES = ["elevator", "aileron", "rudder", "flap_collective", "flap_differential", "vertical_flap"]
+PHASES = list(declarations.PHASES)
+#: The control surfaces: the plant outputs of the deflections commanded by COMMANDS[1:].
+SURFACES = [c.removesuffix("_cmd") for c in declarations.COMMANDS[1:]]
 CRITERIA_FILE = pathlib.Path(__file__).resolve().parents[2] / "modelDescription" / "fragments" / "mission_criteria.json"
 
 
@@ -63,7 +66,8 @@ class MissionCheck:
             )
         if not self.final_pitch_error <= math.radians(c["final_pitch_error_max"]):
             out.append(
-                f"final pitch {math.degrees(self.final_pitch_error):.1f} deg from vertical > {c['final_pitch_error_max']:g}"
+                f"final pitch {math.degrees(self.final_pitch_error):.1f} deg from vertical > "
+                f"{c['final_pitch_error_max']:g}"
             )
         return out
 
@@ -74,7 +78,7 @@ class MissionCheck:
 def phase_starts(mission: Mapping[str, float]) -> list[float]:
     """Start times (s) of the five phases and the end of the mission."""
     out = [0.0]
-    for key in ("t_vertical_1", "t_transition_1", "t_level", "t_transition_2", "t_vertical_2"):
+    for key in declarations.PHASE_DURATIONS:
         out.append(out[-1] + float(mission[key]))
     return out
 
@@ -95,8 +99,7 @@ def declared_mission() -> dict[str, float]:
     """The mission parameters' defaults as the controllers declare them
     (modelDescription/fragments/controller_interface.json, group "mission"); from
     a packaged FMU read the same start values with `Fmu.starts`."""
-    fragment = json.loads((CRITERIA_FILE.parent / "controller_interface.json").read_text())
-    return {v["name"]: float(v["start"]) for v in fragment["variables"] if v.get("group") == "mission"}
+    return {k: float(v) for k, v in declarations.MISSION_DEFAULTS.items()}
 
 
 def mission_check(r: RunResult, mission: Mapping[str, float], theta_level_trim: float) -> MissionCheck:
@@ -168,8 +171,8 @@ def mission_metrics(
     return MissionMetrics(
         completed=not reasons,
         reason="; ".join(reasons) or "ok",
-        max_error=[m if n else nan for m, n in zip(check.phase_max, check.phase_samples)],
-        rms_error=[m if n else nan for m, n in zip(check.phase_rms, check.phase_samples)],
+        max_error=[m if n else nan for m, n in zip(check.phase_max, check.phase_samples, strict=False)],
+        rms_error=[m if n else nan for m, n in zip(check.phase_rms, check.phase_samples, strict=False)],
         altitude_deviation_transition=(alt_dev[0], alt_dev[1]),
         max_alpha_deg=float(np.degrees(np.nanmax(r["alpha"]))),
         saturation_time=float(saturated.sum() * h),

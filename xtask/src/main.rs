@@ -5,8 +5,9 @@
 //!   binaries/win64/<id>.dll, documentation/index.html);
 //! - `ssp`: write the SSP 1.0 closed-loop systems `dist/<controller>.ssp` from the packaged FMUs
 //!   (`dist` writes them too);
-//! - `regen`: rewrite the reviewed copies `modelDescription/generated/<id>.xml` and the
-//!   variable references `modelDescription/generated/<id>.md`.
+//! - `regen`: rewrite the reviewed copies `modelDescription/generated/<id>.xml`, the
+//!   variable references `modelDescription/generated/<id>.md` and the Python
+//!   declarations module `python/tailsim/declarations.py`.
 
 mod ssp;
 
@@ -164,6 +165,13 @@ fn regen() -> Result<(), String> {
             println!("wrote {}", path.display());
         }
     }
+    let root = workspace_root();
+    let path = root.join(model_description::python::MODULE_PATH);
+    let text =
+        model_description::python::declarations_module(&root.join("modelDescription"), env!("CARGO_PKG_VERSION"))
+            .map_err(|e| e.to_string())?;
+    std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+    println!("wrote {}", path.display());
     Ok(())
 }
 

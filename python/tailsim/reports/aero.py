@@ -4,14 +4,14 @@ analysis report rendered from `aero_models.json` (+ `aero_coefficients.csv`),
 which `cargo run --release -p analysis -- all|aero --out DIR` writes.
 
     cargo run --release -p analysis -- aero --out out/analysis
-    PYTHONPATH=python .venv/bin/python -m tailsim.analysis_report out/analysis
+    .venv/bin/python -m tailsim.reports.analysis out/analysis
 
 Tables: the flight cases (default and fast mission, hover wind steps) and the
 analysis's gust sweep, each with the thesis / global values side by side and
 what changed; the parameter sweep of Table 5.1 on both models is in the
-robustness section (`tailsim.analysis_report`, rendered with
+robustness section (`tailsim.reports.analysis`, rendered with
 `robustness_changes` from here). Writes `aero_models.md`
-(via `tailsim.analysis_report`) and the plots
+(via `tailsim.reports.analysis`) and the plots
 `aero_coefficients.png` (C_L, C_D, C_m of both models over α = 0…180°) and
 `aero_flights.png` (largest position error of every flight).
 """
@@ -22,7 +22,7 @@ import json
 import math
 import pathlib
 
-from .report import fmt_or_dash, shortest
+from .markdown import fmt_or_dash, shortest
 
 FILE = "aero_models.json"
 
@@ -130,9 +130,9 @@ def section(d: dict) -> list[str]:
     alphas = c["alpha_deg"]
     gl = c["global"]["c_L"]
     i90 = alphas.index(90.0) if 90.0 in alphas else len(alphas) // 2
-    fwd = [(v, al) for v, al in zip(gl, alphas) if al <= 60]
+    fwd = [(v, al) for v, al in zip(gl, alphas, strict=False) if al <= 60]
     clmax, at = max(fwd)
-    rev = [(-v, al) for v, al in zip(gl, alphas) if al >= 150]
+    rev = [(-v, al) for v, al in zip(gl, alphas, strict=False) if al >= 150]
     clrev, atrev = max(rev) if rev else (float("nan"), float("nan"))
     cl90 = c["thesis"]["c_L"][i90]
     out = [
@@ -183,11 +183,7 @@ def section(d: dict) -> list[str]:
     ctls = d.get("controllers") or sorted({r["controller"] for r in a["rows"]})
     out += gust_table(a, ctls)
     out += sweep_summary(d)
-    lost = [
-        f"{r['controller']} — {desc[r['case']]}"
-        for r in a["rows"]
-        if r["aero_model"] == 1 and not r["passed"]
-    ]
+    lost = [f"{r['controller']} — {desc[r['case']]}" for r in a["rows"] if r["aero_model"] == 1 and not r["passed"]]
     out += [
         "",
         "Lost with the global model (the FMU's default): " + ("; ".join(lost) if lost else "none") + ".",
@@ -294,11 +290,7 @@ def robustness_changes(d: dict, rows: list[dict], alpha_attached: float = 10.0, 
     names = {p["id"]: p["name"] for p in d["params"]}
     out = ["Linear against global (generated from the rows above):", ""]
     for k in d["controllers"]:
-        pairs = [
-            (pid, by[pid, k, 0], by[pid, k, 1])
-            for pid in names
-            if (pid, k, 0) in by and (pid, k, 1) in by
-        ]
+        pairs = [(pid, by[pid, k, 0], by[pid, k, 1]) for pid in names if (pid, k, 0) in by and (pid, k, 1) in by]
         if not pairs:
             continue
         parts = []
@@ -365,20 +357,18 @@ def why_sweeps(d: dict, rows: list[dict], alpha_attached: float = 10.0) -> str:
             else:
                 same_attached += 1
     if not changed and not changed_attached:
-        return (
-            "Why: nothing changed — "
-            + (
-                "every flight stayed in attached flow, where the global model is the thesis's."
-                if not same_stalled
-                else f"{_n(same_stalled, 'sweep')} left attached flow, but too briefly or too little to change a result."
-            )
+        return "Why: nothing changed — " + (
+            "every flight stayed in attached flow, where the global model is the thesis's."
+            if not same_stalled
+            else f"{_n(same_stalled, 'sweep')} left attached flow, but too briefly or too little to change a result."
         )
     text = "Why: "
     if changed:
         alpha = max(max(_num(t["max_alpha_deg"]), _num(g["max_alpha_deg"])) for _, _, t, g in changed)
         stall = max(max(_num(t["max_stall_fraction"]), _num(g["max_stall_fraction"])) for _, _, t, g in changed)
         text += (
-            f"{'the changed sweep' if len(changed) == 1 else f'all {len(changed)} changed sweeps'} left attached flow (stall "
+            f"{'the changed sweep' if len(changed) == 1 else f'all {len(changed)} changed sweeps'} left attached "
+            "flow (stall "
             f"fraction > 0: part of the wing beyond |α| = {shortest(alpha_attached)}° or at large β; α up to "
             f"{alpha:.0f}°, stall fraction up to {stall:.2f}), where the thesis's lift, moments and control power "
             "keep growing linearly while the global model's saturate into flat-plate behaviour (lift capped, drag "
@@ -399,7 +389,8 @@ def why_sweeps(d: dict, rows: list[dict], alpha_attached: float = 10.0) -> str:
     if changed_attached:
         text += (
             f"{_n(len(changed_attached), 'sweep')} changed without leaving attached flow "
-            f"({', '.join(f'{k} {names[pid]}' for k, pid, _, _ in changed_attached)}): not explained by the stall model. "
+            f"({', '.join(f'{k} {names[pid]}' for k, pid, _, _ in changed_attached)}): not explained by the stall "
+            "model. "
         )
     text += (
         f"{_n(same_attached, 'sweep')} stayed in attached flow on both models and fly identically (the global model "
@@ -425,7 +416,7 @@ def plot(folder: str | pathlib.Path) -> list[pathlib.Path]:
     c = a["coefficients"]
     al = c["alpha_deg"]
     fig, axes = plt.subplots(1, 3, figsize=(13, 4))
-    for ax, key, name in zip(axes, ["c_L", "c_D", "c_m"], ["C_L", "C_D", "C_m (CG)"]):
+    for ax, key, name in zip(axes, ["c_L", "c_D", "c_m"], ["C_L", "C_D", "C_m (CG)"], strict=False):
         ax.plot(al, c["thesis"][key], "--", label="thesis (aero_model 0)")
         ax.plot(al, c["global"][key], label="global (aero_model 1)")
         ax.axvspan(c["alpha_attached_deg"], c["alpha_stalled_deg"], color="0.85", lw=0)

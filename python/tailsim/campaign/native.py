@@ -3,7 +3,7 @@ performance): the same samples, parameters, wind and limits as the fmpy runs, th
 `analysis campaign-jobs` (crates/analysis/src/native_campaign.rs), compared row by row
 with the fmpy campaign's rows and timed side by side.
 
-    python -m tailsim.campaign_native --campaign out/campaign [--threads 1] [--samples N]
+    python -m tailsim.campaign.native --campaign out/campaign [--threads 1] [--samples N]
 
 reads the campaign's specification (`campaign.json`) and rows (`results.parquet`), flies
 the perfect-state runs natively and writes `<campaign>/native/rows.jsonl`,
@@ -29,14 +29,15 @@ import subprocess
 import sys
 import tempfile
 import time
-from typing import Any, Iterable, Mapping
+from collections.abc import Iterable, Mapping
+from typing import Any
 
 import numpy as np
 
-from .campaign_runner import FMU_NAMES, metric_columns
-from .campaign_sampling import CONFIGURATION_INDEX, TABLE_5_1, CampaignSpec, jobs, plant_parameters
+from .runner import FMU_NAMES, metric_columns
+from .sampling import CONFIGURATION_INDEX, TABLE_5_1, CampaignSpec, jobs, plant_parameters
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
+ROOT = pathlib.Path(__file__).resolve().parents[3]
 #: Largest |fmpy − native| of a completed run's metric (m, deg, fractions, s). The two
 #: engines fly the same Rust code behind different masters and, with the fmpy master's
 #: timing mirrored (`closed_loop::MeasuredWind::HeldInput`) and the inputs passed as bit
@@ -112,7 +113,14 @@ def run_native(
     tmp = pathlib.Path(workdir or tempfile.mkdtemp(prefix="tailsim-native-"))
     tmp.mkdir(parents=True, exist_ok=True)
     (tmp / "jobs.jsonl").write_text("".join(json.dumps(j) + "\n" for j in js))
-    cmd = [str(analysis_binary(profile)), "campaign-jobs", "--jobs", str(tmp / "jobs.jsonl"), "--out", str(tmp / "rows.jsonl")]
+    cmd = [
+        str(analysis_binary(profile)),
+        "campaign-jobs",
+        "--jobs",
+        str(tmp / "jobs.jsonl"),
+        "--out",
+        str(tmp / "rows.jsonl"),
+    ]
     if threads:
         cmd += ["--threads", str(threads)]
     t0 = time.perf_counter()
@@ -134,7 +142,13 @@ def compare(fmpy_rows: Iterable[Mapping[str, Any]], native_rows: Iterable[Mappin
     Outcomes are compared as (completed, failure); metrics on runs both engines completed,
     NaN equal to NaN."""
     by_key = {r["key"]: r for r in fmpy_rows}
-    out: dict[str, Any] = {"runs": 0, "same_outcome": 0, "outcome_differs": [], "max_abs_diff": {}, "beyond_tolerance": []}
+    out: dict[str, Any] = {
+        "runs": 0,
+        "same_outcome": 0,
+        "outcome_differs": [],
+        "max_abs_diff": {},
+        "beyond_tolerance": [],
+    }
     for n in native_rows:
         f = by_key.get(n["key"])
         if f is None:
@@ -159,8 +173,10 @@ def compare(fmpy_rows: Iterable[Mapping[str, Any]], native_rows: Iterable[Mappin
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m tailsim.campaign_native", description=__doc__.split("\n\n")[0])
-    ap.add_argument("--campaign", default="out/campaign", help="folder of an fmpy campaign (campaign.json, results.parquet)")
+    ap = argparse.ArgumentParser(prog="python -m tailsim.campaign.native", description=__doc__.split("\n\n")[0])
+    ap.add_argument(
+        "--campaign", default="out/campaign", help="folder of an fmpy campaign (campaign.json, results.parquet)"
+    )
     ap.add_argument("--dist", default=str(ROOT / "dist"))
     ap.add_argument("--threads", type=int, help="native threads (default: all cores)")
     ap.add_argument("--samples", type=int, help="only the first N samples")
@@ -194,7 +210,8 @@ def main(argv: list[str] | None = None) -> int:
         + ", ".join(f"{k} {v[0]:.2e}" for k, v in sorted(cmp["max_abs_diff"].items()))
     )
     print(
-        f"CPU per run: fmpy {t['fmpy_cpu_s_per_run_mean'] * 1e3:.1f} ms, native {t['native_cpu_s_per_run_mean'] * 1e3:.1f} ms "
+        f"CPU per run: fmpy {t['fmpy_cpu_s_per_run_mean'] * 1e3:.1f} ms, native "
+        f"{t['native_cpu_s_per_run_mean'] * 1e3:.1f} ms "
         f"({t['speed_ratio']:.1f}×); native wall {wall:.1f} s"
     )
     return 0 if not cmp["outcome_differs"] and not cmp["beyond_tolerance"] else 1

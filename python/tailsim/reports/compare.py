@@ -1,7 +1,7 @@
 """The comparison product: fly the missions and step tests with each
 controller, write CSVs, plots and a report (Markdown + self-contained HTML).
 
-    python -m tailsim.compare --controller both --out out
+    python -m tailsim.reports.compare --controller both --out out
 """
 
 from __future__ import annotations
@@ -15,16 +15,20 @@ import time
 
 import numpy as np
 
-from . import analysis_report, campaign_section
-from .master import ClosedLoop, Fmu, RunResult, pos_error, step
-from .metrics import CRITERIA, PHASES, mission_metrics, phase_starts, step_settling
-from .report import fmt, markdown_to_html
+from .. import declarations
+from ..campaign import section as campaign_section
+from ..masters import ClosedLoop, Fmu, RunResult, pos_error, step
+from ..metrics import CRITERIA, PHASES, mission_metrics, phase_starts, step_settling
+from . import analysis as analysis_report
+from .markdown import fmt, markdown_to_html
 
 NAMES = {"lqr": "tailsitter_lqr", "tsd": "tailsitter_tsd"}
 COLORS = {"lqr": "tab:blue", "tsd": "tab:red"}
 # The mission parameters every controller declares (modelDescription/fragments/controller_interface.json).
-DURATIONS = ["t_vertical_1", "t_transition_1", "t_level", "t_transition_2", "t_vertical_2"]
-MISSION = DURATIONS + ["v_level"]
+DURATIONS = list(declarations.PHASE_DURATIONS)
+MISSION = [*DURATIONS, "v_level"]
+#: The fast mission: the declared preset `fast` (the thesis's T1 = 3 s, T2 = 4 s).
+FAST = declarations.PRESETS["fast"]
 STEP_CASES = [
     # (flight, axis, offset NED, step time, controller params, stop time)
     ("level", "normal", (0.0, 0.0, 5.0), 16.0, {"t_level": 30.0}, 34.0),
@@ -78,7 +82,7 @@ def plot_mission(runs: dict[str, RunResult], title: str, path: pathlib.Path) -> 
         ax[1, 0].plot(t, np.degrees(r["theta"]), color=c, ls=":", label=f"{key.upper()} θ")
         ax[1, 1].plot(t, pos_error(r), color=c, label=key.upper())
         ax[2, 0].plot(t, r["thrust"], color=c, label=f"{key.upper()} T")
-        for s, ls in zip(["elevator", "flap_collective", "aileron", "rudder"], ["-", "--", ":", "-."]):
+        for s, ls in zip(["elevator", "flap_collective", "aileron", "rudder"], ["-", "--", ":", "-."], strict=False):
             ax[2, 1].plot(t, np.degrees(r[s]), color=c, ls=ls, lw=1, label=f"{key.upper()} {s}")
     ax[0, 0].set(xlabel="north [m]", ylabel="height [m]", title="track (Figs. 3.20 / 4.19)")
     ax[0, 0].axis("equal")
@@ -104,7 +108,7 @@ def plot_steps(step_runs: dict[str, dict[str, tuple[RunResult, float]]], path: p
 
     cases = [f"{f} {a}" for f, a, *_ in STEP_CASES]
     fig, ax = plt.subplots(2, 2, figsize=(12, 8))
-    for a, case in zip(ax.flat, cases):
+    for a, case in zip(ax.flat, cases, strict=False):
         for key, runs in step_runs.items():
             if case in runs:
                 r, t_step = runs[case]
@@ -141,12 +145,12 @@ def analysis_section(out: pathlib.Path) -> list[str]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="tailsim.compare", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="tailsim.reports.compare", description=__doc__.split("\n\n")[0])
     ap.add_argument("--controller", choices=["lqr", "tsd", "both"], default="both")
     ap.add_argument("--dist", default="dist", help="folder with the .fmu files")
     ap.add_argument("--out", default="out", help="output folder")
-    ap.add_argument("--fast-t1", type=float, default=3.0, help="T1 of the fast mission [s]")
-    ap.add_argument("--fast-t2", type=float, default=4.0, help="T2 of the fast mission [s]")
+    ap.add_argument("--fast-t1", type=float, default=FAST["t_transition_1"], help="T1 of the fast mission [s]")
+    ap.add_argument("--fast-t2", type=float, default=FAST["t_transition_2"], help="T2 of the fast mission [s]")
     ap.add_argument("--no-steps", action="store_true", help="skip the position-step tests")
     ap.add_argument("--jacobi", action="store_true", help="use a Jacobi master instead of Gauss-Seidel")
     ap.add_argument("--no-avionics", action="store_true", help="skip the missions with avionics in the loop")
@@ -188,7 +192,9 @@ def main(argv: list[str] | None = None) -> int:
                 case = next(c for c in STEP_CASES if f"{c[0]} {c[1]}" == name)
                 _, _, offset, t_step, params, stop = case
                 loop = ClosedLoop(plant, ctrls[key], controller_params=params, ordering=ordering)
-                r = loop.run(stop_time=stop, ref_offset=step(t_step, offset), progress=True, description=f"{key} {name}")
+                r = loop.run(
+                    stop_time=stop, ref_offset=step(t_step, offset), progress=True, description=f"{key} {name}"
+                )
                 step_runs[key][name] = (r, t_step)
                 r.write_csv(out / "csv" / f"{key}_step_{name.replace(' ', '_')}.csv")
         except Exception as e:  # noqa: BLE001 - a failed run is a result of the comparison
@@ -230,10 +236,16 @@ def main(argv: list[str] | None = None) -> int:
     row("mission completed", lambda x: "yes" if x.completed else f"no ({x.reason})")
     for i, ph in enumerate(PHASES):
         row(f"max / RMS position error, {ph} [m]", lambda x, i=i: f"{fmt(x.max_error[i])} / {fmt(x.rms_error[i])}")
-    row("max altitude deviation, transition 1 / 2 [m]", lambda x: " / ".join(fmt(v) for v in x.altitude_deviation_transition))
+    row(
+        "max altitude deviation, transition 1 / 2 [m]",
+        lambda x: " / ".join(fmt(v) for v in x.altitude_deviation_transition),
+    )
     row("max α [deg]", lambda x: fmt(x.max_alpha_deg, 1))
     row("time in actuator saturation [s]", lambda x: fmt(x.saturation_time))
-    row("level flight: max airspeed error [m/s] / pitch error [deg]", lambda x: f"{fmt(x.level_airspeed_error)} / {fmt(x.level_pitch_error_deg)}")
+    row(
+        "level flight: max airspeed error [m/s] / pitch error [deg]",
+        lambda x: f"{fmt(x.level_airspeed_error)} / {fmt(x.level_pitch_error_deg)}",
+    )
     row("controller compute per step (fmpy call incl.) [µs]", lambda x: fmt(x.controller_us_per_step, 0))
     fastest = {}
     alpha_max = CRITERIA["linear_alpha_max"]
@@ -258,19 +270,35 @@ def main(argv: list[str] | None = None) -> int:
         step_rows.append((f"settling time to < {CRITERIA['settling_band']:g} m, 5 m step, {name} [s]", vals))
 
     md = ["# Tail-sitter controller comparison", ""]
-    md.append(f"Master: fmpy, {ordering}; plant `tailsitter_plant`; controllers: {', '.join(NAMES[k] for k in keys)}. "
-              f"Level-trim pitch of the plant at {defaults['v_level']:g} m/s: {math.degrees(theta_trim):.2f}°. Wall time {time.time() - t_start:.0f} s.")
+    md.append(
+        f"Master: fmpy, {ordering}; plant `tailsitter_plant`; controllers: {', '.join(NAMES[k] for k in keys)}. "
+        f"Level-trim pitch of the plant at {defaults['v_level']:g} m/s: {math.degrees(theta_trim):.2f}°. Wall time "
+        f"{time.time() - t_start:.0f} s."
+    )
     md += campaign_section.report_section(out)  # the comparison: paired Monte-Carlo (issue 15)
     md += ["", "## Missions (thesis ch. 6 comparison)", ""]
     md.append("| " + " | ".join(header) + " |")
     md.append("|" + "---|" * len(header))
     for label, vals in rows:
         md.append(f"| {label} | " + " | ".join(vals) + " |")
-    md += ["", f"Fastest transition flown (completed with α < {alpha_max:g}°): " + ", ".join(
-        f"{k.upper()} T1 = {fastest[k][0]:g} s, T2 = {fastest[k][1]:g} s" if fastest[k] else f"{k.upper()}: none of the missions flown kept α < {alpha_max:g}°"
-        for k in keys)]
+    md += [
+        "",
+        f"Fastest transition flown (completed with α < {alpha_max:g}°): "
+        + ", ".join(
+            f"{k.upper()} T1 = {fastest[k][0]:g} s, T2 = {fastest[k][1]:g} s"
+            if fastest[k]
+            else f"{k.upper()}: none of the missions flown kept α < {alpha_max:g}°"
+            for k in keys
+        ),
+    ]
     if step_rows:
-        md += ["", "## Position steps", "", "| step | " + " | ".join(k.upper() for k in keys) + " |", "|" + "---|" * (len(keys) + 1)]
+        md += [
+            "",
+            "## Position steps",
+            "",
+            "| step | " + " | ".join(k.upper() for k in keys) + " |",
+            "|" + "---|" * (len(keys) + 1),
+        ]
         for label, vals in step_rows:
             md.append(f"| {label} | " + " | ".join(vals) + " |")
     if failures:
@@ -281,7 +309,10 @@ def main(argv: list[str] | None = None) -> int:
         md += avionics_section(
             dist,
             keys,
-            {m: {**mission_params(defaults, t1, t2), "v_level": defaults["v_level"]} for m, (t1, t2) in missions.items()},
+            {
+                m: {**mission_params(defaults, t1, t2), "v_level": defaults["v_level"]}
+                for m, (t1, t2) in missions.items()
+            },
             {(m, k): r for m, runs in mission_runs.items() for k, r in runs.items()},
             theta_trim,
             ordering=ordering,

@@ -1,6 +1,6 @@
 """Plots of the analysis report, from the CSV files the Rust campaign
 (`cargo run --release -p analysis -- all --out DIR`) wrote into DIR; called by
-`python -m tailsim.analysis_report DIR`, which renders the whole report.
+`python -m tailsim.reports.analysis DIR`, which renders the whole report.
 
 Writes PNGs beside the CSVs:
   open_loop_modes.png                 open-loop poles (level, vertical), thesis Tables 3.2/3.3
@@ -22,7 +22,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from tailsim import report_envelope  # noqa: E402
+from tailsim.reports import envelope as report_envelope  # noqa: E402
 
 
 def rows(path):
@@ -51,7 +51,9 @@ def main(out):
             ys = [p[1] for p in pts] + [-p[1] for p in pts if p[1] > 0]
             ax.plot(xs, ys, "x", label=cond)
         # The thesis's level-flight modes (Tables 3.2/3.3), as the campaign states them.
-        thesis = [(m["re"], m["im"]) for m in json.loads((out / "report.json").read_text())["open_loop"]["thesis_level"]]
+        thesis = [
+            (m["re"], m["im"]) for m in json.loads((out / "report.json").read_text())["open_loop"]["thesis_level"]
+        ]
         ax.plot([t[0] for t in thesis], [t[1] for t in thesis], "o", mfc="none", label="thesis (level)")
         splane(ax, "Open-loop modes")
         ax.legend(fontsize=7)
@@ -64,7 +66,9 @@ def main(out):
         for cond in sorted({r["condition"] for r in cl}):
             fig, ax = plt.subplots(figsize=(6, 4.5))
             for ctl, mk in (("LQR", "x"), ("TSD", "+")):
-                pts = [(float(r["re"]), float(r["im"])) for r in cl if r["condition"] == cond and r["controller"] == ctl]
+                pts = [
+                    (float(r["re"]), float(r["im"])) for r in cl if r["condition"] == cond and r["controller"] == ctl
+                ]
                 ax.plot([p[0] for p in pts], [p[1] for p in pts], mk, label=ctl)
             splane(ax, f"Closed-loop poles, {cond} flight")
             ax.legend(fontsize=7)
@@ -80,7 +84,7 @@ def main(out):
             )
         combos = sorted({(c, d) for (c, d, _) in loci})
         params = []
-        for (_, _, p) in loci:
+        for _, _, p in loci:
             if p not in params:
                 params.append(p)
 
@@ -96,7 +100,7 @@ def main(out):
             if pitch:
                 fig, axs = plt.subplots(1, len(pitch), figsize=(5 * len(pitch), 4.2))
                 axs = axs if len(pitch) > 1 else [axs]
-                for ax, p in zip(axs, pitch):
+                for ax, p in zip(axs, pitch, strict=False):
                     draw(ax, (ctl, cond, p), f"{ctl} {cond}: {p} (dot = smallest factor)")
                 fig.tight_layout()
                 fig.savefig(out / f"loci_{ctl}_{cond}_pitch.png", dpi=110)
@@ -127,10 +131,17 @@ def main(out):
             ours = {r["param"]: float(r["rms_percent"]) for r in level if r["controller"] == ctl}
             th = {r["param"]: float(r["thesis_percent"]) for r in level if r["controller"] == ctl}
             xs = range(len(params))
-            ax.bar([x + (2 * i - 1.5) * w for x in xs], [th.get(p, 0) for p in params], w, color=col, alpha=0.4,
-                   label=f"{ctl} thesis")
-            ax.bar([x + (2 * i - 0.5) * w for x in xs], [ours.get(p, 0) for p in params], w, color=col,
-                   label=f"{ctl} ours")
+            ax.bar(
+                [x + (2 * i - 1.5) * w for x in xs],
+                [th.get(p, 0) for p in params],
+                w,
+                color=col,
+                alpha=0.4,
+                label=f"{ctl} thesis",
+            )
+            ax.bar(
+                [x + (2 * i - 0.5) * w for x in xs], [ours.get(p, 0) for p in params], w, color=col, label=f"{ctl} ours"
+            )
         ax.set_xticks(range(len(params)))
         ax.set_xticklabels(params, rotation=60, fontsize=8)
         ax.set_ylabel("RMS pole movement (% of ω_n)")
@@ -150,11 +161,14 @@ def main(out):
         models = sorted({x.get("aero_model", "0") for x in r})
         name = {"0": "thesis aero", "1": "global aero"}
         fig, axs = plt.subplots(len(models), 2, figsize=(12, 5 * len(models)), sharey=True, squeeze=False)
-        for row, model in zip(axs, models):
-            for ax, ctl in zip(row, ("LQR", "TSD")):
+        for row, model in zip(axs, models, strict=False):
+            for ax, ctl in zip(row, ("LQR", "TSD"), strict=False):
                 for i, p in enumerate(params):
-                    pts = [(float(x["factor"]), x["passed"] == "true") for x in r
-                           if x["param"] == p and x["controller"] == ctl and x.get("aero_model", "0") == model]
+                    pts = [
+                        (float(x["factor"]), x["passed"] == "true")
+                        for x in r
+                        if x["param"] == p and x["controller"] == ctl and x.get("aero_model", "0") == model
+                    ]
                     ax.scatter([q[0] for q in pts], [i] * len(pts), c=["g" if q[1] else "r" for q in pts], s=6)
                 ax.set_xscale("log")
                 ax.set_yticks(range(len(params)))
@@ -177,8 +191,11 @@ def main(out):
         for i, ctl in enumerate(("LQR", "TSD")):
             best = []
             for ph, axis in cases:
-                pts = sorted((float(x["amplitude"]), x["passed"] == "true") for x in g
-                             if x["controller"] == ctl and x["phase"] == ph and x["axis"] == axis)
+                pts = sorted(
+                    (float(x["amplitude"]), x["passed"] == "true")
+                    for x in g
+                    if x["controller"] == ctl and x["phase"] == ph and x["axis"] == axis
+                )
                 b = 0.0
                 for a, ok in pts:
                     if not ok:

@@ -1,6 +1,6 @@
 """The closed loop under a second, independent master: libcosim (DNV/OSP, PyPI `libcosimpy`).
 
-Two ways in, both returning the `RunResult` of `tailsim.master` so the runs
+Two ways in, both returning the `RunResult` of `tailsim.masters` so the runs
 compare sample by sample with the fmpy master:
 
 - `run_fmus(plant_fmu, controller_fmu, ...)`: the plain FMUs as two local
@@ -22,7 +22,7 @@ ordering of `ClosedLoop(..., ordering="jacobi")`.
 Recording: a time-series observer samples every output after every step.
 Row k of the result holds the plant outputs at t_k and the controller outputs
 computed at t_k (observed by libcosim after the step, at t_k + h), the same
-alignment as `tailsim.master`; the run goes one step past the stop time to
+alignment as `tailsim.masters`; the run goes one step past the stop time to
 get the controller's last sample.
 
 libcosimpy 0.0.6 segfaults when it uses a slave that could not be created
@@ -36,12 +36,12 @@ import pathlib
 import tempfile
 import time as wall
 import zipfile
-from typing import Mapping
+from collections.abc import Mapping
 
 import numpy as np
 from fmpy import read_model_description
 
-from .master import RunResult
+from .fmu import RunResult
 
 NS = 1_000_000_000
 
@@ -57,9 +57,16 @@ def _import_libcosim():
     from libcosimpy.CosimObserver import CosimObserver
     from libcosimpy.CosimSlave import CosimLocalSlave
 
-    return CosimExecution, CosimObserver, CosimLocalSlave, CosimVariableType, CosimVariableCausality, (
-        CosimLogLevel,
-        log_output_level,
+    return (
+        CosimExecution,
+        CosimObserver,
+        CosimLocalSlave,
+        CosimVariableType,
+        CosimVariableCausality,
+        (
+            CosimLogLevel,
+            log_output_level,
+        ),
     )
 
 
@@ -100,7 +107,7 @@ def _set_initial(execution, slave: _Slave, values: Mapping[str, float | int | bo
 
 
 def _fly(execution, plant: _Slave, controller: _Slave, stop: float, h: float, params: Mapping[str, float]) -> RunResult:
-    """Observe every output, simulate to stop + h, assemble a RunResult aligned like tailsim.master."""
+    """Observe every output, simulate to stop + h, assemble a RunResult aligned like tailsim.masters."""
     _, CosimObserver, _, var_type, causality, _ = _import_libcosim()
     n = int(round(stop / h))
     observer = CosimObserver.create_time_series()
@@ -206,7 +213,9 @@ def run_fmus(
         for x in controller.names(causality.OUTPUT)
         if x in plant.names(causality.INPUT) and controller.vars[x].type == plant.vars[x].type == real
     ]
-    undriven = [x for x in plant.names(causality.INPUT) if x.endswith("_cmd") and not any(link[2] == x for link in links)]
+    undriven = [
+        x for x in plant.names(causality.INPUT) if x.endswith("_cmd") and not any(link[2] == x for link in links)
+    ]
     if undriven:
         raise ValueError(f"{controller_fmu.name} does not drive plant inputs {undriven}")
     for src, dst, x in links:

@@ -2,10 +2,10 @@
 
 The process keeps the FMUs it was given (as bytes: no shared filesystem is
 assumed) extracted in a temp dir of its own, and one instance per FMU (per
-thread), reset (fmi2Reset) between runs. The stepping is the Gauss-Seidel
-sequence of `master.ClosedLoop.run` call for call (same FMI calls, same order,
-same values); it only records fewer signals and stops early on divergence or
-timeout. tests/test_campaign.py checks that a run equals ClosedLoop's exactly.
+thread), reset (fmi2Reset) between runs. A run is `ClosedLoop`'s system
+(`tailsim.masters`, Gauss-Seidel) on these instances: it only records fewer
+signals and stops early on divergence or timeout. tests/test_campaign.py checks
+that a run equals ClosedLoop's exactly.
 
 Any failure of a run (an FMI error status, a Python exception) becomes a failed
 row; it never propagates, so one bad sample cannot crash a campaign.
@@ -24,13 +24,15 @@ import socket
 import tempfile
 import threading
 import time
-from typing import Any, Mapping
+from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
+from fmpy.fmi1 import FMICallException
 
-from .campaign_sampling import CONFIGURATIONS, CampaignSpec, plant_parameters, wind_function
-from . import fmilog
-from .master import Fmu
+from .. import declarations, fmilog
+from ..masters import AvionicsLoop, ClosedLoop, Fmu, NonFinite, pos_error
+from .sampling import CONFIGURATIONS, CampaignSpec, plant_parameters, wind_function
 
 FMU_NAMES = {
     "plant": "tailsitter_plant",
@@ -41,19 +43,13 @@ FMU_NAMES = {
 }
 #: The FMUs a state source needs beside the plant and the controllers.
 STATE_SOURCE_FMUS = {"perfect": (), "avionics": ("sensors", "ekf")}
-N_PHASES = 5
-#: Command limits of the saturation metric: thrust 0 / 150 N, surfaces ±25° (plant defaults).
-THRUST_LIMITS = (0.0, 150.0)
-DEFLECTION_LIMIT = math.radians(25.0)
-COMMANDS = [
-    "thrust_cmd",
-    "elevator_cmd",
-    "aileron_cmd",
-    "rudder_cmd",
-    "flap_collective_cmd",
-    "flap_differential_cmd",
-    "vertical_flap_cmd",
-]
+N_PHASES = len(declarations.PHASES)
+#: Command limits of the saturation metric: the plant's declared thrust limits and surface
+#: deflection limit (its parameters' defaults).
+THRUST_LIMITS = declarations.THRUST_LIMITS
+DEFLECTION_LIMIT = declarations.DEFLECTION_LIMIT
+#: The commands, thrust first.
+COMMANDS = list(declarations.COMMANDS)
 FAILURES = ("fmi_error", "divergence", "timeout", "exception")
 
 
@@ -66,7 +62,7 @@ def digest(data: bytes) -> str:
 _lock = threading.Lock()
 _fmus: dict[str, Fmu] = {}  # by sha256 of the .fmu bytes
 _dirs: list[str] = []
-_slaves: dict[tuple[int, str], "_Slave"] = {}  # (thread id, digest) -> instance
+_slaves: dict[tuple[int, str], _Slave] = {}  # (thread id, digest) -> instance
 
 
 class _Slave:
@@ -154,6 +150,11 @@ class TimedOut(Exception):
     pass
 
 
+#: What a campaign run records: plant outputs, then controller outputs.
+RECORD_PLANT = ["pos_d", "alpha"]
+RECORD_CONTROLLER = ["ref_pos_d", "pos_error", "phase", *COMMANDS]
+
+
 def fly(
     plant: Fmu,
     p,
@@ -167,103 +168,38 @@ def fly(
     divergence_m: float = math.inf,
     deadline: float = math.inf,
 ) -> tuple[dict[str, np.ndarray], str, str]:
-    """Fly instances `p`, `c` (freshly instantiated or reset) as ClosedLoop.run does
-    with ordering 'gauss-seidel' and a zero ref_offset.
+    """Fly instances `p`, `c` (freshly instantiated or reset) through `ClosedLoop`'s
+    system (Gauss-Seidel, zero ref_offset), stopping early on divergence or timeout.
 
     Returns the recorded signals (up to where it stopped) — time, phase, pos_error,
-    ref_pos_d, pos_d, alpha and the seven commands, each as ClosedLoop records it —
+    ref_pos_d, pos_d, alpha and the seven commands, as ClosedLoop records them —
     and (failure, detail) with failure '' when it reached the stop time.
     """
-    h = float(step_size)
-    n = int(round(float(stop_time) / h))
-    pv, cv = plant.variables, controller.variables
-    p_out = set(plant.names("output"))
-    p_in = set(plant.names("input"))
-    to_controller = [x for x in controller.names("input") if x in p_out]
-    to_plant = [x for x in controller.names("output") if x in p_in]
-    p_vr_out = [pv[x].valueReference for x in to_controller]
-    c_vr_in = [cv[x].valueReference for x in to_controller]
-    c_vr_out = [cv[x].valueReference for x in to_plant]
-    p_vr_in = [pv[x].valueReference for x in to_plant]
-    wind_vr = [pv[f"wind_{k}"].valueReference for k in "ned"]
-    offset_vr = [cv[f"ref_offset_{k}"].valueReference for k in "ned"]
-    rec_p = [pv["pos_d"].valueReference, pv["alpha"].valueReference]
-    rec_c = [cv["ref_pos_d"].valueReference, cv["pos_error"].valueReference]
-    phase_vr = [cv["phase"].valueReference]
-    cmd_idx = [to_plant.index(x) for x in COMMANDS]
-    zero = [0.0, 0.0, 0.0]
+    system = ClosedLoop(plant, controller, plant_params, controller_params).system(
+        wind, None, RECORD_PLANT, RECORD_CONTROLLER, finite_sources=["plant"]
+    )
+    i_err = system.signal_names().index("pos_error")
 
-    time_ = np.full(n + 1, np.nan)
-    phase = np.full(n + 1, -1, dtype=np.int64)
-    rec = np.full((n + 1, 4), np.nan)  # pos_d, alpha, ref_pos_d, pos_error
-    cmds = np.full((n + 1, len(COMMANDS)), np.nan)
-    failure, detail, k_end = "", "", -1
+    def monitor(k: int, t: float, row: np.ndarray) -> None:
+        e = row[i_err]
+        if not e <= divergence_m:
+            raise Diverged(f"position error {e:.1f} m > {divergence_m:g} m at t = {t:.2f} s")
+        if k % 50 == 0 and time.perf_counter() > deadline:
+            raise TimedOut(f"wall-time limit reached at t = {t:.2f} s")
 
-    for s in (p, c):
-        s.setupExperiment(startTime=0.0)
-        s.enterInitializationMode()
-    plant.set(p, plant_params)
-    p.setReal(wind_vr, list(wind(0.0)))
-    p.exitInitializationMode()
-    controller.set(c, controller_params)
-    c.setReal(c_vr_in, p.getReal(p_vr_out))
-    c.setReal(offset_vr, zero)
-    c.exitInitializationMode()
+    failure = detail = ""
     try:
-        for k in range(n + 1):
-            t = k * h
-            w = wind(t)
-            y_p = p.getReal(p_vr_out)
-            if not math.isfinite(math.fsum(y_p)):
-                raise Diverged(f"non-finite plant output at t = {t:.2f} s")
-            c.setReal(c_vr_in, y_p)
-            c.setReal(offset_vr, zero)
-            p.setReal(wind_vr, list(w))
-            c.doStep(currentCommunicationPoint=t, communicationStepSize=h)
-            u_c = c.getReal(c_vr_out)
-            p.setReal(p_vr_in, u_c)
-            time_[k] = t
-            rec[k, 0:2] = p.getReal(rec_p)
-            rec[k, 2:4] = c.getReal(rec_c)
-            phase[k] = c.getInteger(phase_vr)[0]
-            cmds[k] = [u_c[i] for i in cmd_idx]
-            k_end = k
-            e = rec[k, 3]
-            if not e <= divergence_m:
-                raise Diverged(f"position error {e:.1f} m > {divergence_m:g} m at t = {t:.2f} s")
-            if k % 50 == 0 and time.perf_counter() > deadline:
-                raise TimedOut(f"wall-time limit reached at t = {t:.2f} s")
-            if k < n:
-                p.doStep(currentCommunicationPoint=t, communicationStepSize=h)
-    except Diverged as exc:
-        failure, detail = "divergence", str(exc)
+        r = system.run(stop_time, step_size, slaves={"plant": p, "controller": c}, monitor=monitor)
+    except (Diverged, NonFinite) as exc:
+        failure, detail, r = "divergence", str(exc), exc.partial_result
     except TimedOut as exc:
-        failure, detail = "timeout", str(exc)
-    except Exception as exc:  # noqa: BLE001 - an error status mid-flight: keep what was flown
-        from fmpy.fmi1 import FMICallException
-
-        if not isinstance(exc, FMICallException):
-            raise
-        failure, detail = "fmi_error", f"{exc} at t = {k * h:.2f} s"
-    for s in (p, c):
-        if failure:
-            try:  # after a divergence the instances are discarded anyway
-                s.terminate()
-            except Exception:  # noqa: BLE001
-                pass
-        else:
-            s.terminate()
-    m = slice(0, k_end + 1)
-    signals = {
-        "time": time_[m],
-        "phase": phase[m],
-        "pos_d": rec[m, 0],
-        "alpha": rec[m, 1],
-        "ref_pos_d": rec[m, 2],
-        "pos_error": rec[m, 3],
-    }
-    for i, name in enumerate(COMMANDS):
-        signals[name] = cmds[m, i]
+        failure, detail, r = "timeout", str(exc), exc.partial_result
+    except FMICallException as exc:  # an error status mid-flight: keep what was flown
+        if exc.t is None:
+            raise  # in initialisation: not a flight
+        failure, detail, r = "fmi_error", f"{exc} at t = {exc.t:.2f} s", exc.partial_result
+    signals = {name: r[name] for name in ("time", "pos_d", "alpha", "ref_pos_d", "pos_error", *COMMANDS)}
+    signals["phase"] = r["phase"].astype(np.int64)
     return signals, failure, detail
 
 
@@ -294,7 +230,7 @@ def run_metrics(sig: Mapping[str, np.ndarray]) -> dict[str, float]:
     run; altitude loss in transition 1 and 2 = largest height below the reference
     (pos_d − ref_pos_d, ≥ 0) in phase 1 / 3; max α over phases 1–3 (α is not
     meaningful in the near-hover vertical phases); saturation = fraction of samples
-    with any command at its limit (thrust ≤ 0 or ≥ 150 N, a surface at ±25°).
+    with any command at its limit (thrust at `THRUST_LIMITS`, a surface at ±`DEFLECTION_LIMIT`).
     """
     out: dict[str, float] = {}
     err, phase = sig["pos_error"], sig["phase"]
@@ -384,8 +320,6 @@ def run_job(job: Mapping[str, Any], spec_json: Mapping[str, Any], digests: Mappi
         row.update(completed=not failure, failure=failure, detail=detail)
         plant_ok = ctrl_ok = not failure
     except Exception as exc:  # noqa: BLE001 - a failed run is a result, not a crash
-        from fmpy.fmi1 import FMICallException
-
         kind = "fmi_error" if isinstance(exc, FMICallException) else "exception"
         logs = _error_logs(pd_, cd_)
         row.update(completed=False, failure=kind, detail=" | ".join([f"{type(exc).__name__}: {exc}", *logs]))
@@ -401,9 +335,13 @@ def run_job(job: Mapping[str, Any], spec_json: Mapping[str, Any], digests: Mappi
 
 
 def _run_avionics(
-    job: Mapping[str, Any], spec: CampaignSpec, digests: Mapping[str, str], pp: Mapping[str, float], cp: Mapping[str, Any]
+    job: Mapping[str, Any],
+    spec: CampaignSpec,
+    digests: Mapping[str, str],
+    pp: Mapping[str, float],
+    cp: Mapping[str, Any],
 ) -> dict[str, Any]:
-    """Metrics and outcome of one run with avionics in the loop (`tailsim.avionics.AvionicsLoop`,
+    """Metrics and outcome of one run with avionics in the loop (`tailsim.masters.AvionicsLoop`,
     Gauss-Seidel, fresh instances): the sensors seeded with the sample's `noise_seed`. Position
     error, altitude loss and α are the TRUE ones (plant outputs against the controller's
     reference), not the controller's view of its estimate. A run whose true position error
@@ -411,9 +349,6 @@ def _run_avionics(
     (the plant's envelope check: a divergence; any other: an fmi_error) ends the run, its
     metrics taken over the record up to the last completed step (`partial_result`, as `fly`
     keeps what was flown)."""
-    from .avionics import AvionicsLoop
-    from .master import pos_error
-
     fmus = {}
     for role in ("plant", "sensors", "ekf", job["controller"]):
         d = digests.get(role)
@@ -437,11 +372,7 @@ def _run_avionics(
         failure = detail = ""
         try:
             r = loop.run(stop_time=spec.stop_time, step_size=spec.step_size, wind=wind_function(job))
-        except Exception as exc:  # noqa: BLE001 - an error status mid-flight
-            from fmpy.fmi1 import FMICallException
-
-            if not isinstance(exc, FMICallException):
-                raise
+        except FMICallException as exc:  # an error status mid-flight
             logs = [m for m in messages if m.startswith("[3]") or m.startswith("[4]")]
             failure = "divergence" if any("left its envelope" in m for m in logs) else "fmi_error"
             r = getattr(exc, "partial_result", None)
@@ -461,7 +392,8 @@ def _run_avionics(
             k = int(over[0])
             failure = "divergence"
             detail = (
-                f"true position error {sig['pos_error'][k]:.1f} m > {spec.divergence_m:g} m at t = {sig['time'][k]:.2f} s"
+                f"true position error {sig['pos_error'][k]:.1f} m > {spec.divergence_m:g} m "
+                f"at t = {sig['time'][k]:.2f} s"
             )
             sig = {n: v[: k + 1] for n, v in sig.items()}
         out = run_metrics(sig)
@@ -480,7 +412,7 @@ def _error_logs(*digests: str) -> list[str]:
 
 
 def _scaled_names() -> set[str]:
-    from .campaign_sampling import TABLE_5_1
+    from .sampling import TABLE_5_1
 
     return {n for p in TABLE_5_1 for n in p.plant_params}
 

@@ -9,17 +9,18 @@ and Jacobi, global aerodynamics.
 
 from __future__ import annotations
 
-from .report import shortest
+from .. import declarations
+from .markdown import shortest
 
-PHASES = ["vertical 1", "transition 1", "level", "transition 2", "vertical 2"]
+PHASES = list(declarations.PHASES)
 ORDERINGS = ["Gauss-Seidel", "Jacobi"]
-
 
 
 def _controller_ordering_header(first: tuple[str, ...], controllers) -> list[str]:
     """Header and rule of a table with the `first` columns, then one per controller × ordering."""
     cols = list(first) + [f"{k} {o}" for k in controllers for o in ORDERINGS]
     return ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
+
 
 def _cell(r: dict | None, key: str = "max_pos_error") -> str:
     """`✓ 2.99 m` for a hold, `✗ 131 m` otherwise (the largest position error)."""
@@ -94,11 +95,16 @@ def section(d: dict) -> list[str]:
                 for o in ORDERINGS:
                     line += f" {_cell(by.get((k, o, v, b)))} |"
             out.append(line)
-    held = {(k, o): [r for r in tuned if r["controller"] == k and r["ordering"] == o] for k in controllers for o in ORDERINGS}
+    held = {
+        (k, o): [r for r in tuned if r["controller"] == k and r["ordering"] == o]
+        for k in controllers
+        for o in ORDERINGS
+    }
     out += ["", "Held / flown, per speed:", ""]
     for (k, o), rows in held.items():
         per = ", ".join(
-            f"{shortest(v)} m/s {sum(r['held'] for r in rows if r['speed'] == v)}/{sum(1 for r in rows if r['speed'] == v)}"
+            f"{shortest(v)} m/s {sum(r['held'] for r in rows if r['speed'] == v)}/"
+            f"{sum(1 for r in rows if r['speed'] == v)}"
             for v in st["speeds"]
         )
         out.append(f"- {k}, {o}: {per}")

@@ -20,10 +20,13 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any, Mapping
+from typing import Any
 
 import numpy as np
+
+from .. import declarations
 
 # Thesis Table 5.1: (column name, symbol, plant-FMU parameters, uncertainty class).
 # The plant interpolates each stability/control derivative between α = 0 and
@@ -74,7 +77,7 @@ assert len(TABLE_5_1) == 25
 #: (the controller FMUs' `configuration`: 0 = tuned, the default; 1 = the thesis's
 #: configuration as printed, see the parameter's description). A state source is what the
 #: controller flies on: `perfect` = the plant's outputs; `avionics` = the estimate of
-#: `tailsitter_ekf` fed by `tailsitter_sensors` (tailsim.avionics, Gauss-Seidel), the
+#: `tailsitter_ekf` fed by `tailsitter_sensors` (tailsim.masters.avionics, Gauss-Seidel), the
 #: sensors seeded with the sample's `noise_seed`.
 CONTROLLERS = ("lqr", "tsd")
 CONFIGURATIONS: dict[str, dict[str, dict[str, int]]] = {
@@ -85,17 +88,16 @@ CONFIGURATIONS: dict[str, dict[str, dict[str, int]]] = {
 CONFIGURATION_INDEX = {"tuned": 0, "thesis": 1}
 STATE_SOURCES = ("perfect", "avionics")
 
-#: Missions (controller parameters; identical for both controllers) and their stop times (s).
+#: Missions (controller parameters; identical for both controllers): the phase durations of
+#: the declared presets `default` (the controllers' defaults: 5 s climb, T1 = 5 s, 10 s level,
+#: T2 = 10 s, 5 s vertical) and `short` (all five phases in 11 s, for tests and smoke runs).
 MISSIONS: dict[str, dict[str, float]] = {
-    # The controllers' defaults: 5 s climb, T1 = 5 s, 10 s level, T2 = 10 s, 5 s vertical.
-    "default": {"t_vertical_1": 5.0, "t_transition_1": 5.0, "t_level": 10.0, "t_transition_2": 10.0, "t_vertical_2": 5.0},
-    # A short mission for tests and smoke runs (all five phases in 11 s).
-    "short": {"t_vertical_1": 1.0, "t_transition_1": 3.0, "t_level": 2.0, "t_transition_2": 4.0, "t_vertical_2": 1.0},
+    name: {k: declarations.mission(name)[k] for k in declarations.PHASE_DURATIONS} for name in ("default", "short")
 }
 
 
 def mission_stop_time(mission: Mapping[str, float]) -> float:
-    return float(sum(mission[k] for k in ("t_vertical_1", "t_transition_1", "t_level", "t_transition_2", "t_vertical_2")))
+    return declarations.stop_time(dict(mission))
 
 
 @dataclass(frozen=True)
@@ -139,8 +141,11 @@ class CampaignSpec:
         for s in self.state_sources:
             if s not in STATE_SOURCES:
                 raise ValueError(f"unknown state source {s!r} (available: {STATE_SOURCES})")
-        for name, axis in (("controllers", self.controllers), ("configurations", self.configurations),
-                           ("state_sources", self.state_sources)):
+        for name, axis in (
+            ("controllers", self.controllers),
+            ("configurations", self.configurations),
+            ("state_sources", self.state_sources),
+        ):
             if not axis or len(set(axis)) != len(axis):
                 raise ValueError(f"{name} = {axis!r}: expected distinct values, at least one")
         if self.aero_model not in (0, 1):
@@ -159,7 +164,7 @@ class CampaignSpec:
         return d
 
     @classmethod
-    def from_json(cls, d: Mapping[str, Any]) -> "CampaignSpec":
+    def from_json(cls, d: Mapping[str, Any]) -> CampaignSpec:
         d = dict(d)
         for k in ("controllers", "configurations", "state_sources", "gust_duration"):
             d[k] = tuple(d[k])
@@ -192,7 +197,7 @@ def draw_sample(spec: CampaignSpec, i: int) -> dict[str, Any]:
     s: dict[str, Any] = {"sample_id": int(i)}
     # Log-uniform on [1/τ, τ]: k = τ^u with u ~ U(−1, 1) (thesis (5.1.1) spans the same range).
     u = rng.uniform(-1.0, 1.0, size=len(TABLE_5_1))
-    for p, ui in zip(TABLE_5_1, u):
+    for p, ui in zip(TABLE_5_1, u, strict=False):
         s[f"k_{p.name}"] = float(spec.tau(p) ** ui)
     speed = rng.uniform(0.0, spec.wind_max)
     heading = rng.uniform(0.0, 2.0 * math.pi)

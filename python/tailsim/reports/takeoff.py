@@ -4,8 +4,8 @@
 take off, fly the thesis's mission and land on a target point, on the global
 aerodynamics, Gauss-Seidel and Jacobi.
 
-`section(d)` gives the Markdown lines (hooked into `tailsim.analysis_report.SECTIONS`);
-`plot(folder)` draws `takeoff_landing.png` (called by `tailsim.analysis_report.write`).
+`section(d)` gives the Markdown lines (hooked into `tailsim.reports.analysis.SECTIONS`);
+`plot(folder)` draws `takeoff_landing.png` (called by `tailsim.reports.analysis.write`).
 """
 
 from __future__ import annotations
@@ -14,11 +14,10 @@ import json
 import math
 import pathlib
 
+from .. import declarations
+
 #: Phase codes of the controllers' `phase` output (modelDescription/fragments/controller_interface.json).
-PHASE_NAMES = {
-    0: "vertical 1", 1: "transition 1", 2: "level", 3: "transition 2", 4: "vertical 2",
-    5: "on ground", 6: "take-off", 7: "approach", 8: "descent", 9: "flare", 10: "landed",
-}
+PHASE_NAMES = declarations.PHASE_NAMES
 
 
 def _f(x, digits=2) -> str:
@@ -124,22 +123,14 @@ def plot(folder: str | pathlib.Path) -> pathlib.Path | None:
 
 
 #: The take-off-to-landing mission of the report (the Rust `analysis::takeoff_landing::mission`):
-#: controller parameters on top of the declared defaults.
-MISSION = {
-    "takeoff_spinup_time": 2.0,
-    "takeoff_time": 2.0,
-    "landing_descent_rate": 2.0,
-    "landing_target_n": 460.0,
-    "landing_target_e": 0.0,
-    "landing_target_d": 0.0,
-    "landing_approach_speed": 3.0,
-}
+#: controller parameters on top of the declared defaults (the declared preset `takeoff_landing`).
+MISSION = dict(declarations.PRESETS["takeoff_landing"])
 #: The plant at rest on the gear (global aerodynamics and the ground are its defaults).
 PLANT = {"initial_condition": 2}
 
 
 def touchdown(result, mission: dict | None = None) -> dict:
-    """Touchdown figures of a `tailsim.master.RunResult` of the mission (plant outputs):
+    """Touchdown figures of a `tailsim.masters.RunResult` of the mission (plant outputs):
     first contact after lift-off, the gear's sink rate there (`touchdown_speed`, the larger of
     the plant's output and the CG's sink just before), miss distance from the target at
     touchdown and at the end, tilt from the vertical (|90° − θ|), bounce (contact lost after

@@ -12,13 +12,13 @@ Two sources, both shown when present:
 * the documented full run (≥ 1000 samples), summarised once into
   `docs/campaign_full_run.json` by
 
-      python -m tailsim.campaign_section --write docs/campaign_full_run.json FOLDER...
+      python -m tailsim.campaign.section --write docs/campaign_full_run.json FOLDER...
 
   (FOLDERs: campaigns of the same seed and sample space, e.g. one per axis; their rows
   are merged, samples paired by id — a sample's draw does not depend on the axes);
 * the main job's small campaign (`<out>/campaign`, `scripts/main.sh`).
 
-`report_section(out)` is the hook of `tailsim.compare`.
+`report_section(out)` is the hook of `tailsim.reports.compare`.
 """
 
 from __future__ import annotations
@@ -27,17 +27,28 @@ import argparse
 import json
 import pathlib
 import sys
-from typing import Any, Iterable, Mapping
+from collections.abc import Iterable, Mapping
+from typing import Any
 
 import numpy as np
 
-from .campaign_report import arms, bootstrap_mean_ci, paired, wilson_interval, _arm_mask
-from .campaign_sampling import CampaignSpec
+from .report import _arm_mask, arms, bootstrap_mean_ci, paired, wilson_interval
+from .sampling import CampaignSpec
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
+ROOT = pathlib.Path(__file__).resolve().parents[3]
 FULL_RUN = ROOT / "docs" / "campaign_full_run.json"
 #: Spec fields that fix the samples: campaigns merged into one summary must agree on them.
-SAMPLE_SPACE = ("seed", "tau_aero", "tau_mass", "wind_max", "gust_max", "gust_duration", "mission", "aero_model", "step_size")
+SAMPLE_SPACE = (
+    "seed",
+    "tau_aero",
+    "tau_mass",
+    "wind_max",
+    "gust_max",
+    "gust_duration",
+    "mission",
+    "aero_model",
+    "step_size",
+)
 
 
 def _load(folders: Iterable[str | pathlib.Path]):
@@ -84,9 +95,17 @@ def summarize(folders: Iterable[str | pathlib.Path]) -> dict[str, Any]:
         for r in cols["failure"][m]:
             if r:
                 reasons[str(r)] = reasons.get(str(r), 0) + 1
-        med = {q: float(np.median(cols[q][ok].astype(float))) if ok.any() else float("nan") for q in ("max_err", "rms_err")}
-        out["arms"]["/".join(a)] = {"runs": n, "completed": k, "p": k / n if n else float("nan"), "wilson95": [lo, hi],
-                                    "failures": reasons, "median_completed": med}
+        med = {
+            q: float(np.median(cols[q][ok].astype(float))) if ok.any() else float("nan") for q in ("max_err", "rms_err")
+        }
+        out["arms"]["/".join(a)] = {
+            "runs": n,
+            "completed": k,
+            "p": k / n if n else float("nan"),
+            "wilson95": [lo, hi],
+            "failures": reasons,
+            "median_completed": med,
+        }
     for a in A:
         if a[0] != "tsd" or ("lqr", a[1], a[2]) not in A:
             continue
@@ -105,8 +124,12 @@ def summarize(folders: Iterable[str | pathlib.Path]) -> dict[str, Any]:
 
 def _ci(d: np.ndarray) -> dict[str, float]:
     lo, hi = bootstrap_mean_ci(d)
-    return {"n": int(d.size), "mean": float(d.mean()) if d.size else float("nan"), "ci95": [lo, hi],
-            "median": float(np.median(d)) if d.size else float("nan")}
+    return {
+        "n": int(d.size),
+        "mean": float(d.mean()) if d.size else float("nan"),
+        "ci95": [lo, hi],
+        "median": float(np.median(d)) if d.size else float("nan"),
+    }
 
 
 def _f(x: float, nd: int = 3) -> str:
@@ -120,21 +143,25 @@ def markdown(summary: Mapping[str, Any], title: str) -> list[str]:
     md = [
         f"### {title}",
         "",
-        f"Up to {n_samples} samples per arm (seed {s['seed']}; Table 5.1 factors log-uniform within τ = {s['tau_aero']:g} "
+        f"Up to {n_samples} samples per arm (seed {s['seed']}; Table 5.1 factors log-uniform within τ = "
+        f"{s['tau_aero']:g} "
         f"aero / {s['tau_mass']:g} mass and inertia; steady wind ≤ {s['wind_max']:g} m/s and a 1 − cos gust ≤ "
         f"{s['gust_max']:g} m/s of random direction and timing; plant aerodynamics "
         f"{'global (post-stall)' if s['aero_model'] == 1 else 'thesis (linear)'}; mission "
         f"{sum(s['mission'].values()):g} s). Arm = controller/configuration/state source.",
         "",
-        "| arm | runs | completed | P(complete) | 95 % Wilson interval | failures | median max / RMS error of completed runs (m) |",
+        "| arm | runs | completed | P(complete) | 95 % Wilson interval | failures | median max / RMS error of "
+        "completed runs (m) |",
         "|---|---|---|---|---|---|---|",
     ]
     for arm, r in summary["arms"].items():
         f = ", ".join(f"{k}: {v}" for k, v in sorted(r["failures"].items())) or "none"
         lo, hi = r["wilson95"]
         med = r["median_completed"]
-        md.append(f"| {arm} | {r['runs']} | {r['completed']} | {_f(r['p'])} | [{_f(lo)}, {_f(hi)}] | {f} | "
-                  f"{_f(med['max_err'], 2)} / {_f(med['rms_err'], 2)} |")
+        md.append(
+            f"| {arm} | {r['runs']} | {r['completed']} | {_f(r['p'])} | [{_f(lo)}, {_f(hi)}] | {f} | "
+            f"{_f(med['max_err'], 2)} / {_f(med['rms_err'], 2)} |"
+        )
     if summary["paired"]:
         md += [
             "",
@@ -145,25 +172,42 @@ def markdown(summary: Mapping[str, Any], title: str) -> list[str]:
             "|---|---|---|---|---|---|",
         ]
         for pair, res in summary["paired"].items():
-            for q, label in (("completion", "completion"), ("rms_err", "RMS position error (m)"), ("max_err", "max position error (m)")):
+            for q, label in (
+                ("completion", "completion"),
+                ("rms_err", "RMS position error (m)"),
+                ("max_err", "max position error (m)"),
+            ):
                 r = res[q]
-                md.append(f"| {pair} | {label} | {r['n']} | {_f(r['mean'])} | [{_f(r['ci95'][0])}, {_f(r['ci95'][1])}] | "
-                          f"{_f(r['median'])} |")
+                md.append(
+                    f"| {pair} | {label} | {r['n']} | {_f(r['mean'])} | [{_f(r['ci95'][0])}, {_f(r['ci95'][1])}] | "
+                    f"{_f(r['median'])} |"
+                )
     rt = [r for r in summary["runtime"] if r.get("runs_done_now")]
     if rt:
-        md += ["", "Runtime: " + "; ".join(
-            f"{r['folder']}: {r['runs_done_now']} runs in {r['elapsed_s']:.0f} s on {r['worker_threads']} worker(s) "
-            f"({r['runs_per_s']:.2f} runs/s, {1e3 / r['runs_per_cpu_s']:.0f} ms CPU per run"
-            + (f"; native Rust on identical jobs {1e3 * r['native']['native_cpu_s_per_run_mean']:.0f} ms CPU per run, "
-               f"{r['native']['speed_ratio']:.1f}× faster" if "native" in r else "")
-            + ")"
-            for r in rt
-        ) + "."]
+        md += [
+            "",
+            "Runtime: "
+            + "; ".join(
+                f"{r['folder']}: {r['runs_done_now']} runs in {r['elapsed_s']:.0f} s on {r['worker_threads']} "
+                "worker(s) "
+                f"({r['runs_per_s']:.2f} runs/s, {1e3 / r['runs_per_cpu_s']:.0f} ms CPU per run"
+                + (
+                    f"; native Rust on identical jobs {1e3 * r['native']['native_cpu_s_per_run_mean']:.0f} ms CPU "
+                    "per run, "
+                    f"{r['native']['speed_ratio']:.1f}× faster"
+                    if "native" in r
+                    else ""
+                )
+                + ")"
+                for r in rt
+            )
+            + ".",
+        ]
     return md
 
 
 def report_section(out: str | pathlib.Path) -> list[str]:
-    """The report's comparison section (hook of `tailsim.compare`): the documented full run
+    """The report's comparison section (hook of `tailsim.reports.compare`): the documented full run
     and, when present, the main job's campaign in `<out>/campaign`."""
     md = [
         "",
@@ -186,7 +230,7 @@ def report_section(out: str | pathlib.Path) -> list[str]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m tailsim.campaign_section", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m tailsim.campaign.section", description=__doc__.split("\n\n")[0])
     ap.add_argument("folders", nargs="+", help="campaign folders of one sample space (rows merged, paired by sample)")
     ap.add_argument("--write", help="write the summary JSON here (e.g. docs/campaign_full_run.json)")
     a = ap.parse_args(argv)

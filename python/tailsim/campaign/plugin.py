@@ -12,7 +12,7 @@ import importlib
 import os
 import sys
 import tempfile
-from typing import Mapping
+from collections.abc import Mapping
 
 from distributed import WorkerPlugin
 
@@ -36,14 +36,14 @@ class FmuPlugin(WorkerPlugin):
             if path not in sys.path:
                 sys.path.insert(0, path)
             importlib.invalidate_caches()
-        from tailsim.campaign_runner import install_fmus
+        from tailsim.campaign.runner import install_fmus
 
         install_fmus(self.blobs)
 
     def teardown(self, worker=None):
         # Called when the worker closes (the plugin is registered once per FMU set).
         try:
-            from tailsim.campaign_runner import release_all
+            from tailsim.campaign.runner import release_all
         except ImportError:
             return
         release_all()
@@ -55,7 +55,7 @@ def make_task():
     the graph, needs no tailsim); on a worker the plugin has made tailsim importable."""
 
     def run_task(job, spec_json, digests):
-        from tailsim.campaign_runner import run_job
+        from tailsim.campaign.runner import run_job
 
         return run_job(job, spec_json, digests)
 

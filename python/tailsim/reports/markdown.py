@@ -1,6 +1,6 @@
 """The one rendering layer of the project's reports: number formats and the
 Markdown → self-contained HTML conversion used by the comparison report
-(`tailsim.compare`) and the analysis report (`tailsim.analysis_report`).
+(`tailsim.reports.compare`) and the analysis report (`tailsim.reports.analysis`).
 
 Rust writes data (CSV, JSON); everything a reader sees is formatted here.
 """
@@ -11,7 +11,7 @@ import base64
 import html
 import math
 import pathlib
-from typing import Iterable
+from collections.abc import Iterable
 
 STYLE = (
     "body{font-family:sans-serif;max-width:80em;margin:2em auto}table{border-collapse:collapse}"

@@ -2,14 +2,14 @@
 `report.json` (written by `crates/analysis/src/envelope_transitions.rs`) as a Markdown
 section and a plot of the fastest transitions each controller flies inside α ≤ 15°.
 
-Hooked into `tailsim.analysis_report` (section) and `tailsim.analysis_plots` (plot).
+Hooked into `tailsim.reports.analysis` (section) and `tailsim.reports.analysis_plots` (plot).
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
-from .report import fmt_or_dash, shortest
+from .markdown import fmt_or_dash, shortest
 
 ISSUE_TIMINGS = [(5.0, 10.0), (3.0, 4.0), (2.0, 3.0)]
 
@@ -26,7 +26,8 @@ def section(d: dict) -> list[str]:
         "",
         f"Global aerodynamics (aero_model = {e['aero_model']}), flown natively (`closed_loop::fly`). The tuned "
         "controllers (configuration 0) fly the α- and thrust-limited point-mass profile "
-        f"(|α_ref| ≤ {shortest(round(e['profile_alpha_max_deg'], 6))}°, T_ref ≤ {shortest(e['profile_thrust_fraction'])} T_max; "
+        f"(|α_ref| ≤ {shortest(round(e['profile_alpha_max_deg'], 6))}°, T_ref ≤ "
+        f"{shortest(e['profile_thrust_fraction'])} T_max; "
         "derivation in `crates/flight-mission/README.md`); the thesis configuration (1) flies the thesis's "
         "transitions unchanged. Altitude deviation: max |h − h_ref| from the start of a transition to "
         f"{shortest(e['settle_window_s'])} s after its end; max α: largest |α| from the first transition to "
@@ -45,7 +46,8 @@ def section(d: dict) -> list[str]:
             f"| {r['controller']} | {'tuned' if r['configuration'] == 0 else 'thesis'} | {r['ordering']} | "
             f"{shortest(r['t1'])} / {shortest(r['t2'])} | {fmt_or_dash(r['max_alpha_deg'], 1)} | "
             f"{fmt_or_dash(r['alt_dev_t1'])} / {fmt_or_dash(r['alt_dev_t2'])} | {fmt_or_dash(r['max_pos_error'])} | "
-            f"{fmt_or_dash(r['rotation_t1'])} / {fmt_or_dash(r['rotation_t2'])} | {fmt_or_dash(r['ref_climb_t2'], 1)} | "
+            f"{fmt_or_dash(r['rotation_t1'])} / {fmt_or_dash(r['rotation_t2'])} | "
+            f"{fmt_or_dash(r['ref_climb_t2'], 1)} | "
             f"{'yes' if r['meets_goal'] else ('no' if r['completed'] else 'crashed')} |"
         )
     out += [

@@ -1,14 +1,14 @@
 """The analysis report, rendered from the data the Rust campaign writes.
 
     cargo run --release -p analysis -- all --out out/analysis
-    PYTHONPATH=python .venv/bin/python -m tailsim.analysis_report out/analysis
+    .venv/bin/python -m tailsim.reports.analysis out/analysis
 
 The campaign (`crates/analysis`) writes data only: `report.json` (every table
 as structured data) and the CSV files of every table and figure. This module
 renders them: `report.md` (everything) and one Markdown file per section
 (`open_loop_modes.md`, `closed_loop_poles.md`, `table_5_1.md`,
 `robustness.md`, `gusts.md`, `aero_models.md`), `report.html` and the plots
-(`tailsim.analysis_plots`, `tailsim.aero_report`). `tailsim.compare` includes the same sections in
+(`tailsim.reports.analysis_plots`, `tailsim.reports.aero`). `tailsim.reports.compare` includes the same sections in
 the comparison report.
 """
 
@@ -18,11 +18,11 @@ import argparse
 import json
 import pathlib
 
-from . import aero_report
-from . import report_hover
-from . import report_envelope
-from . import report_takeoff
-from .report import fmt_or_dash, fmt_pole, markdown_to_html, shortest
+from . import aero as aero_report
+from . import envelope as report_envelope
+from . import hover as report_hover
+from . import takeoff as report_takeoff
+from .markdown import fmt_or_dash, fmt_pole, markdown_to_html, shortest
 
 OPEN_LOOP_NOTES = (
     "Differences from the thesis: the thesis's modes were computed from its AVL-based model with numbers it "
@@ -63,7 +63,8 @@ def open_loop(d: dict) -> list[str]:
     tr = lvl["trim"]
     out = ["## Open-loop modes (thesis §3.4.2, Tables 3.2 and 3.3)", ""]
     out += [
-        f"{lvl['condition']}: trim α = {tr['alpha_deg']:.2f}°, δe = {tr['elevator_deg']:.2f}°, T = {tr['thrust_n']:.2f} N. "
+        f"{lvl['condition']}: trim α = {tr['alpha_deg']:.2f}°, δe = {tr['elevator_deg']:.2f}°, T = "
+        f"{tr['thrust_n']:.2f} N. "
         "Coordinates (V̄, α, β, p, q, r, φ, θ, ψ), 3-2-1 Euler angles; mode shapes normalised to the largest displayed "
         "component (V in m/s, angles in rad, rates in rad/s).",
         "",
@@ -107,7 +108,8 @@ def closed_loop(d: dict) -> list[str]:
         "",
         "One method for both controllers: plant over one sample time + controller update, perturbed in the plant's "
         "19 minimal coordinates and the controller's integrators (through its save/restore state), at the operating "
-        f"point the nominal mission reaches (level: t = {at['level']:.1f} s, vertical 3 m/s climb: t = {at['vertical']:.1f} s). "
+        f"point the nominal mission reaches (level: t = {at['level']:.1f} s, vertical 3 m/s climb: t = "
+        f"{at['vertical']:.1f} s). "
         "Upper half plane only; servo (−20) and thrust-lag (−10) poles included.",
         "",
     ]
@@ -124,8 +126,10 @@ def closed_loop(d: dict) -> list[str]:
         out.append("")
         if run["tsd_placed"]:
             out += [
-                "TSD placed (Table 4.3, our parameters) against achieved (nearest closed-loop pole, one-to-one, closest "
-                "pairs first; where loops couple and poles crowd, the assignment is ambiguous — the dominant coordinates "
+                "TSD placed (Table 4.3, our parameters) against achieved (nearest closed-loop pole, one-to-one, "
+                "closest "
+                "pairs first; where loops couple and poles crowd, the assignment is ambiguous — the dominant "
+                "coordinates "
                 "in the list above identify the loops):",
                 "",
                 "| loop | placed | achieved (ours) | thesis Table 4.4 |",
@@ -145,7 +149,8 @@ def table_5_1(d: dict) -> list[str]:
         "## Sensitivity (thesis §5.1, Table 5.1)",
         "",
         "Each parameter scaled in the plant alone by C₀·τ^(−1+2k/N), k = 0…N−1, "
-        f"N = {d['n']}, τ = 1.5 (aerodynamic) / 1.1 (m, I); controllers keep their nominal design model. Entry: RMS over "
+        f"N = {d['n']}, τ = 1.5 (aerodynamic) / 1.1 (m, I); controllers keep their nominal design model. Entry: RMS "
+        "over "
         "the closed-loop poles of each pole's largest excursion from nominal, in % of its nominal natural frequency "
         f"(poles with ω_n < {shortest(s['min_omega'])} rad/s left out). `!` marks sweeps with an unstable closed-loop "
         "pole somewhere, `✗n` sweeps where n points failed to reach the operating point, `sn` sweeps where at n points "
@@ -364,7 +369,7 @@ def write(folder: str | pathlib.Path, with_plots: bool = True) -> pathlib.Path:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="tailsim.analysis_report", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="tailsim.reports.analysis", description=__doc__.split("\n\n")[0])
     ap.add_argument("folder", nargs="?", default="out/analysis", help="output folder of the analysis campaign")
     ap.add_argument("--no-plots", action="store_true", help="tables only")
     args = ap.parse_args(argv)

@@ -8,12 +8,12 @@ from __future__ import annotations
 
 import math
 import pathlib
-from typing import Mapping, Sequence
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from .campaign_sampling import TABLE_5_1, CampaignSpec
-from .metrics import PHASES
+from ..metrics import PHASES
+from .sampling import TABLE_5_1, CampaignSpec
 
 Z95 = 1.959963984540054  # standard normal 97.5 % quantile
 COLORS = {"lqr": "tab:blue", "tsd": "tab:red"}
@@ -55,7 +55,9 @@ def spearman(x: Sequence[float], y: Sequence[float]) -> float:
     return float((rx * ry).sum() / d) if d > 0 else float("nan")
 
 
-def bootstrap_mean_ci(d: Sequence[float], n_boot: int = 4000, seed: int = 0, level: float = 0.95) -> tuple[float, float]:
+def bootstrap_mean_ci(
+    d: Sequence[float], n_boot: int = 4000, seed: int = 0, level: float = 0.95
+) -> tuple[float, float]:
     """Percentile bootstrap interval of the mean of `d` (resampling its elements)."""
     d = np.asarray(d, dtype=float)
     if d.size == 0:
@@ -75,7 +77,7 @@ def _columns(table) -> dict[str, np.ndarray]:
 
 
 def arms(cols: Mapping[str, np.ndarray]) -> list[tuple[str, str, str]]:
-    keys = sorted(set(zip(cols["controller"], cols["configuration"], cols["state_source"])))
+    keys = sorted(set(zip(cols["controller"], cols["configuration"], cols["state_source"], strict=False)))
     return [tuple(map(str, k)) for k in keys]
 
 
@@ -90,8 +92,8 @@ def _arm_mask(cols, arm) -> np.ndarray:
 def paired(cols, a, b, metric: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Values of `metric` of arms a and b on the samples both flew, by sample id."""
     ma, mb = _arm_mask(cols, a), _arm_mask(cols, b)
-    ia = dict(zip(cols["sample_id"][ma].tolist(), np.nonzero(ma)[0]))
-    ib = dict(zip(cols["sample_id"][mb].tolist(), np.nonzero(mb)[0]))
+    ia = dict(zip(cols["sample_id"][ma].tolist(), np.nonzero(ma)[0], strict=False))
+    ib = dict(zip(cols["sample_id"][mb].tolist(), np.nonzero(mb)[0], strict=False))
     ids = np.array(sorted(set(ia) & set(ib)), dtype=int)
     va = np.array([cols[metric][ia[i]] for i in ids], dtype=float)
     vb = np.array([cols[metric][ib[i]] for i in ids], dtype=float)
@@ -159,17 +161,26 @@ def write_report(out: str | pathlib.Path, spec: CampaignSpec | None = None, tabl
         md += [
             f"{n_samples} samples (seed {spec.seed}), mission '{spec.mission_name}' "
             f"({', '.join(f'{k} = {v:g} s' for k, v in spec.mission.items())}; {spec.stop_time:g} s), "
-            f"every controller flying the same samples. Each of the 25 parameters of the thesis's Table 5.1 is scaled by an "
-            f"independent log-uniform factor in [1/τ, τ] (τ = {spec.tau_aero:g} aerodynamic, {spec.tau_mass:g} mass and "
-            f"inertia); steady horizontal wind up to {spec.wind_max:g} m/s of random heading; one 1 − cos gust of random "
-            f"direction, amplitude ≤ {spec.gust_max:g} m/s, duration {spec.gust_duration[0]:g}–{spec.gust_duration[1]:g} s "
+            "every controller flying the same samples. Each of the 25 parameters of the thesis's Table 5.1 is "
+            "scaled by an "
+            f"independent log-uniform factor in [1/τ, τ] (τ = {spec.tau_aero:g} aerodynamic, {spec.tau_mass:g} mass "
+            "and "
+            f"inertia); steady horizontal wind up to {spec.wind_max:g} m/s of random heading; one 1 − cos gust of "
+            "random "
+            f"direction, amplitude ≤ {spec.gust_max:g} m/s, duration "
+            f"{spec.gust_duration[0]:g}–{spec.gust_duration[1]:g} s "
             f"and start time. A run fails on an FMI error, a divergence (position error > {spec.divergence_m:g} m or a "
             f"non-finite plant output) or a wall-time limit ({spec.timeout_s:g} s).",
             "",
         ]
 
     # 1. completion
-    md += ["## Completion", "", "| controller | runs | completed | P(complete) | 95 % Wilson interval | failures (phase reached) |", "|---|---|---|---|---|---|"]
+    md += [
+        "## Completion",
+        "",
+        "| controller | runs | completed | P(complete) | 95 % Wilson interval | failures (phase reached) |",
+        "|---|---|---|---|---|---|",
+    ]
     comp = {}
     for a in A:
         m = _arm_mask(cols, a)
@@ -177,7 +188,7 @@ def write_report(out: str | pathlib.Path, spec: CampaignSpec | None = None, tabl
         lo, hi = wilson_interval(k, n)
         comp[a] = (k, n, lo, hi)
         reasons: dict[str, dict[str, int]] = {}
-        for r, ph in zip(cols["failure"][m], cols["last_phase"][m]):
+        for r, ph in zip(cols["failure"][m], cols["last_phase"][m], strict=False):
             if r:
                 where = f"phase {int(ph)}" if np.isfinite(ph) else "before the first step"
                 reasons.setdefault(str(r), {})
@@ -244,18 +255,27 @@ def write_report(out: str | pathlib.Path, spec: CampaignSpec | None = None, tabl
     ax.legend()
     for ax, (m, title) in zip(
         [axes[0, 1], axes[0, 2], axes[1, 0]],
-        [("alt_loss_t1", "altitude loss, transition 1 [m]"), ("alt_loss_t2", "altitude loss, transition 2 [m]"), ("max_alpha_deg", "max α [deg]")],
+        [
+            ("alt_loss_t1", "altitude loss, transition 1 [m]"),
+            ("alt_loss_t2", "altitude loss, transition 2 [m]"),
+            ("max_alpha_deg", "max α [deg]"),
+        ],
+        strict=False,
     ):
         data = []
         for a in A:
             v = cols[m][_arm_mask(cols, a) & cols["completed"].astype(bool)].astype(float)
             data.append(v[np.isfinite(v)])
         vp = ax.violinplot([d if d.size else np.array([np.nan]) for d in data], showmedians=True)
-        for body, a in zip(vp["bodies"], A):
+        for body, a in zip(vp["bodies"], A, strict=False):
             body.set(facecolor=color[a], edgecolor=color[a], alpha=0.5)
         ax.set_xticks(range(1, len(A) + 1), [lab[a] for a in A])
         ax.set(title=title)
-    for ax, (m, title) in zip([axes[1, 1], axes[1, 2]], [("max_err", "max position error [m]"), ("rms_err", "RMS position error [m]")]):
+    for ax, (m, title) in zip(
+        [axes[1, 1], axes[1, 2]],
+        [("max_err", "max position error [m]"), ("rms_err", "RMS position error [m]")],
+        strict=False,
+    ):
         for a in A:
             msk = _arm_mask(cols, a)
             v = np.where(cols["completed"][msk].astype(bool), cols[m][msk].astype(float), np.inf)
@@ -292,13 +312,16 @@ def write_report(out: str | pathlib.Path, spec: CampaignSpec | None = None, tabl
             "|---|---|---|---|---|---|",
         ]
         fig, axes = plt.subplots(1, len(pairs), figsize=(6 * len(pairs), 4), squeeze=False)
-        for (b, a), ax in zip(pairs, axes[0]):
+        for (b, a), ax in zip(pairs, axes[0], strict=False):
             name = f"{lab[a]} − {lab[b]}"
             ids, cb, ca = paired(cols, b, a, "completed")
             d = ca.astype(float) - cb.astype(float)
             lo, hi = bootstrap_mean_ci(d)
             diff_summary["completed"] = (float(d.mean()) if d.size else float("nan"), lo, hi, d.size)
-            md.append(f"| {name} | completion | {d.size} | {_fmt(d.mean() if d.size else np.nan, 3)} | [{_fmt(lo, 3)}, {_fmt(hi, 3)}] | — |")
+            md.append(
+                f"| {name} | completion | {d.size} | {_fmt(d.mean() if d.size else np.nan, 3)} | [{_fmt(lo, 3)}, "
+                f"{_fmt(hi, 3)}] | — |"
+            )
             both = (cb > 0) & (ca > 0)
             for m, title in PAIRED_METRICS:
                 _, vb, va = paired(cols, b, a, m)
@@ -426,7 +449,10 @@ def _thesis_paragraph(A, lab, comp, diff, rho, names, cols, spec=None) -> str:
                 if lo > 0
                 else "not distinguishable"
             )
-            text += f"The largest position error in {what} is {verdict} (paired mean TSD − LQR {m:+.2f} m, CI [{lo:+.2f}, {hi:+.2f}], {n} samples). "
+            text += (
+                f"The largest position error in {what} is {verdict} (paired mean TSD − LQR {m:+.2f} m, "
+                f"CI [{lo:+.2f}, {hi:+.2f}], {n} samples). "
+            )
     sl, st = _spread(cols, lqr), _spread(cols, tsd)
     if np.isfinite(sl) and np.isfinite(st):
         text += (
@@ -435,7 +461,8 @@ def _thesis_paragraph(A, lab, comp, diff, rho, names, cols, spec=None) -> str:
             + (
                 ": TSD's errors vary relatively more with the sampled uncertainty, in line with the thesis. "
                 if st > sl
-                else ": LQR's errors vary relatively more with the sampled uncertainty, unlike the thesis's linear ranking. "
+                else ": LQR's errors vary relatively more with the sampled uncertainty, "
+                "unlike the thesis's linear ranking. "
             )
         )
     top = []
@@ -449,7 +476,8 @@ def _thesis_paragraph(A, lab, comp, diff, rho, names, cols, spec=None) -> str:
         text += (
             "The quantities most associated with large errors and failures (the thesis's Table 5.1 names C_mδe, C_Lα "
             "and C_mα for both controllers) are " + "; ".join(top) + ". "
-            "Note the difference of method: Table 5.1 moves one parameter at a time in the linearised loop; here all 25 "
+            "Note the difference of method: Table 5.1 moves one parameter at a time in the linearised loop; here all "
+            "25 "
             f"vary together in the nonlinear mission{where}, so a parameter's rank correlation also reflects the "
             "range it was sampled over (τ = 1.1 for mass and inertias) and the controller's tuning in this project."
         )

@@ -20,15 +20,21 @@ import sys
 import time
 import uuid
 import zipfile
-from typing import Any, Callable, Mapping
+from collections.abc import Callable, Mapping
+from typing import Any
 
-from .campaign_runner import digest, install_fmus, load_fmu_bytes, metric_columns, run_job
-from .campaign_sampling import MISSIONS, CampaignSpec, jobs, sample_columns
+from .runner import digest, install_fmus, load_fmu_bytes, metric_columns, run_job
+from .sampling import MISSIONS, CampaignSpec, jobs, sample_columns
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
+ROOT = pathlib.Path(__file__).resolve().parents[3]
 #: Columns that depend on where and when a run was executed, not on what was run.
 NONDETERMINISTIC = ("worker", "wall_time_s", "cpu_time_s")
-SORT_KEYS = [("sample_id", "ascending"), ("controller", "ascending"), ("configuration", "ascending"), ("state_source", "ascending")]
+SORT_KEYS = [
+    ("sample_id", "ascending"),
+    ("controller", "ascending"),
+    ("configuration", "ascending"),
+    ("state_source", "ascending"),
+]
 
 
 # --- Parquet store ------------------------------------------------------------------------
@@ -50,7 +56,12 @@ def row_schema():
     fields += [(c, pa.float64()) for c in metric_columns()]
     for c in sample_columns()[1:]:
         fields.append((c, pa.int64() if c == "noise_seed" else pa.float64()))
-    fields += [("overrides", pa.string()), ("worker", pa.string()), ("wall_time_s", pa.float64()), ("cpu_time_s", pa.float64())]
+    fields += [
+        ("overrides", pa.string()),
+        ("worker", pa.string()),
+        ("wall_time_s", pa.float64()),
+        ("cpu_time_s", pa.float64()),
+    ]
     return pa.schema(fields)
 
 
@@ -168,11 +179,11 @@ def local_cluster(n_workers: int | None = None):
 
 def _package_zip() -> bytes:
     """The tailsim package as zip bytes, for workers that do not have it."""
-    pkg = pathlib.Path(__file__).resolve().parent
+    pkg = pathlib.Path(__file__).resolve().parents[1]
     buf = io.BytesIO()
     with zipfile.ZipFile(buf, "w") as z:
-        for f in sorted(pkg.glob("*.py")):
-            info = zipfile.ZipInfo(f"tailsim/{f.name}", date_time=(2020, 1, 1, 0, 0, 0))
+        for f in sorted(pkg.rglob("*.py")):
+            info = zipfile.ZipInfo(f"tailsim/{f.relative_to(pkg).as_posix()}", date_time=(2020, 1, 1, 0, 0, 0))
             z.writestr(info, f.read_bytes())
     return buf.getvalue()
 
@@ -246,7 +257,7 @@ def run_campaign(
                 else:
                     cluster = local_cluster(n_workers)
                     own_client = client = Client(cluster)
-            from . import campaign_plugin
+            from . import plugin as campaign_plugin
 
             package = None
             if upload if upload is not None else bool(scheduler):
@@ -346,7 +357,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--configurations", default="tuned")
     ap.add_argument("--state-sources", default="perfect")
     ap.add_argument("--mission", choices=sorted(MISSIONS), default="default")
-    ap.add_argument("--aero-model", type=int, choices=(0, 1), default=1, help="plant aerodynamics: 1 global (default), 0 thesis")
+    ap.add_argument(
+        "--aero-model", type=int, choices=(0, 1), default=1, help="plant aerodynamics: 1 global (default), 0 thesis"
+    )
     ap.add_argument("--tau-aero", type=float, default=1.5)
     ap.add_argument("--tau-mass", type=float, default=1.1)
     ap.add_argument("--wind-max", type=float, default=5.0, help="largest steady horizontal wind (m/s)")
@@ -395,7 +408,8 @@ def main(argv: list[str] | None = None) -> int:
         if stats["runs_done_now"]:
             done = (
                 f"{stats['runs_done_now']} runs in {stats['elapsed_s']:.1f} s ({stats['runs_per_s']:.2f} runs/s on "
-                f"{stats['worker_threads']} worker threads after start-up, {stats['runs_per_cpu_s']:.1f} runs per CPU-second)"
+                f"{stats['worker_threads']} worker threads after start-up, {stats['runs_per_cpu_s']:.1f} runs per "
+                "CPU-second)"
             )
         else:
             done = "nothing to run (every run is already in the folder)"
@@ -404,7 +418,7 @@ def main(argv: list[str] | None = None) -> int:
             + (f"; {stats['not_recorded']} not recorded (run again to resume)" if stats["not_recorded"] else "")
         )
     if not a.no_report:
-        from .campaign_report import write_report
+        from .report import write_report
 
         path = write_report(out, spec)
         print(f"report: {path}")

@@ -1,0 +1,131 @@
+"""Plant + controller: the reference configuration of `tailsim.masters.system`.
+
+Gauss-Seidel (the reference): at each communication point t the controller inputs
+are set from the plant outputs at t, the controller steps, the plant inputs are set
+from the controller outputs, the plant steps. Jacobi: both units are set from values
+at t before either steps, so the plant flies the command of the previous sample.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+from .fmu import Fmu, RunResult
+from .profiles import TimeFunction, zero
+from .system import External, Link, System, Unit, check_ordering, default_step, default_stop, wire
+
+#: The plant's wind inputs and the controller's reference-offset inputs (NED).
+WIND = ("wind_n", "wind_e", "wind_d")
+REF_OFFSET = ("ref_offset_n", "ref_offset_e", "ref_offset_d")
+
+
+def wind_external(function: TimeFunction | None) -> External:
+    return External("plant", WIND, function or zero, WIND, "m/s")
+
+
+def ref_offset_external(function: TimeFunction | None) -> External:
+    return External("controller", REF_OFFSET, function or zero, REF_OFFSET, "m")
+
+
+def commands_driven(plant: Fmu, controller: Fmu) -> list[str]:
+    """The controller outputs wired to plant inputs; every plant command input must be one."""
+    to_plant = wire(controller, plant)
+    missing = [n for n in plant.names("input") if n.endswith("_cmd") and n not in to_plant]
+    if missing:
+        raise ValueError(f"{controller.identifier} does not drive plant inputs {missing}")
+    return to_plant
+
+
+def real_outputs(fmu: Fmu) -> list[str]:
+    return [n for n in fmu.names("output") if fmu.variables[n].type == "Real"]
+
+
+def int_outputs(fmu: Fmu) -> list[str]:
+    return [n for n in fmu.names("output") if fmu.variables[n].type == "Integer"]
+
+
+class ClosedLoop:
+    """Plant + controller, wired by port name.
+
+    plant_params / controller_params: start values set in initialisation mode
+    (parameters and inputs, by name). `wind` and `ref_offset` are functions of
+    time giving (n, e, d); they drive the plant's `wind_*` and the controller's
+    `ref_offset_*` inputs.
+    """
+
+    def __init__(
+        self,
+        plant: Fmu,
+        controller: Fmu,
+        plant_params: Mapping[str, float] | None = None,
+        controller_params: Mapping[str, float] | None = None,
+        ordering: str = "gauss-seidel",
+        callbacks=None,
+    ):
+        check_ordering(ordering)
+        self.plant, self.controller = plant, controller
+        self.plant_params = dict(plant_params or {})
+        self.controller_params = dict(controller_params or {})
+        self.ordering = ordering
+        self.callbacks = callbacks
+        # Wiring by name: controller input ← plant output, controller output → plant input.
+        self.to_controller = wire(plant, controller)
+        self.to_plant = commands_driven(plant, controller)
+
+    def system(
+        self,
+        wind: TimeFunction | None = None,
+        ref_offset: TimeFunction | None = None,
+        record_plant: Sequence[str] | None = None,
+        record_controller: Sequence[str] | None = None,
+        finite_sources: Sequence[str] = (),
+    ) -> System:
+        """The system of this loop; records every plant output and the controller's Real
+        then Integer outputs unless `record_*` name others."""
+        c = self.controller
+        return System(
+            [
+                Unit(
+                    "controller",
+                    c,
+                    self.controller_params,
+                    sampler=True,
+                    record=list(
+                        record_controller if record_controller is not None else real_outputs(c) + int_outputs(c)
+                    ),
+                ),
+                Unit(
+                    "plant",
+                    self.plant,
+                    self.plant_params,
+                    minor=True,
+                    record=list(record_plant if record_plant is not None else self.plant.names("output")),
+                ),
+            ],
+            [Link("plant", "controller", self.to_controller), Link("controller", "plant", self.to_plant)],
+            [wind_external(wind), ref_offset_external(ref_offset)],
+            ordering=self.ordering,
+            init_order=["plant", "controller"],
+            finite_sources=finite_sources,
+            record_order=["plant", "controller"],
+        )
+
+    def run(
+        self,
+        stop_time: float | None = None,
+        step_size: float | None = None,
+        wind: TimeFunction | None = None,
+        ref_offset: TimeFunction | None = None,
+        progress: bool = False,
+        description: str = "",
+    ) -> RunResult:
+        return self.system(wind, ref_offset).run(
+            default_stop(self.controller, stop_time),
+            default_step(self.controller, self.controller_params, step_size),
+            callbacks=self.callbacks,
+            progress=progress,
+            description=description or self.controller.identifier,
+        )
+
+
+__all__ = ["REF_OFFSET", "WIND", "ClosedLoop", "commands_driven", "ref_offset_external", "wind_external"]
