@@ -685,12 +685,12 @@ impl SampledUnit for LqrController {
         Self::restore(self, next)
     }
 
-    /// One sample of Fig. 3.2, stage by stage: take-off / landing ([`Self::ground_stage`]) →
-    /// reference x_t, u_t ([`Self::reference_stage`], §3.3) → Euler set and error state
-    /// ([`error_state::euler_set`], [`Self::state_and_reference`], 3.2.1) → gain schedule
-    /// ([`Self::schedule_gains`], §3.1.3, §3.2.4) → feedback u = u_t − K dx
-    /// ([`Self::command_stage`]) → integrators ([`Self::integrator_stage`], 3.2.12–3.2.14) →
-    /// diagnostics. The switches of each stage come from [`LqrParams::stages`].
+    /// One sample of Fig. 3.2, stage by stage (README, "Where the blocks of Fig. 3.2 live"):
+    /// take-off / landing (`ground_stage`) → reference x_t, u_t (`reference_stage`, §3.3) →
+    /// Euler set and error state (`euler_set`, `state_and_reference`, 3.2.1) → gain schedule
+    /// (`schedule_gains`, §3.1.3, §3.2.4) → feedback u = u_t − K dx (`command_stage`) →
+    /// integrators (`integrator_stage`, 3.2.12–3.2.14) → diagnostics. The switches of each
+    /// stage come from `LqrParams::stages`.
     fn sample(&mut self, input: &ControllerInput) -> Result<ControllerOutput, ControlError> {
         let m = &input.measurement;
         if let Some(name) = m.first_non_finite() {

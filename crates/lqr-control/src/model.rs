@@ -198,8 +198,8 @@ pub fn linearise_central(af: &Airframe, rep: EulerRep, x: &X, u: &U) -> (SMatrix
 
 impl EulerRep {
     /// ∂DCM^BE/∂φ, ∂/∂θ, ∂/∂ψ. For `DCM = R₁(φ) R₂(θ) R₃(ψ)` (frame rotations about the
-    /// axes e₁, e₂, e₃, dR_k/da = −[e_k]× R_k): ∂/∂φ = −[e₁]× C, ∂/∂θ = −[R₁ e₂]× C,
-    /// ∂/∂ψ = −C [e₃]× (3-2-1: e₁ e₂ e₃ = x y z; 2-3-1: x z y).
+    /// axes e₁, e₂, e₃, dR_k/da = −\[e_k\]× R_k): ∂/∂φ = −\[e₁\]× C, ∂/∂θ = −\[R₁ e₂\]× C,
+    /// ∂/∂ψ = −C \[e₃\]× (3-2-1: e₁ e₂ e₃ = x y z; 2-3-1: x z y).
     pub fn dcm_partials(self, a: &Vector3<f64>) -> [Matrix3<f64>; 3] {
         let c = self.dcm(a);
         let (e2, e3) = match self {
