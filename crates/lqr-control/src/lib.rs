@@ -14,25 +14,35 @@
 //!
 //! See README.md for the equations and the design choices.
 
+mod command;
+mod error_state;
+mod gain;
 pub mod linalg;
 pub mod model;
+mod reference;
 pub mod trajectory;
 pub mod weights;
 
-use flight_mission::{
-    Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, GroundMode, GroundPhases, MissionParams,
-    Notice, ParamError, SampledUnit, VerticalReference, Weathervane, WeathervaneParams,
+pub use gain::{
+    GainSolution, NR, WARM_MAX_NEWTON_STEPS, WARM_MAX_RESIDUAL, WARM_MAX_START_RESIDUAL, WARM_MAX_STEP_RESIDUAL,
 };
-use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
-use tailsitter_physics::{Airframe, Surfaces};
 
-use linalg::{
-    dare_newton_step, dare_residual, dare_sda, discretise_zoh, lqr_gain, riccati_backward, spectral_radius_bound,
-    RiccatiError,
+use std::ops::ControlFlow;
+
+use flight_mission::{
+    Command, ControlError, ControllerInput, ControllerOutput, GroundPhases, MissionParams, ParamError, SampledUnit,
+    Weathervane, WeathervaneParams,
 };
-use model::{ix, linearise, state_of, wrap_pi, EulerRep, I_POS, NA, NU, NX, U, X};
-use trajectory::{TrajPoint, Trajectory, TrajectoryMode, TrajectoryOptions};
-use weights::{load_set, WeightSchedule, Weights, DEFAULT_WEIGHTS_JSON};
+use nalgebra::{SMatrix, Vector3};
+use tailsitter_physics::Airframe;
+
+use command::IntegratorSwitches;
+use error_state::{euler_set, ErrorStateSwitches};
+use gain::GainScheduleSwitches;
+use model::{EulerRep, NA, NU};
+use reference::ReferenceSwitches;
+use trajectory::{Trajectory, TrajectoryMode, TrajectoryOptions};
+use weights::{load_set, WeightSchedule, DEFAULT_WEIGHTS_JSON};
 
 /// Smallest reference airspeed the (V, α, β) model for control supports (m/s).
 pub const MIN_AIRSPEED: f64 = 0.5;
@@ -55,9 +65,6 @@ pub const WIND_TRIM_RAMP: (f64, f64) = (0.5, 1.5);
 pub const HOVER_SHIFT_TIME: f64 = 3.0;
 /// Bound on that integral's shift of the regulated position (m).
 pub const HOVER_SHIFT_LIMIT: f64 = 5.0;
-
-/// Size of the augmented ZOH exponential: states + integrator + inputs.
-const NM: usize = NA + NU;
 
 /// The gain matrix K (inputs × [integrator, model states]).
 pub type Gain = SMatrix<f64, NU, NA>;
@@ -242,118 +249,43 @@ pub struct LqrController {
 /// Names of the commands, for [`Notice::Saturated`].
 use tailsitter_physics::idx::INPUT_NAMES as COMMAND_NAMES;
 
-/// The result of one gain computation.
+/// The configuration switches of the stages of Fig. 3.2 (README, "Where the blocks of
+/// Fig. 3.2 live"), each stage's own, from the effective parameters: where the tuned
+/// configuration departs from the printed thesis, per stage.
 #[derive(Debug, Clone, Copy)]
-pub struct GainSolution {
-    pub gain: Gain,
-    pub phi: SMatrix<f64, NA, NA>,
-    pub gamma: SMatrix<f64, NA, NU>,
-    pub spectral_radius: f64,
-    /// The DARE solution of the design on the [∫ΔV; x] block (inert position integrators,
-    /// `riccati_method` 0): the warm start of the next solve. `None` otherwise.
-    pub p: Option<SMatrix<f64, NR, NR>>,
-    /// Whether the warm start was accepted (else the DARE was solved cold).
-    pub warm: bool,
+pub(crate) struct Stages {
+    pub reference: ReferenceSwitches,
+    pub error_state: ErrorStateSwitches,
+    pub gain: GainScheduleSwitches,
+    pub integrator: IntegratorSwitches,
 }
 
-/// Size of the design when the position integrators are inert: integrator + model states.
-pub const NR: usize = 1 + NX;
-/// Size of the augmented ZOH exponential of that design.
-const NRM: usize = NR + NU;
-
-/// Warm start of the DARE (README, "Riccati"): a Newton step from the extrapolated previous
-/// P is tried only when that start's relative DARE residual on the new model is at most this
-/// (close enough for one quadratic step to reach rounding; a farther start goes cold at
-/// once, having cost only the residual).
-pub const WARM_MAX_START_RESIDUAL: f64 = 1e-7;
-/// Newton steps of the warm start before it gives up and solves cold. One: a step (Smith's
-/// doubling of the Stein equation, ≈ 13 doublings like the cold SDA's: the slow closed-loop
-/// poles set both counts) costs ≈ 0.55 of the cold solve, so a second step loses.
-pub const WARM_MAX_NEWTON_STEPS: usize = 1;
-/// A further Newton step is taken only from a residual at most this.
-pub const WARM_MAX_STEP_RESIDUAL: f64 = 1e-7;
-/// The warm solution is accepted when its relative DARE residual is at most this (the cold
-/// doubling reaches ≈ 1e-16); otherwise the cold doubling solves again.
-pub const WARM_MAX_RESIDUAL: f64 = 1e-13;
-
-/// Discretised model, gain and closed-loop spectral-radius bound of one design.
-struct Design<const N: usize> {
-    k: SMatrix<f64, NU, N>,
-    phi: SMatrix<f64, N, N>,
-    gamma: SMatrix<f64, N, NU>,
-    rho: f64,
-    /// The DARE solution (`riccati_method` 0).
-    p: Option<SMatrix<f64, N, N>>,
-    /// Whether the warm start was accepted.
-    warm: bool,
-}
-
-/// ZOH discretisation of (A, B) over `ts` (`M` = N + NU), gain by the DARE (`riccati_method`
-/// 0, residual checked; warm-started by one Newton step from `warm` when given and close
-/// enough, else the cold doubling) or the backward iteration (1), and the stability check of
-/// Φ − ΓK against `limit`.
-#[allow(clippy::too_many_arguments)]
-fn design<const N: usize, const M: usize>(
-    a: &SMatrix<f64, N, N>,
-    b: &SMatrix<f64, N, NU>,
-    q_diag: &SVector<f64, N>,
-    r: &SVector<f64, NU>,
-    ts: f64,
-    params: &LqrParams,
-    limit: f64,
-    warm: Option<&SMatrix<f64, N, N>>,
-) -> Result<Design<N>, RiccatiError> {
-    let (phi, gamma) = discretise_zoh::<N, NU, M>(a, b, ts);
-    let q = SMatrix::<f64, N, N>::from_diagonal(q_diag);
-    let (k, p, warm) = if params.riccati_method == 0 {
-        // Warm: Newton steps from the previous P, accepted on the residual.
-        let warm_solution = warm.and_then(|p0| {
-            let mut p = *p0;
-            let mut max_start = WARM_MAX_START_RESIDUAL;
-            for _ in 0..WARM_MAX_NEWTON_STEPS {
-                // A start already converged (the model has not changed: steady flight) is
-                // returned as it is and accepted on the residual below.
-                p = dare_newton_step(&phi, &gamma, &q, r, &p, max_start, WARM_MAX_RESIDUAL)
-                    .ok()?
-                    .0;
-                let k = lqr_gain(&phi, &gamma, &p, r).ok()?;
-                let res = dare_residual(&phi, &gamma, &q, &p, &k);
-                if res <= WARM_MAX_RESIDUAL {
-                    return Some((k, p));
-                }
-                // The next step starts from here: it must converge at once.
-                max_start = WARM_MAX_STEP_RESIDUAL;
-            }
-            None
-        });
-        match warm_solution {
-            Some((k, p)) => (k, Some(p), true),
-            None => {
-                let p = dare_sda(&phi, &gamma, &q, r)?;
-                let k = lqr_gain(&phi, &gamma, &p, r)?;
-                let res = dare_residual(&phi, &gamma, &q, &p, &k);
-                if res.is_nan() || res >= 1e-6 {
-                    return Err(RiccatiError::Residual(res));
-                }
-                (k, Some(p), false)
-            }
+impl LqrParams {
+    /// The switches of each stage of `sample` (call on [`Self::effective`] parameters).
+    pub(crate) fn stages(&self) -> Stages {
+        let tuned = self.configuration == 0;
+        Stages {
+            reference: ReferenceSwitches {
+                reanchor: self.reanchors(),
+                hover_in_wind: tuned,
+                wind_compensation: self.wind_compensation != 0,
+                position_integral: self.position_integral != 0,
+            },
+            error_state: ErrorStateSwitches {
+                euler_switch_pitch: self.euler_switch_pitch,
+            },
+            gain: GainScheduleSwitches {
+                relinearisation_period: self.relinearisation_period,
+                reference_after_back_transition: tuned,
+            },
+            integrator: IntegratorSwitches {
+                integrator_limit: self.integrator_limit,
+                integrator_leak: self.integrator_leak,
+                position_integrator_limit: self.position_integrator_limit,
+                position_integrator_leak: self.position_integrator_leak,
+            },
         }
-    } else {
-        let k = riccati_backward(&phi, &gamma, &q, r, params.riccati_horizon as usize, None)?.0;
-        (k, None, false)
-    };
-    let rho = spectral_radius_bound(&(phi - gamma * k));
-    if rho.is_nan() || rho >= limit {
-        return Err(RiccatiError::Unstable(rho));
     }
-    Ok(Design {
-        k,
-        phi,
-        gamma,
-        rho,
-        p,
-        warm,
-    })
 }
 
 impl LqrController {
@@ -384,70 +316,8 @@ impl LqrController {
                 mission.v_vertical
             )));
         }
-        let positive = [
-            ("relinearisation_period", params.relinearisation_period),
-            ("r_scale", params.r_scale),
-            ("integrator_limit", params.integrator_limit),
-            ("position_integrator_limit", params.position_integrator_limit),
-            ("wind_filter_time", params.wind_filter_time),
-        ];
-        for (name, v) in positive {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(ControlError(format!("{name} = {v}: must be finite and > 0")));
-            }
-        }
-        let leak = params.integrator_leak;
-        if !(leak.is_finite() && (leak > 0.0 || leak == 0.0 && params.riccati_method == 1)) {
-            return Err(ControlError(format!(
-                "integrator_leak = {leak}: must be finite and > 0 (= 0 only with riccati_method = 1, the \
-                 backward iteration: with the DARE the undamped integrator is an uncontrollable mode at z = 1)"
-            )));
-        }
-        if !(params.position_integrator_leak.is_finite() && params.position_integrator_leak >= 0.0) {
-            return Err(ControlError(format!(
-                "position_integrator_leak = {}: must be finite and >= 0",
-                params.position_integrator_leak
-            )));
-        }
-        if !(0..=1).contains(&params.wind_compensation) {
-            return Err(ControlError(format!(
-                "wind_compensation = {}: expected 0 (no-wind reference) or 1",
-                params.wind_compensation
-            )));
-        }
-        if !(0..=1).contains(&params.position_integral) {
-            return Err(ControlError(format!(
-                "position_integral = {}: expected 0 (thesis: airspeed integrator only) or 1 (position integrators)",
-                params.position_integral
-            )));
-        }
-        if !(params.euler_switch_pitch > 0.1 && params.euler_switch_pitch < 1.47) {
-            return Err(ControlError(format!(
-                "euler_switch_pitch = {}: must lie in (0.1, 1.47) rad, away from both Euler singularities",
-                params.euler_switch_pitch
-            )));
-        }
-        if !(0..=1).contains(&params.riccati_method) {
-            return Err(ControlError(format!(
-                "riccati_method = {}: expected 0 (DARE) or 1 (backward)",
-                params.riccati_method
-            )));
-        }
-        if params.riccati_horizon < 1 {
-            return Err(ControlError(format!(
-                "riccati_horizon = {}: must be >= 1",
-                params.riccati_horizon
-            )));
-        }
-        let mode = match params.trajectory_mode {
-            0 => TrajectoryMode::Thesis,
-            1 => TrajectoryMode::ForceBalance,
-            m => {
-                return Err(ControlError(format!(
-                    "trajectory_mode = {m}: expected 0 (thesis) or 1 (force balance)"
-                )))
-            }
-        };
+        check_tuning(&params)?;
+        let mode = check_switches(&params)?;
         let json = weights_json;
         let index = usize::try_from(params.weight_set).map_err(|_| ControlError("weight_set must be >= 0".into()))?;
         let set = load_set(json, index).map_err(ControlError)?;
@@ -496,19 +366,24 @@ impl LqrController {
             warm_len: 0,
             verify_warm: false,
         };
-        // Initial gains on the trajectory's start point, so a failure shows at construction.
-        let p0 = c.trajectory.at(0.0);
-        let rep = c.rep_for(&p0);
-        let sol = c.solve_gain(rep, &p0.state(rep), &p0.u, 0.0).map_err(|e| {
+        c.initial_gains()?;
+        Ok(c)
+    }
+
+    /// Initial gains on the trajectory's start point, so a failure shows at construction.
+    fn initial_gains(&mut self) -> Result<(), ControlError> {
+        let p0 = self.trajectory.at(0.0);
+        let rep = euler_set(p0.euler_321.y, &self.params.stages().error_state);
+        let sol = self.solve_gain(rep, &p0.state(rep), &p0.u, 0.0).map_err(|e| {
             ControlError(format!(
                 "gain computation at the start of the trajectory failed: {}",
                 e.describe()
             ))
         })?;
-        c.gain = sol.gain;
-        c.rep = rep;
-        c.have_gain = true;
-        Ok(c)
+        self.gain = sol.gain;
+        self.rep = rep;
+        self.have_gain = true;
+        Ok(())
     }
 
     /// The reference trajectory.
@@ -571,363 +446,6 @@ impl LqrController {
     /// The weight schedule.
     pub fn schedule(&self) -> &WeightSchedule {
         &self.schedule
-    }
-
-    /// The Euler set for a reference point: 2-3-1 when the reference 3-2-1 pitch exceeds
-    /// `euler_switch_pitch` (vertical flight and the nose-high parts of the transitions,
-    /// where 3-2-1 is singular), 3-2-1 otherwise (§2.2.1, §3.2.3.2).
-    fn rep_for(&self, p: &TrajPoint) -> EulerRep {
-        if p.euler_321.y.abs() > self.params.euler_switch_pitch {
-            EulerRep::E231
-        } else {
-            EulerRep::E321
-        }
-    }
-
-    /// Linearise about (x, u_t), discretise by ZOH with the airspeed integrator, and solve
-    /// for the gain with the weights of time t. No allocation.
-    ///
-    /// Integrator (3.2.12–3.2.14), derived in continuous time and discretised with the
-    /// model: `ẋ_I = V − V_t − λ x_I = H_I x_p − λ x_I`, so the augmented system is
-    /// `[ẋ_I; ẋ_p] = [−λ H_I; 0 F] [x_I; x_p] + [0; G] u_p`, and ZOH gives
-    /// `Φ_I = [e^{−λT_s} ∫H_I e^{Fτ}dτ; 0 Φ]`, `Γ_I = [·; Γ]` — to first order in T_s and
-    /// for λ = 0 `Φ_I ≈ [1 T_s H_I; 0 Φ]`; the printed (3.2.13) has T_s in the (1,1)
-    /// position and Γ_I's first row is not zero but O(T_s²). The small leak λ
-    /// (`integrator_leak`) makes the augmented pair stabilisable (see [`LqrParams`]).
-    ///
-    /// The DARE is solved cold (structured doubling); [`Self::solve_gain_warm`] starts from a
-    /// previous solution.
-    pub fn solve_gain(&self, rep: EulerRep, x: &X, u: &U, t: f64) -> Result<GainSolution, RiccatiError> {
-        self.solve_gain_warm(rep, x, u, t, None)
-    }
-
-    /// [`Self::solve_gain`] with the DARE warm-started from `warm`, the [`GainSolution::p`] of
-    /// an earlier solve (README, "Riccati"): one Newton step, accepted when the residual of its
-    /// result is ≤ [`WARM_MAX_RESIDUAL`], else the cold doubling. Only the design with inert
-    /// position integrators (the default) is warm-started.
-    pub fn solve_gain_warm(
-        &self,
-        rep: EulerRep,
-        x: &X,
-        u: &U,
-        t: f64,
-        warm: Option<&SMatrix<f64, NR, NR>>,
-    ) -> Result<GainSolution, RiccatiError> {
-        let mut xl = *x;
-        // Keep the linearisation point inside the model's domain (V > 0, away from the
-        // Euler singularity the rep choice avoids anyway).
-        xl[ix::V] = xl[ix::V].max(1.0);
-        let (f, g) = linearise(&self.airframe, rep, &xl, u);
-        let mut a = SMatrix::<f64, NA, NA>::zeros();
-        a[(0, 0)] = -self.params.integrator_leak;
-        a[(0, 1 + ix::V)] = 1.0;
-        a.fixed_view_mut::<NX, NX>(1, 1).copy_from(&f);
-        for j in 0..3 {
-            if self.position_integral_on(j) {
-                // ẋ_Ip = p − p_t − λ_p x_Ip, p ∈ {N, E, h}.
-                a[(I_POS + j, 1 + ix::N + j)] = 1.0;
-                a[(I_POS + j, I_POS + j)] = -self.params.position_integrator_leak;
-            } else {
-                // Thesis structure: the position integrators are inert, decoupled, stable
-                // states (not driven by the model, not driving it). The DARE solution is then
-                // block-diagonal and their gain columns are zero: K on the other states is
-                // exactly the thesis's 14-state gain.
-                a[(I_POS + j, I_POS + j)] = -1.0;
-            }
-        }
-        let mut b = SMatrix::<f64, NA, NU>::zeros();
-        b.fixed_view_mut::<NX, NU>(1, 0).copy_from(&g);
-        if !a.iter().chain(b.iter()).all(|v| v.is_finite()) {
-            return Err(RiccatiError::NonFinite);
-        }
-        let w: Weights = self.schedule.at(&self.mission, t);
-        let ts = self.mission.sample_time;
-        // With the undamped integrator (leak 0, thesis) the integrator-minus-along-track
-        // mode sits at z = 1 whatever the gain: accept the marginal bound (a Jordan block at
-        // z = 1 raises the 2¹⁶-power bound to at most (2¹⁶)^(1/2¹⁶) ≈ 1 + 1.7e-4).
-        let limit = if self.params.integrator_leak == 0.0 {
-            1.0 + 1e-3
-        } else {
-            1.0
-        };
-        if (0..3).any(|j| self.position_integral_on(j)) {
-            let d = design::<NA, NM>(&a, &b, &w.q, &w.r, ts, &self.params, limit, None)?;
-            return Ok(GainSolution {
-                gain: d.k,
-                phi: d.phi,
-                gamma: d.gamma,
-                spectral_radius: d.rho,
-                p: None,
-                warm: false,
-            });
-        }
-        // Inert position integrators (the default): they are decoupled (ẋ_Ip = −x_Ip, no
-        // input), so Φ, Γ, P are block-diagonal and their gain columns zero. The design runs
-        // on the leading [∫ΔV; x] block alone (NR = 14 states: ≈ 0.56× the cubic work of 17)
-        // and the result is embedded: the same gains to rounding (an inert state only ever
-        // adds exact zeros to the full problem's sums).
-        let d = design::<NR, NRM>(
-            &a.fixed_view::<NR, NR>(0, 0).into_owned(),
-            &b.fixed_view::<NR, NU>(0, 0).into_owned(),
-            &w.q.fixed_rows::<NR>(0).into_owned(),
-            &w.r,
-            ts,
-            &self.params,
-            limit,
-            warm,
-        )?;
-        let mut k = Gain::zeros();
-        k.fixed_view_mut::<NU, NR>(0, 0).copy_from(&d.k);
-        let mut phi = SMatrix::<f64, NA, NA>::zeros();
-        phi.fixed_view_mut::<NR, NR>(0, 0).copy_from(&d.phi);
-        let inert = (-ts).exp();
-        for j in NR..NA {
-            phi[(j, j)] = inert;
-        }
-        let mut gamma = SMatrix::<f64, NA, NU>::zeros();
-        gamma.fixed_view_mut::<NR, NU>(0, 0).copy_from(&d.gamma);
-        // The inert block's eigenvalue e^{−T_s} joins the spectrum of the closed loop.
-        let rho = d.rho.max(inert);
-        Ok(GainSolution {
-            gain: k,
-            phi,
-            gamma,
-            spectral_radius: rho,
-            p: d.p,
-            warm: d.warm,
-        })
-    }
-
-    /// Update the wind estimate: ŵ ← ŵ + (1 − e^{−T_s/τ_w}) (v_inertial − DCMᵀ v_air − ŵ),
-    /// v_air = V (cα cβ, sβ, sα cβ); initialised with the first measurement, bounded by
-    /// [`MAX_WIND_ESTIMATE`], only finite values committed.
-    fn estimate_wind(&mut self, m: &flight_mission::Measurement) {
-        if self.params.wind_compensation == 0 {
-            self.wind = Vector3::zeros();
-            return;
-        }
-        let (sa, ca) = m.alpha.sin_cos();
-        let (sb, cb) = m.beta.sin_cos();
-        let v_air = m.airspeed * Vector3::new(ca * cb, sb, sa * cb);
-        let raw = m.vel_ned - model::dcm_of_quat(&m.quat).transpose() * v_air;
-        let mut w = if self.wind.iter().all(|v| v.is_finite()) {
-            let k = 1.0 - (-self.mission.sample_time / self.params.wind_filter_time).exp();
-            self.wind + k * (raw - self.wind)
-        } else {
-            raw
-        };
-        let n = w.norm();
-        let bounded = n > MAX_WIND_ESTIMATE;
-        if bounded {
-            w *= MAX_WIND_ESTIMATE / n;
-        }
-        if w.iter().all(|v| v.is_finite()) {
-            self.wind = w;
-            // The filter's own rate, dŵ/dt = (raw − ŵ)/τ_w; none while the bound holds ŵ.
-            let rate = (raw - w) / self.params.wind_filter_time;
-            self.wind_rate = if !bounded && rate.iter().all(|v| v.is_finite()) {
-                rate
-            } else {
-                Vector3::zeros()
-            };
-        }
-    }
-
-    /// Sideways weight of the wind in the air-data reference, max(sin²θ_ref, (V_t/V_L)²).
-    fn lateral_wind_weight(&self, p: &TrajPoint) -> f64 {
-        p.euler_321
-            .y
-            .sin()
-            .powi(2)
-            .max((p.v / self.mission.v_level).powi(2).min(1.0))
-    }
-
-    /// The reference point trimmed for the estimated wind (README, "Gusts"), weighted by the
-    /// lift-borne fraction (V_t/V_L)²: pitch θ_t + δ with α_t + δ (the same ground velocity),
-    /// the pitch rate δ̇ added to the body rates (through the wind estimate's rate), thrust and
-    /// elevator changed. None without wind compensation, in still air or where the trim fails.
-    fn trimmed(&self, p: &TrajPoint) -> Option<TrajPoint> {
-        let h = self.mission.sample_time;
-        let w_next = self.wind + h * self.wind_rate;
-        let lift = (p.v / self.mission.v_level).powi(2).min(1.0);
-        let (w0, w1) = WIND_TRIM_RAMP;
-        let weight = |w: &Vector3<f64>| {
-            let x = ((w.norm() - w0) / (w1 - w0)).clamp(0.0, 1.0);
-            lift * x * x * (3.0 - 2.0 * x)
-        };
-        let (k, k_next) = (weight(&self.wind), weight(&w_next));
-        if self.params.wind_compensation == 0 || !(k > 0.0 || k_next > 0.0) {
-            return None;
-        }
-        let s_lat = self.lateral_wind_weight(p);
-        let z = self.wind_trim(p, &self.wind, s_lat)?;
-        let z_next = self.wind_trim(p, &w_next, s_lat)?;
-        let rate = (k_next * z_next.x - k * z.x) / h;
-        let mut q = *p;
-        q.euler_321.y += k * z.x;
-        q.alpha += k * z.x;
-        let (sphi, cphi) = p.euler_321.x.sin_cos();
-        q.rates += rate * Vector3::new(0.0, cphi, -sphi);
-        q.thrust += k * z.y;
-        q.u[0] += k * z.y;
-        q.u[1] += k * z.z;
-        Some(q)
-    }
-
-    /// Lift-borne wind trim of a reference point (README, "Gusts"): the pitch rotation δ, the
-    /// thrust change ΔT and the elevator change Δδe that keep the reference's force and
-    /// pitching moment — hence its ground-path acceleration (2.2.19–2.2.21) and q̇
-    /// (2.2.22–2.2.24) — in the wind `wind` (NED, m/s): with C(δ) the reference attitude
-    /// pitched by δ and v_a = v_g,t − ŵ, solve
-    /// C(δ)ᵀ F(C(δ) v_a, T_t + ΔT, δe_t + Δδe) = C_tᵀ F(v_b,t, T_t, δe_t) (in-plane x, z) and
-    /// M_y(…) = M_y,t by Newton's method on the model for control. None where it does not
-    /// converge or leaves the limits (the untrimmed reference is then used).
-    fn wind_trim(&self, p: &TrajPoint, wind: &Vector3<f64>, s_lat: f64) -> Option<Vector3<f64>> {
-        let af = &self.airframe;
-        let surfaces = |dde: f64| Surfaces::from_array([p.u[1] + dde, p.u[2], p.u[3], p.u[4], p.u[5], p.u[6]]);
-        let c_t = model::dcm_of_quat(&p.quat());
-        let vb_t = model::body_velocity(p.v, p.alpha, 0.0);
-        let fm_t = af.forces_moments(&vb_t, &p.rates, p.thrust, &surfaces(0.0));
-        let f_e = c_t.transpose() * fm_t.force_body;
-        let v_g = c_t.transpose() * vb_t;
-        let (v_a, v_lat) = (v_g - wind, v_g - s_lat * wind);
-        let residual = |z: &Vector3<f64>| -> Vector3<f64> {
-            let mut q = *p;
-            q.euler_321.y += z.x;
-            let c = model::dcm_of_quat(&q.quat());
-            let mut vb = c * v_a;
-            vb.y = (c * v_lat).y;
-            let fm = af.forces_moments(&vb, &p.rates, p.thrust + z.y, &surfaces(z.z));
-            let df = c_t * (c.transpose() * fm.force_body - f_e);
-            Vector3::new(df.x, df.z, fm.moment_body.y - fm_t.moment_body.y)
-        };
-        let steps = Vector3::new(1e-6, 1e-4, 1e-6);
-        let mut z = Vector3::zeros();
-        for _ in 0..8 {
-            let r = residual(&z);
-            if !r.iter().all(|v| v.is_finite()) {
-                return None;
-            }
-            if r.xy().norm() < 1e-6 * af.mass * af.gravity && r.z.abs() < 1e-7 {
-                let in_limits = z.x.abs() <= WIND_TRIM_MAX_PITCH
-                    && (af.thrust_min..=af.thrust_max).contains(&(p.thrust + z.y))
-                    && (p.u[1] + z.z).abs() <= af.deflection_limit;
-                return in_limits.then_some(z);
-            }
-            let mut jac = Matrix3::zeros();
-            for j in 0..3 {
-                let mut zj = z;
-                zj[j] += steps[j];
-                jac.set_column(j, &((residual(&zj) - r) / steps[j]));
-            }
-            z -= jac.lu().solve(&r)?;
-        }
-        None
-    }
-
-    /// Reference (V, α, β): with wind compensation, those of the air velocity
-    /// `DCM_t (v_g,t − ŵ)` in the reference body axes, where `v_g,t = DCM_tᵀ V_t (cα_t, 0, sα_t)`
-    /// is the reference (no-wind) ground velocity. In vertical flight holding a position in
-    /// wind needs large α or β (with the no-wind reference α_t = β_t = 0 the LQR fights the
-    /// air angles, yaws about the thrust axis and loses the aircraft beyond ≈ 3 m/s). In
-    /// level flight and the transitions the reference ground path is held through gusts:
-    /// the airspeed and α follow the wind (README, "Gusts"; with the mission's airspeed
-    /// and α the LQR ran 3.5 m ahead in a 5 m/s tailwind gust and sank 3.9 m in a down
-    /// gust). The sideways component (β) is weighted by s = max(sin²θ_ref, (V_t/V_L)²):
-    /// counted in full, a 5 m/s gust across the path in the slow part of transition 1
-    /// (V_t ≈ 10 m/s, β ≈ 27°) left the aircraft 5.8 m off (1.2 m with s = sin²θ_ref).
-    fn air_reference(&self, p: &TrajPoint) -> Vector3<f64> {
-        let plain = Vector3::new(p.v, p.alpha, 0.0);
-        if self.params.wind_compensation == 0 || !self.wind.iter().all(|v| v.is_finite()) {
-            return plain;
-        }
-        let s_lat = self.lateral_wind_weight(p);
-        let c = model::dcm_of_quat(&p.quat());
-        let (sa, ca) = p.alpha.sin_cos();
-        let v_g = c.transpose() * (p.v * Vector3::new(ca, 0.0, sa));
-        let full = c * (v_g - self.wind);
-        let v_b = Vector3::new(full.x, (c * (v_g - s_lat * self.wind)).y, full.z);
-        let v = v_b.norm();
-        if !(v.is_finite() && v >= MIN_AIRSPEED) {
-            return plain;
-        }
-        Vector3::new(v, v_b.z.atan2(v_b.x), (v_b.y / v).clamp(-1.0, 1.0).asin())
-    }
-
-    /// Position integrators ∫ΔN, ∫ΔE, ∫Δh: x_Ip(k+1) = e^{−λ_p T_s} x_Ip(k) + T_s (p − p_t),
-    /// with anti-windup per integrator: the update is skipped when its increment would push a
-    /// saturated command further into its limit (conditional integration, through the
-    /// integrator's gain column), the result is clamped to `position_integrator_limit`, and
-    /// only finite values are committed.
-    fn integrate_position(&mut self, x: &X, xt: &X, saturated: &[f64; NU]) {
-        let ts = self.mission.sample_time;
-        let lim = self.params.position_integrator_limit;
-        let decay = (-self.params.position_integrator_leak * ts).exp();
-        for j in 0..3 {
-            if !self.position_integral_on(j) {
-                continue;
-            }
-            let old = self.pos_integrator[j];
-            let next = (decay * old + ts * (x[ix::N + j] - xt[ix::N + j])).clamp(-lim, lim);
-            let delta = next - old;
-            // Command change caused by this increment: −K[:, I_POS + j] · delta.
-            let winds_up =
-                (0..NU).any(|i| saturated[i] != 0.0 && -self.gain[(i, I_POS + j)] * delta * saturated[i] > 0.0);
-            if next.is_finite() && !winds_up {
-                self.pos_integrator[j] = next;
-            }
-        }
-    }
-
-    /// The reference point of a take-off / landing reference (flight_mission::ground): the
-    /// mission's vertical attitude (nose up, belly north) and rates, the position relative
-    /// to the origin, airspeed |v|, and the vertical trim inputs with the thrust
-    /// `T = m (g + a_up) + (T_trim − m g) · climb/V_V` (weight, the reference acceleration and
-    /// the trim's drag scaled with the climb rate).
-    fn ground_point(&self, v: &VerticalReference) -> TrajPoint {
-        let mut p = self.trajectory.at(f64::NEG_INFINITY);
-        let af = &self.airframe;
-        let w = af.mass * af.gravity;
-        let climb = -v.vel.z;
-        let thrust = w + af.mass * (-v.accel.z) + (p.u[0] - w) * (climb / self.mission.v_vertical).clamp(-1.0, 1.0);
-        let o = self.origin.unwrap_or_else(Vector3::zeros);
-        p.v = v.vel.norm();
-        p.pos_neh = Vector3::new(v.pos.x, v.pos.y, -v.pos.z) - o;
-        p.thrust = thrust;
-        p.u[0] = thrust;
-        p
-    }
-
-    /// Air data in the take-off and landing phases: near hover V, α, β are undefined (α
-    /// jumps to π in the tail-first descent), so x and x_t carry the body air velocity
-    /// `v_a = V (cα cβ, sβ, sα cβ)` as `(u_a, w_a/V_e, v_a/V_e)` in place of `(V, α, β)`, the
-    /// reference's from `DCM_t (v_ref − ŵ)`, with `V_e = max(u_a,t, 1 m/s)`: to first order
-    /// the model's (V, α, β) at α = β = 0 and V = V_e, where `solve_gain` linearises (the same
-    /// 1 m/s floor), and continuous through V = 0 and reversed flow.
-    fn hover_air_data(
-        &self,
-        m: &flight_mission::Measurement,
-        v: &VerticalReference,
-        reference: &TrajPoint,
-        x: &mut X,
-        xt: &mut X,
-    ) {
-        let (sa, ca) = m.alpha.sin_cos();
-        let (sb, cb) = m.beta.sin_cos();
-        let va = m.airspeed * Vector3::new(ca * cb, sb, sa * cb);
-        let wind = if self.wind.iter().all(|w| w.is_finite()) {
-            self.wind
-        } else {
-            Vector3::zeros()
-        };
-        let vat = model::dcm_of_quat(&reference.quat()) * (v.vel - wind);
-        let ve = vat.x.max(1.0);
-        x[ix::V] = va.x;
-        x[ix::ALPHA] = va.z / ve;
-        x[ix::BETA] = va.y / ve;
-        xt[ix::V] = vat.x;
-        xt[ix::ALPHA] = vat.z / ve;
-        xt[ix::BETA] = vat.y / ve;
     }
 
     /// Append the controller's state (everything `sample` depends on besides its
@@ -1044,6 +562,78 @@ impl LqrController {
     }
 }
 
+/// The numeric tuning of `params` (effective): periods, limits, scales finite and > 0, the
+/// leaks finite and ≥ 0 (the airspeed integrator's > 0 with the DARE, see [`LqrParams`]).
+fn check_tuning(params: &LqrParams) -> Result<(), ControlError> {
+    let positive = [
+        ("relinearisation_period", params.relinearisation_period),
+        ("r_scale", params.r_scale),
+        ("integrator_limit", params.integrator_limit),
+        ("position_integrator_limit", params.position_integrator_limit),
+        ("wind_filter_time", params.wind_filter_time),
+    ];
+    for (name, v) in positive {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(ControlError(format!("{name} = {v}: must be finite and > 0")));
+        }
+    }
+    let leak = params.integrator_leak;
+    if !(leak.is_finite() && (leak > 0.0 || leak == 0.0 && params.riccati_method == 1)) {
+        return Err(ControlError(format!(
+            "integrator_leak = {leak}: must be finite and > 0 (= 0 only with riccati_method = 1, the \
+             backward iteration: with the DARE the undamped integrator is an uncontrollable mode at z = 1)"
+        )));
+    }
+    if !(params.position_integrator_leak.is_finite() && params.position_integrator_leak >= 0.0) {
+        return Err(ControlError(format!(
+            "position_integrator_leak = {}: must be finite and >= 0",
+            params.position_integrator_leak
+        )));
+    }
+    Ok(())
+}
+
+/// The switches of `params` (effective) in range; the trajectory mode they select.
+fn check_switches(params: &LqrParams) -> Result<TrajectoryMode, ControlError> {
+    if !(0..=1).contains(&params.wind_compensation) {
+        return Err(ControlError(format!(
+            "wind_compensation = {}: expected 0 (no-wind reference) or 1",
+            params.wind_compensation
+        )));
+    }
+    if !(0..=1).contains(&params.position_integral) {
+        return Err(ControlError(format!(
+            "position_integral = {}: expected 0 (thesis: airspeed integrator only) or 1 (position integrators)",
+            params.position_integral
+        )));
+    }
+    if !(params.euler_switch_pitch > 0.1 && params.euler_switch_pitch < 1.47) {
+        return Err(ControlError(format!(
+            "euler_switch_pitch = {}: must lie in (0.1, 1.47) rad, away from both Euler singularities",
+            params.euler_switch_pitch
+        )));
+    }
+    if !(0..=1).contains(&params.riccati_method) {
+        return Err(ControlError(format!(
+            "riccati_method = {}: expected 0 (DARE) or 1 (backward)",
+            params.riccati_method
+        )));
+    }
+    if params.riccati_horizon < 1 {
+        return Err(ControlError(format!(
+            "riccati_horizon = {}: must be >= 1",
+            params.riccati_horizon
+        )));
+    }
+    match params.trajectory_mode {
+        0 => Ok(TrajectoryMode::Thesis),
+        1 => Ok(TrajectoryMode::ForceBalance),
+        m => Err(ControlError(format!(
+            "trajectory_mode = {m}: expected 0 (thesis) or 1 (force balance)"
+        ))),
+    }
+}
+
 /// Everything an [`LqrController`] is built from: the FMU's parameters.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LqrConfig {
@@ -1095,6 +685,12 @@ impl SampledUnit for LqrController {
         Self::restore(self, next)
     }
 
+    /// One sample of Fig. 3.2, stage by stage (README, "Where the blocks of Fig. 3.2 live"):
+    /// take-off / landing (`ground_stage`) → reference x_t, u_t (`reference_stage`, §3.3) →
+    /// Euler set and error state (`euler_set`, `state_and_reference`, 3.2.1) → gain schedule
+    /// (`schedule_gains`, §3.1.3, §3.2.4) → feedback u = u_t − K dx (`command_stage`) →
+    /// integrators (`integrator_stage`, 3.2.12–3.2.14) → diagnostics. The switches of each
+    /// stage come from `LqrParams::stages`.
     fn sample(&mut self, input: &ControllerInput) -> Result<ControllerOutput, ControlError> {
         let m = &input.measurement;
         if let Some(name) = m.first_non_finite() {
@@ -1103,391 +699,32 @@ impl SampledUnit for LqrController {
         if !input.t.is_finite() {
             return Err(ControlError(format!("sample time t = {} is not finite", input.t)));
         }
-        // Take-off and landing around the mission (flight_mission::ground): the mission time
-        // t is the FMU time less the spin-up and take-off climb (the same without take-off).
+        let sw = self.params.stages();
+        // The mission time t is the FMU time less the spin-up and take-off climb (the same
+        // without take-off).
         let t = input.t - self.ground.mission_start();
         let measured_neh = Vector3::new(m.pos_ned.x, m.pos_ned.y, -m.pos_ned.z);
-        let (trajectory, lqr_origin) = (&self.trajectory, self.origin);
-        let mode = self.ground.step(input.t, m, |tm| {
-            let p = trajectory.at(tm);
-            let o = lqr_origin.unwrap_or(measured_neh);
-            let off = &input.ref_offset_ned;
-            let (sg, cg) = p.gamma.sin_cos();
-            let (sp, cp) = p.euler_321.z.sin_cos();
-            let pos = o + p.pos_neh + Vector3::new(off.x, off.y, -off.z);
-            (
-                Vector3::new(pos.x, pos.y, -pos.z),
-                p.v * Vector3::new(cg * cp, cg * sp, -sg),
-            )
-        });
-        let (offset, ground_ref) = match mode {
-            GroundMode::Mission { offset, .. } => (offset, None),
-            GroundMode::Vertical(v) => (Vector3::zeros(), Some(v)),
-            GroundMode::Idle { phase, thrust } => {
-                // On the gear: no gain computation, no integration (no wind-up).
-                let af = &self.airframe;
-                return Ok(ControllerOutput {
-                    command: Command {
-                        thrust: thrust.clamp(af.thrust_min, af.thrust_max),
-                        ..Command::default()
-                    },
-                    diagnostics: Diagnostics {
-                        ref_pos_ned: m.pos_ned,
-                        ref_airspeed: 0.0,
-                        phase,
-                        pos_error: 0.0,
-                    },
-                    notice: None,
-                });
-            }
+        let ground = match self.ground_stage(input, measured_neh, &sw.reference) {
+            ControlFlow::Continue(ground) => ground,
+            ControlFlow::Break(idle) => return Ok(idle),
         };
-        if self.origin.is_none() && self.ground.takeoff() {
-            // Mission origin: the take-off point (measured on the gear); gains relinearised
-            // from the first flying sample.
-            let o = self.ground.origin().unwrap_or(m.pos_ned);
-            self.origin = Some(Vector3::new(o.x, o.y, -o.z));
-            self.next_relinearisation = f64::NEG_INFINITY;
-        }
-        if ground_ref.is_some() != self.ground_active {
-            // Into or out of the take-off / landing phases: the gains change structure (the
-            // position integrators' columns); relinearise now, integrators from zero.
-            self.ground_active = ground_ref.is_some();
-            self.next_relinearisation = f64::NEG_INFINITY;
-            if self.params.position_integral == 0 {
-                self.pos_integrator = Vector3::zeros();
-            }
-        }
-        // Heading reference in vertical flight (README, "Weathervaning"); the take-off and
-        // landing phases keep their own vertical reference.
-        let heading = self.weathervane.update(&self.mission, t, m);
-        let reference = match &ground_ref {
-            Some(v) => self.ground_point(v),
-            None => self.trajectory.at(t).turned(&heading),
+        let r = self.reference_stage(input, t, measured_neh, ground, &sw.reference);
+        let rep = euler_set(r.pitch_321, &sw.error_state);
+        let (x, xt) = self.state_and_reference(rep, m, &r);
+        let mut notice = self.schedule_gains(t, m, &r, rep, (&x, &xt), &sw.gain);
+        // A failed solve at an Euler switch keeps the gains in use, and with them their set.
+        let (x, xt) = if self.rep == rep {
+            (x, xt)
+        } else {
+            self.state_and_reference(self.rep, m, &r)
         };
-        let off = &(input.ref_offset_ned + offset);
-        let phase = self.mission.phase_at(t).0 as i32;
-        if ground_ref.is_none() && self.params.reanchors() && self.origin.is_some() && phase != self.anchored_phase {
-            // §3.5.1: each new trajectory starts at the current position, so the reference
-            // position equals the measured one at the first sample of the segment.
-            self.origin = Some(measured_neh - reference.pos_neh - Vector3::new(off.x, off.y, -off.z));
-        }
-        if ground_ref.is_none() {
-            self.anchored_phase = phase;
-        }
-        let origin = *self.origin.get_or_insert(measured_neh);
-        // Reference position: start + trajectory + offset, as (N, E, h); in the take-off and
-        // landing phases the vertical reference (NED, origin included) + offset.
-        let ref_neh = match &ground_ref {
-            Some(v) => Vector3::new(v.pos.x + off.x, v.pos.y + off.y, -(v.pos.z + off.z)),
-            None => origin + reference.pos_neh + Vector3::new(off.x, off.y, -off.z),
-        };
-        let rep = self.rep_for(&reference);
-        // Vertical flight in wind: where the weathervane may turn (`Weathervane::free`), it
-        // is engaged (a filtered horizontal wind ≥ its engage speed) or, before the filter has caught up with a sudden wind, measured air
-        // angles beyond [`HOVER_WIND_AIR_ANGLE`] with an unfiltered air-data wind ≥ the engage
-        // speed (in still air the climb's air comes from the nose, α, β ≈ 0, and the air-data
-        // wind is zero). Tuned configuration only (the thesis's has no weathervane).
-        let in_wind = ground_ref.is_none()
-            && self.params.configuration == 0
-            && self.weathervane.free(&self.mission, t)
-            && (self.weathervane.engaged()
-                || (m.alpha.abs() > HOVER_WIND_AIR_ANGLE || m.beta.abs() > HOVER_WIND_AIR_ANGLE)
-                    && flight_mission::weathervane::air_data_wind(m).xy().norm()
-                        >= self.weathervane.params().engage_speed);
-        // Integral action on the horizontal position in wind (README, "Hover in wind"): the
-        // position the gains regulate to is the reference moved against the integrated error,
-        // s ← s + T_s/τ_s (p − p_ref), regulated to p_ref − s, so the steady error of a
-        // steady wind vanishes; out of wind s decays with τ_s, and in still air it stays 0.
-        {
-            let ts = self.mission.sample_time;
-            let e = Vector3::new(measured_neh.x - ref_neh.x, measured_neh.y - ref_neh.y, 0.0);
-            let next = if in_wind {
-                let mut s = self.wind_shift + e * (ts / HOVER_SHIFT_TIME);
-                let n = s.norm();
-                if n > HOVER_SHIFT_LIMIT {
-                    s *= HOVER_SHIFT_LIMIT / n;
-                }
-                s
-            } else if self.wind_shift != Vector3::zeros() {
-                let s = self.wind_shift * (-ts / HOVER_SHIFT_TIME).exp();
-                if s.norm() < 1e-6 {
-                    Vector3::zeros()
-                } else {
-                    s
-                }
-            } else {
-                self.wind_shift
-            };
-            if next.iter().all(|v| v.is_finite()) {
-                self.wind_shift = next;
-            }
-        }
-        let ctrl_neh = ref_neh - self.wind_shift;
-
-        self.estimate_wind(m);
-        let reference = match ground_ref {
-            None => self.trimmed(&reference).unwrap_or(reference),
-            Some(_) => reference,
-        };
-        let mut x = state_of(
-            rep, m.airspeed, m.alpha, m.beta, &m.rates, &m.quat, &m.pos_ned, m.thrust,
-        );
-        let mut xt = reference.state(rep);
-        xt[ix::N] = ctrl_neh.x;
-        xt[ix::E] = ctrl_neh.y;
-        xt[ix::H] = ctrl_neh.z;
-        let air_ref = self.air_reference(&reference);
-        xt[ix::V] = air_ref.x;
-        xt[ix::ALPHA] = air_ref.y;
-        xt[ix::BETA] = air_ref.z;
-        if let Some(v) = &ground_ref {
-            self.hover_air_data(m, v, &reference, &mut x, &mut xt);
-        }
-
-        let mut notice = None;
-        let due = t + 1e-9 >= self.next_relinearisation;
-        if !self.have_gain || rep != self.rep || due {
-            // Relinearise about the current estimated state with the trajectory's inputs
-            // (§3.1.3, 3.2.7–3.2.9); positions do not enter the model.
-            // Hover in wind (README, "Hover in wind"): relinearise about the reference (the
-            // weathervaned vertical attitude with the wind-consistent air data) rather than
-            // the measured state, whose tilt into the wind and α, β of 30–90° put the linear
-            // model far outside its range (gains that over-tilted and lost the aircraft
-            // from 7 m/s). In still air the weathervane is never engaged: unchanged.
-            // After the back transition (vertical 2, before the weathervane is free) a wind
-            // across the slowing climb shows as air angles of 30–70° too: relinearise about the
-            // reference there as well (README, "Gusts"; about the measured β of −66° the gains
-            // of a 5 m/s east gust cut the thrust to zero and then saturated it: 2.15 m added
-            // under Jacobi, 1.71 m now).
-            let lin_ref = in_wind
-                || ground_ref.is_none()
-                    && self.params.configuration == 0
-                    && self.mission.phase_at(t).0 == flight_mission::Phase::Vertical2
-                    && (m.alpha.abs() > HOVER_WIND_AIR_ANGLE || m.beta.abs() > HOVER_WIND_AIR_ANGLE)
-                    && flight_mission::weathervane::air_data_wind(m).xy().norm()
-                        >= self.weathervane.params().engage_speed;
-            let mut x_lin = if lin_ref { xt } else { x };
-            // In the take-off and landing phases linearise at α = β = 0: x carries the body
-            // air velocity there (`hover_air_data`), exact at α = β = 0 for any w/V_e.
-            if ground_ref.is_some() {
-                x_lin[ix::ALPHA] = 0.0;
-                x_lin[ix::BETA] = 0.0;
-            }
-            // Warm start: the previous solutions in the same Euler set, extrapolated (quadratic
-            // through the last three, linear through two, else the last).
-            let warm = if rep == self.rep {
-                self.warm_p.map(|p1| match self.warm_len {
-                    0 => p1,
-                    1 => p1 * 2.0 - self.warm_hist[0],
-                    _ => p1 * 3.0 - self.warm_hist[0] * 3.0 + self.warm_hist[1],
-                })
-            } else {
-                // A P of the other Euler set is no start (nor history) for this one.
-                self.warm_p = None;
-                self.warm_len = 0;
-                None
-            };
-            match self.solve_gain_warm(rep, &x_lin, &reference.u, t, warm.as_ref()) {
-                Ok(sol) => {
-                    if sol.warm {
-                        self.stats.warm_solves += 1;
-                        if self.verify_warm {
-                            if let Ok(cold) = self.solve_gain(rep, &x_lin, &reference.u, t) {
-                                let e = (sol.gain - cold.gain).amax() / cold.gain.amax();
-                                self.stats.warm_max_gain_error = self.stats.warm_max_gain_error.max(e);
-                            } else {
-                                self.stats.warm_max_gain_error = f64::INFINITY;
-                            }
-                        }
-                    }
-                    self.gain = sol.gain;
-                    self.have_gain = true;
-                    self.stats.last_spectral_radius = sol.spectral_radius;
-                    if let (Some(_), Some(old)) = (sol.p, self.warm_p) {
-                        self.warm_hist[1] = self.warm_hist[0];
-                        self.warm_hist[0] = old;
-                        self.warm_len = (self.warm_len + 1).min(2);
-                    } else {
-                        self.warm_len = 0;
-                    }
-                    self.warm_p = sol.p;
-                }
-                Err(e) => {
-                    self.stats.fallbacks += 1;
-                    notice = Some(Notice::GainFallback(e.describe()));
-                    if rep != self.rep {
-                        // The old gains belong to the other Euler set: they cannot be reused
-                        // on this state vector. Keep the old representation until a solve succeeds.
-                        x = state_of(
-                            self.rep, m.airspeed, m.alpha, m.beta, &m.rates, &m.quat, &m.pos_ned, m.thrust,
-                        );
-                        xt = reference.state(self.rep);
-                        xt[ix::N] = ctrl_neh.x;
-                        xt[ix::E] = ctrl_neh.y;
-                        xt[ix::H] = ctrl_neh.z;
-                        xt[ix::V] = air_ref.x;
-                        xt[ix::ALPHA] = air_ref.y;
-                        xt[ix::BETA] = air_ref.z;
-                        if let Some(v) = &ground_ref {
-                            self.hover_air_data(m, v, &reference, &mut x, &mut xt);
-                        }
-                    }
-                }
-            }
-            if notice.is_none() {
-                self.rep = rep;
-            }
-            self.stats.solves += 1;
-            if due {
-                self.next_relinearisation = t + self.params.relinearisation_period;
-            }
-        }
-
-        let mut dx = SVector::<f64, NA>::zeros();
-        dx[0] = self.integrator;
-        for j in 0..3 {
-            dx[I_POS + j] = self.pos_integrator[j];
-        }
-        for i in 0..NX {
-            let d = x[i] - xt[i];
-            dx[1 + i] = if (ix::PHI..=ix::PSI).contains(&i) {
-                wrap_pi(d)
-            } else {
-                d
-            };
-        }
-        let mut u = reference.u - self.gain * dx;
-        // Limits of the plant: thrust range, deflection limit.
-        let af = &self.airframe;
-        let mut thrust_saturated = 0.0;
-        // Direction (+1 above the upper limit, −1 below the lower, 0 inside) per command.
-        let mut saturated = [0.0f64; NU];
-        for i in 0..NU {
-            let (lo, hi) = if i == 0 {
-                (af.thrust_min, af.thrust_max)
-            } else {
-                (-af.deflection_limit, af.deflection_limit)
-            };
-            if u[i] < lo || u[i] > hi {
-                saturated[i] = if u[i] > hi { 1.0 } else { -1.0 };
-                if i == 0 {
-                    thrust_saturated = saturated[i];
-                }
-                u[i] = u[i].clamp(lo, hi);
-                if notice.is_none() {
-                    notice = Some(Notice::Saturated(COMMAND_NAMES[i]));
-                }
-            }
-        }
-        if !u.iter().all(|v| v.is_finite()) {
-            return Err(ControlError(format!("non-finite command at t = {t}")));
-        }
-        // Integrator x_I(k+1) = x_I(k) + T_s (V − V_t) (3.2.12–3.2.14), with anti-windup:
-        // not integrated further into a thrust limit, and bounded.
-        let dv = x[ix::V] - xt[ix::V];
-        // Negative airspeed error asks for more thrust (K row of T_c on x_I is negative).
-        let pushes_up = dv < 0.0;
-        if !(thrust_saturated > 0.0 && pushes_up || thrust_saturated < 0.0 && !pushes_up) {
-            let lim = self.params.integrator_limit;
-            let ts = self.mission.sample_time;
-            let decay = (-self.params.integrator_leak * ts).exp();
-            let next = (decay * self.integrator + ts * dv).clamp(-lim, lim);
-            if next.is_finite() {
-                self.integrator = next;
-            }
-        }
-        if self.has_position_integral() {
-            self.integrate_position(&x, &xt, &saturated);
-        }
-
-        let pos = Vector3::new(m.pos_ned.x, m.pos_ned.y, -m.pos_ned.z);
-        let diagnostics = Diagnostics {
-            ref_pos_ned: Vector3::new(ref_neh.x, ref_neh.y, -ref_neh.z),
-            ref_airspeed: reference.v,
-            phase: ground_ref.map_or(self.mission.phase_at(t).0, |v| v.phase),
-            pos_error: flight_mission::distance(&pos, &ref_neh),
-        };
-        let command = Command::from_array(u.into());
+        let dx = self.error_vector(&x, &xt);
+        let (u, saturated) = self.command_stage(t, &r.point.u, &dx, &mut notice)?;
+        self.integrator_stage(&x, &xt, &saturated, &sw.integrator);
         Ok(ControllerOutput {
-            command,
-            diagnostics,
+            command: Command::from_array(u.into()),
+            diagnostics: self.diagnostics(t, &measured_neh, &r),
             notice,
         })
-    }
-}
-
-#[cfg(test)]
-mod wind_trim_tests {
-    use super::*;
-
-    /// Earth-frame force (N) and pitching moment (N m) of the model for control at reference
-    /// point `p` in the wind `w`, its ground velocity being that of (V_t, α_t, attitude).
-    fn loads(af: &Airframe, p: &TrajPoint, w: &Vector3<f64>) -> (Vector3<f64>, f64) {
-        let c = model::dcm_of_quat(&p.quat());
-        let v_g = c.transpose() * model::body_velocity(p.v, p.alpha, 0.0);
-        let s = Surfaces::from_array([p.u[1], p.u[2], p.u[3], p.u[4], p.u[5], p.u[6]]);
-        let fm = af.forces_moments(&(c * (v_g - w)), &p.rates, p.thrust, &s);
-        (c.transpose() * fm.force_body, fm.moment_body.y)
-    }
-
-    fn controller() -> LqrController {
-        LqrController::new(Airframe::default(), MissionParams::default(), LqrParams::default()).unwrap()
-    }
-
-    /// The trimmed level-flight reference in a steady 5 m/s tail- or headwind has the
-    /// still-air reference's force and pitching moment (the same ground-path acceleration and
-    /// q̇, 2.2.19–2.2.24) at the same ground velocity; a tailwind lowers the dynamic pressure,
-    /// so it pitches up to a larger α (lift ∝ V̄² α), a headwind the other way.
-    #[test]
-    fn level_flight_trim_keeps_force_and_moment() {
-        let mut c = controller();
-        let af = Airframe::default();
-        let p = c.trajectory().at(15.0);
-        let (f_still, m_still) = loads(&af, &p, &Vector3::zeros());
-        for sign in [1.0, -1.0] {
-            let w = Vector3::new(5.0 * sign, 0.0, 0.0);
-            c.wind = w;
-            c.wind_rate = Vector3::zeros();
-            let q = c.trimmed(&p).expect("trim converges");
-            let (f, m) = loads(&af, &q, &w);
-            assert!(
-                (f - f_still).norm() < 1e-5 * af.mass * af.gravity,
-                "{sign}: {f} vs {f_still}"
-            );
-            assert!((m - m_still).abs() < 1e-6, "{sign}: {m} vs {m_still}");
-            let dtheta = q.euler_321.y - p.euler_321.y;
-            let alpha_air = c.air_reference(&q).y;
-            assert!(
-                sign * dtheta > 0.0 && sign * (alpha_air - p.alpha) > 0.0,
-                "{sign}: δ {dtheta}, α {alpha_air}"
-            );
-            // Without a wind rate the reference gains no pitch rate.
-            assert_eq!(q.rates, p.rates);
-        }
-    }
-
-    /// In still air, in an estimated wind below the ramp (what an estimator makes of still
-    /// air) and without wind compensation the reference is not touched, so the still-air
-    /// flights are bit-identical to the untrimmed controller's.
-    #[test]
-    fn no_trim_in_still_air_or_without_compensation() {
-        let mut c = controller();
-        let p = c.trajectory().at(15.0);
-        c.wind_rate = Vector3::zeros();
-        for w in [0.0, 0.99 * WIND_TRIM_RAMP.0] {
-            c.wind = Vector3::new(w, 0.0, 0.0);
-            assert!(c.trimmed(&p).is_none(), "{w}");
-        }
-        let mut t = LqrController::new(
-            Airframe::default(),
-            MissionParams::default(),
-            LqrParams {
-                configuration: 1,
-                ..Default::default()
-            },
-        )
-        .unwrap();
-        t.wind = Vector3::new(5.0, 0.0, 0.0);
-        assert!(t.trimmed(&p).is_none());
     }
 }

@@ -25,9 +25,11 @@
 //! with central differences ([`linearise_central`]) as the fallback.
 
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3, Vector4};
+use tailsitter_physics::aero_jacobian::arg;
 use tailsitter_physics::numeric::central_differences;
 use tailsitter_physics::{
-    dcm_earth_to_body, dcm_from_euler_231, euler_231_from_quat, euler_321_from_quat, Airframe, Surfaces,
+    dcm_earth_to_body, dcm_from_euler_231, euler_231_from_quat, euler_321_from_quat, Airframe, FmJacobian,
+    ForcesMoments, Surfaces,
 };
 
 /// Number of model states.
@@ -196,8 +198,8 @@ pub fn linearise_central(af: &Airframe, rep: EulerRep, x: &X, u: &U) -> (SMatrix
 
 impl EulerRep {
     /// ∂DCM^BE/∂φ, ∂/∂θ, ∂/∂ψ. For `DCM = R₁(φ) R₂(θ) R₃(ψ)` (frame rotations about the
-    /// axes e₁, e₂, e₃, dR_k/da = −[e_k]× R_k): ∂/∂φ = −[e₁]× C, ∂/∂θ = −[R₁ e₂]× C,
-    /// ∂/∂ψ = −C [e₃]× (3-2-1: e₁ e₂ e₃ = x y z; 2-3-1: x z y).
+    /// axes e₁, e₂, e₃, dR_k/da = −\[e_k\]× R_k): ∂/∂φ = −\[e₁\]× C, ∂/∂θ = −\[R₁ e₂\]× C,
+    /// ∂/∂ψ = −C \[e₃\]× (3-2-1: e₁ e₂ e₃ = x y z; 2-3-1: x z y).
     pub fn dcm_partials(self, a: &Vector3<f64>) -> [Matrix3<f64>; 3] {
         let c = self.dcm(a);
         let (e2, e3) = match self {
@@ -254,7 +256,6 @@ pub fn linearise_analytic(
     x: &X,
     u: &U,
 ) -> Option<(SMatrix<f64, NX, NX>, SMatrix<f64, NX, NU>)> {
-    use tailsitter_physics::aero_jacobian::arg;
     let speed = x[ix::V];
     let (alpha, beta) = (x[ix::ALPHA], x[ix::BETA]);
     let w = Vector3::new(x[ix::P], x[ix::Q], x[ix::R]);
@@ -267,11 +268,8 @@ pub fn linearise_analytic(
     }
     let surfaces = Surfaces::from_array([u[1], u[2], u[3], u[4], u[5], u[6]]);
     let (fm, jfm) = af.forces_moments_jacobian(&vb, &w, x[ix::T], &surfaces)?;
-    let (jf, jm) = (jfm.fixed_rows::<3>(0), jfm.fixed_rows::<3>(3));
     let c = rep.dcm(&ang);
     let dc = rep.dcm_partials(&ang);
-    let m = af.mass;
-    let inertia = Vector3::new(af.i_xx, af.i_yy, af.i_zz);
 
     // ∂v/∂(V, α, β).
     let jv = Matrix3::from_columns(&[
@@ -279,31 +277,84 @@ pub fn linearise_analytic(
         Vector3::new(-speed * sa * cb, 0.0, speed * ca * cb),
         Vector3::new(-speed * ca * sb, speed * cb, -speed * sa * sb),
     ]);
-    let mut dv = SMatrix::<f64, 3, NX>::zeros();
-    dv.fixed_columns_mut::<3>(ix::V).copy_from(&jv);
-
-    // a = F/m + DCM (0, 0, g) − ω × v and its partials.
-    let a = fm.force_body / m + c * Vector3::new(0.0, 0.0, af.gravity) - w.cross(&vb);
-    let mut da = SMatrix::<f64, 3, NX>::zeros();
-    let mut da_u = SMatrix::<f64, 3, NU>::zeros();
-    let jf_v = jf.fixed_columns::<3>(arg::VELOCITY) * jv;
-    da.fixed_columns_mut::<3>(ix::V)
-        .copy_from(&(jf_v / m - w.cross_matrix() * jv));
-    da.fixed_columns_mut::<3>(ix::P)
-        .copy_from(&(jf.fixed_columns::<3>(arg::RATES) / m + vb.cross_matrix()));
-    for (k, dck) in dc.iter().enumerate() {
-        da.set_column(ix::PHI + k, &(dck.column(2) * af.gravity));
-    }
-    da.set_column(ix::T, &(jf.column(arg::THRUST) / m));
-    for k in 0..6 {
-        da_u.set_column(1 + k, &(jf.column(arg::SURFACES + k) / m));
-    }
-
+    let body = BodyPartials::new(af, &fm, &jfm, (&c, &dc), &w, vb, jv);
     let mut f = SMatrix::<f64, NX, NX>::zeros();
     let mut g = SMatrix::<f64, NX, NU>::zeros();
+    air_data_rows(&mut f, &mut g, speed, (sb, cb), &body);
+    rate_rows(&mut f, &mut g, af, &jfm, &body.jv, &w);
+    kinematic_rows(&mut f, rep, (&ang, &w), (&c, &dc), &body);
+    // Ṫ = (T_c − T)/τ_T.
+    f[(ix::T, ix::T)] = -1.0 / af.tau_thrust;
+    g[(ix::T, 0)] = 1.0 / af.tau_thrust;
+    Some((f, g))
+}
 
+/// The body air velocity v and acceleration a = F/m + DCM (0, 0, g) − ω × v with their
+/// partials over x and u (2.2.19–2.2.21), shared by the rows of [`linearise_analytic`].
+struct BodyPartials {
+    vb: Vector3<f64>,
+    /// ∂v/∂(V, α, β).
+    jv: Matrix3<f64>,
+    /// ∂v/∂x (non-zero in the V, α, β columns only).
+    dv: SMatrix<f64, 3, NX>,
+    a: Vector3<f64>,
+    da: SMatrix<f64, 3, NX>,
+    da_u: SMatrix<f64, 3, NU>,
+}
+
+impl BodyPartials {
+    /// From the force model's forces `fm` and Jacobian `jfm`, the DCM and its partials, ω,
+    /// v and ∂v/∂(V, α, β) `jv`.
+    fn new(
+        af: &Airframe,
+        fm: &ForcesMoments,
+        jfm: &FmJacobian,
+        (c, dc): (&Matrix3<f64>, &[Matrix3<f64>; 3]),
+        w: &Vector3<f64>,
+        vb: Vector3<f64>,
+        jv: Matrix3<f64>,
+    ) -> Self {
+        let jf = jfm.fixed_rows::<3>(0);
+        let m = af.mass;
+        let mut dv = SMatrix::<f64, 3, NX>::zeros();
+        dv.fixed_columns_mut::<3>(ix::V).copy_from(&jv);
+        let a = fm.force_body / m + c * Vector3::new(0.0, 0.0, af.gravity) - w.cross(&vb);
+        let mut da = SMatrix::<f64, 3, NX>::zeros();
+        let mut da_u = SMatrix::<f64, 3, NU>::zeros();
+        let jf_v = jf.fixed_columns::<3>(arg::VELOCITY) * jv;
+        da.fixed_columns_mut::<3>(ix::V)
+            .copy_from(&(jf_v / m - w.cross_matrix() * jv));
+        da.fixed_columns_mut::<3>(ix::P)
+            .copy_from(&(jf.fixed_columns::<3>(arg::RATES) / m + vb.cross_matrix()));
+        for (k, dck) in dc.iter().enumerate() {
+            da.set_column(ix::PHI + k, &(dck.column(2) * af.gravity));
+        }
+        da.set_column(ix::T, &(jf.column(arg::THRUST) / m));
+        for k in 0..6 {
+            da_u.set_column(1 + k, &(jf.column(arg::SURFACES + k) / m));
+        }
+        Self {
+            vb,
+            jv,
+            dv,
+            a,
+            da,
+            da_u,
+        }
+    }
+}
+
+/// Rows V̇ = v·a/V, α̇ = (u a_z − w a_x)/(u² + w²) and β̇ = (a_y − sβ V̇)/(V cβ) of F and G.
+fn air_data_rows(
+    f: &mut SMatrix<f64, NX, NX>,
+    g: &mut SMatrix<f64, NX, NU>,
+    speed: f64,
+    (sb, cb): (f64, f64),
+    b: &BodyPartials,
+) {
+    let (vb, a, dv, da, da_u) = (&b.vb, &b.a, &b.dv, &b.da, &b.da_u);
     // V̇ = v·a/V.
-    let vdot = vb.dot(&a) / speed;
+    let vdot = vb.dot(a) / speed;
     let mut dvdot = (a.transpose() * dv + vb.transpose() * da) / speed;
     dvdot[ix::V] -= vdot / speed;
     let dvdot_u = vb.transpose() * da_u / speed;
@@ -328,9 +379,20 @@ pub fn linearise_analytic(
     ddd[ix::BETA] = -speed * sb;
     f.set_row(ix::BETA, &((dn - ddd * beta_dot) / dd));
     g.set_row(ix::BETA, &((da_u.row(1) - dvdot_u * sb) / dd));
+}
 
-    // ω̇ = I⁻¹(M − ω × Iω).
-    let iw = inertia.component_mul(&w);
+/// Rows ω̇ = I⁻¹(M − ω × Iω) of F and G (2.2.22–2.2.24), `jv` = ∂v/∂(V, α, β).
+fn rate_rows(
+    f: &mut SMatrix<f64, NX, NX>,
+    g: &mut SMatrix<f64, NX, NU>,
+    af: &Airframe,
+    jfm: &FmJacobian,
+    jv: &Matrix3<f64>,
+    w: &Vector3<f64>,
+) {
+    let jm = jfm.fixed_rows::<3>(3);
+    let inertia = Vector3::new(af.i_xx, af.i_yy, af.i_zz);
+    let iw = inertia.component_mul(w);
     let mut dwdot = SMatrix::<f64, 3, NX>::zeros();
     dwdot
         .fixed_columns_mut::<3>(ix::V)
@@ -348,26 +410,29 @@ pub fn linearise_analytic(
         f.set_row(ix::P + i, &(dwdot.row(i) / inertia[i]));
         g.set_row(ix::P + i, &(dwdot_u.row(i) / inertia[i]));
     }
+}
 
-    // Euler kinematics.
-    let (d_ang, d_w) = rep.rates_partials(&ang, &w);
+/// Rows of the Euler kinematics ([`EulerRep::rates_partials`]) and of the position rates
+/// (Ṅ, Ė, −ḣ) = DCMᵀ v (2.4.22–2.4.24) of F.
+fn kinematic_rows(
+    f: &mut SMatrix<f64, NX, NX>,
+    rep: EulerRep,
+    (ang, w): (&Vector3<f64>, &Vector3<f64>),
+    (c, dc): (&Matrix3<f64>, &[Matrix3<f64>; 3]),
+    b: &BodyPartials,
+) {
+    let (d_ang, d_w) = rep.rates_partials(ang, w);
     f.fixed_view_mut::<3, 3>(ix::PHI, ix::PHI).copy_from(&d_ang);
     f.fixed_view_mut::<3, 3>(ix::PHI, ix::P).copy_from(&d_w);
 
-    // (Ṅ, Ė, −ḣ) = DCMᵀ v.
     let mut dpos = SMatrix::<f64, 3, NX>::zeros();
-    dpos.fixed_columns_mut::<3>(ix::V).copy_from(&(c.transpose() * jv));
+    dpos.fixed_columns_mut::<3>(ix::V).copy_from(&(c.transpose() * b.jv));
     for (k, dck) in dc.iter().enumerate() {
-        dpos.set_column(ix::PHI + k, &(dck.transpose() * vb));
+        dpos.set_column(ix::PHI + k, &(dck.transpose() * b.vb));
     }
     f.set_row(ix::N, &dpos.row(0));
     f.set_row(ix::E, &dpos.row(1));
     f.set_row(ix::H, &(-dpos.row(2)));
-
-    // Ṫ = (T_c − T)/τ_T.
-    f[(ix::T, ix::T)] = -1.0 / af.tau_thrust;
-    g[(ix::T, 0)] = 1.0 / af.tau_thrust;
-    Some((f, g))
 }
 
 /// The model state of a measured quaternion attitude and the other measured quantities,

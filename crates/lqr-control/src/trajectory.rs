@@ -26,7 +26,7 @@
 //!   in the vertical and level segments. The thesis names trajectory accuracy as the
 //!   limiting factor of the LQR (§3.5.1); this removes the α guesswork of (3.3.3–3.3.4).
 //!   Each point is solved (residual < 1e-10) by a quasi-Newton iteration started from the
-//!   previous points' solutions extrapolated (issue 17: two residuals per point on average,
+//!   previous points' solutions extrapolated (two residuals per point on average,
 //!   the whole table in ≈ 4.5 ms instead of 11 ms; test `fast_construction_equals_the_slow_reference`).
 //!
 //! Banked turn (3.3.18–3.3.21), level segment only, `turn_radius` ρ ≠ 0: heading rate
@@ -72,7 +72,7 @@ pub struct TrajectoryOptions {
     /// Turn radius ρ (m) of the level segment (3.3.18–3.3.21); 0 = straight, < 0 left.
     pub turn_radius: f64,
     /// V and γ of the α- and thrust-limited point-mass profile
-    /// ([`flight_mission::profile`], issue 16) instead of the thesis's cosine blends.
+    /// ([`flight_mission::profile`]) instead of the thesis's cosine blends.
     pub limited_path: bool,
 }
 
@@ -403,7 +403,7 @@ fn central_jacobian(z: &[f64; 3], f: impl Fn(&[f64; 3]) -> Vector3<f64>) -> Matr
     jac
 }
 
-/// The construction's solver (issue 17): each point started from the previous points'
+/// The construction's solver: each point started from the previous points'
 /// solutions extrapolated, one quasi-Newton (Broyden) iteration; the induced velocity of
 /// the last residual warm-starts the next.
 #[derive(Default)]
@@ -417,30 +417,16 @@ struct QuasiNewton {
     chord: Option<Matrix3<f64>>,
 }
 
-impl BalanceSolver for QuasiNewton {
-    fn start_pass(&mut self, pass: usize, n: usize) {
+impl QuasiNewton {
+    /// Predictor of point `i` in pass `pass` (`weight`: m g, the first point's thrust):
+    /// pass 0 extrapolates the previous points' solutions (quartic), later passes add the
+    /// correction of the previous points over their previous-pass solutions, extrapolated
+    /// (cubic), to this point's previous-pass solution. From there one quasi-Newton step
+    /// usually meets the tolerance.
+    fn predict(&self, i: usize, pass: usize, weight: f64) -> [f64; 3] {
         if pass == 0 {
-            self.z_hist = vec![[0.0; 3]; n];
-            self.z_prev_pass = vec![[0.0; 3]; n];
-            self.w_start = f64::NAN;
-        } else {
-            self.z_prev_pass.copy_from_slice(&self.z_hist);
-        }
-        self.chord = None;
-    }
-
-    fn solve(&mut self, p: &PointProblem) -> Result<[f64; 3], String> {
-        let (bal, t, i, pass) = (&p.bal, p.t, p.i, p.pass);
-        let af = bal.af;
-        let g = af.gravity;
-        // Predictor: pass 0 extrapolates the previous points' solutions
-        // (quartic), later passes add the correction of the previous points
-        // over their previous-pass solutions, extrapolated (cubic), to
-        // this point's previous-pass solution. From there one quasi-Newton
-        // step usually meets the tolerance.
-        let mut z = if pass == 0 {
             match i {
-                0 => [0.0, af.mass * g, 0.0],
+                0 => [0.0, weight, 0.0],
                 1..=4 => self.z_hist[i - 1],
                 _ => core::array::from_fn(|k| {
                     5.0 * (self.z_hist[i - 1][k] - self.z_hist[i - 4][k])
@@ -458,7 +444,25 @@ impl BalanceSolver for QuasiNewton {
                     base[k] + 4.0 * (d(i - 1, k) + d(i - 3, k)) - 6.0 * d(i - 2, k) - d(i - 4, k)
                 }),
             }
-        };
+        }
+    }
+}
+
+impl BalanceSolver for QuasiNewton {
+    fn start_pass(&mut self, pass: usize, n: usize) {
+        if pass == 0 {
+            self.z_hist = vec![[0.0; 3]; n];
+            self.z_prev_pass = vec![[0.0; 3]; n];
+            self.w_start = f64::NAN;
+        } else {
+            self.z_prev_pass.copy_from_slice(&self.z_hist);
+        }
+        self.chord = None;
+    }
+
+    fn solve(&mut self, p: &PointProblem) -> Result<[f64; 3], String> {
+        let (bal, t, i, pass) = (&p.bal, p.t, p.i, p.pass);
+        let mut z = self.predict(i, pass, bal.af.mass * bal.af.gravity);
         let mut ok = false;
         let mut r_last = f64::INFINITY;
         // The last step and its residual (Broyden update of the Jacobian).
@@ -517,49 +521,54 @@ impl BalanceSolver for QuasiNewton {
     }
 }
 
-impl Trajectory {
-    /// Build the table for `mission` with the controller's airframe `af`.
-    pub fn new(af: &Airframe, mission: &MissionParams, opt: &TrajectoryOptions) -> Result<Self, String> {
-        Self::build(af, mission, opt, &mut QuasiNewton::default())
-    }
+/// The reference path of a mission: the flight-path blends (3.3.1–3.3.6, or the limited
+/// profile) and the banked turn (3.3.18–3.3.21).
+struct RefPath<'a> {
+    mission: &'a MissionParams,
+    profile: Option<&'a Profile>,
+    opt: &'a TrajectoryOptions,
+}
 
-    /// Build the table, each `ForceBalance` point solved by `solver`.
-    fn build(
-        af: &Airframe,
-        mission: &MissionParams,
-        opt: &TrajectoryOptions,
-        solver: &mut dyn BalanceSolver,
-    ) -> Result<Self, String> {
-        mission.validate().map_err(|e| e.0)?;
-        let end = mission.end_time() + 1.0;
-        let n = (end / TABLE_STEP).ceil() as usize + 2;
-        let g = af.gravity;
-        // Level trim α for the thesis mode (and the solve's initial guesses).
-        let level = tailsitter_physics::Plant::new(*af)
-            .trim_level(mission.v_level)
-            .map_err(|e| format!("level trim at v_level = {} failed: {e}", mission.v_level))?;
+/// The kinematics of one table point (§3.3): path speed and angles, bank (3.3.18), heading
+/// and the rates the body follows.
+struct PointKinematics {
+    t: f64,
+    /// V, V̇ (m/s, m/s²).
+    v: f64,
+    vdot: f64,
+    /// Flight-path angle γ (rad).
+    gamma: f64,
+    /// Bank φ (3.3.18) and heading ψ (rad).
+    phi: f64,
+    psi: f64,
+    /// α̇ of the previous pass (rad/s); θ̇ = γ̇ + α̇, θ̈ = γ̈ + α̈ (3.3.7–3.3.8).
+    alpha_dot: f64,
+    theta_dot: f64,
+    theta_ddot: f64,
+    /// φ̇ (rad/s) and the turn rate ψ̇ (rad/s).
+    phi_dot: f64,
+    turn_rate: f64,
+}
 
-        let profile = if opt.limited_path {
-            let pm = PointMass::from_level_trim(af, mission.v_level).map_err(|e| e.0)?;
-            Some(Profile::new(mission, &pm, &ProfileLimits::of(mission)).map_err(|e| e.0)?)
-        } else {
-            None
-        };
-        let profile = profile.as_ref();
-        // Pass 0: kinematic path, heading, bank.
+impl RefPath<'_> {
+    /// Pass 0: the kinematic path, heading (the turn rate integrated by the trapezoidal
+    /// rule) and zero bank, α by (3.3.3–3.3.4) in the thesis mode (0 for the force balance).
+    /// The points and their α.
+    fn kinematic_pass(&self, n: usize, alpha_level: f64) -> (Vec<TrajPoint>, Vec<f64>) {
+        let (mission, opt) = (self.mission, self.opt);
         let mut pts: Vec<TrajPoint> = Vec::with_capacity(n);
         let mut psi = 0.0;
         let mut alphas = Vec::with_capacity(n);
         for i in 0..n {
             let t = i as f64 * TABLE_STEP;
-            let (_, [v, _, gamma, _, _]) = path(mission, profile, t);
+            let (_, [v, _, gamma, _, _]) = path(mission, self.profile, t);
             if i > 0 {
                 let (w0, _) = turn_rate(mission, t - TABLE_STEP, opt.turn_radius);
                 let (w1, _) = turn_rate(mission, t, opt.turn_radius);
                 psi += 0.5 * (w0 + w1) * TABLE_STEP;
             }
             let alpha = match opt.mode {
-                TrajectoryMode::Thesis => alpha_thesis(mission, t, level.alpha, opt.alpha_max),
+                TrajectoryMode::Thesis => alpha_thesis(mission, t, alpha_level, opt.alpha_max),
                 TrajectoryMode::ForceBalance => 0.0,
             };
             alphas.push(alpha);
@@ -575,9 +584,154 @@ impl Trajectory {
                 u: U::zeros(),
             });
         }
+        (pts, alphas)
+    }
 
-        // Passes: body rates from θ̇, ψ̇, φ̇; then α, T, δe; twice for the force balance
-        // (the second pass uses α̇, α̈ of the first).
+    /// The kinematics of table point `p` with the pass's α̇, α̈ (`g`: gravity).
+    fn point(&self, g: f64, p: &TrajPoint, alpha_dot: f64, alpha_ddot: f64) -> PointKinematics {
+        let t = p.t;
+        let (_, [v, vdot, gamma, gdot, gddot]) = path(self.mission, self.profile, t);
+        let (w, wdot) = turn_rate(self.mission, t, self.opt.turn_radius);
+        let phi = (v * w / g).atan(); // (3.3.18)
+                                      // φ̇ from the derivative of atan(V ω / g).
+        let k = v * w / g;
+        PointKinematics {
+            t,
+            v,
+            vdot,
+            gamma,
+            phi,
+            psi: p.euler_321.z,
+            alpha_dot,
+            theta_dot: gdot + alpha_dot,
+            theta_ddot: gddot + alpha_ddot,
+            phi_dot: (vdot * w + v * wdot) / g / (1.0 + k * k),
+            turn_rate: w,
+        }
+    }
+}
+
+impl PointKinematics {
+    /// Body rates at θ = γ + α, 3-2-1: p = φ̇ − ψ̇ sθ, q = θ̇ cφ + ψ̇ sφ cθ,
+    /// r = −θ̇ sφ + ψ̇ cφ cθ.
+    fn rates(&self, alpha: f64) -> Vector3<f64> {
+        let th = self.gamma + alpha;
+        let (sf, cf) = self.phi.sin_cos();
+        let (st, ct) = th.sin_cos();
+        let (w, theta_dot) = (self.turn_rate, self.theta_dot);
+        Vector3::new(
+            self.phi_dot - w * st,
+            theta_dot * cf + w * sf * ct,
+            -theta_dot * sf + w * cf * ct,
+        )
+    }
+
+    /// The force balance of this point (`ForceBalance` mode) in pass `pass`, `table` its
+    /// (α, T, δe) before the solve.
+    fn problem<'a>(&self, af: &'a Airframe, i: usize, pass: usize, table: [f64; 3]) -> PointProblem<'a> {
+        PointProblem {
+            bal: Balance {
+                af,
+                v: self.v,
+                sincos_gamma: self.gamma.sin_cos(),
+                sincos_phi: self.phi.sin_cos(),
+                theta_dot: self.theta_dot,
+                turn_rate: self.turn_rate,
+                phi_dot: self.phi_dot,
+                target: Vector3::new(self.vdot, self.alpha_dot, self.theta_ddot),
+            },
+            t: self.t,
+            i,
+            pass,
+            gamma: self.gamma,
+            phi: self.phi,
+            psi: self.psi,
+            table,
+        }
+    }
+}
+
+/// `Thesis` mode: the rates of the kinematic α, T by (3.3.13–3.3.14) and δe by the moment
+/// balance (3.3.15–3.3.17) with the slip-stream scaling, written into `p`.
+fn thesis_point(af: &Airframe, k: &PointKinematics, alpha: f64, p: &mut TrajPoint) {
+    let (v, g) = (k.v, af.gravity);
+    let rates = k.rates(alpha);
+    // (3.3.13–3.3.14).
+    let thrust = af.mass * k.vdot + af.mass * g * k.gamma.sin() + 0.5 * af.air_density * v * v * af.wing_area * af.c_D0;
+    // (3.3.15–3.3.17) with the slip-stream scaling.
+    let c = af.coefficients(alpha);
+    let wi = af.induced_velocity(v, v * alpha.cos(), thrust);
+    let qbar = 0.5 * af.air_density * v * v * af.wing_area * af.mean_chord;
+    let de =
+        (af.i_yy * k.theta_ddot / qbar - af.c_m0 - c.c_m_alpha * alpha - af.mean_chord / (2.0 * v) * c.c_m_q * rates.y)
+            / c.c_m_de
+            * (v / (v + 2.0 * wi)).powi(2);
+    p.rates = rates;
+    p.thrust = thrust;
+    p.u[1] = de;
+    p.euler_321 = Vector3::new(k.phi, k.gamma + alpha, k.psi);
+}
+
+/// Positions by integrating the path velocity (3.3.9–3.3.12, trapezoidal rule) and the
+/// thrust command leading the state by the lag, T_c = T + τ_T Ṫ (2.3.16), clamped to the
+/// thrust range; in the `Thesis` mode α back to the kinematic `alphas`.
+fn positions_and_commands(af: &Airframe, mode: TrajectoryMode, pts: &mut [TrajPoint], alphas: &[f64]) {
+    let thrusts: Vec<f64> = pts.iter().map(|p| p.thrust).collect();
+    let tdot = derivative(&thrusts);
+    let mut pos = Vector3::zeros();
+    for i in 0..pts.len() {
+        if i > 0 {
+            let vel = |p: &TrajPoint| {
+                let (sg, cg) = p.gamma.sin_cos();
+                let (sp, cp) = p.euler_321.z.sin_cos();
+                Vector3::new(p.v * cg * cp, p.v * cg * sp, p.v * sg)
+            };
+            pos += 0.5 * (vel(&pts[i - 1]) + vel(&pts[i])) * TABLE_STEP;
+        }
+        let p = &mut pts[i];
+        p.pos_neh = pos;
+        p.u[0] = (p.thrust + af.tau_thrust * tdot[i]).clamp(af.thrust_min, af.thrust_max);
+        if mode == TrajectoryMode::Thesis {
+            p.alpha = alphas[i];
+        }
+    }
+}
+
+impl Trajectory {
+    /// Build the table for `mission` with the controller's airframe `af`.
+    pub fn new(af: &Airframe, mission: &MissionParams, opt: &TrajectoryOptions) -> Result<Self, String> {
+        Self::build(af, mission, opt, &mut QuasiNewton::default())
+    }
+
+    /// Build the table, each `ForceBalance` point solved by `solver`: the kinematic path
+    /// ([`kinematic_pass`]), then per pass the body rates, α, T and δe of every point (twice
+    /// for the force balance: the second pass uses α̇, α̈ of the first), then the positions
+    /// and thrust commands ([`positions_and_commands`]).
+    fn build(
+        af: &Airframe,
+        mission: &MissionParams,
+        opt: &TrajectoryOptions,
+        solver: &mut dyn BalanceSolver,
+    ) -> Result<Self, String> {
+        mission.validate().map_err(|e| e.0)?;
+        let end = mission.end_time() + 1.0;
+        let n = (end / TABLE_STEP).ceil() as usize + 2;
+        // Level trim α for the thesis mode (and the solve's initial guesses).
+        let level = tailsitter_physics::Plant::new(*af)
+            .trim_level(mission.v_level)
+            .map_err(|e| format!("level trim at v_level = {} failed: {e}", mission.v_level))?;
+        let profile = if opt.limited_path {
+            let pm = PointMass::from_level_trim(af, mission.v_level).map_err(|e| e.0)?;
+            Some(Profile::new(mission, &pm, &ProfileLimits::of(mission)).map_err(|e| e.0)?)
+        } else {
+            None
+        };
+        let path = RefPath {
+            mission,
+            profile: profile.as_ref(),
+            opt,
+        };
+        let (mut pts, mut alphas) = path.kinematic_pass(n, level.alpha);
         let passes = if opt.mode == TrajectoryMode::ForceBalance { 2 } else { 1 };
         for pass in 0..passes {
             solver.start_pass(pass, n);
@@ -586,103 +740,24 @@ impl Trajectory {
             let alpha_dot = smooth(&derivative(&alphas), 10);
             let alpha_ddot = smooth(&derivative(&alpha_dot), 10);
             for i in 0..n {
-                let t = pts[i].t;
-                let (_, [v, vdot, gamma, gdot, gddot]) = path(mission, profile, t);
-                let (w, wdot) = turn_rate(mission, t, opt.turn_radius);
-                let phi = (v * w / g).atan(); // (3.3.18)
-                let psi = pts[i].euler_321.z;
-                let theta_dot = gdot + alpha_dot[i];
-                let theta_ddot = gddot + alpha_ddot[i];
-                // φ̇ from the derivative of atan(V ω / g).
-                let k = v * w / g;
-                let phi_dot = (vdot * w + v * wdot) / g / (1.0 + k * k);
-                let rates_of = |alpha: f64| {
-                    let th = gamma + alpha;
-                    let (sf, cf) = phi.sin_cos();
-                    let (st, ct) = th.sin_cos();
-                    // 3-2-1: p = φ̇ − ψ̇ sθ, q = θ̇ cφ + ψ̇ sφ cθ, r = −θ̇ sφ + ψ̇ cφ cθ.
-                    Vector3::new(
-                        phi_dot - w * st,
-                        theta_dot * cf + w * sf * ct,
-                        -theta_dot * sf + w * cf * ct,
-                    )
-                };
+                let k = path.point(af.gravity, &pts[i], alpha_dot[i], alpha_ddot[i]);
                 match opt.mode {
-                    TrajectoryMode::Thesis => {
-                        let alpha = alphas[i];
-                        let rates = rates_of(alpha);
-                        // (3.3.13–3.3.14).
-                        let thrust = af.mass * vdot
-                            + af.mass * g * gamma.sin()
-                            + 0.5 * af.air_density * v * v * af.wing_area * af.c_D0;
-                        // (3.3.15–3.3.17) with the slip-stream scaling.
-                        let c = af.coefficients(alpha);
-                        let wi = af.induced_velocity(v, v * alpha.cos(), thrust);
-                        let qbar = 0.5 * af.air_density * v * v * af.wing_area * af.mean_chord;
-                        let de = (af.i_yy * theta_ddot / qbar
-                            - af.c_m0
-                            - c.c_m_alpha * alpha
-                            - af.mean_chord / (2.0 * v) * c.c_m_q * rates.y)
-                            / c.c_m_de
-                            * (v / (v + 2.0 * wi)).powi(2);
-                        let p = &mut pts[i];
-                        p.rates = rates;
-                        p.thrust = thrust;
-                        p.u[1] = de;
-                        p.euler_321 = Vector3::new(phi, gamma + alpha, psi);
-                    }
+                    TrajectoryMode::Thesis => thesis_point(af, &k, alphas[i], &mut pts[i]),
                     TrajectoryMode::ForceBalance => {
-                        let bal = Balance {
-                            af,
-                            v,
-                            sincos_gamma: gamma.sin_cos(),
-                            sincos_phi: phi.sin_cos(),
-                            theta_dot,
-                            turn_rate: w,
-                            phi_dot,
-                            target: Vector3::new(vdot, alpha_dot[i], theta_ddot),
-                        };
-                        let z = solver.solve(&PointProblem {
-                            bal,
-                            t,
-                            i,
-                            pass,
-                            gamma,
-                            phi,
-                            psi,
-                            table: [alphas[i], pts[i].thrust, pts[i].u[1]],
-                        })?;
+                        let table = [alphas[i], pts[i].thrust, pts[i].u[1]];
+                        let z = solver.solve(&k.problem(af, i, pass, table))?;
                         alphas[i] = z[0];
                         let p = &mut pts[i];
                         p.alpha = z[0];
-                        p.rates = rates_of(z[0]);
+                        p.rates = k.rates(z[0]);
                         p.thrust = z[1];
                         p.u[1] = z[2];
-                        p.euler_321 = Vector3::new(phi, gamma + z[0], psi);
+                        p.euler_321 = Vector3::new(k.phi, k.gamma + z[0], k.psi);
                     }
                 }
             }
         }
-        // Thrust command leads the state by the lag (2.3.16); positions (3.3.9–3.3.12).
-        let thrusts: Vec<f64> = pts.iter().map(|p| p.thrust).collect();
-        let tdot = derivative(&thrusts);
-        let mut pos = Vector3::zeros();
-        for i in 0..n {
-            if i > 0 {
-                let vel = |p: &TrajPoint| {
-                    let (sg, cg) = p.gamma.sin_cos();
-                    let (sp, cp) = p.euler_321.z.sin_cos();
-                    Vector3::new(p.v * cg * cp, p.v * cg * sp, p.v * sg)
-                };
-                pos += 0.5 * (vel(&pts[i - 1]) + vel(&pts[i])) * TABLE_STEP;
-            }
-            let p = &mut pts[i];
-            p.pos_neh = pos;
-            p.u[0] = (p.thrust + af.tau_thrust * tdot[i]).clamp(af.thrust_min, af.thrust_max);
-            if opt.mode == TrajectoryMode::Thesis {
-                p.alpha = alphas[i];
-            }
-        }
+        positions_and_commands(af, opt.mode, &mut pts, &alphas);
         if pts
             .iter()
             .any(|p| !(p.v.is_finite() && p.u.iter().all(|x| x.is_finite()) && p.pos_neh.iter().all(|x| x.is_finite())))
@@ -755,8 +830,7 @@ fn derivative(y: &[f64]) -> Vec<f64> {
 mod tests {
     use super::*;
 
-    /// The force-balance solver as it was before the construction was made fast (issue
-    /// 17): each point started from the previous point's solution, a chord iteration with
+    /// The plain force-balance solver: each point started from the previous point's solution, a chord iteration with
     /// central-difference Jacobians of the full model for control
     /// ([`crate::model::derivatives`]), cold induced-velocity solves. The slow reference
     /// the fast construction is compared against.

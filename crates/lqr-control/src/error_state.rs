@@ -1,0 +1,98 @@
+//! The error state of Fig. 3.2: the Euler selection switch (§2.2.1, §3.2.3.2), the measured
+//! state x and the trajectory state x_t in the selected set, and the deviation
+//! x_p = x − x_t (3.2.1) augmented with the integrators (3.2.12–3.2.14) — the vector the
+//! gain K multiplies.
+
+use flight_mission::{Measurement, VerticalReference};
+use nalgebra::{SVector, Vector3};
+
+use crate::model::{self, ix, state_of, wrap_pi, EulerRep, I_POS, NA, NX, X};
+use crate::reference::Reference;
+use crate::trajectory::TrajPoint;
+use crate::LqrController;
+
+/// Switches of the error state (from [`crate::LqrParams::effective`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ErrorStateSwitches {
+    /// Reference 3-2-1 pitch above which the 2-3-1 Euler set is used (rad).
+    pub euler_switch_pitch: f64,
+}
+
+/// The Euler selection switch for a reference 3-2-1 pitch: 2-3-1 when it exceeds
+/// `euler_switch_pitch` (vertical flight and the nose-high parts of the transitions, where
+/// 3-2-1 is singular), 3-2-1 otherwise (§2.2.1, §3.2.3.2).
+pub(crate) fn euler_set(pitch_321: f64, sw: &ErrorStateSwitches) -> EulerRep {
+    if pitch_321.abs() > sw.euler_switch_pitch {
+        EulerRep::E231
+    } else {
+        EulerRep::E321
+    }
+}
+
+impl LqrController {
+    /// The measured state x (the estimated state of Fig. 3.2) and the trajectory state x_t in
+    /// Euler set `rep` (§2.4): x_t at the regulated position `ctrl_neh` with the air-data
+    /// reference; in the take-off and landing phases both carry the body air velocity
+    /// ([`Self::hover_air_data`]).
+    pub(crate) fn state_and_reference(&self, rep: EulerRep, m: &Measurement, r: &Reference) -> (X, X) {
+        let mut x = state_of(
+            rep, m.airspeed, m.alpha, m.beta, &m.rates, &m.quat, &m.pos_ned, m.thrust,
+        );
+        let mut xt = r.point.state(rep);
+        xt[ix::N] = r.ctrl_neh.x;
+        xt[ix::E] = r.ctrl_neh.y;
+        xt[ix::H] = r.ctrl_neh.z;
+        xt[ix::V] = r.air.x;
+        xt[ix::ALPHA] = r.air.y;
+        xt[ix::BETA] = r.air.z;
+        if let Some(v) = &r.ground {
+            self.hover_air_data(m, v, &r.point, &mut x, &mut xt);
+        }
+        (x, xt)
+    }
+
+    /// The error state [x_I; x − x_t; x_Ip] (3.2.1, 3.2.12–3.2.14): the airspeed integrator,
+    /// the deviation from the trajectory (angle errors wrapped to (−π, π]) and the position
+    /// integrators.
+    pub(crate) fn error_vector(&self, x: &X, xt: &X) -> SVector<f64, NA> {
+        let mut dx = SVector::<f64, NA>::zeros();
+        dx[0] = self.integrator;
+        for j in 0..3 {
+            dx[I_POS + j] = self.pos_integrator[j];
+        }
+        for i in 0..NX {
+            let d = x[i] - xt[i];
+            dx[1 + i] = if (ix::PHI..=ix::PSI).contains(&i) {
+                wrap_pi(d)
+            } else {
+                d
+            };
+        }
+        dx
+    }
+
+    /// Air data in the take-off and landing phases: near hover V, α, β are undefined (α
+    /// jumps to π in the tail-first descent), so x and x_t carry the body air velocity
+    /// `v_a = V (cα cβ, sβ, sα cβ)` as `(u_a, w_a/V_e, v_a/V_e)` in place of `(V, α, β)`, the
+    /// reference's from `DCM_t (v_ref − ŵ)`, with `V_e = max(u_a,t, 1 m/s)`: to first order
+    /// the model's (V, α, β) at α = β = 0 and V = V_e, where `solve_gain` linearises (the same
+    /// 1 m/s floor), and continuous through V = 0 and reversed flow.
+    fn hover_air_data(&self, m: &Measurement, v: &VerticalReference, reference: &TrajPoint, x: &mut X, xt: &mut X) {
+        let (sa, ca) = m.alpha.sin_cos();
+        let (sb, cb) = m.beta.sin_cos();
+        let va = m.airspeed * Vector3::new(ca * cb, sb, sa * cb);
+        let wind = if self.wind.iter().all(|w| w.is_finite()) {
+            self.wind
+        } else {
+            Vector3::zeros()
+        };
+        let vat = model::dcm_of_quat(&reference.quat()) * (v.vel - wind);
+        let ve = vat.x.max(1.0);
+        x[ix::V] = va.x;
+        x[ix::ALPHA] = va.z / ve;
+        x[ix::BETA] = va.y / ve;
+        xt[ix::V] = vat.x;
+        xt[ix::ALPHA] = vat.z / ve;
+        xt[ix::BETA] = vat.y / ve;
+    }
+}
