@@ -8,7 +8,7 @@
 //! Timing: after fmi2ExitInitializationMode the outputs hold the wind at the start
 //! time; `doStep(t, h)` takes the internal turbulence samples at t₀ + k·T ≤ t from
 //! the inputs set for t, and the outputs then hold the wind for [t, t + h) (steady
-//! wind and gust at t, the turbulence of the last sample): a master steps the
+//! wind at the inputs' height, turbulence and gust of the last sample): a master steps the
 //! atmosphere before the plant (Gauss-Seidel) or alongside it (Jacobi).
 
 use atmosphere::{Atmosphere, Inputs, Params, State};

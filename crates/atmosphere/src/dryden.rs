@@ -133,6 +133,16 @@ impl SecondOrder {
         }
     }
 
+    /// Propagate (x₁, x₂) by one sample with the normals n₁, n₂.
+    pub fn advance_for_test(&self, x: &mut [f64; 2], n1: f64, n2: f64) {
+        self.advance(x, n1, n2);
+    }
+
+    /// The Cholesky factor [L₁₁, L₂₁, L₂₂] of the one-sample noise covariance.
+    pub fn chol_for_test(&self) -> [f64; 3] {
+        self.chol
+    }
+
     fn advance(&self, x: &mut [f64; 2], n1: f64, n2: f64) {
         let x1 = self.decay * x[0] + self.decay_eta * x[1] + self.chol[0] * n1;
         let x2 = self.decay * x[1] + self.chol[1] * n1 + self.chol[2] * n2;

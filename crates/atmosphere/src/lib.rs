@@ -8,9 +8,11 @@
 //! - a discrete 1 − cos gust.
 //!
 //! [`Atmosphere::start`] at the start time, then [`Atmosphere::step`]`(inputs, t, h)`
-//! returns the wind for [t, t + h): steady wind and gust at t, the turbulence of the
-//! last internal sample at or before t. Internal samples sit at t₀ + k·T whatever
-//! the communication step; the samples in (t_prev, t] use the inputs set for t.
+//! returns the wind for [t, t + h): the steady wind at the height of the inputs set
+//! for t, the turbulence and the gust of the last internal sample at or before t.
+//! Internal samples sit at t₀ + k·T whatever the communication step (so the output
+//! at a common instant does not depend on the step, to the bit, for inputs constant
+//! over the coarser step); the samples in (t_prev, t] use the inputs set for t.
 //! [`State`] saves and restores bit-exactly.
 
 pub mod dryden;
@@ -426,8 +428,14 @@ impl Atmosphere {
         c
     }
 
-    /// The output at t from the held filter state.
-    fn output(&mut self, inputs: &Inputs, t: f64) -> [f64; 3] {
+    /// Time of the last internal sample taken (s).
+    pub fn last_sample_time(&self) -> f64 {
+        self.state.t0 + self.state.next_sample.saturating_sub(1) as f64 * self.params.turbulence_sample_time
+    }
+
+    /// The output from the held filter state: steady wind at the inputs' height,
+    /// turbulence and gust at the last internal sample.
+    fn output(&mut self, inputs: &Inputs) -> [f64; 3] {
         let h = self.height(inputs);
         let mut wind = self.steady_wind(h);
         if self.turbulent() {
@@ -438,7 +446,7 @@ impl Atmosphere {
             }
             wind[2] += w;
         }
-        let g = self.gust(t);
+        let g = self.gust(self.last_sample_time());
         for i in 0..3 {
             wind[i] += g[i];
         }
@@ -462,12 +470,13 @@ impl Atmosphere {
             Dryden::default()
         };
         st.started = true;
-        self.state.wind = self.output(inputs, t0);
+        self.state.wind = self.output(inputs);
         Ok(self.state.wind)
     }
 
     /// Advance to `t` (the internal samples at t0 + k·T ≤ t, with the inputs set for
-    /// t) and return the wind for [t, t + h). `h` ≥ 0 is only checked: the output
+    /// t) and return the wind for [t, t + h): steady wind at the inputs' height,
+    /// turbulence and gust of the last sample. `h` ≥ 0 is only checked: the output
     /// holds over the step.
     pub fn step(&mut self, inputs: &Inputs, t: f64, h: f64) -> Result<[f64; 3], InputError> {
         if !(t.is_finite() && h.is_finite() && h >= 0.0) {
@@ -503,7 +512,7 @@ impl Atmosphere {
             }
             self.state.next_sample = end;
         }
-        self.state.wind = self.output(inputs, t);
+        self.state.wind = self.output(inputs);
         Ok(self.state.wind)
     }
 }
