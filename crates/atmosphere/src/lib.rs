@@ -158,7 +158,13 @@ impl Params {
         within("origin_height", self.origin_height, -1e4, 1e4, "m")?;
         within("turbulence_w20", self.turbulence_w20, 0.0, 50.0, "m/s")?;
         within("turbulence_sample_time", self.turbulence_sample_time, 1e-4, 1.0, "s")?;
-        within("turbulence_min_airspeed", self.turbulence_min_airspeed, 0.1, 100.0, "m/s")?;
+        within(
+            "turbulence_min_airspeed",
+            self.turbulence_min_airspeed,
+            0.1,
+            100.0,
+            "m/s",
+        )?;
         for (name, a) in [
             ("gust_amplitude_n", self.gust_amplitude_n),
             ("gust_amplitude_e", self.gust_amplitude_e),
@@ -282,7 +288,8 @@ impl State {
             }
         };
         let s = [word()?, word()?, word()?, word()?];
-        let rng = NoiseRng::from_parts(s).ok_or_else(|| "atmosphere state: invalid noise generator state".to_string())?;
+        let rng =
+            NoiseRng::from_parts(s).ok_or_else(|| "atmosphere state: invalid noise generator state".to_string())?;
         let t0 = finite(word()?, "t0")?;
         let next_sample = word()?;
         let mut x = [0.0; dryden::STATE_LEN];
@@ -441,16 +448,12 @@ impl Atmosphere {
         if self.turbulent() {
             let c = self.coefficients(h, inputs.airspeed);
             let [u, v, w] = self.state.turbulence.output(&c);
-            for i in 0..2 {
-                wind[i] += u * self.axis_u[i] + v * self.axis_v[i];
-            }
+            wind[0] += u * self.axis_u[0] + v * self.axis_v[0];
+            wind[1] += u * self.axis_u[1] + v * self.axis_v[1];
             wind[2] += w;
         }
         let g = self.gust(self.last_sample_time());
-        for i in 0..3 {
-            wind[i] += g[i];
-        }
-        wind
+        [wind[0] + g[0], wind[1] + g[1], wind[2] + g[2]]
     }
 
     /// Start at `t0`: the turbulence filters start in their stationary distribution

@@ -28,7 +28,8 @@ fn defaults_are_valid_and_quiet() {
 
 #[test]
 fn every_invalid_parameter_is_an_error_naming_it() {
-    let cases: Vec<(&str, Box<dyn Fn(&mut Params)>)> = vec![
+    type Setter = Box<dyn Fn(&mut Params)>;
+    let cases: Vec<(&str, Setter)> = vec![
         ("wind_speed", Box::new(|p| p.wind_speed = f64::NAN)),
         ("wind_speed", Box::new(|p| p.wind_speed = -1.0)),
         ("wind_from", Box::new(|p| p.wind_from = f64::INFINITY)),
@@ -171,7 +172,10 @@ fn the_gust_peaks_at_its_middle_and_lasts_its_duration() {
         }
     }
     assert!((peak.0 - 2.0).abs() < 1e-12 && (peak.1 - 1.2).abs() < 1e-9, "{peak:?}");
-    assert!((nonzero.0 - 1.001).abs() < 1e-9 && (nonzero.1 - 1.399).abs() < 1e-9, "{nonzero:?}");
+    assert!(
+        (nonzero.0 - 1.001).abs() < 1e-9 && (nonzero.1 - 1.399).abs() < 1e-9,
+        "{nonzero:?}"
+    );
     // Exactly the half amplitude at a quarter of the duration.
     let g = a.gust(1.1);
     assert!((g[0] - 1.0).abs() < 1e-12);
@@ -244,7 +248,10 @@ fn the_discretisation_is_exact_its_covariance_stationary() {
         if eta < 1e-2 {
             let q11 = ch[0] * ch[0];
             let series = 4.0 / 3.0 * eta.powi(3) * (1.0 - 1.5 * eta);
-            assert!((q11 / series - 1.0).abs() < 2.0 * eta * eta + 1e-12, "eta {eta}: {q11} vs {series}");
+            assert!(
+                (q11 / series - 1.0).abs() < 2.0 * eta * eta + 1e-12,
+                "eta {eta}: {q11} vs {series}"
+            );
         }
     }
 }
