@@ -392,3 +392,16 @@ fn non_finite_inputs_and_steps_are_errors_and_huge_ones_stay_finite() {
     let e = a.step(&inputs(1.0, 1.0), 1e6, 0.01).unwrap_err();
     assert!(e.0.contains("turbulence_sample_time"), "{e}");
 }
+
+#[test]
+fn below_the_airspeed_floor_the_turbulence_is_that_at_the_floor() {
+    let p = turbulent(10.0);
+    let at_floor = run(p, 8.0, p.turbulence_min_airspeed, &[0.02], 300);
+    for v in [0.0, 0.3, -2.0] {
+        assert_eq!(run(p, 8.0, v, &[0.02], 300), at_floor, "V = {v}");
+    }
+    assert_ne!(run(p, 8.0, 1.5, &[0.02], 300), at_floor);
+    // Hover at the floor: correlation time L_u / 1 m/s; the turbulence still varies.
+    let w = run(p, 8.0, 0.0, &[0.02], 300);
+    assert!(w.windows(2).all(|x| x[0] != x[1]));
+}
