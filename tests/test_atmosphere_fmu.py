@@ -200,3 +200,17 @@ def test_nan_input_is_refused_and_outputs_stay_finite(atmosphere):
     after = atmosphere.get(s, *WIND)
     assert all(math.isfinite(x) for x in after) and after != before
     s.freeInstance()
+
+
+def test_reset_mid_run_repeats_the_run(atmosphere):
+    s = started(atmosphere, "reset", ints={"turbulence_intensity": 1}, airspeed=20.0, pos_d=-15.0)
+    first = run(atmosphere, s, 60)
+    s.reset()  # every variable back to its start value
+    s.setupExperiment(startTime=0.0)
+    s.enterInitializationMode()
+    s.setInteger([atmosphere.vr["turbulence_intensity"]], [1])
+    atmosphere.set(s, airspeed=20.0, pos_d=-15.0)
+    s.exitInitializationMode()
+    assert run(atmosphere, s, 60) == first
+    s.terminate()
+    s.freeInstance()
