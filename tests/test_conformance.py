@@ -21,7 +21,7 @@ from fmpy.validation import validate_fmu
 
 from fmu_util import LogRecorder, fmu_path
 
-ALL = ["tailsitter_plant", "tailsitter_lqr", "tailsitter_tsd", "tailsitter_sensors", "tailsitter_ekf"]
+ALL = ["tailsitter_plant", "tailsitter_lqr", "tailsitter_tsd", "tailsitter_sensors", "tailsitter_ekf", "tailsitter_atmosphere"]
 MODELS = [m.strip() for m in os.environ.get("TAILSITTER_FMUS", "").split(",") if m.strip()] or ALL
 FMUTOOL = Path(sys.executable).with_name("fmutool")
 

@@ -7,7 +7,7 @@ import pytest
 
 from fmu_util import LogRecorder
 
-FMUS = ["tailsitter_plant", "tailsitter_lqr", "tailsitter_tsd", "tailsitter_sensors", "tailsitter_ekf"]
+FMUS = ["tailsitter_plant", "tailsitter_lqr", "tailsitter_tsd", "tailsitter_sensors", "tailsitter_ekf", "tailsitter_atmosphere"]
 
 
 def getter(slave, v):

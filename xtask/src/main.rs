@@ -44,6 +44,11 @@ const FMUS: &[(&str, &str, &[&str])] = &[
         "tailsitter_ekf",
         &["fmu-ekf/README.md", "crates/state-estimator/README.md"],
     ),
+    (
+        "fmu-atmosphere",
+        "tailsitter_atmosphere",
+        &["fmu-atmosphere/README.md", "crates/atmosphere/README.md"],
+    ),
 ];
 
 #[derive(Parser)]

@@ -31,12 +31,13 @@ pub mod model_description_types {
 }
 
 /// Every FMU of the workspace.
-pub const ALL_MODELS: [&str; 5] = [
+pub const ALL_MODELS: [&str; 6] = [
     "tailsitter_plant",
     "tailsitter_lqr",
     "tailsitter_tsd",
     "tailsitter_sensors",
     "tailsitter_ekf",
+    "tailsitter_atmosphere",
 ];
 
 /// The models whose `fmi2DoStep` random inputs make fail (the plant leaves its flight
