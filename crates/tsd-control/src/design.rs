@@ -348,8 +348,8 @@ impl TsdController {
     }
 
     /// Normal loop (4.2.9–4.2.17) in (C_W, Q′, E_C) with the mixed actuator δm (Table 4.1).
-    /// Z_α = V̄ a11 includes the thrust's normal component −T sin α of (2.5.28): in vertical
-    /// flight it is the main normal force. Switch `hover_wind_design` (through
+    /// Z_α = V̄ a11 includes the thrust's normal component −T sin α of (2.5.28) with
+    /// `normal_thrust_term` (D-4.1): in vertical flight it is the main normal force. Switch `hover_wind_design` (through
     /// `fc.hover_wind`): in hover in a strong crossflow the poles are slowed by
     /// HOVER_WIND_NORMAL_POLE_FACTOR (README, "Hover in a span-wise wind").
     fn normal_design(&self, fc: &FlightCondition, mp: &ModelPoint) -> Result<NormalDesign, &'static str> {
@@ -388,7 +388,8 @@ impl TsdController {
     }
 
     /// Roll rate (4.2.21–4.2.26) with the NVD loop (4.3.7–4.3.11): ailerons (free stream)
-    /// and differential flaps (slip-stream) deflected together. Switch `hover_wind_design`
+    /// and, with `roll_differential_flaps` (D-4.4), differential flaps (slip-stream)
+    /// deflected together. Switch `hover_wind_design`
     /// (through `fc.hover_wind`): a slower roll-rate pair in hover in wind (README, "Hover in
     /// a span-wise wind").
     fn roll_design(&self, fc: &FlightCondition, mp: &ModelPoint) -> Result<RollDesign, &'static str> {
@@ -416,7 +417,8 @@ impl TsdController {
     }
 
     /// Directional loop (4.2.27–4.2.31) in (B_W, R′, E_B) with the mixed actuator δR
-    /// (Table 4.2): Y_β = V̄ a11 with the thrust term −T cos α sin β.
+    /// (Table 4.2): Y_β = V̄ a11, with the thrust term −T cos α sin β under
+    /// `lateral_thrust_term` (D-4.2).
     fn directional_design(&self, mp: &ModelPoint) -> Result<DirectionalDesign, &'static str> {
         let p = &self.params;
         let af = &self.airframe;

@@ -36,7 +36,8 @@
 //! accelerations) → `design` (gain schedule of every loop) → `guidance` (4.3.24) → `nvd`
 //! (decomposition 4.3.27–4.3.30, NVD error 4.3.5) → `inner_loops` (axial, normal, roll,
 //! directional laws) → `integrators` (bumpless start, anti-windup) → `mixing` (surface
-//! allocation, saturation); `deviations` holds the thesis-vs-tuned switch of each stage.
+//! allocation, saturation); `deviations` holds the thesis-vs-tuned switches, one parameter
+//! per deviation of docs/THESIS.md (−1 follow `configuration`, 0 printed, 1 deviation).
 //!
 //! Frames: earth NED, body (x nose, y right wing, z belly), wind axes (x along the air
 //! velocity, z in the plane of symmetry). Units SI, angles rad.

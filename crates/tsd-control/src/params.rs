@@ -113,7 +113,8 @@ pub struct TsdParams {
     pub guidance_pole_re_level: f64,
     /// Guidance pair, imaginary part, level flight (1/s).
     pub guidance_pole_im_level: f64,
-    /// Integrator anti-windup tracking gain of every loop (§4.2.1: 50) (1/s).
+    /// Integrator anti-windup tracking gain (§4.2.1: 50), on every inner loop or on the axial
+    /// loop only (`antiwindup_all_loops`) (1/s).
     pub antiwindup_gain: f64,
     /// Factor k of the elevator/collective-flap mixing r = −k·C_Lδe/C_Lδfc (4.2.12: 1.1).
     pub flap_mixing_factor: f64,
@@ -436,5 +437,56 @@ impl TsdParams {
             )));
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `configuration` picks the default of every switch left at −1 (0: all on; 1: all off but
+    /// `slipstream_in_design`); a switch set to 0 or 1 overrides it; other values are errors.
+    #[test]
+    fn configuration_picks_the_switch_defaults_and_a_switch_overrides() {
+        let tuned = TsdParams::default().effective().unwrap();
+        assert!(tuned.switches().iter().all(|(_, v)| *v == 1), "{:?}", tuned.switches());
+        assert_eq!(tuned.wind_frame_speed_low, TsdParams::default().wind_frame_speed_low);
+        let thesis = TsdParams {
+            configuration: 1,
+            ..TsdParams::default()
+        };
+        let e = thesis.effective().unwrap();
+        for (name, v) in e.switches() {
+            assert_eq!(v, i32::from(name == "slipstream_in_design"), "{name}");
+        }
+        assert_eq!((e.wind_frame_speed_low, e.feedforward_lead), (0.0, 0.0));
+        assert_eq!((e.normal_vector_blend_time, e.min_normal_accel), (0.0, 0.0));
+        assert_eq!(
+            (e.guidance_pole_re_level, e.guidance_pole_im_level),
+            TABLE_4_3_GUIDANCE_LEVEL
+        );
+        let one = TsdParams {
+            normal_thrust_term: 1,
+            low_speed_path_frame: 1,
+            ..thesis
+        }
+        .effective()
+        .unwrap();
+        assert_eq!((one.normal_thrust_term, one.lateral_thrust_term), (1, 0));
+        assert_eq!(one.wind_frame_speed_low, TsdParams::default().wind_frame_speed_low);
+        let off = TsdParams {
+            slipstream_in_design: 0,
+            feedforward_preview: 0,
+            ..TsdParams::default()
+        }
+        .effective()
+        .unwrap();
+        assert_eq!((off.slipstream_in_design, off.feedforward_lead), (0, 0.0));
+        assert_eq!(off.limited_profile, 1);
+        let bad = TsdParams {
+            antiwindup_all_loops: 2,
+            ..TsdParams::default()
+        };
+        assert!(bad.effective().unwrap_err().0.contains("antiwindup_all_loops"));
     }
 }
