@@ -38,7 +38,8 @@ impl TsdController {
     /// Notice of the first command (in [`COMMAND_NAMES`] order) that saturates at this
     /// sample and did not at the last one; remembers this sample's saturations.
     pub(crate) fn saturation_notice(&mut self, u: &VirtualCommands, mixing: (f64, f64)) -> Option<Notice> {
-        let mask = saturation_mask(u, mixing, &self.airframe);
+        let diff_flaps = crate::deviations::Deviations::of(&self.params).roll_differential_flaps;
+        let mask = saturation_mask(u, mixing, diff_flaps, &self.airframe);
         let fresh = mask & !self.saturated;
         self.saturated = mask;
         (fresh != 0).then(|| Notice::Saturated(COMMAND_NAMES[fresh.trailing_zeros() as usize]))
@@ -74,7 +75,7 @@ pub(crate) fn allocate(
 }
 
 /// Bit mask of the commands outside their limits, in [`COMMAND_NAMES`] order.
-fn saturation_mask(u: &VirtualCommands, (rn, rv): (f64, f64), af: &Airframe) -> u32 {
+fn saturation_mask(u: &VirtualCommands, (rn, rv): (f64, f64), diff_flaps: bool, af: &Airframe) -> u32 {
     let lim = af.deflection_limit;
     let values = [
         (u.thrust, af.thrust_min, af.thrust_max),
@@ -82,7 +83,7 @@ fn saturation_mask(u: &VirtualCommands, (rn, rv): (f64, f64), af: &Airframe) -> 
         (u.da, -lim, lim),
         (u.dr, -lim, lim),
         (rn * u.dm, -lim, lim),
-        (u.da, -lim, lim),
+        (if diff_flaps { u.da } else { 0.0 }, -lim, lim),
         (rv * u.dr, -lim, lim),
     ];
     let mut mask = 0u32;
