@@ -36,7 +36,8 @@
 //! accelerations) → `design` (gain schedule of every loop) → `guidance` (4.3.24) → `nvd`
 //! (decomposition 4.3.27–4.3.30, NVD error 4.3.5) → `inner_loops` (axial, normal, roll,
 //! directional laws) → `integrators` (bumpless start, anti-windup) → `mixing` (surface
-//! allocation, saturation); `deviations` holds the thesis-vs-tuned switch of each stage.
+//! allocation, saturation); `deviations` holds the thesis-vs-tuned switches, one parameter
+//! per deviation of docs/THESIS.md (−1 follow `configuration`, 0 printed, 1 deviation).
 //!
 //! Frames: earth NED, body (x nose, y right wing, z belly), wind axes (x along the air
 //! velocity, z in the plane of symmetry). Units SI, angles rad.
@@ -384,17 +385,23 @@ impl SampledUnit for TsdController {
         // Inner loops (Fig. 4.1, §4.2), their integrators, mixing and saturation.
         let laws = self.inner_loops(&s, &sigma_ahead, cmd.roll_error, dev);
         if !self.initialized {
-            self.integrators.bumpless_start(&s, &laws);
+            self.integrators
+                .bumpless_start(&s, &laws, dev.integrators_as_accelerations);
             self.initialized = true;
         }
-        let u = self.integrators.commands(&s, &laws, self.airframe.deflection_limit);
-        let (command, u_sat) = mixing::allocate(&u, s.d.mixing, &self.airframe);
+        let u = self.integrators.commands(
+            &s,
+            &laws,
+            self.airframe.deflection_limit,
+            dev.integrators_as_accelerations,
+        );
+        let (command, u_sat) = mixing::allocate(&u, s.d.mixing, dev.roll_differential_flaps, &self.airframe);
         if !command.is_finite() {
             return Err(Self::err(format!("non-finite command at t = {} s", input.t)));
         }
         let e = integrators::loop_errors(&s.axes, &cmd, &laws);
         let (ts, gain) = (self.mission.sample_time, self.params.antiwindup_gain);
-        self.integrators.anti_windup_step(&s.d, e, &u, &u_sat, ts, gain);
+        self.integrators.anti_windup_step(&s.d, e, &u, &u_sat, ts, gain, dev);
         // Diagnostics.
         let notice = self.saturation_notice(&u, s.d.mixing);
         self.internals = Internals::of(&s, &sigma, &cmd, &u);
