@@ -35,6 +35,10 @@ pub struct Config {
     /// models (the LQR FMU builds its trajectory and gains in every instantiate
     /// and reset) get fewer sequences in the short run.
     pub per_fmu_cap: BTreeMap<String, u64>,
+    /// Before each sequence, overwrite this file with the sequence's index, FMU and
+    /// seed-state ([`crate::progress`]): after a crash or abort it names the sequence
+    /// to replay. `None`: only the in-memory marker the abort handler prints.
+    pub progress_file: Option<std::path::PathBuf>,
 }
 
 impl Default for Config {
@@ -45,6 +49,7 @@ impl Default for Config {
             deadline: None,
             max_calls: 40,
             per_fmu_cap: BTreeMap::new(),
+            progress_file: None,
         }
     }
 }
@@ -257,9 +262,26 @@ pub struct Fuzzer<'a> {
     rng: Rng,
     report: Report,
     donors: Vec<Donor<'a>>,
-    /// Serialized states per FMU (bytes, mirror at serialization).
+    /// Serialized states per FMU (bytes, mirror at serialization), of the current
+    /// sequence only (so that a sequence depends on its seed-state alone).
     banks: Vec<Vec<(Vec<u8>, Mirror)>>,
+    /// Index of the current sequence (1-based) and the RNG state it started from.
     seq: u64,
+    seq_state: u64,
+    /// Print every call, its status and its log records (replay).
+    verbose: bool,
+    /// The run's `Config::max_calls` (for the replay hint).
+    max_calls: usize,
+}
+
+/// The RNG state sequence `index` of a run with `seed` starts from: a pure function
+/// of both, so that any sequence can be replayed alone (`fmi-fuzz fuzz --replay`).
+pub fn sequence_state(seed: u64, index: u64) -> u64 {
+    // splitmix64 of (seed, index); never 0 (xorshift's fixed point).
+    let mut z = seed ^ index.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    (z ^ (z >> 31)) | 1
 }
 
 /// The instance under test in one sequence.
@@ -307,35 +329,81 @@ impl<'a> Fuzzer<'a> {
             donors,
             banks: fmus.iter().map(|_| Vec::new()).collect(),
             seq: 0,
+            seq_state: 0,
+            verbose: false,
+            max_calls: 0,
         }
     }
 
+    /// Run sequences 1, 2, … of `cfg.seed` until a limit is reached. Sequence `i` starts
+    /// from [`sequence_state`]`(seed, i)`: its first draw picks the FMU (a sequence whose
+    /// FMU has reached its cap is skipped), the rest drives the calls.
     pub fn run(mut self, cfg: &Config) -> Report {
+        let mut progress = crate::progress::Progress::new(cfg.progress_file.as_deref(), cfg.seed, cfg.max_calls);
+        self.max_calls = cfg.max_calls;
+        let mut index = 0u64;
         while self.report.sequences < cfg.sequences && cfg.deadline.is_none_or(|d| Instant::now() < d) {
-            let t0 = Instant::now();
-            let open: Vec<usize> = (0..self.fmus.len())
-                .filter(|&i| {
-                    let id = &self.fmus[i].id;
-                    cfg.per_fmu_cap
-                        .get(id)
-                        .is_none_or(|cap| self.report.per_fmu.get(id).map_or(0, |e| e.0) < *cap)
-                })
-                .collect();
-            if open.is_empty() {
+            let open = (0..self.fmus.len()).any(|i| !self.capped(cfg, i));
+            if !open {
                 break;
             }
-            let f = *self.rng.pick(&open);
-            let id = self.sequence(f, cfg.max_calls);
+            index += 1;
+            let state = sequence_state(cfg.seed, index);
+            self.rng = Rng::from_state(state);
+            let f = self.rng.below(self.fmus.len());
+            if self.capped(cfg, f) {
+                continue;
+            }
+            progress.mark(index, state, &self.fmus[f].id);
+            let t0 = Instant::now();
+            let id = self.sequence(index, state, f, cfg.max_calls);
             let entry = self.report.per_fmu.entry(id).or_default();
             entry.0 += 1;
             entry.1 += t0.elapsed().as_secs_f64();
             self.report.sequences += 1;
         }
+        progress.finish();
+        self.free_donors();
+        self.report
+    }
+
+    /// Run the one sequence that starts from RNG state `state` (as logged by a run, or
+    /// [`sequence_state`] of a seed and an index), printing every call, its status and
+    /// what the FMU logged.
+    pub fn replay(mut self, index: u64, state: u64, max_calls: usize) -> Report {
+        self.verbose = true;
+        self.max_calls = max_calls;
+        self.rng = Rng::from_state(state);
+        let f = self.rng.below(self.fmus.len());
+        println!(
+            "replay: sequence {index}, seed-state {state:#x}, FMU {}",
+            self.fmus[f].id
+        );
+        let mut progress = crate::progress::Progress::new(None, 0, max_calls);
+        progress.mark(index, state, &self.fmus[f].id);
+        let t0 = Instant::now();
+        let id = self.sequence(index, state, f, max_calls);
+        let entry = self.report.per_fmu.entry(id).or_default();
+        entry.0 += 1;
+        entry.1 += t0.elapsed().as_secs_f64();
+        self.report.sequences += 1;
+        progress.finish();
+        self.free_donors();
+        self.report
+    }
+
+    fn capped(&self, cfg: &Config, f: usize) -> bool {
+        let id = &self.fmus[f].id;
+        cfg.per_fmu_cap
+            .get(id)
+            .is_some_and(|cap| self.report.per_fmu.get(id).map_or(0, |e| e.0) >= *cap)
+    }
+
+    fn free_donors(&mut self) {
         for d in &mut self.donors {
             let mut st = d.state;
             assert_eq!(d.inst.free_state(&mut st), OK);
         }
-        self.report
     }
 
     fn violation(&mut self, fmu: &Fmu, what: String) {
@@ -354,8 +422,8 @@ impl<'a> Fuzzer<'a> {
             .or_default() += 1;
         if self.report.first_violations.len() < 40 {
             self.report.first_violations.push(format!(
-                "[{} seq {} seed-state {:#x}] {what}",
-                fmu.id, self.seq, self.rng.0
+                "[{} seq {} seed-state {:#x}: replay with `fmi-fuzz fuzz --replay {:#x} --max-calls {}`] {what}",
+                fmu.id, self.seq, self.seq_state, self.seq_state, self.max_calls
             ));
         }
     }
@@ -375,6 +443,12 @@ impl<'a> Fuzzer<'a> {
     ) {
         self.count(func, state.name(), got);
         let new = live.inst.host.since(log_from);
+        if self.verbose {
+            println!("    {detail} → expected {expect:?}");
+            for r in &new {
+                println!("      log [{}] {}", status_name(r.status), r.message);
+            }
+        }
         if !expect.admits(got) {
             self.violation(
                 fmu,
@@ -413,6 +487,9 @@ impl<'a> Fuzzer<'a> {
 
     fn count(&mut self, func: &str, state: &str, got: fmi2Status) {
         self.report.calls += 1;
+        if self.verbose {
+            println!("  {func} @ {state}: {}", status_name(got));
+        }
         let slot = self.report.coverage.entry(format!("{func} @ {state}")).or_default();
         if let Some(n) = slot.get_mut(got as usize) {
             *n += 1;
@@ -424,9 +501,13 @@ impl<'a> Fuzzer<'a> {
         (!others.is_empty()).then(|| *self.rng.pick(&others))
     }
 
-    /// One random sequence on a random FMU; returns its id.
-    fn sequence(&mut self, f: usize, max_calls: usize) -> String {
-        self.seq += 1;
+    /// One random sequence on FMU `f`; returns its id.
+    fn sequence(&mut self, index: u64, state: u64, f: usize, max_calls: usize) -> String {
+        self.seq = index;
+        self.seq_state = state;
+        for bank in &mut self.banks {
+            bank.clear();
+        }
         let fmu: &'a Fmu = &self.fmus[f];
         let logging_on = self.rng.chance(0.5);
         let mut live = Live::new(fmu, &format!("fuzz{}", self.seq), logging_on);
@@ -436,6 +517,9 @@ impl<'a> Fuzzer<'a> {
         for _ in 0..n {
             let t0 = Instant::now();
             let op = self.rng.below(100);
+            if self.verbose {
+                println!("op {op}:");
+            }
             self.op(op, f, fmu, &mut live, &mut states, &mut fake);
             let dt = t0.elapsed().as_secs_f64();
             if dt > 1.0 && self.report.slow_calls.len() < 20 {
