@@ -501,8 +501,7 @@ pub unsafe fn set_fmu_state<M: FmuModel>(c: fmi2Component, state: fmi2FMUstate) 
                     "the FMU state belongs to an instance of the other interface (Model Exchange vs Co-Simulation)",
                 ));
             }
-            inst.restore(snap);
-            Ok(())
+            inst.restore(snap)
         })
     }
 }
