@@ -543,15 +543,19 @@ impl<M: FmuModel> Instance<M> {
     }
 
     /// fmi2GetString: pointers stay valid until the next fmi2GetString / Reset / FreeInstance.
+    /// Nothing is sized from `nvr` before the value references are read (a host's count
+    /// alone must not decide an allocation).
     pub fn get_strings(&mut self, vrs: &[u32], out: &mut [*const std::os::raw::c_char]) -> Fmi2Result {
-        let mut strings = Vec::with_capacity(vrs.len());
-        {
-            let mut tmp: Vec<String> = vec![String::new(); vrs.len()];
-            self.get_values(vrs, &mut tmp, ValueType::String, |v, vr| {
-                v.get_string(vr).map(str::to_string)
-            })?;
-            for s in tmp {
-                strings.push(crate::logger::to_cstring(&s));
+        debug_assert_eq!(vrs.len(), out.len());
+        let mut strings = Vec::new();
+        if !vrs.is_empty() {
+            self.refresh()?;
+            for vr in vrs {
+                let spec = Self::spec_for(*vr, ValueType::String)?;
+                let s = self.vars.get_string(*vr).ok_or_else(|| {
+                    Fmi2Error::error(format!("value reference {vr} ({}) has no String value", spec.name))
+                })?;
+                strings.push(crate::logger::to_cstring(s));
             }
         }
         for (slot, s) in out.iter_mut().zip(&strings) {
