@@ -17,7 +17,7 @@
 
 use crate::*;
 use fmi_sys::fmi2::*;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::ffi::{c_char, c_void};
 use std::time::Instant;
 
@@ -27,6 +27,8 @@ pub struct Config {
     pub seed: u64,
     /// Stop after this many sequences…
     pub sequences: u64,
+    /// …or once this many FMI calls were issued (checked between sequences)…
+    pub max_total_calls: u64,
     /// …or at this instant, whichever comes first.
     pub deadline: Option<Instant>,
     /// Calls per sequence (uniform in 1..=max_calls).
@@ -46,6 +48,7 @@ impl Default for Config {
         Self {
             seed: 1,
             sequences: 1000,
+            max_total_calls: u64::MAX,
             deadline: None,
             max_calls: 40,
             per_fmu_cap: BTreeMap::new(),
@@ -107,6 +110,47 @@ impl Report {
         }
     }
 
+    /// The FMI functions called at least once, and the states they were called in
+    /// (from the coverage keys "function @ state").
+    pub fn functions_and_states(&self) -> (BTreeSet<String>, BTreeSet<String>) {
+        let mut functions = BTreeSet::new();
+        let mut states = BTreeSet::new();
+        for key in self.coverage.keys() {
+            let (f, st) = key.split_once(" @ ").unwrap_or((key, ""));
+            if f == "fmi2GetTypesPlatform/Version" {
+                functions.insert("fmi2GetTypesPlatform".to_string());
+                functions.insert("fmi2GetVersion".to_string());
+            } else {
+                functions.insert(f.to_string());
+            }
+            states.insert(st.to_string());
+        }
+        (functions, states)
+    }
+
+    /// One line each: FMI 2.0 functions exercised (and any never called), the states
+    /// the calls were made in.
+    pub fn print_coverage_summary(&self) {
+        let (functions, states) = self.functions_and_states();
+        let missing: Vec<&str> = FMI2_FUNCTIONS
+            .iter()
+            .copied()
+            .filter(|f| !functions.contains(*f))
+            .collect();
+        println!(
+            "coverage: {} of the {} FMI 2.0 functions called (never: {}); calls made in {} states: {}",
+            FMI2_FUNCTIONS.len() - missing.len(),
+            FMI2_FUNCTIONS.len(),
+            if missing.is_empty() {
+                "none".to_string()
+            } else {
+                missing.join(", ")
+            },
+            states.len(),
+            states.iter().cloned().collect::<Vec<_>>().join(", ")
+        );
+    }
+
     pub fn print_coverage(&self) {
         println!(
             "{:<52} {:>9} {:>9} {:>9} {:>9}",
@@ -117,6 +161,54 @@ impl Report {
         }
     }
 }
+
+/// Every function of the FMI 2.0 C API (common, Co-Simulation, Model Exchange).
+pub const FMI2_FUNCTIONS: [&str; 44] = [
+    "fmi2GetTypesPlatform",
+    "fmi2GetVersion",
+    "fmi2SetDebugLogging",
+    "fmi2Instantiate",
+    "fmi2FreeInstance",
+    "fmi2SetupExperiment",
+    "fmi2EnterInitializationMode",
+    "fmi2ExitInitializationMode",
+    "fmi2Terminate",
+    "fmi2Reset",
+    "fmi2GetReal",
+    "fmi2GetInteger",
+    "fmi2GetBoolean",
+    "fmi2GetString",
+    "fmi2SetReal",
+    "fmi2SetInteger",
+    "fmi2SetBoolean",
+    "fmi2SetString",
+    "fmi2GetFMUstate",
+    "fmi2SetFMUstate",
+    "fmi2FreeFMUstate",
+    "fmi2SerializedFMUstateSize",
+    "fmi2SerializeFMUstate",
+    "fmi2DeSerializeFMUstate",
+    "fmi2GetDirectionalDerivative",
+    "fmi2SetRealInputDerivatives",
+    "fmi2GetRealOutputDerivatives",
+    "fmi2DoStep",
+    "fmi2CancelStep",
+    "fmi2GetStatus",
+    "fmi2GetRealStatus",
+    "fmi2GetIntegerStatus",
+    "fmi2GetBooleanStatus",
+    "fmi2GetStringStatus",
+    "fmi2EnterEventMode",
+    "fmi2NewDiscreteStates",
+    "fmi2EnterContinuousTimeMode",
+    "fmi2CompletedIntegratorStep",
+    "fmi2SetTime",
+    "fmi2SetContinuousStates",
+    "fmi2GetDerivatives",
+    "fmi2GetEventIndicators",
+    "fmi2GetContinuousStates",
+    "fmi2GetNominalsOfContinuousStates",
+];
 
 /// Mirror of the state-machine fields an FMU state captures.
 #[derive(Debug, Clone, Copy)]
@@ -342,7 +434,10 @@ impl<'a> Fuzzer<'a> {
         let mut progress = crate::progress::Progress::new(cfg.progress_file.as_deref(), cfg.seed, cfg.max_calls);
         self.max_calls = cfg.max_calls;
         let mut index = 0u64;
-        while self.report.sequences < cfg.sequences && cfg.deadline.is_none_or(|d| Instant::now() < d) {
+        while self.report.sequences < cfg.sequences
+            && self.report.calls < cfg.max_total_calls
+            && cfg.deadline.is_none_or(|d| Instant::now() < d)
+        {
             let open = (0..self.fmus.len()).any(|i| !self.capped(cfg, i));
             if !open {
                 break;

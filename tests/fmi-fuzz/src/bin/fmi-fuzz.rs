@@ -1,8 +1,9 @@
 //! Long-run driver (see scripts/hardening.sh):
 //!
-//! - `fmi-fuzz fuzz [--seconds N] [--seed S] [--sequences N] [--max-calls N] [--coverage]
-//!   [--progress FILE]`: the call-sequence fuzzer over every required FMU until the time or
-//!   sequence budget is spent; before each sequence, FILE (default
+//! - `fmi-fuzz fuzz [--seconds N] [--seed S] [--sequences N] [--calls N] [--max-calls N]
+//!   [--coverage] [--progress FILE]`: the call-sequence fuzzer over every required FMU until
+//!   the time, sequence or total-call (`--calls`) budget is spent (`--max-calls`: calls per
+//!   sequence); before each sequence, FILE (default
 //!   `target/fmi-fuzz-progress.txt`) is overwritten with its index and seed-state, and a
 //!   fatal signal (abort, crash) prints them to stderr;
 //! - `fmi-fuzz fuzz --replay 0xSTATE [--max-calls N]` (a seed-state as logged) or
@@ -57,6 +58,7 @@ fn main() {
             let cfg = Config {
                 seed,
                 sequences,
+                max_total_calls: arg(&args, "--calls", u64::MAX),
                 deadline: Some(Instant::now() + Duration::from_secs(seconds)),
                 max_calls,
                 per_fmu_cap: Default::default(),
@@ -64,10 +66,16 @@ fn main() {
             };
             let t0 = Instant::now();
             let report = Fuzzer::new(&fmus, seed).run(&cfg);
-            println!("FMUs {ids:?}, seed {seed:#x}, {:.1} s", t0.elapsed().as_secs_f64());
+            let secs = t0.elapsed().as_secs_f64();
+            println!(
+                "FMUs {ids:?}, seed {seed:#x}, {secs:.1} s, {} FMI calls ({:.0} calls/s)",
+                report.calls,
+                report.calls as f64 / secs.max(1e-9)
+            );
             if args.iter().any(|a| a == "--coverage") {
                 report.print_coverage();
             }
+            report.print_coverage_summary();
             report.print();
             std::process::exit(i32::from(report.violations > 0));
         }
@@ -116,7 +124,7 @@ fn main() {
         }
         _ => {
             eprintln!(
-                "usage: fmi-fuzz fuzz [--seconds N] [--seed S] [--sequences N] [--max-calls N] [--coverage] [--progress FILE]"
+                "usage: fmi-fuzz fuzz [--seconds N] [--seed S] [--sequences N] [--calls N] [--max-calls N] [--coverage] [--progress FILE]"
             );
             eprintln!("       fmi-fuzz fuzz --replay 0xSEED_STATE|INDEX [--seed S] [--max-calls N]");
             eprintln!("       fmi-fuzz cycles [--n N]");
