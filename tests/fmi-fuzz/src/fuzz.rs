@@ -137,8 +137,28 @@ impl Report {
             .copied()
             .filter(|f| !functions.contains(*f))
             .collect();
+        // FMI states (Co-Simulation, "ME …" Model Exchange) vs. other call contexts
+        // (fmi2Instantiate argument variants, foreign components, "any").
+        let fmi = |st: &str| {
+            let st = st.strip_prefix("ME ").unwrap_or(st);
+            matches!(
+                st,
+                "Instantiated"
+                    | "InitializationMode"
+                    | "StepComplete"
+                    | "StepInProgress"
+                    | "StepFailed"
+                    | "StepCanceled"
+                    | "Terminated"
+                    | "EventMode"
+                    | "ContinuousTimeMode"
+            )
+        };
+        let (in_states, contexts): (Vec<&String>, Vec<&String>) = states.iter().partition(|s| fmi(s));
+        let join = |v: &[&String]| v.iter().map(|s| s.as_str()).collect::<Vec<_>>().join(", ");
         println!(
-            "coverage: {} of the {} FMI 2.0 functions called (never: {}); calls made in {} states: {}",
+            "coverage: {} of the {} FMI 2.0 functions called (never: {}); calls in {} FMI states: {}; \
+             other call contexts: {}",
             FMI2_FUNCTIONS.len() - missing.len(),
             FMI2_FUNCTIONS.len(),
             if missing.is_empty() {
@@ -146,8 +166,9 @@ impl Report {
             } else {
                 missing.join(", ")
             },
-            states.len(),
-            states.iter().cloned().collect::<Vec<_>>().join(", ")
+            in_states.len(),
+            join(&in_states),
+            join(&contexts)
         );
     }
 
