@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Long-run hardening of the FMU libraries (issue 7). Not part of scripts/test.sh,
+# Long-run hardening of the FMU libraries. Not part of scripts/test.sh,
 # which runs the short versions (cargo test -p fmi-fuzz: 2500 fuzz sequences,
 # 64-thread check, 10 000-cycle RSS check; pytest test_conformance/test_interop).
 #
