@@ -1604,7 +1604,16 @@ impl<'a> Fuzzer<'a> {
             self.rng.pick(&self.banks[f]).clone()
         };
         let mut null_out = false;
-        let (bytes, expect, mirror, label): (Vec<u8>, Expect, Option<Mirror>, String) = match self.rng.below(12) {
+        let (bytes, expect, mirror, label): (Vec<u8>, Expect, Option<Mirror>, String) = match self.rng.below(13) {
+            12 => match self.forge_variable(fmu, &own) {
+                // A parameter or input forged, re-sealed: refused exactly when fmi2Set* would
+                // refuse the value (crates/fmi2-export/README.md, FMU state).
+                Some((b, refused, label)) => {
+                    let expect = if refused { Expect::Error } else { Expect::OkOrError };
+                    (b, expect, (!refused).then_some(mirror), label)
+                }
+                None => (own, Expect::Ok, Some(mirror), "intact".into()),
+            },
             0 => {
                 let n = self.rng.below(own.len());
                 (own[..n].to_vec(), Expect::Error, None, format!("truncated to {n}"))
@@ -1692,6 +1701,78 @@ impl<'a> Fuzzer<'a> {
                 fmu,
                 format!("fmi2DeSerializeFMUstate failed ({label}) but wrote a state"),
             );
+        }
+    }
+
+    /// `own` (a serialized state of `fmu`) with one Real or Integer parameter or input
+    /// replaced by a value from the edges of its range (or beyond: non-finite, huge,
+    /// just outside), re-sealed with a valid checksum. Returns the buffer, whether
+    /// fmi2Set* would refuse the value, and a label; `None` if the payload does not have
+    /// the declared layout (machine fields, then every variable in declaration order).
+    fn forge_variable(&mut self, fmu: &Fmu, own: &[u8]) -> Option<(Vec<u8>, bool, String)> {
+        const MACHINE_BYTES: usize = 38;
+        let env = open(own)?;
+        let mut payload = env.payload.clone();
+        let mut at = MACHINE_BYTES;
+        let mut slots = Vec::new();
+        for v in &fmu.vars {
+            let len = match v.ty {
+                VarType::Real => 8,
+                VarType::Integer => 4,
+                VarType::Boolean => 1,
+                VarType::String => 4 + u32::from_le_bytes(payload.get(at..at + 4)?.try_into().ok()?) as usize,
+            };
+            let bounded = matches!(v.causality, Causality::Parameter | Causality::Input)
+                && v.variability != Variability::Constant
+                && matches!(v.ty, VarType::Real | VarType::Integer);
+            if bounded {
+                slots.push((v, at));
+            }
+            at += len;
+        }
+        if at > payload.len() || slots.is_empty() {
+            return None;
+        }
+        let (v, at) = *self.rng.pick(&slots);
+        let (lo, hi) = (v.min, v.max);
+        let above = if hi.is_finite() {
+            hi + hi.abs().max(1.0) * 1e-6
+        } else {
+            1e300
+        };
+        let below = if lo.is_finite() {
+            lo - lo.abs().max(1.0) * 1e-6
+        } else {
+            -1e300
+        };
+        let inside = self.rng.in_range(lo, hi);
+        if v.ty == VarType::Real {
+            let x = *self.rng.pick(&[
+                f64::NAN,
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+                2e10,
+                -2e10,
+                f64::MAX,
+                above,
+                below,
+                inside,
+            ]);
+            payload[at..at + 8].copy_from_slice(&x.to_le_bytes());
+            let refused = !x.is_finite() || x < lo || x > hi;
+            Some((seal(&env.head, &payload), refused, format!("forged {} = {x}", v.name)))
+        } else {
+            let clamp = |x: f64| x.clamp(f64::from(i32::MIN), f64::from(i32::MAX)) as i32;
+            let x = *self.rng.pick(&[
+                i32::MIN,
+                i32::MAX,
+                clamp(lo.max(-1e6) - 1.0),
+                clamp(hi.min(1e6) + 1.0),
+                clamp(inside.round()),
+            ]);
+            payload[at..at + 4].copy_from_slice(&x.to_le_bytes());
+            let refused = f64::from(x) < lo || f64::from(x) > hi;
+            Some((seal(&env.head, &payload), refused, format!("forged {} = {x}", v.name)))
         }
     }
 
