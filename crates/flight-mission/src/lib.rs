@@ -87,6 +87,13 @@ pub const FAST_T_TRANSITION_1: f64 = 2.0;
 /// T2 of the fast mission ([`MissionParams::fast`]) (s).
 pub const FAST_T_TRANSITION_2: f64 = 3.0;
 
+/// Longest mission [`MissionParams::validate`] accepts (s): the sum of the declared maxima
+/// of the five phase durations (`t_vertical_1`, `t_level`, `t_vertical_2` ≤ 10 000 s,
+/// `t_transition_1`, `t_transition_2` ≤ 1 000 s). The reference tables (the flight-path
+/// profile, the LQR trajectory) are sampled every 10 ms over the whole mission: this bounds
+/// them at 3.2 million points, so no parameter set can ask for an absurd allocation.
+pub const MAX_MISSION_DURATION: f64 = 32_000.0;
+
 /// A parameter that is not acceptable, with the reason.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ParamError(pub String);
@@ -100,7 +107,8 @@ impl fmt::Display for ParamError {
 impl std::error::Error for ParamError {}
 
 impl MissionParams {
-    /// Every duration finite and non-negative, transitions and sample time positive,
+    /// Every duration finite and non-negative, the mission at most
+    /// [`MAX_MISSION_DURATION`] long, transitions and sample time positive,
     /// `v_level > v_vertical ≥ 0`.
     pub fn validate(&self) -> Result<(), ParamError> {
         let named = self.named_values();
@@ -110,6 +118,14 @@ impl MissionParams {
             if !value.is_finite() || value < 0.0 && !signed {
                 return Err(ParamError(format!("{name} = {value}: must be finite and ≥ 0")));
             }
+        }
+        if self.end_time() > MAX_MISSION_DURATION {
+            return Err(ParamError(format!(
+                "t_vertical_1 + t_transition_1 + t_level + t_transition_2 + t_vertical_2 = {} s: \
+                 the mission may last at most {MAX_MISSION_DURATION} s (its reference tables are sampled \
+                 over the whole mission)",
+                self.end_time()
+            )));
         }
         for (name, value) in [
             ("t_transition_1", self.t_transition_1),
@@ -665,6 +681,33 @@ mod tests {
             ..Default::default()
         };
         assert!(m.validate().unwrap_err().0.contains("v_level"));
+    }
+
+    #[test]
+    fn mission_duration_is_bounded() {
+        // The longest mission the declared maxima allow is accepted…
+        let m = MissionParams {
+            t_vertical_1: 10_000.0,
+            t_transition_1: 1_000.0,
+            t_level: 10_000.0,
+            t_transition_2: 1_000.0,
+            t_vertical_2: 10_000.0,
+            ..Default::default()
+        };
+        assert_eq!(m.end_time(), MAX_MISSION_DURATION);
+        assert!(m.validate().is_ok());
+        // …a longer one (a corrupted t_level of 2e10 s would ask for 2e12 table points) is
+        // refused before any table is sized, naming the phase durations.
+        for t_level in [10_000.001, 2e10, f64::MAX] {
+            let m = MissionParams { t_level, ..m };
+            let e = m.validate().unwrap_err().0;
+            assert!(e.contains("t_level") && e.contains("at most 32000 s"), "{e}");
+        }
+        let m = MissionParams {
+            t_vertical_2: 2e10,
+            ..Default::default()
+        };
+        assert!(m.validate().unwrap_err().0.contains("t_vertical_2"));
     }
 
     fn samples(h: f64, until: f64) -> Vec<f64> {
