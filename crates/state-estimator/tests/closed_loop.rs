@@ -63,6 +63,10 @@ enum Variant {
     NoFilterCompensation,
     NoSideslip,
     AppD,
+    /// App. D with the filter compensation back on.
+    AppDFilterCompensation,
+    /// App. D with the filter compensation and the model prediction back on.
+    AppDFilterCompensationModelPrediction,
 }
 
 const GAUSS_SEIDEL: Chain = Chain {
@@ -88,6 +92,15 @@ fn estimator_params(chain: Chain, sensor_params: &sensor_model::Params) -> Estim
         Variant::NoFilterCompensation => params.filter.compensate = false,
         Variant::NoSideslip => params.tuning.sideslip_pseudo_measurement = false,
         Variant::AppD => params = params.app_d(),
+        Variant::AppDFilterCompensation => {
+            params = params.app_d();
+            params.filter.compensate = true;
+        }
+        Variant::AppDFilterCompensationModelPrediction => {
+            params = params.app_d();
+            params.filter.compensate = true;
+            params.prediction.model = true;
+        }
     }
     if chain.jacobi {
         params.filter.latency = H;
@@ -399,10 +412,12 @@ fn extras_and_the_app_d_configuration_on_the_default_mission() {
         Variant::NoFilterCompensation,
         Variant::NoSideslip,
         Variant::AppD,
+        Variant::AppDFilterCompensation,
+        Variant::AppDFilterCompensationModelPrediction,
     ];
     let mut tuned = Vec::new();
     for variant in variants {
-        for seed in [1, 2] {
+        for seed in [1, 2, 3] {
             let chain = Chain {
                 variant,
                 ..GAUSS_SEIDEL
