@@ -94,13 +94,13 @@ pub struct Params {
     pub gps_height_std: f64,
     /// σ of each NED velocity component (m/s), Table D.1.
     pub gps_vel_std: f64,
-    /// σ of each accelerometer axis before the filter (m/s²), Table D.1.
+    /// σ of each accelerometer axis on the delivered (filtered) output (m/s²), Table D.1.
     pub accel_std: f64,
-    /// σ of each gyro axis before the filter (rad/s), Table D.1.
+    /// σ of each gyro axis on the delivered output (rad/s), Table D.1.
     pub gyro_std: f64,
-    /// σ of each magnetometer axis before the filter (Gauss), Table D.1.
+    /// σ of each magnetometer axis on the delivered output (Gauss), Table D.1.
     pub mag_std: f64,
-    /// σ of the pitot's differential pressure before the filter (Pa).
+    /// σ of the pitot's differential pressure after the filter (Pa).
     pub pitot_std: f64,
     /// Constant biases (channel units; pitot in Pa).
     pub accel_bias: Vector3<f64>,
@@ -136,7 +136,7 @@ impl Default for Params {
         let deg = std::f64::consts::PI / 180.0;
         Self {
             seed: 1,
-            accel_rate: 200.0,
+            accel_rate: 1000.0,
             gyro_rate: 200.0,
             mag_rate: 50.0,
             pitot_rate: 50.0,
@@ -446,6 +446,9 @@ impl State {
 struct Derived {
     period: [f64; N_SENSORS],
     filter: [Butterworth2; 4],
+    /// σ of the white noise before the filter (accel, gyro, mag, pitot): the delivered σ
+    /// over the filter's noise gain, so that the output carries the parameter's σ.
+    white_std: [f64; 4],
     tangent: LocalTangent,
     field_ned: Vector3<f64>,
 }
@@ -604,14 +607,18 @@ impl SensorModel {
                 Butterworth2::IDENTITY
             }
         };
+        let filter = [
+            filter_of(params.accel_rate),
+            filter_of(params.gyro_rate),
+            filter_of(params.mag_rate),
+            filter_of(params.pitot_rate),
+        ];
+        let delivered = [params.accel_std, params.gyro_std, params.mag_std, params.pitot_std];
+        let white_std = std::array::from_fn(|i| delivered[i] / filter[i].noise_gain());
         let derived = Derived {
             period,
-            filter: [
-                filter_of(params.accel_rate),
-                filter_of(params.gyro_rate),
-                filter_of(params.mag_rate),
-                filter_of(params.pitot_rate),
-            ],
+            filter,
+            white_std,
             tangent: LocalTangent::new(params.ref_latitude, params.ref_longitude, params.ref_height)
                 .expect("validated"),
             field_ned: params.field_ned(),
@@ -660,7 +667,8 @@ impl SensorModel {
     }
 
     /// σ_out/σ_in of the Butterworth for white noise (accel, gyro, mag, pitot pressure);
-    /// 1 with the filter disabled.
+    /// 1 with the filter disabled. The white noise before the filter has σ = the parameter's
+    /// σ over this gain, so the delivered output carries the parameter's σ (Table D.1).
     pub fn noise_gains(&self) -> [f64; 4] {
         self.derived.filter.map(|f| f.noise_gain())
     }
@@ -756,16 +764,6 @@ impl SensorModel {
         }
     }
 
-    fn std(&self, s: Sensor) -> f64 {
-        match s {
-            Sensor::Accel => self.params.accel_std,
-            Sensor::Gyro => self.params.gyro_std,
-            Sensor::Mag => self.params.mag_std,
-            Sensor::Pitot => self.params.pitot_std,
-            Sensor::Gps => 0.0,
-        }
-    }
-
     /// The sample indices [first, end) of sensor `s` with instants before `t_end`.
     fn due(&mut self, s: Sensor, t_end: f64) -> (u64, u64) {
         let period = self.derived.period[s as usize];
@@ -795,7 +793,7 @@ impl SensorModel {
                 Sensor::Mag => 6..9,
                 _ => 9..10,
             };
-            let std = self.std(s);
+            let std = self.derived.white_std[s as usize];
             let period = self.derived.period[s as usize];
             let coeffs = self.derived.filter[s as usize];
             for k in first..end {
