@@ -3,7 +3,7 @@
 //!
 //! * [`model`]: the full-state Euler model for control (§2.4, candidate 2 of §3.2.3) on the
 //!   physics crate's force model, linearised analytically (3.2.7–3.2.9).
-//! * [`linalg`]: zero-order-hold discretisation (replacing (3.2.10–3.2.11)), the steady-state
+//! * [`linalg`]: zero-order-hold discretisation (the tuned alternative to (3.2.10–3.2.11)), the steady-state
 //!   DARE by structured doubling, the thesis's N-step backward iteration (3.1.3–3.1.5).
 //! * [`trajectory`]: the reference trajectory of §3.3.
 //! * [`weights`]: Table 3.4 weights per phase (3.4.1–3.4.3), blended between phases.
@@ -88,7 +88,7 @@ pub struct LqrParams {
     pub weight_blend_time: f64,
     /// Reference 3-2-1 pitch above which the 2-3-1 Euler set is used (rad).
     pub euler_switch_pitch: f64,
-    /// Limit of the airspeed-error integrator |∫ΔV dt| (m).
+    /// Limit of the airspeed-error integrator |∫ΔV dt| (m), applied with `integrator_clamp`.
     pub integrator_limit: f64,
     /// Leak λ of the airspeed integrator, ẋ_I = V − V_t − λ x_I (1/s). Must be > 0 with the
     /// DARE (`riccati_method` 0): with λ = 0 the integrator minus the along-track position
@@ -126,7 +126,8 @@ pub struct LqrParams {
     /// [`Self::effective`]): backward iteration over `riccati_horizon`, airspeed-integrator
     /// leak 0, Table 3.4 verbatim (weight set 0, switched without blending), the closed-form trajectory (3.3.x), the
     /// no-wind reference, airspeed integral only, and the reference re-anchored at the
-    /// measured position at the start of every mission segment (§3.5.1).
+    /// measured position at the start of every mission segment (§3.5.1); the switches below
+    /// at −1 take the configuration's form (thesis: the printed one).
     pub configuration: i32,
     /// Discretisation of the model for control (docs/THESIS.md D-3.3): 0 = exact zero-order
     /// hold, 1 = the printed first-order form Φ ≈ I + F T_s, Γ ≈ G T_s (3.2.10–3.2.11), with
