@@ -2130,7 +2130,7 @@ VARIABLES: dict[str, dict[str, Variable]] = {
             10.0,
             1e-6,
             1000.0,
-            "Bound on the airspeed-error integrator state (anti-windup; it also stops integrating into a thrust limit).",
+            "Bound on the airspeed-error integrator state (anti-windup), applied when integrator_clamp is on (tuned configuration by default; the stop while integrating into a thrust limit is integrator_freeze).",
         ),
         "integrator_leak": Variable(
             "integrator_leak",
