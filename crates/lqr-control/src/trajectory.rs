@@ -74,6 +74,9 @@ pub struct TrajectoryOptions {
     /// V and γ of the α- and thrust-limited point-mass profile
     /// ([`flight_mission::profile`]) instead of the thesis's cosine blends.
     pub limited_path: bool,
+    /// Thrust command T_c = T + τ_T Ṫ leading the lagged thrust state (2.3.16); off: T_c = T,
+    /// the printed (3.3.13–3.3.14) (docs/THESIS.md D-3.15).
+    pub thrust_lead: bool,
 }
 
 impl Default for TrajectoryOptions {
@@ -83,6 +86,7 @@ impl Default for TrajectoryOptions {
             alpha_max: 15f64.to_radians(),
             turn_radius: 0.0,
             limited_path: true,
+            thrust_lead: true,
         }
     }
 }
@@ -673,9 +677,12 @@ fn thesis_point(af: &Airframe, k: &PointKinematics, alpha: f64, p: &mut TrajPoin
 }
 
 /// Positions by integrating the path velocity (3.3.9–3.3.12, trapezoidal rule) and the
-/// thrust command leading the state by the lag, T_c = T + τ_T Ṫ (2.3.16), clamped to the
-/// thrust range; in the `Thesis` mode α back to the kinematic `alphas`.
-fn positions_and_commands(af: &Airframe, mode: TrajectoryMode, pts: &mut [TrajPoint], alphas: &[f64]) {
+/// thrust command, with `thrust_lead` leading the state by the lag, T_c = T + τ_T Ṫ (2.3.16),
+/// else T_c = T (3.3.13–3.3.14), clamped to the thrust range; in the `Thesis` mode α back to
+/// the kinematic `alphas`.
+fn positions_and_commands(af: &Airframe, opt: &TrajectoryOptions, pts: &mut [TrajPoint], alphas: &[f64]) {
+    let mode = opt.mode;
+    let lead = if opt.thrust_lead { af.tau_thrust } else { 0.0 };
     let thrusts: Vec<f64> = pts.iter().map(|p| p.thrust).collect();
     let tdot = derivative(&thrusts);
     let mut pos = Vector3::zeros();
@@ -690,7 +697,7 @@ fn positions_and_commands(af: &Airframe, mode: TrajectoryMode, pts: &mut [TrajPo
         }
         let p = &mut pts[i];
         p.pos_neh = pos;
-        p.u[0] = (p.thrust + af.tau_thrust * tdot[i]).clamp(af.thrust_min, af.thrust_max);
+        p.u[0] = (p.thrust + lead * tdot[i]).clamp(af.thrust_min, af.thrust_max);
         if mode == TrajectoryMode::Thesis {
             p.alpha = alphas[i];
         }
@@ -757,7 +764,7 @@ impl Trajectory {
                 }
             }
         }
-        positions_and_commands(af, opt.mode, &mut pts, &alphas);
+        positions_and_commands(af, opt, &mut pts, &alphas);
         if pts
             .iter()
             .any(|p| !(p.v.is_finite() && p.u.iter().all(|x| x.is_finite()) && p.pos_neh.iter().all(|x| x.is_finite())))
