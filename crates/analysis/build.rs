@@ -1,5 +1,5 @@
-//! Hashes the source of every crate whose code decides the campaign results
-//! (physics, mission, closed loop and its mission criteria, both controllers, this crate) into
+//! Hashes the source of every crate whose code decides the sweep results
+//! (physics, mission, guidance, closed loop and its mission criteria, both controllers, this crate) into
 //! `RESULTS_SOURCE_HASH`, part of every cache key: editing any of them
 //! invalidates the cached results instead of serving stale ones.
 
@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 const SOURCES: &[&str] = &[
     "../tailsitter-physics/src",
     "../flight-mission/src",
+    "../guidance/src",
     "../closed-loop/src",
     "../lqr-control/src",
     "../lqr-control/resources",

@@ -20,9 +20,10 @@ pub mod trajectory;
 pub mod weights;
 
 use flight_mission::{
-    Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, GroundMode, GroundPhases, MissionParams,
-    Notice, ParamError, SampledUnit, VerticalReference, Weathervane, WeathervaneParams,
+    Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, MissionParams, Notice, ParamError,
+    SampledUnit,
 };
+use guidance::{GroundMode, GroundPhases, VerticalReference, Weathervane, WeathervaneParams};
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 use tailsitter_physics::{Airframe, Surfaces};
 
@@ -1192,8 +1193,7 @@ impl SampledUnit for LqrController {
             && self.weathervane.free(&self.mission, t)
             && (self.weathervane.engaged()
                 || (m.alpha.abs() > HOVER_WIND_AIR_ANGLE || m.beta.abs() > HOVER_WIND_AIR_ANGLE)
-                    && flight_mission::weathervane::air_data_wind(m).xy().norm()
-                        >= self.weathervane.params().engage_speed);
+                    && guidance::weathervane::air_data_wind(m).xy().norm() >= self.weathervane.params().engage_speed);
         // Integral action on the horizontal position in wind (README, "Hover in wind"): the
         // position the gains regulate to is the reference moved against the integrated error,
         // s ← s + T_s/τ_s (p − p_ref), regulated to p_ref − s, so the steady error of a
@@ -1264,8 +1264,7 @@ impl SampledUnit for LqrController {
                     && self.params.configuration == 0
                     && self.mission.phase_at(t).0 == flight_mission::Phase::Vertical2
                     && (m.alpha.abs() > HOVER_WIND_AIR_ANGLE || m.beta.abs() > HOVER_WIND_AIR_ANGLE)
-                    && flight_mission::weathervane::air_data_wind(m).xy().norm()
-                        >= self.weathervane.params().engage_speed;
+                    && guidance::weathervane::air_data_wind(m).xy().norm() >= self.weathervane.params().engage_speed;
             let mut x_lin = if lin_ref { xt } else { x };
             // In the take-off and landing phases linearise at α = β = 0: x carries the body
             // air velocity there (`hover_air_data`), exact at α = β = 0 for any w/V_e.

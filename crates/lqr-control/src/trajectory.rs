@@ -37,7 +37,8 @@
 
 use std::sync::Arc;
 
-use flight_mission::{HeadingRef, MissionParams, Phase, PointMass, Profile, ProfileLimits};
+use flight_mission::{MissionParams, Phase};
+use guidance::{HeadingRef, PointMass, Profile, ProfileLimits};
 use nalgebra::{Matrix3, Vector3, Vector4};
 use tailsitter_physics::{quat_from_euler_321, Airframe, Surfaces};
 

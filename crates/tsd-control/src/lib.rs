@@ -46,15 +46,16 @@ pub use params::{
 pub use trajectory::{Reference, Trajectory};
 
 use flight_mission::{
-    Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, GroundMode, GroundPhases, MissionParams,
-    Notice, ParamError, Phase, SampledUnit, Weathervane, WeathervaneParams,
+    Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, MissionParams, Notice, ParamError, Phase,
+    SampledUnit,
 };
+use guidance::{GroundMode, GroundPhases, Weathervane, WeathervaneParams};
 use nalgebra::{Matrix3, Quaternion, RowVector3, UnitQuaternion, Vector3};
 use tailsitter_physics::Airframe;
 
 /// Number of f64 values written by [`TsdController::save`]: the loops' six, the
 /// weathervane's and the take-off / landing phases'.
-pub const STATE_LEN: usize = 6 + flight_mission::weathervane::WEATHERVANE_STATE_LEN + GroundPhases::SAVED_LEN;
+pub const STATE_LEN: usize = 6 + guidance::weathervane::WEATHERVANE_STATE_LEN + GroundPhases::SAVED_LEN;
 
 /// Internal signals of the last sample, for tests, plots and tuning.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -220,8 +221,8 @@ impl TsdController {
         // The tuned configuration flies the α- and thrust-limited profile (issue 16), the
         // thesis configuration the quarter loops of §4.3.3.
         let trajectory = if params.configuration == 0 {
-            let pm = flight_mission::PointMass::from_level_trim(&airframe, mission.v_level)?;
-            let profile = flight_mission::Profile::new(&mission, &pm, &flight_mission::ProfileLimits::of(&mission))?;
+            let pm = guidance::PointMass::from_level_trim(&airframe, mission.v_level)?;
+            let profile = guidance::Profile::new(&mission, &pm, &guidance::ProfileLimits::of(&mission))?;
             Trajectory::limited(mission, airframe.gravity, profile)
         } else {
             Trajectory::new(mission, airframe.gravity)
@@ -322,9 +323,7 @@ impl TsdController {
         } else {
             0
         };
-        let mut rest = v[6 + flight_mission::weathervane::WEATHERVANE_STATE_LEN..]
-            .iter()
-            .copied();
+        let mut rest = v[6 + guidance::weathervane::WEATHERVANE_STATE_LEN..].iter().copied();
         self.ground
             .restore(&mut || rest.next())
             .ok_or_else(|| ControlError("truncated TSD controller state".into()))?;
@@ -640,7 +639,7 @@ impl SampledUnit for TsdController {
         // vector turned about the earth's down axis by ψ_w; zero in still air and in the
         // take-off and landing phases (their own vertical reference).
         let heading = if sigma_ground.is_some() {
-            flight_mission::HeadingRef::default()
+            guidance::HeadingRef::default()
         } else {
             self.weathervane.update(&self.mission, t_mission, meas)
         };

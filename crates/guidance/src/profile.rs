@@ -33,7 +33,7 @@
 
 use std::sync::Arc;
 
-use crate::{MissionParams, ParamError, Phase};
+use flight_mission::{MissionParams, ParamError, Phase};
 
 /// Table step of the profile (s).
 pub const PROFILE_STEP: f64 = 0.01;
