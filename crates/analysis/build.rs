@@ -1,5 +1,6 @@
 //! Hashes the source of every crate whose code decides the sweep results
-//! (physics, mission, guidance, closed loop and its mission criteria, both controllers, this crate) into
+//! (physics, mission, guidance, closed loop and its mission criteria, both controllers, the
+//! declarations their parameter defaults are generated from, this crate) into
 //! `RESULTS_SOURCE_HASH`, part of every cache key: editing any of them
 //! invalidates the cached results instead of serving stale ones.
 
@@ -13,7 +14,11 @@ const SOURCES: &[&str] = &[
     "../lqr-control/src",
     "../lqr-control/resources",
     "../tsd-control/src",
-    "../../modelDescription/fragments/mission_criteria.json",
+    "../../modelDescription/fragments",
+    "../../modelDescription/tailsitter_plant.json",
+    "../../modelDescription/tailsitter_lqr.json",
+    "../../modelDescription/tailsitter_tsd.json",
+    "../../modelDescription/src/defaults.rs",
     "src",
 ];
 

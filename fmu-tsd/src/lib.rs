@@ -33,12 +33,6 @@ mod tests {
     use fmi2_export::{FmuModel, Logger, StateReader, StateWriter, VariableStore};
 
     #[test]
-    fn declared_start_values_are_the_library_defaults() {
-        let vars = Variables::with_start_values();
-        assert_eq!(vars.tsd(), tsd_control::TsdParams::default());
-    }
-
-    #[test]
     fn initialization_holds_the_trim_command_and_steps_hold_between_samples() {
         let mut vars = Variables::with_start_values();
         let mut model = TsdModel::new(&vars);

@@ -5,8 +5,9 @@
 //!   binaries/win64/<id>.dll, documentation/index.html);
 //! - `ssp`: write the SSP 1.0 closed-loop systems `dist/<controller>.ssp` from the packaged FMUs
 //!   (`dist` writes them too);
-//! - `regen`: rewrite the reviewed copies `modelDescription/generated/<id>.xml` and the
-//!   variable references `modelDescription/generated/<id>.md`.
+//! - `regen`: rewrite the reviewed copies `modelDescription/generated/<id>.xml`, the
+//!   variable references `modelDescription/generated/<id>.md` and the generated Rust
+//!   parameter defaults `modelDescription/generated/*_generated.rs`.
 
 mod ssp;
 
@@ -72,7 +73,7 @@ enum Task {
         #[arg(long, default_value = "dist")]
         out: PathBuf,
     },
-    /// Regenerate modelDescription/generated/<id>.xml from the declarations.
+    /// Regenerate modelDescription/generated/ (XML, variable references, Rust defaults) from the declarations.
     Regen,
 }
 
@@ -163,6 +164,14 @@ fn regen() -> Result<(), String> {
             std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))?;
             println!("wrote {}", path.display());
         }
+    }
+    let declarations = workspace_root().join("modelDescription");
+    for c in model_description::defaults::CRATES {
+        let (text, _) =
+            model_description::defaults::generate(&declarations, c).map_err(|e| format!("{}: {e}", c.file))?;
+        let path = dir.join(c.out);
+        std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+        println!("wrote {}", path.display());
     }
     Ok(())
 }

@@ -78,11 +78,13 @@ pub struct TrajectoryOptions {
 }
 
 impl Default for TrajectoryOptions {
+    /// The options of the default [`crate::LqrParams`] (`trajectory_mode` 1, `configuration` 0).
     fn default() -> Self {
+        let p = crate::LqrParams::default();
         Self {
             mode: TrajectoryMode::ForceBalance,
-            alpha_max: 15f64.to_radians(),
-            turn_radius: 0.0,
+            alpha_max: p.alpha_max,
+            turn_radius: p.turn_radius,
             limited_path: true,
         }
     }
