@@ -463,7 +463,9 @@ pub fn struct_defaults(
     source: &str,
     extra: &[(&str, String)],
 ) -> String {
-    let mut fields: Vec<(String, Vec<(Option<usize>, String)>)> = Vec::new();
+    // Per field in order of first appearance: (element index, start literal) of each parameter.
+    type Elements = Vec<(Option<usize>, String)>;
+    let mut fields: Vec<(String, Elements)> = Vec::new();
     for d in decls
         .iter()
         .filter(|d| d.group.as_deref() == Some(group) && d.causality == Causality::Parameter)
