@@ -34,7 +34,7 @@ pub struct StructDefaults {
     pub named_values: bool,
 }
 
-/// The generated defaults of one crate: one file `OUT_DIR/<out>`.
+/// Generated defaults of a crate: one file `OUT_DIR/<out>` (a crate may have several).
 #[derive(Debug, Clone, Copy)]
 pub struct CrateDefaults {
     /// Package name; its sources are `crates/<krate>/src`.
@@ -66,6 +66,12 @@ pub const CRATES: &[CrateDefaults] = &[
             named_values: true,
             ..plain("Airframe", "airframe", "")
         }],
+    },
+    CrateDefaults {
+        krate: "tailsitter-physics",
+        file: "tailsitter_plant.json",
+        out: "ground_generated.rs",
+        structs: &[plain("Ground", "ground", "")],
     },
     CrateDefaults {
         krate: "flight-mission",
@@ -165,24 +171,24 @@ pub fn generate(dir: &Path, c: &CrateDefaults) -> Result<(String, Vec<PathBuf>),
     Ok((text, sources))
 }
 
-/// The entry of crate `krate` in [`CRATES`].
-pub fn of(krate: &str) -> &'static CrateDefaults {
-    CRATES
-        .iter()
-        .find(|c| c.krate == krate)
-        .unwrap_or_else(|| panic!("no generated defaults for crate '{krate}'"))
+/// The entries of crate `krate` in [`CRATES`].
+pub fn of(krate: &str) -> Vec<&'static CrateDefaults> {
+    let entries: Vec<_> = CRATES.iter().filter(|c| c.krate == krate).collect();
+    assert!(!entries.is_empty(), "no generated defaults for crate '{krate}'");
+    entries
 }
 
-/// Build-script entry: writes `OUT_DIR/<out>` of the calling crate (`CARGO_PKG_NAME`)
-/// and prints `cargo:rerun-if-changed` for every declaration read.
+/// Build-script entry: writes every `OUT_DIR/<out>` of the calling crate
+/// (`CARGO_PKG_NAME`) and prints `cargo:rerun-if-changed` for every declaration read.
 pub fn build() {
     let var = |name: &str| PathBuf::from(std::env::var(name).unwrap_or_else(|_| panic!("{name} set by cargo")));
     let krate = std::env::var("CARGO_PKG_NAME").expect("set by cargo");
-    let c = of(&krate);
     let dir = var("CARGO_MANIFEST_DIR").join("../../modelDescription");
-    let (text, sources) = generate(&dir, c).unwrap_or_else(|e| panic!("declaration {}: {e}", c.file));
-    std::fs::write(var("OUT_DIR").join(c.out), text).unwrap_or_else(|e| panic!("write {}: {e}", c.out));
-    for s in sources {
-        println!("cargo:rerun-if-changed={}", s.display());
+    for c in of(&krate) {
+        let (text, sources) = generate(&dir, c).unwrap_or_else(|e| panic!("declaration {}: {e}", c.file));
+        std::fs::write(var("OUT_DIR").join(c.out), text).unwrap_or_else(|e| panic!("write {}: {e}", c.out));
+        for s in sources {
+            println!("cargo:rerun-if-changed={}", s.display());
+        }
     }
 }
