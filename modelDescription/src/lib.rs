@@ -16,6 +16,7 @@
 //! packager runs the first and the last. A reviewable copy of each XML is kept in
 //! `modelDescription/generated/` and a test fails when it drifts.
 
+pub mod defaults;
 pub mod html;
 pub mod python;
 pub mod rust;

@@ -2222,7 +2222,7 @@ VARIABLES: dict[str, dict[str, Variable]] = {
             0.20943951023931956,
             0.05,
             0.45,
-            "Largest angle of attack of the tuned controllers' flight-path profile (12 deg): the transition reference is the point-mass response to alpha and thrust bounded by construction (crates/flight-mission/README.md); the thesis configuration flies the thesis's closed-form transitions and ignores it.",
+            "Largest angle of attack of the tuned controllers' flight-path profile (12 deg): the transition reference is the point-mass response to alpha and thrust bounded by construction (crates/guidance/README.md); the thesis configuration flies the thesis's closed-form transitions and ignores it.",
         ),
         "transition_thrust_fraction": Variable(
             "transition_thrust_fraction",
@@ -6870,7 +6870,7 @@ VARIABLES: dict[str, dict[str, Variable]] = {
             0.20943951023931956,
             0.05,
             0.45,
-            "Largest angle of attack of the tuned controllers' flight-path profile (12 deg): the transition reference is the point-mass response to alpha and thrust bounded by construction (crates/flight-mission/README.md); the thesis configuration flies the thesis's closed-form transitions and ignores it.",
+            "Largest angle of attack of the tuned controllers' flight-path profile (12 deg): the transition reference is the point-mass response to alpha and thrust bounded by construction (crates/guidance/README.md); the thesis configuration flies the thesis's closed-form transitions and ignores it.",
         ),
         "transition_thrust_fraction": Variable(
             "transition_thrust_fraction",

@@ -6,7 +6,8 @@
 //! - `ssp`: write the SSP 1.0 closed-loop systems `dist/<controller>.ssp` from the packaged FMUs
 //!   (`dist` writes them too);
 //! - `regen`: rewrite the reviewed copies `modelDescription/generated/<id>.xml`, the
-//!   variable references `modelDescription/generated/<id>.md` and the Python
+//!   variable references `modelDescription/generated/<id>.md`, the generated Rust
+//!   parameter defaults `modelDescription/generated/*_generated.rs` and the Python
 //!   declarations module `python/tailsim/declarations.py`.
 
 mod ssp;
@@ -78,7 +79,7 @@ enum Task {
         #[arg(long, default_value = "dist")]
         out: PathBuf,
     },
-    /// Regenerate modelDescription/generated/<id>.xml from the declarations.
+    /// Regenerate modelDescription/generated/ (XML, variable references, Rust defaults) from the declarations.
     Regen,
 }
 
@@ -169,6 +170,14 @@ fn regen() -> Result<(), String> {
             std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))?;
             println!("wrote {}", path.display());
         }
+    }
+    let declarations = workspace_root().join("modelDescription");
+    for c in model_description::defaults::CRATES {
+        let (text, _) =
+            model_description::defaults::generate(&declarations, c).map_err(|e| format!("{}: {e}", c.file))?;
+        let path = dir.join(c.out);
+        std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+        println!("wrote {}", path.display());
     }
     let root = workspace_root();
     let path = root.join(model_description::python::MODULE_PATH);

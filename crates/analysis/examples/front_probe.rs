@@ -6,7 +6,8 @@
 use analysis::controllers::Kind;
 use analysis::envelope_transitions::{fly_mission, measure, ROTATION_TOLERANCE};
 use closed_loop::{Ordering, Sample, Trace};
-use flight_mission::{MissionParams, PointMass, Profile, ProfileLimits};
+use flight_mission::MissionParams;
+use guidance::{PointMass, Profile, ProfileLimits};
 use tailsitter_physics::Airframe;
 
 fn gamma_deg(s: &Sample) -> f64 {

@@ -4,7 +4,7 @@
 //! the start): the default and the fast mission, hover wind steps, the analysis's gust
 //! sweep; plus the force and moment coefficients of both models over α = 0…180°. (The
 //! parameter sweep of Table 5.1 is flown on both models by the robustness sweep itself,
-//! [`crate::campaign`].) Data only: `aero_models.json` and three CSV files;
+//! [`crate::sweep`].) Data only: `aero_models.json` and three CSV files;
 //! `python -m tailsim.analysis_report` renders them (`tailsim.aero_report`).
 
 use std::fmt::Write as _;

@@ -1,7 +1,7 @@
 //! Issue 16, goal 1: the transitions on the global aerodynamics (the plant's default
 //! `aero_model` = 1), both controllers, Gauss-Seidel and Jacobi, flown natively
 //! ([`closed_loop::fly`]); the minimum transition times of the α- and thrust-limited
-//! point-mass profile ([`flight_mission::profile`]) against thrust-to-weight; and the
+//! point-mass profile ([`guidance::profile`]) against thrust-to-weight; and the
 //! fastest transitions each controller flies with α ≤ 15°. Written as the key
 //! `envelope_transitions` of `report.json` (rendered by `tailsim.report_envelope`).
 //!
@@ -17,7 +17,8 @@
 //!   there to the end of the window.
 
 use closed_loop::{fly, Ordering, Scenario, Trace};
-use flight_mission::{MissionParams, PointMass, Profile, ProfileLimits};
+use flight_mission::MissionParams;
+use guidance::{PointMass, Profile, ProfileLimits};
 use lqr_control::{LqrController, LqrParams};
 use serde_json::{json, Value};
 use tailsitter_physics::{Airframe, Plant};
@@ -235,7 +236,7 @@ pub fn runs() -> Vec<TransitionRun> {
 /// The point mass of the default airframe with thrust-to-weight `tw`.
 pub fn point_mass(tw: f64) -> PointMass {
     let af = Airframe::default();
-    let mut pm = flight_mission::PointMass::from_level_trim(&af, MissionParams::default().v_level).expect("level trim");
+    let mut pm = guidance::PointMass::from_level_trim(&af, MissionParams::default().v_level).expect("level trim");
     pm.thrust_max = tw * af.mass * af.gravity;
     pm
 }

@@ -37,7 +37,8 @@
 use std::f64::consts::{FRAC_PI_2, PI};
 
 use closed_loop::{fly, Ordering, Scenario, Trace};
-use flight_mission::{MissionParams, PointMass, Profile, ProfileLimits};
+use flight_mission::MissionParams;
+use guidance::{PointMass, Profile, ProfileLimits};
 use lqr_control::{LqrController, LqrParams};
 use nalgebra::Vector3;
 use tailsitter_physics::{AeroModel, Airframe, GlobalAero, Plant, Surfaces};

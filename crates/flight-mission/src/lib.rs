@@ -12,14 +12,10 @@
 use nalgebra::{Vector3, Vector4};
 use std::fmt;
 
-pub mod ground;
-pub mod profile;
+mod ports;
 mod unit;
-pub mod weathervane;
-pub use ground::{GroundMode, GroundPhases, VerticalReference};
-pub use profile::{PathPoint, PointMass, Profile, ProfileLimits};
+pub use ports::{measure, measurement, plant_inputs};
 pub use unit::{HeldOutput, Sampled, SampledUnit, SteppedUnit, UnitLog};
-pub use weathervane::{HeadingRef, Weathervane, WeathervaneParams};
 
 /// Mission parameters (docs/DESIGN.md §3), the same names and defaults in both controllers.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -40,12 +36,12 @@ pub struct MissionParams {
     pub v_vertical: f64,
     /// Controller sample period T_s (s) (§3.2.4).
     pub sample_time: f64,
-    /// Largest |α| of the tuned controllers' flight-path profile ([`profile`]) (rad).
+    /// Largest |α| of the tuned controllers' flight-path profile (`guidance::profile`) (rad).
     pub transition_alpha_max: f64,
     /// Largest thrust of the flight-path profile as a fraction of T_max.
     pub transition_thrust_fraction: f64,
     /// Spin-up time on the gear before the take-off climb (s); 0 = the mission starts in
-    /// flight (no take-off, the thesis's mission). See [`ground`].
+    /// flight (no take-off, the thesis's mission). See `guidance::ground`.
     pub takeoff_spinup_time: f64,
     /// Thrust at the end of the spin-up as a fraction of the weight m g.
     pub takeoff_spinup_thrust: f64,
@@ -246,7 +242,7 @@ pub enum Phase {
     TransitionToVertical = 3,
     /// Vertical flight after the mission's second transition.
     Vertical2 = 4,
-    /// On the gear, motors spinning up (take-off, [`ground`]).
+    /// On the gear, motors spinning up (take-off, `guidance::ground`).
     OnGround = 5,
     /// Take-off climb, climb rate ramping up to `v_vertical`.
     TakeOff = 6,

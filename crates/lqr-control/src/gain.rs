@@ -389,7 +389,7 @@ impl LqrController {
     /// nose, α, β ≈ 0, and the air-data wind is zero).
     pub(crate) fn wind_in_air_data(&self, m: &Measurement) -> bool {
         (m.alpha.abs() > HOVER_WIND_AIR_ANGLE || m.beta.abs() > HOVER_WIND_AIR_ANGLE)
-            && flight_mission::weathervane::air_data_wind(m).xy().norm() >= self.weathervane.params().engage_speed
+            && guidance::weathervane::air_data_wind(m).xy().norm() >= self.weathervane.params().engage_speed
     }
 
     /// Warm start of the DARE in Euler set `rep`: the previous solutions in the same set,

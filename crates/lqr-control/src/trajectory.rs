@@ -37,7 +37,8 @@
 
 use std::sync::Arc;
 
-use flight_mission::{HeadingRef, MissionParams, Phase, PointMass, Profile, ProfileLimits};
+use flight_mission::{MissionParams, Phase};
+use guidance::{HeadingRef, PointMass, Profile, ProfileLimits};
 use nalgebra::{Matrix3, Vector3, Vector4};
 use tailsitter_physics::{quat_from_euler_321, Airframe, Surfaces};
 
@@ -72,7 +73,7 @@ pub struct TrajectoryOptions {
     /// Turn radius ρ (m) of the level segment (3.3.18–3.3.21); 0 = straight, < 0 left.
     pub turn_radius: f64,
     /// V and γ of the α- and thrust-limited point-mass profile
-    /// ([`flight_mission::profile`]) instead of the thesis's cosine blends.
+    /// ([`guidance::profile`]) instead of the thesis's cosine blends.
     pub limited_path: bool,
     /// Thrust command T_c = T + τ_T Ṫ leading the lagged thrust state (2.3.16); off: T_c = T,
     /// the printed (3.3.13–3.3.14) (docs/THESIS.md D-3.15).
@@ -80,11 +81,13 @@ pub struct TrajectoryOptions {
 }
 
 impl Default for TrajectoryOptions {
+    /// The options of the default [`crate::LqrParams`] (`trajectory_mode` 1, `configuration` 0).
     fn default() -> Self {
+        let p = crate::LqrParams::default();
         Self {
             mode: TrajectoryMode::ForceBalance,
-            alpha_max: 15f64.to_radians(),
-            turn_radius: 0.0,
+            alpha_max: p.alpha_max,
+            turn_radius: p.turn_radius,
             limited_path: true,
             thrust_lead: true,
         }
@@ -190,7 +193,7 @@ fn path(m: &MissionParams, profile: Option<&Profile>, t: f64) -> (Phase, [f64; 5
     let dv = m.v_level - m.v_vertical;
     let r = match phase {
         Phase::Vertical1 | Phase::Vertical2 => [m.v_vertical, 0.0, FRAC_PI_2, 0.0, 0.0],
-        // Take-off and landing: flown from flight_mission::ground, never a mission time.
+        // Take-off and landing: flown from guidance::ground, never a mission time.
         Phase::OnGround | Phase::TakeOff | Phase::Approach | Phase::Descent | Phase::Flare | Phase::Landed => {
             [m.v_vertical, 0.0, FRAC_PI_2, 0.0, 0.0]
         }

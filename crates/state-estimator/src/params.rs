@@ -33,22 +33,6 @@ pub struct SensorNoise {
     pub imu_period: f64,
 }
 
-impl Default for SensorNoise {
-    fn default() -> Self {
-        Self {
-            sigma_gps_latlon: 6.2832e-7,
-            sigma_gps_height: 4.0,
-            sigma_gps_vel: 0.5,
-            sigma_accel: 0.1414,
-            sigma_gyro: 27.925e-3,
-            sigma_mag: 0.02,
-            sigma_pitot_dp: 1.0,
-            sigma_pitot: 0.2,
-            imu_period: 0.0,
-        }
-    }
-}
-
 /// Process noise beyond the IMU's own noise.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ProcessNoise {
@@ -63,18 +47,6 @@ pub struct ProcessNoise {
     pub accel_bias_walk: f64,
     /// Wind random walk (m/s/√s).
     pub wind_walk: f64,
-}
-
-impl Default for ProcessNoise {
-    fn default() -> Self {
-        Self {
-            accel_model: 0.01,
-            gyro_model: 0.0005,
-            gyro_bias_walk: 1e-4,
-            accel_bias_walk: 1e-3,
-            wind_walk: 0.1,
-        }
-    }
 }
 
 /// Reference point of the local NED frame and the Earth's fields there.
@@ -96,20 +68,6 @@ pub struct Earth {
     pub mag_inclination: f64,
     /// Gravitational acceleration (m/s²), as the plant's `gravity` (9.81).
     pub gravity: f64,
-}
-
-impl Default for Earth {
-    fn default() -> Self {
-        Self {
-            ref_latitude: (-33.93f64).to_radians(),
-            ref_longitude: 18.86f64.to_radians(),
-            ref_height: 0.0,
-            mag_field_total: 0.2513,
-            mag_declination: (-26.61f64).to_radians(),
-            mag_inclination: (-64.73f64).to_radians(),
-            gravity: 9.81,
-        }
-    }
 }
 
 impl SensorNoise {
@@ -168,24 +126,6 @@ pub struct Tuning {
     pub relative_to_start: bool,
 }
 
-impl Default for Tuning {
-    fn default() -> Self {
-        Self {
-            init_std_wind: 3.0,
-            init_std_gyro_bias: 0.005,
-            init_std_accel_bias: 0.05,
-            init_std_pos_no_gps: 50.0,
-            init_std_vel_no_gps: 5.0,
-            pitot_min_airspeed: 1.0,
-            sigma_sideslip: 0.1,
-            sideslip_min_airspeed: 10.0,
-            sideslip_pseudo_measurement: true,
-            gps_reset_after: 8,
-            relative_to_start: true,
-        }
-    }
-}
-
 /// The avionics' analogue low-pass filter on the IMU, magnetometer and pitot channels
 /// (thesis App. D.3: second-order Butterworth), as the sensor model's `filter_enabled`,
 /// `filter_bandwidth`. The estimator compensates its group delay (see [`AnalogFilter::delay`]).
@@ -202,17 +142,6 @@ pub struct AnalogFilter {
     /// the communication point beyond the filter's delay, e.g. one communication step when
     /// a Jacobi master gives the estimator the sensors' outputs of the previous step.
     pub latency: f64,
-}
-
-impl Default for AnalogFilter {
-    fn default() -> Self {
-        Self {
-            enabled: true,
-            bandwidth: 8.0,
-            compensate: true,
-            latency: 0.0,
-        }
-    }
 }
 
 impl AnalogFilter {
@@ -277,15 +206,10 @@ pub struct Prediction {
     pub aero_model: i32,
 }
 
-impl Default for Prediction {
-    fn default() -> Self {
-        Self {
-            model: true,
-            lead: 0.0,
-            aero_model: 1,
-        }
-    }
-}
+// `impl Default` of SensorNoise, ProcessNoise, Earth, Tuning, AnalogFilter and Prediction:
+// the start values of group `estimator` of modelDescription/tailsitter_ekf.json, generated
+// by build.rs.
+include!(concat!(env!("OUT_DIR"), "/estimator_params_generated.rs"));
 
 /// Everything the estimator needs besides the measurements.
 #[derive(Debug, Clone, PartialEq, Default)]

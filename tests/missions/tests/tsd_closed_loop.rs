@@ -3,7 +3,7 @@
 //! (Gauss-Seidel: the controller samples the plant outputs at t, then the plant
 //! advances 20 ms). The plant starts in its trimmed 3 m/s vertical climb.
 //!
-//! Run with `cargo test --release -p tsd-control -- --nocapture` to see the numbers.
+//! Run with `cargo test --release -p missions --test tsd_closed_loop -- --nocapture` to see the numbers.
 
 use closed_loop::{fly, MissionCheck, Ordering, Scenario, Trace};
 use flight_mission::MissionParams;
