@@ -3,6 +3,7 @@
 //! - `OUT_DIR/mission_generated.rs`: `impl Default for MissionParams` and
 //!   `MissionParams::named_values` (group `mission`, table
 //!   `model_description::defaults::CRATES`);
+//! - `OUT_DIR/presets_generated.rs`: `PRESETS`, the named missions (`presets`);
 //! - `OUT_DIR/measurement_generated.rs`: `Measurement::first_non_finite`, naming
 //!   the port of a non-finite value (group `measurement`).
 
@@ -23,6 +24,9 @@ fn main() {
         &format!("modelDescription/{file}"),
     );
     std::fs::write(out.join("measurement_generated.rs"), check).expect("write measurement_generated.rs");
+    let presets = model_description::load_presets(&dir).unwrap_or_else(|e| panic!("mission presets: {e}"));
+    let text = model_description::rust::mission_presets(&presets, &format!("modelDescription/{file}"));
+    std::fs::write(out.join("presets_generated.rs"), text).expect("write presets_generated.rs");
     for s in sources {
         println!("cargo:rerun-if-changed={}", s.display());
     }

@@ -8612,6 +8612,10 @@ PRESETS: dict[str, dict[str, float]] = {
         "t_transition_1": 3.0,
         "t_transition_2": 4.0,
     },
+    "fast_limited": {
+        "t_transition_1": 2.0,
+        "t_transition_2": 3.0,
+    },
     "short": {
         "t_vertical_1": 1.0,
         "t_transition_1": 3.0,
@@ -8634,6 +8638,7 @@ PRESETS: dict[str, dict[str, float]] = {
 PRESET_DESCRIPTIONS: dict[str, str] = {
     "default": "The declared defaults: 5 s vertical, T1 = 5 s, 10 s level, T2 = 10 s, 5 s vertical (thesis chapter 6).",
     "fast": "The thesis's fast mission (App. E.1: the TSD controller flies T1 = 3 s, T2 = 4 s).",
+    "fast_limited": "Short transitions asked of the α- and thrust-limited profile (T1 = 2 s, T2 = 3 s): the front-transition and envelope analyses; the profile flies them as fast as its limits allow.",
     "short": "All five phases in 11 s (1, 3, 2, 4, 1 s): tests and smoke runs of the campaign.",
     "takeoff_landing": "Take-off from the ground, the mission, landing 460 m north of the start (the analysis report's take-off-to-landing flight).",
 }

@@ -20,7 +20,7 @@ fn main() {
         .skip(1)
         .map(|s| s.parse().expect("t1 t2 (s)"))
         .collect();
-    let f = MissionParams::fast();
+    let f = MissionParams::fast_limited();
     let (t1, t2) = if a.len() >= 2 {
         (a[0], a[1])
     } else {

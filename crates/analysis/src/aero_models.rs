@@ -40,9 +40,10 @@ pub struct Case {
 /// vertical phase held for 40 s, 30 s flown) in a wind stepping at 5 s to 5 or 7 m/s from
 /// the north (head-on to the wing: α → 90° of the free stream) or the east (side wind).
 pub fn cases(mission: &MissionParams) -> Vec<Case> {
+    let preset = MissionParams::fast();
     let fast = MissionParams {
-        t_transition_1: 3.0,
-        t_transition_2: 4.0,
+        t_transition_1: preset.t_transition_1,
+        t_transition_2: preset.t_transition_2,
         ..*mission
     };
     let hover = MissionParams {

@@ -225,15 +225,11 @@ impl Scenario {
         }
     }
 
-    /// A violent manoeuvre for accuracy and speed checks: the fast mission of the
-    /// thesis-era timings (T1 = 3 s, T2 = 4 s, α up to ≈ 44° on the LQR) with a 1 − cos
+    /// A violent manoeuvre for accuracy and speed checks: the fast mission (preset `fast`,
+    /// T1 = 3 s, T2 = 4 s, α up to ≈ 44° on the LQR) with a 1 − cos
     /// gust of 6 m/s (north, up) over 2 s at t = 12 s and 5 m reference steps at 20 s and 23 s.
     pub fn violent_manoeuvre() -> Self {
-        let mut s = Self::mission(MissionParams {
-            t_transition_1: 3.0,
-            t_transition_2: 4.0,
-            ..MissionParams::default()
-        });
+        let mut s = Self::mission(MissionParams::fast());
         s.wind = Wind::OneMinusCosine {
             t_start: 12.0,
             duration: 2.0,

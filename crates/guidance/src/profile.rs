@@ -481,7 +481,7 @@ mod tests {
     /// 2.04 s.
     #[test]
     fn the_fast_front_transition_rotates_within_two_seconds() {
-        let m = MissionParams::fast();
+        let m = MissionParams::fast_limited();
         let p = Profile::new(&m, &airframe(), &ProfileLimits::of(&m)).unwrap();
         let s = m.phase_starts();
         let rotation = p.settle_time(s[1], s[3], 0.0, 5f64.to_radians()).unwrap();

@@ -959,7 +959,7 @@ mod tests {
     #[test]
     fn fast_construction_equals_the_slow_reference() {
         let af = Airframe::default();
-        let fast = MissionParams::fast();
+        let fast = MissionParams::fast_limited();
         let slow_turns = MissionParams {
             t_transition_1: 3.0,
             t_transition_2: 4.0,

@@ -310,7 +310,7 @@ mod tests {
     /// two are the same vector.
     #[test]
     fn preview_is_resolved_in_the_path_axes() {
-        let m = MissionParams::fast();
+        let m = MissionParams::fast_limited();
         let pm = guidance::PointMass {
             mass: 9.0,
             gravity: 9.81,

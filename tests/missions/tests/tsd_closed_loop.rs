@@ -74,11 +74,7 @@ fn default_mission_gauss_seidel() {
 
 #[test]
 fn fast_mission_gauss_seidel() {
-    let mission = MissionParams {
-        t_transition_1: 3.0,
-        t_transition_2: 4.0,
-        ..Default::default()
-    };
+    let mission = MissionParams::fast();
     let (trace, check) = run(mission, Ordering::GaussSeidel);
     report(
         "fast mission (T1 = 3 s, T2 = 4 s), Gauss-Seidel",
