@@ -67,13 +67,7 @@ impl PlantModel {
         })?;
         let aero = GlobalAero {
             model,
-            alpha_attached: vars.alpha_attached,
-            alpha_stalled: vars.alpha_stalled,
-            beta_attached: vars.beta_attached,
-            beta_stalled: vars.beta_stalled,
-            c_D_90: vars.c_D_90,
-            // Reversed-flow band: not FMU parameters (the physics crate's defaults).
-            ..GlobalAero::default()
+            ..vars.global_aero()
         };
         aero.validate()
             .map_err(|e| ModelError::new(format!("invalid aerodynamic parameter: {e}")))?;

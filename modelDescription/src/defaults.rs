@@ -74,6 +74,21 @@ pub const CRATES: &[CrateDefaults] = &[
         structs: &[plain("Ground", "ground", "")],
     },
     CrateDefaults {
+        krate: "tailsitter-physics",
+        file: "tailsitter_plant.json",
+        out: "global_aero_generated.rs",
+        structs: &[StructDefaults {
+            extra: &[(
+                "model",
+                Extra::Variant {
+                    name: "aero_model",
+                    variants: &["AeroModel::Thesis", "AeroModel::Global"],
+                },
+            )],
+            ..plain("GlobalAero", "global_aero", "")
+        }],
+    },
+    CrateDefaults {
         krate: "flight-mission",
         file: "fragments/controller_interface.json",
         out: "mission_generated.rs",

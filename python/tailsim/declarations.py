@@ -5350,6 +5350,28 @@ VARIABLES: dict[str, dict[str, Variable]] = {
             None,
             "Time derivative of the vertical_flap deflection: sat_rate((sat(delta_c) - delta)/servo_tau) (App. D.5), rate-limited to +/-servo_rate_limit and the target saturated to +/-deflection_limit; Model Exchange state derivative.",
         ),
+        "alpha_reverse_attached": Variable(
+            "alpha_reverse_attached",
+            "Real",
+            "parameter",
+            "fixed",
+            "rad",
+            0.12217304763960307,
+            0.0,
+            1.5,
+            "Global model, reversed flow (tail first): incidence between the flow and the -x axis up to which the reversed wing is attached (default 7 deg: the reversed NACA 0015 section of Sheldahl and Klimas 1981 scaled to the wing like the forward band).",
+        ),
+        "alpha_reverse_stalled": Variable(
+            "alpha_reverse_stalled",
+            "Real",
+            "parameter",
+            "fixed",
+            "rad",
+            0.3839724354387525,
+            0.0,
+            1.5,
+            "Global model, reversed flow: incidence from which the reversed wing is fully separated (default 22 deg); blended from alpha_reverse_attached.",
+        ),
     },
     "tailsitter_sensors": {
         "pos_n": Variable(
