@@ -44,12 +44,13 @@ def _number(text: str) -> float:
     return x
 
 
-def _fmt_range(lo: float | None, hi: float | None, lo_open: bool = False) -> str:
+def _outside(text: str, lo: float | None, hi: float | None, lo_open: bool = False) -> str:
+    """The message of a value `text` outside [lo, hi] (lo excluded with `lo_open`)."""
     if lo is not None and hi is not None:
-        return f"[{lo:g}, {hi:g}]" if not lo_open else f"({lo:g}, {hi:g}]"
+        return f"{text} is outside {'(' if lo_open else '['}{lo:g}, {hi:g}]"
     if lo is not None:
-        return f"{'>' if lo_open else '≥'} {lo:g}"
-    return f"≤ {hi:g}"
+        return f"{text}: expected a value {'>' if lo_open else '≥'} {lo:g}"
+    return f"{text}: expected a value ≤ {hi:g}"
 
 
 def number(lo: float | None = None, hi: float | None = None, *, lo_open: bool = False) -> Callable[[str], float]:
@@ -59,7 +60,7 @@ def number(lo: float | None = None, hi: float | None = None, *, lo_open: bool = 
         x = _number(text)
         below = lo is not None and (x <= lo if lo_open else x < lo)
         if below or (hi is not None and x > hi):
-            raise argparse.ArgumentTypeError(f"{text} is outside {_fmt_range(lo, hi, lo_open)}")
+            raise argparse.ArgumentTypeError(_outside(text, lo, hi, lo_open))
         return x
 
     parse.__name__ = "number"
@@ -75,7 +76,7 @@ def integer(lo: int | None = None, hi: int | None = None) -> Callable[[str], int
         except ValueError:
             raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
         if (lo is not None and n < lo) or (hi is not None and n > hi):
-            raise argparse.ArgumentTypeError(f"{text} is outside {_fmt_range(lo, hi)}")
+            raise argparse.ArgumentTypeError(_outside(text, lo, hi))
         return n
 
     parse.__name__ = "integer"
