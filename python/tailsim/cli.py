@@ -109,7 +109,8 @@ def choices_list(allowed: Sequence[str]) -> Callable[[str], tuple[str, ...]]:
         items = tuple(s.strip() for s in text.split(","))
         bad = [s for s in items if s not in allowed]
         if bad or not items:
-            raise argparse.ArgumentTypeError(f"unknown {', '.join(map(repr, bad))} (choose from {', '.join(allowed)})")
+            unknown = ", ".join(map(repr, bad))
+            raise argparse.ArgumentTypeError(f"{text!r}: unknown {unknown} (choose from {', '.join(allowed)})")
         if len(set(items)) != len(items):
             raise argparse.ArgumentTypeError(f"{text!r}: a name is repeated")
         return items
