@@ -30,19 +30,19 @@ struct Common {
     #[arg(long, default_value = "out/analysis")]
     out: PathBuf,
     /// N of the geometric sweep (5.1.1), at least 2; the thesis uses 50.
-    #[arg(long, default_value_t = 50, value_parser = parse_n)]
+    #[arg(long, default_value_t = 50, value_parser = parse_n, allow_negative_numbers = true)]
     n: usize,
     /// Only these parameter ids (CLa, CLq, CLde, CYb, …, m, Ix, Iy, Iz); default all 25.
     #[arg(long, value_delimiter = ',', value_parser = parse_param_id)]
     params: Vec<String>,
     /// Largest gust amplitude (m/s), at least 1; the sweep is 1, 2, … this.
-    #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..), allow_negative_numbers = true)]
     max_gust: u32,
     /// The wider nonlinear sweep covers τ^this (0 = no wider sweep); finite, ≥ 0.
-    #[arg(long, default_value_t = 3.0, value_parser = parse_tau_power)]
+    #[arg(long, default_value_t = 3.0, value_parser = parse_tau_power, allow_negative_numbers = true)]
     wide_tau_power: f64,
     /// Threads (default: all cores); at least 1.
-    #[arg(long, value_parser = parse_threads)]
+    #[arg(long, value_parser = parse_threads, allow_negative_numbers = true)]
     threads: Option<usize>,
     /// No progress bars.
     #[arg(long)]
@@ -77,7 +77,7 @@ struct CampaignJobs {
     #[arg(long)]
     out: PathBuf,
     /// Threads (default: all cores; 1 for the per-run timing of one core); at least 1.
-    #[arg(long, value_parser = parse_threads)]
+    #[arg(long, value_parser = parse_threads, allow_negative_numbers = true)]
     threads: Option<usize>,
 }
 
@@ -240,6 +240,7 @@ mod tests {
         for args in [
             ["linear", "--n", "0"],
             ["linear", "--n", "1"],
+            ["linear", "--n", "-1"],
             ["linear", "--max-gust", "0"],
             ["linear", "--wide-tau-power", "nan"],
             ["linear", "--wide-tau-power", "-1"],
