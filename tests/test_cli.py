@@ -197,3 +197,10 @@ def test_rust_analysis_cli_refuses_bad_options(args, words, tmp_path):
     for w in words:
         assert w in first, (w, first)
     assert not (tmp_path / "a").exists()
+
+
+def test_campaign_section_and_native_refuse_folders_without_a_campaign(tmp_path):
+    empty = str(tmp_path)
+    assert_refused(run("tailsim.campaign.section", empty), empty, "campaign.json")
+    assert_refused(run("tailsim.campaign.native", "--campaign", empty), "--campaign", empty, "campaign.json")
+    assert_refused(run("tailsim.campaign.native", "--threads", "0"), "--threads", "0", "≥ 1")
