@@ -7,15 +7,51 @@
 # with the LQR and the TSD controller, and write CSVs, plots and the
 # comparison report (out/report.md, out/report.html).
 #
-#   scripts/main.sh [--no-analysis] [runner options: --controller lqr|tsd|both, --jacobi, --no-steps, ...]
+#   scripts/main.sh [--help] [--no-analysis] [runner options: --controller lqr|tsd|both, --jacobi, --no-steps, ...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
+
+usage() {
+    cat <<'EOF'
+usage: scripts/main.sh [--no-analysis] [runner options]
+
+The main job: set up the machine (scripts/setup.sh), build and package the FMUs and
+the SSP systems into dist/ (cargo xtask dist), run the analysis campaign (out/analysis),
+a small Monte-Carlo campaign (out/campaign), fly the missions and the position steps
+with each controller and write the comparison report (out/report.md, out/report.html).
+
+  -h, --help       this help (nothing is set up or built)
+  --no-analysis    skip the analysis campaign
+  runner options   passed to `python -m tailsim.reports.compare` and checked before
+                   anything is built: --controller lqr|tsd|both, --jacobi, --no-steps,
+                   --no-avionics, --fast-t1 S, --fast-t2 S, --debug
+                   (.venv/bin/python -m tailsim.reports.compare --help)
+EOF
+}
+
 analysis=1
 runner_args=()
 for arg in "$@"; do
-    if [ "$arg" = "--no-analysis" ]; then analysis=0; else runner_args+=("$arg"); fi
+    case "$arg" in
+        -h | --help) usage; exit 0 ;;
+        --no-analysis) analysis=0 ;;
+        *) runner_args+=("$arg") ;;
+    esac
 done
+
+# The runner's options, checked (types, ranges, names) before any set-up or build work;
+# its FMUs are checked by the runner itself once they are built.
+check_runner_args() {
+    .venv/bin/python -c 'import sys; from tailsim.reports.compare import parser; parser().parse_args(sys.argv[1:])' \
+        "${runner_args[@]+"${runner_args[@]}"}"
+}
+checked=0
+if [ -x .venv/bin/python ] && .venv/bin/python -c 'import tailsim' 2>/dev/null; then
+    check_runner_args
+    checked=1
+fi
 scripts/setup.sh
+[ "$checked" = 1 ] || check_runner_args
 cargo xtask dist
 if [ "$analysis" = 1 ]; then
     echo "== analysis campaign (out/analysis)"

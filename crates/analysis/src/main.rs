@@ -29,20 +29,20 @@ struct Common {
     /// Output folder (report.json, CSV, summary.json, cache/).
     #[arg(long, default_value = "out/analysis")]
     out: PathBuf,
-    /// N of the geometric sweep (5.1.1); the thesis uses 50.
-    #[arg(long, default_value_t = 50)]
+    /// N of the geometric sweep (5.1.1), at least 2; the thesis uses 50.
+    #[arg(long, default_value_t = 50, value_parser = parse_n, allow_negative_numbers = true)]
     n: usize,
     /// Only these parameter ids (CLa, CLq, CLde, CYb, …, m, Ix, Iy, Iz); default all 25.
-    #[arg(long, value_delimiter = ',')]
+    #[arg(long, value_delimiter = ',', value_parser = parse_param_id)]
     params: Vec<String>,
-    /// Largest gust amplitude (m/s); the sweep is 1, 2, … this.
-    #[arg(long, default_value_t = 20)]
+    /// Largest gust amplitude (m/s), at least 1; the sweep is 1, 2, … this.
+    #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..), allow_negative_numbers = true)]
     max_gust: u32,
-    /// The wider nonlinear sweep covers τ^this (0 = no wider sweep).
-    #[arg(long, default_value_t = 3.0)]
+    /// The wider nonlinear sweep covers τ^this (0 = no wider sweep); finite, ≥ 0.
+    #[arg(long, default_value_t = 3.0, value_parser = parse_tau_power, allow_negative_numbers = true)]
     wide_tau_power: f64,
-    /// Threads (default: all cores).
-    #[arg(long)]
+    /// Threads (default: all cores); at least 1.
+    #[arg(long, value_parser = parse_threads, allow_negative_numbers = true)]
     threads: Option<usize>,
     /// No progress bars.
     #[arg(long)]
@@ -76,9 +76,44 @@ struct CampaignJobs {
     /// JSON-lines file of rows (`analysis::native_campaign::Row`).
     #[arg(long)]
     out: PathBuf,
-    /// Threads (default: all cores; 1 for the per-run timing of one core).
-    #[arg(long)]
+    /// Threads (default: all cores; 1 for the per-run timing of one core); at least 1.
+    #[arg(long, value_parser = parse_threads, allow_negative_numbers = true)]
     threads: Option<usize>,
+}
+
+/// Smallest N of the geometric sweep (5.1.1): the factors τ^-1 and τ^0 = 1.
+const N_MIN: usize = 2;
+
+fn parse_n(s: &str) -> Result<usize, String> {
+    let n: usize = s.parse().map_err(|_| format!("expected a whole number ≥ {N_MIN}"))?;
+    if n < N_MIN {
+        return Err(format!("expected a whole number ≥ {N_MIN}"));
+    }
+    Ok(n)
+}
+
+/// A Table 5.1 parameter id of [`analysis::sensitivity::params`].
+fn parse_param_id(s: &str) -> Result<String, String> {
+    let ids: Vec<&str> = analysis::sensitivity::params().iter().map(|p| p.id).collect();
+    if ids.contains(&s) {
+        Ok(s.to_string())
+    } else {
+        Err(format!("unknown parameter id; known ids: {}", ids.join(", ")))
+    }
+}
+
+fn parse_tau_power(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(x) if x.is_finite() && x >= 0.0 => Ok(x),
+        _ => Err("expected a finite number ≥ 0".to_string()),
+    }
+}
+
+fn parse_threads(s: &str) -> Result<usize, String> {
+    match s.parse::<usize>() {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => Err("expected a whole number ≥ 1".to_string()),
+    }
 }
 
 fn campaign_jobs(a: &CampaignJobs) -> Result<usize, String> {
@@ -133,7 +168,7 @@ fn main() {
     if robustness || aero_only {
         // Thesis (aero_model 0) against global (1) aerodynamics: analysis::aero_models.
         let start = std::time::Instant::now();
-        let amplitudes: Vec<f64> = (1..=c.max_gust.max(1)).map(f64::from).collect();
+        let amplitudes: Vec<f64> = (1..=c.max_gust).map(f64::from).collect();
         match analysis::aero_models::run(&c.out, &flight_mission::MissionParams::default(), &amplitudes) {
             Ok(rows) => eprintln!(
                 "wrote {}/aero_models.json: {} flights in {:.1} s",
@@ -151,9 +186,9 @@ fn main() {
         }
     }
     let mut cfg = Config::full(c.out);
-    cfg.n = c.n.max(2);
+    cfg.n = c.n;
     cfg.params = c.params;
-    cfg.gust_amplitudes = (1..=c.max_gust.max(1)).map(f64::from).collect();
+    cfg.gust_amplitudes = (1..=c.max_gust).map(f64::from).collect();
     cfg.robustness = robustness;
     cfg.wide_tau_power = c.wide_tau_power;
     cfg.gusts = gusts;
@@ -176,5 +211,45 @@ fn main() {
             eprintln!("analysis failed: {e}");
             std::process::exit(1);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::error::ErrorKind;
+
+    fn parse(args: &[&str]) -> Result<Cli, clap::Error> {
+        Cli::try_parse_from(["analysis"].iter().chain(args))
+    }
+
+    #[test]
+    fn unknown_param_ids_are_refused_with_the_known_ids() {
+        let e = parse(&["linear", "--params", "CLa,XYZ"]).err().expect("XYZ refused");
+        assert_eq!(e.kind(), ErrorKind::ValueValidation);
+        let msg = e.to_string();
+        assert!(
+            msg.contains("XYZ") && msg.contains("--params") && msg.contains("CLa, CLq"),
+            "{msg}"
+        );
+        assert!(parse(&["linear", "--params", "CLa,Iz"]).is_ok());
+    }
+
+    #[test]
+    fn numeric_options_are_ranged() {
+        for args in [
+            ["linear", "--n", "0"],
+            ["linear", "--n", "1"],
+            ["linear", "--n", "-1"],
+            ["linear", "--max-gust", "0"],
+            ["linear", "--wide-tau-power", "nan"],
+            ["linear", "--wide-tau-power", "-1"],
+            ["linear", "--threads", "0"],
+        ] {
+            let e = parse(&args).err().unwrap_or_else(|| panic!("{args:?} accepted"));
+            assert_eq!(e.kind(), ErrorKind::ValueValidation, "{args:?}");
+            assert_eq!(e.exit_code(), 2);
+        }
+        assert!(parse(&["linear", "--n", "2", "--max-gust", "1", "--wide-tau-power", "0"]).is_ok());
     }
 }

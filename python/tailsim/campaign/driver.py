@@ -1,5 +1,5 @@
 """Monte-Carlo campaign: both controllers on the same uncertain plants, winds and
-gusts (issue 15, parts 3–4), run as Dask tasks on an embedded LocalCluster or on
+gusts, run as Dask tasks on an embedded LocalCluster or on
 an existing Dask cluster, streamed to Parquet (resumable), then reported.
 
     python -m tailsim.campaign --samples 200 --seed 1 --out out/campaign
@@ -16,6 +16,7 @@ import io
 import json
 import os
 import pathlib
+import re
 import sys
 import time
 import uuid
@@ -23,8 +24,9 @@ import zipfile
 from collections.abc import Callable, Mapping
 from typing import Any
 
-from .runner import digest, install_fmus, load_fmu_bytes, metric_columns, run_job
-from .sampling import MISSIONS, CampaignSpec, jobs, sample_columns
+from .. import cli, declarations
+from .runner import FMU_NAMES, STATE_SOURCE_FMUS, digest, install_fmus, load_fmu_bytes, metric_columns, run_job
+from .sampling import CONFIGURATIONS, CONTROLLERS, MISSIONS, STATE_SOURCES, CampaignSpec, jobs, sample_columns
 
 ROOT = pathlib.Path(__file__).resolve().parents[3]
 #: Columns that depend on where and when a run was executed, not on what was run.
@@ -347,33 +349,90 @@ def run_campaign(
 # --- command line -------------------------------------------------------------------------
 
 
-def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m tailsim.campaign", description=__doc__.split("\n\n")[0])
+def parser() -> cli.Parser:
+    atmosphere = "tailsitter_atmosphere"
+    wind = declarations.VARIABLES[atmosphere]["wind_speed"]
+    gust = declarations.VARIABLES[atmosphere]["gust_amplitude_n"]
+    ap = cli.Parser(prog="python -m tailsim.campaign", description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", default="out/campaign", help="output folder (resumes what is there)")
     ap.add_argument("--dist", default=str(ROOT / "dist"), help="folder of the .fmu files")
-    ap.add_argument("--samples", type=int, default=64, help="number of samples (each flown by every controller)")
-    ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--controllers", default="lqr,tsd")
-    ap.add_argument("--configurations", default="tuned")
-    ap.add_argument("--state-sources", default="perfect")
+    ap.add_argument(
+        "--samples", type=cli.integer(1), default=64, help="number of samples, ≥ 1 (each flown by every controller)"
+    )
+    ap.add_argument("--seed", type=cli.integer(0), default=0, help="seed of the sample generators, ≥ 0")
+    ap.add_argument(
+        "--controllers",
+        type=cli.choices_list(CONTROLLERS),
+        default=CONTROLLERS,
+        help=f"comma-separated, of {', '.join(CONTROLLERS)}",
+    )
+    ap.add_argument(
+        "--configurations",
+        type=cli.choices_list(tuple(CONFIGURATIONS)),
+        default=("tuned",),
+        help=f"comma-separated, of {', '.join(CONFIGURATIONS)}",
+    )
+    ap.add_argument(
+        "--state-sources",
+        type=cli.choices_list(STATE_SOURCES),
+        default=("perfect",),
+        help=f"comma-separated, of {', '.join(STATE_SOURCES)}",
+    )
     ap.add_argument("--mission", choices=sorted(MISSIONS), default="default")
     ap.add_argument(
         "--aero-model", type=int, choices=(0, 1), default=1, help="plant aerodynamics: 1 global (default), 0 thesis"
     )
-    ap.add_argument("--tau-aero", type=float, default=1.5)
-    ap.add_argument("--tau-mass", type=float, default=1.1)
-    ap.add_argument("--wind-max", type=float, default=5.0, help="largest steady horizontal wind (m/s)")
-    ap.add_argument("--gust-max", type=float, default=5.0, help="largest 1-cos gust amplitude (m/s)")
-    ap.add_argument("--timeout", type=float, default=300.0, help="wall-time limit of one run (s)")
-    ap.add_argument("--scheduler", help="tcp://HOST:PORT of an existing Dask scheduler")
-    ap.add_argument("--workers", type=int, help="LocalCluster workers (default: one per core)")
+    ap.add_argument("--tau-aero", type=cli.number(1.0), default=1.5, help="aerodynamic factors in [1/τ, τ], τ ≥ 1")
+    ap.add_argument("--tau-mass", type=cli.number(1.0), default=1.1, help="mass and inertia factors in [1/τ, τ], τ ≥ 1")
+    ap.add_argument(
+        "--wind-max",
+        type=cli.declared(atmosphere, "wind_speed"),
+        default=5.0,
+        help=f"largest steady horizontal wind (m/s), within the declared [{wind.min:g}, {wind.max:g}] of `wind_speed`",
+    )
+    ap.add_argument(
+        "--gust-max",
+        type=cli.declared_magnitude(atmosphere, "gust_amplitude_n"),
+        default=5.0,
+        help=f"largest 1-cos gust amplitude (m/s), ≥ 0 and within the declared gust amplitudes "
+        f"[{gust.min:g}, {gust.max:g}]",
+    )
+    ap.add_argument(
+        "--timeout", type=cli.number(0.0, lo_open=True), default=300.0, help="wall-time limit of one run (s), > 0"
+    )
+    ap.add_argument("--scheduler", type=_scheduler, help="tcp://HOST:PORT of an existing Dask scheduler")
+    ap.add_argument("--workers", type=cli.integer(1), help="LocalCluster workers, ≥ 1 (default: one per core)")
     ap.add_argument("--serial", action="store_true", help="no Dask: run in this process")
     ap.add_argument("--replace", action="store_true", help="discard --out's runs if they are of another campaign/FMUs")
     ap.add_argument("--no-upload", action="store_true", help="workers already have tailsim importable")
     ap.add_argument("--no-progress", action="store_true")
     ap.add_argument("--report-only", action="store_true", help="only (re)write the report of what is in --out")
     ap.add_argument("--no-report", action="store_true")
+    return ap
+
+
+def _scheduler(text: str) -> str:
+    if not re.fullmatch(r"([a-z]+://)?(\[[0-9a-fA-F:.]+\]|[^\s:/\[\]]+):\d+", text):
+        raise argparse.ArgumentTypeError(f"{text!r}: expected an address [PROTOCOL://]HOST:PORT (tcp://HOST:8786)")
+    return text
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = parser()
     a = ap.parse_args(argv)
+    cli.check_out(ap, "--out", a.out)
+    if a.report_only:
+        if a.no_report:
+            ap.error("argument --no-report: not allowed with --report-only (nothing to do)")
+        if not (pathlib.Path(a.out) / "campaign.json").is_file():
+            ap.error(f"argument --out: {a.out!r} holds no campaign (no campaign.json) for --report-only")
+    else:
+        names = ["plant", *a.controllers, *[n for s in a.state_sources for n in STATE_SOURCE_FMUS[s]]]
+        cli.check_fmus(ap, "--dist", a.dist, [FMU_NAMES[n] for n in names])
+    return cli.guard(ap.prog, a.debug, lambda: _main(a))
+
+
+def _main(a: argparse.Namespace) -> int:
     out = pathlib.Path(a.out)
     if a.report_only:
         spec = CampaignSpec.from_json(json.loads((out / "campaign.json").read_text())["spec"])
@@ -381,9 +440,9 @@ def main(argv: list[str] | None = None) -> int:
         spec = CampaignSpec(
             seed=a.seed,
             n_samples=a.samples,
-            controllers=tuple(a.controllers.split(",")),
-            configurations=tuple(a.configurations.split(",")),
-            state_sources=tuple(a.state_sources.split(",")),
+            controllers=a.controllers,
+            configurations=a.configurations,
+            state_sources=a.state_sources,
             tau_aero=a.tau_aero,
             tau_mass=a.tau_mass,
             aero_model=a.aero_model,

@@ -34,6 +34,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import cli
 from .runner import FMU_NAMES, metric_columns
 from .sampling import CONFIGURATION_INDEX, TABLE_5_1, CampaignSpec, jobs, plant_parameters
 
@@ -173,14 +174,22 @@ def compare(fmpy_rows: Iterable[Mapping[str, Any]], native_rows: Iterable[Mappin
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m tailsim.campaign.native", description=__doc__.split("\n\n")[0])
+    ap = cli.Parser(prog="python -m tailsim.campaign.native", description=__doc__.split("\n\n")[0])
     ap.add_argument(
         "--campaign", default="out/campaign", help="folder of an fmpy campaign (campaign.json, results.parquet)"
     )
     ap.add_argument("--dist", default=str(ROOT / "dist"))
-    ap.add_argument("--threads", type=int, help="native threads (default: all cores)")
-    ap.add_argument("--samples", type=int, help="only the first N samples")
+    ap.add_argument("--threads", type=cli.integer(1), help="native threads, ≥ 1 (default: all cores)")
+    ap.add_argument("--samples", type=cli.integer(1), help="only the first N samples, ≥ 1")
     a = ap.parse_args(argv)
+    for name in ("campaign.json", "results.parquet"):
+        if not (pathlib.Path(a.campaign) / name).is_file():
+            ap.error(f"argument --campaign: {a.campaign!r} holds no {name} (run `python -m tailsim.campaign` first)")
+    cli.check_fmus(ap, "--dist", a.dist, [FMU_NAMES["plant"]])
+    return cli.guard(ap.prog, a.debug, lambda: _main(a))
+
+
+def _main(a: argparse.Namespace) -> int:
     import pyarrow.parquet as pq
 
     folder = pathlib.Path(a.campaign)

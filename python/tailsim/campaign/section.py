@@ -23,7 +23,6 @@ Two sources, both shown when present:
 
 from __future__ import annotations
 
-import argparse
 import json
 import pathlib
 import sys
@@ -32,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import cli
 from .report import _arm_mask, arms, bootstrap_mean_ci, paired, wilson_interval
 from .sampling import CampaignSpec
 
@@ -230,15 +230,25 @@ def report_section(out: str | pathlib.Path) -> list[str]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m tailsim.campaign.section", description=__doc__.split("\n\n")[0])
+    ap = cli.Parser(prog="python -m tailsim.campaign.section", description=__doc__.split("\n\n")[0])
     ap.add_argument("folders", nargs="+", help="campaign folders of one sample space (rows merged, paired by sample)")
     ap.add_argument("--write", help="write the summary JSON here (e.g. docs/campaign_full_run.json)")
     a = ap.parse_args(argv)
-    s = summarize(a.folders)
-    if a.write:
-        pathlib.Path(a.write).write_text(json.dumps(s, indent=1) + "\n")
-    print("\n".join(markdown(s, "Paired Monte-Carlo")))
-    return 0
+    for f in a.folders:
+        for name in ("campaign.json", "results.parquet"):
+            if not (pathlib.Path(f) / name).is_file():
+                ap.error(f"argument folders: {f!r} holds no {name} (run `python -m tailsim.campaign` first)")
+    if a.write and pathlib.Path(a.write).is_dir():
+        ap.error(f"argument --write: {a.write!r} is a folder (expected a file name)")
+
+    def run() -> int:
+        s = summarize(a.folders)
+        if a.write:
+            pathlib.Path(a.write).write_text(json.dumps(s, indent=1) + "\n")
+        print("\n".join(markdown(s, "Paired Monte-Carlo")))
+        return 0
+
+    return cli.guard(ap.prog, a.debug, run)
 
 
 if __name__ == "__main__":

@@ -14,7 +14,6 @@ the comparison report.
 
 from __future__ import annotations
 
-import argparse
 import json
 import pathlib
 
@@ -369,13 +368,24 @@ def write(folder: str | pathlib.Path, with_plots: bool = True) -> pathlib.Path:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="tailsim.reports.analysis", description=__doc__.split("\n\n")[0])
+    from .. import cli
+
+    ap = cli.Parser(prog="tailsim.reports.analysis", description=__doc__.split("\n\n")[0])
     ap.add_argument("folder", nargs="?", default="out/analysis", help="output folder of the analysis campaign")
     ap.add_argument("--no-plots", action="store_true", help="tables only")
     args = ap.parse_args(argv)
-    path = write(args.folder, with_plots=not args.no_plots)
-    print(f"analysis report: {path} and {path.with_suffix('.html')}")
-    return 0
+    if not (pathlib.Path(args.folder) / "report.json").is_file():
+        ap.error(
+            f"argument folder: {args.folder!r} holds no report.json; "
+            "write it with `cargo run --release -p analysis -- all --out FOLDER`"
+        )
+
+    def run() -> int:
+        path = write(args.folder, with_plots=not args.no_plots)
+        print(f"analysis report: {path} and {path.with_suffix('.html')}")
+        return 0
+
+    return cli.guard(ap.prog, args.debug, run)
 
 
 if __name__ == "__main__":

@@ -6,7 +6,6 @@ controller, write CSVs, plots and a report (Markdown + self-contained HTML).
 
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import pathlib
@@ -15,7 +14,7 @@ import time
 
 import numpy as np
 
-from .. import controllers, declarations
+from .. import cli, controllers, declarations
 from ..campaign import section as campaign_section
 from ..masters import ClosedLoop, Fmu, RunResult, pos_error, step
 from ..metrics import CRITERIA, PHASES, mission_metrics, phase_starts, step_settling
@@ -144,18 +143,39 @@ def analysis_section(out: pathlib.Path) -> list[str]:
     return lines
 
 
-def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="tailsim.reports.compare", description=__doc__.split("\n\n")[0])
+def parser() -> cli.Parser:
+    ap = cli.Parser(prog="tailsim.reports.compare", description=__doc__.split("\n\n")[0])
     ap.add_argument("--controller", choices=[*controllers.KEYS, "both"], default="both")
     ap.add_argument("--dist", default="dist", help="folder with the .fmu files")
     ap.add_argument("--out", default="out", help="output folder")
-    ap.add_argument("--fast-t1", type=float, default=FAST["t_transition_1"], help="T1 of the fast mission [s]")
-    ap.add_argument("--fast-t2", type=float, default=FAST["t_transition_2"], help="T2 of the fast mission [s]")
+    for k, n in (("t_transition_1", "T1"), ("t_transition_2", "T2")):
+        lo, hi = declarations.MISSION_RANGES[k]
+        ap.add_argument(
+            f"--fast-{n.lower()}",
+            type=cli.declared_mission(k),
+            default=FAST[k],
+            help=f"{n} of the fast mission [s], within the declared [{lo:g}, {hi:g}] of `{k}`",
+        )
     ap.add_argument("--no-steps", action="store_true", help="skip the position-step tests")
     ap.add_argument("--jacobi", action="store_true", help="use a Jacobi master instead of Gauss-Seidel")
     ap.add_argument("--no-avionics", action="store_true", help="skip the missions with avionics in the loop")
-    args = ap.parse_args(argv)
+    return ap
 
+
+def main(argv: list[str] | None = None) -> int:
+    ap = parser()
+    args = ap.parse_args(argv)
+    keys = list(controllers.KEYS) if args.controller == "both" else [args.controller]
+    needed = ["tailsitter_plant", *(NAMES[k] for k in keys)]
+    if not args.no_avionics:
+        needed += ["tailsitter_sensors", "tailsitter_ekf"]
+    cli.check_fmus(ap, "--dist", args.dist, needed)
+    cli.check_out(ap, "--out", args.out)
+    return cli.guard(ap.prog, args.debug, lambda: run(args))
+
+
+def run(args) -> int:
+    """The comparison of the parsed and checked options `args` (see `main`)."""
     from tqdm import tqdm
 
     out = pathlib.Path(args.out)
