@@ -19,3 +19,4 @@ pub mod native_campaign;
 pub mod robust;
 pub mod sensitivity;
 pub mod takeoff_landing;
+pub mod wind_envelope;

@@ -66,6 +66,41 @@ enum Cmd {
     /// The Monte-Carlo campaign's jobs flown natively (`python -m tailsim.campaign_native`
     /// writes them): one JSON job per line in, one JSON row per line out, in job order.
     CampaignJobs(CampaignJobs),
+    /// Wind envelope over whole missions (wind_envelope.json, wind_envelope.csv): both
+    /// tuned controllers, steady wind stepping in and turbulent from the start, every
+    /// speed and bearing (`analysis::wind_envelope`).
+    WindEnvelope(WindEnvelopeArgs),
+}
+
+#[derive(clap::Args, Clone)]
+struct WindEnvelopeArgs {
+    /// Output folder.
+    #[arg(long, default_value = "out/analysis")]
+    out: PathBuf,
+    /// Threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// The default mission only (not the take-off-to-landing mission).
+    #[arg(long)]
+    default_only: bool,
+}
+
+fn wind_envelope(a: &WindEnvelopeArgs) -> Result<(), String> {
+    use analysis::wind_envelope::{run, MissionKind};
+    let missions: &[MissionKind] = if a.default_only {
+        &[MissionKind::Default]
+    } else {
+        &[MissionKind::Default, MissionKind::TakeoffLanding]
+    };
+    let start = std::time::Instant::now();
+    let cells = run(&a.out, &Kind::ALL, missions)?;
+    eprintln!(
+        "wrote {}/wind_envelope.json: {} flights in {:.1} s",
+        a.out.display(),
+        cells.len(),
+        start.elapsed().as_secs_f64()
+    );
+    Ok(())
 }
 
 #[derive(clap::Args, Clone)]
@@ -113,6 +148,16 @@ fn main() {
         Cmd::Linear(c) => (c, false, false, false),
         Cmd::Nonlinear(c) => (c, true, true, false),
         Cmd::Aero(c) => (c, false, false, true),
+        Cmd::WindEnvelope(a) => {
+            if let Some(t) = a.threads {
+                let _ = rayon::ThreadPoolBuilder::new().num_threads(t).build_global();
+            }
+            if let Err(e) = wind_envelope(&a) {
+                eprintln!("wind envelope failed: {e}");
+                std::process::exit(1);
+            }
+            return;
+        }
         Cmd::CampaignJobs(a) => {
             if let Some(t) = a.threads {
                 let _ = rayon::ThreadPoolBuilder::new().num_threads(t).build_global();
