@@ -70,6 +70,64 @@ enum Cmd {
     /// tuned controllers, steady wind stepping in and turbulent from the start, every
     /// speed and bearing (`analysis::wind_envelope`).
     WindEnvelope(WindEnvelopeArgs),
+    /// One native flight of the default mission through the atmosphere, as CSV (for the
+    /// comparison with the FMU master: tests/test_master_atmosphere.py).
+    WindTrace(WindTraceArgs),
+}
+
+#[derive(clap::Args, Clone)]
+struct WindTraceArgs {
+    /// "lqr" or "tsd".
+    #[arg(long, default_value = "tsd")]
+    controller: String,
+    /// "gauss-seidel" or "jacobi".
+    #[arg(long, default_value = "gauss-seidel")]
+    ordering: String,
+    /// Steady wind speed at the reference height (m/s) and the bearing it comes from (deg).
+    #[arg(long, default_value_t = 0.0)]
+    speed: f64,
+    #[arg(long, default_value_t = 0.0)]
+    from_deg: f64,
+    /// `wind_profile`, `turbulence_intensity`, `seed`, `origin_height` of the atmosphere.
+    #[arg(long, default_value_t = 1)]
+    profile: i32,
+    #[arg(long, default_value_t = 0)]
+    intensity: i32,
+    #[arg(long, default_value_t = 1)]
+    seed: i32,
+    #[arg(long, default_value_t = 0.0)]
+    origin_height: f64,
+    /// Stop time (s).
+    #[arg(long, default_value_t = 5.0)]
+    stop: f64,
+    /// CSV file.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+fn wind_trace(a: &WindTraceArgs) -> Result<(), String> {
+    use closed_loop::Ordering;
+    let kind = match a.controller.as_str() {
+        "lqr" => Kind::Lqr,
+        "tsd" => Kind::Tsd,
+        other => return Err(format!("controller '{other}': lqr or tsd")),
+    };
+    let ordering = match a.ordering.as_str() {
+        "gauss-seidel" => Ordering::GaussSeidel,
+        "jacobi" => Ordering::Jacobi,
+        other => return Err(format!("ordering '{other}': gauss-seidel or jacobi")),
+    };
+    let params = atmosphere::Params {
+        wind_speed: a.speed,
+        wind_from: a.from_deg.to_radians(),
+        wind_profile: a.profile,
+        turbulence_intensity: a.intensity,
+        seed: a.seed,
+        origin_height: a.origin_height,
+        ..atmosphere::Params::default()
+    };
+    let csv = analysis::wind_envelope::trace_csv(kind, ordering, params, a.stop)?;
+    std::fs::write(&a.out, csv).map_err(|e| format!("{}: {e}", a.out.display()))
 }
 
 #[derive(clap::Args, Clone)]
@@ -154,6 +212,13 @@ fn main() {
             }
             if let Err(e) = wind_envelope(&a) {
                 eprintln!("wind envelope failed: {e}");
+                std::process::exit(1);
+            }
+            return;
+        }
+        Cmd::WindTrace(a) => {
+            if let Err(e) = wind_trace(&a) {
+                eprintln!("wind trace failed: {e}");
                 std::process::exit(1);
             }
             return;

@@ -340,6 +340,51 @@ impl WindForm {
     }
 }
 
+/// Columns of [`trace_csv`].
+pub const TRACE_COLUMNS: [&str; 9] = [
+    "time", "pos_n", "pos_e", "pos_d", "wind_n", "wind_e", "wind_d", "thrust_cmd", "elevator_cmd",
+];
+
+/// One native flight of the default mission through the atmosphere `params`, as the FMU
+/// master flies it (`tailsim.masters.ClosedLoop(..., atmosphere=...)`: the plant FMU's
+/// default start, the controller measuring the plant outputs with the wind the plant holds)
+/// as CSV of [`TRACE_COLUMNS`] (shortest round-trip decimals), one row per communication
+/// point up to `stop_time`. For the comparison with the FMU master.
+pub fn trace_csv(kind: Kind, ordering: Ordering, params: atmosphere::Params, stop_time: f64) -> Result<String, String> {
+    let plant = plant();
+    let mission = MissionParams::default();
+    let x0 = trimmed_climb(&plant, mission.v_vertical)?;
+    let mut scenario = Scenario::mission(mission);
+    scenario.stop_time = stop_time;
+    scenario.ordering = ordering;
+    scenario.wind = Wind::Atmosphere(params);
+    scenario.measured_wind = closed_loop::MeasuredWind::HeldInput;
+    let mut c = kind.make(&mission);
+    let trace = fly(&plant, x0, &mut c, &scenario);
+    if let Some(f) = trace.failure {
+        return Err(f);
+    }
+    let mut out = TRACE_COLUMNS.join(",");
+    out.push('\n');
+    for s in &trace.samples {
+        let p = s.measurement.pos_ned;
+        let row = [
+            s.t,
+            p.x,
+            p.y,
+            p.z,
+            s.wind.x,
+            s.wind.y,
+            s.wind.z,
+            s.command.thrust,
+            s.command.elevator,
+        ];
+        out.push_str(&row.map(|v| format!("{v:?}")).join(","));
+        out.push('\n');
+    }
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
