@@ -127,7 +127,14 @@ def test_native_loop_flies_the_same_turbulent_run(fmus, tmp_path, ordering, cont
     assert len(native) == len(r.time)
     np.testing.assert_array_equal(native["time"], r.time)
     worst = {}
-    for name in ("pos_n", "pos_e", "pos_d", "thrust_cmd", "elevator_cmd", *WIND):
+    for name in ("pos_n", "pos_e", "pos_d"):
         worst[name] = float(np.max(np.abs(native[name] - r[name])))
+    # The native trace records what the plant flies from t; the FMU master records the
+    # controller's and the atmosphere's outputs at t: under Jacobi the plant flies them one
+    # point later.
+    lag = 1 if ordering == "jacobi" else 0
+    for name in ("thrust_cmd", "elevator_cmd", *WIND):
+        worst[name] = float(np.max(np.abs(native[name][lag:] - r[name][: len(r.time) - lag])))
+    print(f"\n{controller} {ordering}: largest |native − FMU master| {max(worst.values()):.1e}")
     assert max(worst.values()) < 1e-9, worst
     assert np.ptp(r["wind_n"]) > 0.1  # turbulent
