@@ -199,7 +199,12 @@ pub fn write_all(dir: &Path) -> Result<Vec<PathBuf>, String> {
 
 /// Write one SSP archive: the SSD and the FMUs (plant, controller, the atmosphere if given)
 /// under `resources/`.
-pub fn write_ssp(path: &Path, plant_fmu: &Path, controller_fmu: &Path, atmosphere_fmu: Option<&Path>) -> Result<(), String> {
+pub fn write_ssp(
+    path: &Path,
+    plant_fmu: &Path,
+    controller_fmu: &Path,
+    atmosphere_fmu: Option<&Path>,
+) -> Result<(), String> {
     let read = |p: &Path| std::fs::read(p).map_err(|e| format!("{}: {e}", p.display()));
     let (plant_bytes, controller_bytes) = (read(plant_fmu)?, read(controller_fmu)?);
     let plant = fmu_info(&plant_bytes).map_err(|e| format!("{}: {e}", plant_fmu.display()))?;
@@ -487,7 +492,10 @@ pub fn system_description_with(
     atmosphere: Option<&FmuInfo>,
 ) -> Result<String, String> {
     let mut links = connections(plant, controller)?;
-    let atmosphere = atmosphere.map(|a| atmosphere_element(plant, a)).transpose()?.zip(atmosphere);
+    let atmosphere = atmosphere
+        .map(|a| atmosphere_element(plant, a))
+        .transpose()?
+        .zip(atmosphere);
     if let Some(((l, _), _)) = &atmosphere {
         links.extend(l.iter().cloned());
     }
@@ -574,7 +582,10 @@ pub fn avionics_system_description_with(
     links.extend(links_between(ekf, "estimator", controller, "controller")?);
     links.extend(links_between(controller, "controller", plant, "plant")?);
     links.extend(links_between(controller, "controller", ekf, "estimator")?);
-    let atmosphere = atmosphere.map(|a| atmosphere_element(plant, a)).transpose()?.zip(atmosphere);
+    let atmosphere = atmosphere
+        .map(|a| atmosphere_element(plant, a))
+        .transpose()?
+        .zip(atmosphere);
     if let Some(((l, _), _)) = &atmosphere {
         links.extend(l.iter().cloned());
     }
@@ -914,12 +925,12 @@ mod tests {
     }
 
     fn atmosphere() -> FmuInfo {
-        let mut ports = vec![
-            port("pos_d", "input", "Real"),
-            port("wind_n", "output", "Real"),
-        ];
+        let mut ports = vec![port("pos_d", "input", "Real"), port("wind_n", "output", "Real")];
         for (n, _) in ATMOSPHERE_PARAMS.iter() {
-            let kind = if matches!(*n, "wind_profile" | "turbulence_model" | "turbulence_intensity" | "seed") {
+            let kind = if matches!(
+                *n,
+                "wind_profile" | "turbulence_model" | "turbulence_intensity" | "seed"
+            ) {
                 "Integer"
             } else {
                 "Real"

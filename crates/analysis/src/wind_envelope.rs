@@ -342,7 +342,15 @@ impl WindForm {
 
 /// Columns of [`trace_csv`].
 pub const TRACE_COLUMNS: [&str; 9] = [
-    "time", "pos_n", "pos_e", "pos_d", "wind_n", "wind_e", "wind_d", "thrust_cmd", "elevator_cmd",
+    "time",
+    "pos_n",
+    "pos_e",
+    "pos_d",
+    "wind_n",
+    "wind_e",
+    "wind_d",
+    "thrust_cmd",
+    "elevator_cmd",
 ];
 
 /// One native flight of the default mission through the atmosphere `params`, as the FMU
@@ -402,7 +410,13 @@ mod tests {
         let Wind::Atmosphere(p) = wind(WindForm::Turbulent, 5.0, 2, 10.0) else {
             panic!("not the atmosphere")
         };
-        assert_eq!((p.wind_speed, p.wind_profile, p.seed, p.origin_height), (5.0, 0, 3, 10.0));
-        assert_eq!(Wind::Atmosphere(p).at(0.0), wind(WindForm::Step, 5.0, 2, 10.0).at(STEP_TIME));
+        assert_eq!(
+            (p.wind_speed, p.wind_profile, p.seed, p.origin_height),
+            (5.0, 0, 3, 10.0)
+        );
+        assert_eq!(
+            Wind::Atmosphere(p).at(0.0),
+            wind(WindForm::Step, 5.0, 2, 10.0).at(STEP_TIME)
+        );
     }
 }
