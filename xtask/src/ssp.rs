@@ -214,7 +214,7 @@ pub fn write_ssp(
         (Some(b), Some(p)) => Some(fmu_info(b).map_err(|e| format!("{}: {e}", p.display()))?),
         _ => None,
     };
-    let ssd = system_description_with(&plant, &controller, atmosphere.as_ref())?;
+    let ssd = system_description(&plant, &controller, atmosphere.as_ref())?;
     let file = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let mut zip = zip::ZipWriter::new(file);
     let deflated = zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
@@ -480,13 +480,8 @@ fn atmosphere_element(plant: &FmuInfo, atmosphere: &FmuInfo) -> Result<(Vec<Conn
     Ok((links, vec![("atmosphere", bindings(atmosphere, &values)?)]))
 }
 
-/// SystemStructure.ssd of the closed loop.
-pub fn system_description(plant: &FmuInfo, controller: &FmuInfo) -> Result<String, String> {
-    system_description_with(plant, controller, None)
-}
-
 /// SystemStructure.ssd of the closed loop, with the atmosphere component if given.
-pub fn system_description_with(
+pub fn system_description(
     plant: &FmuInfo,
     controller: &FmuInfo,
     atmosphere: Option<&FmuInfo>,
@@ -559,18 +554,9 @@ fn links_between(
 
 /// SystemStructure.ssd of avionics in the loop: plant → sensors → estimator → controller →
 /// plant and controller → estimator (the commands), every connection explicit and by name.
-/// The sensors and the estimator keep their (equal) defaults of the shared parameters.
+/// The sensors and the estimator keep their (equal) defaults of the shared parameters; the
+/// atmosphere, if given, is wired and bound as in the closed loop.
 pub fn avionics_system_description(
-    plant: &FmuInfo,
-    sensors: &FmuInfo,
-    ekf: &FmuInfo,
-    controller: &FmuInfo,
-) -> Result<String, String> {
-    avionics_system_description_with(plant, sensors, ekf, controller, None)
-}
-
-/// The same with the atmosphere component if given (wired and bound as in the closed loop).
-pub fn avionics_system_description_with(
     plant: &FmuInfo,
     sensors: &FmuInfo,
     ekf: &FmuInfo,
@@ -665,7 +651,7 @@ pub fn write_avionics_ssp(dir: &Path, controller_id: &str) -> Result<PathBuf, St
         bytes.push(read(ATMOSPHERE)?);
     }
     let infos = bytes.iter().map(|b| fmu_info(b)).collect::<Result<Vec<_>, _>>()?;
-    let ssd = avionics_system_description_with(&infos[0], &infos[1], &infos[2], &infos[3], infos.get(4))?;
+    let ssd = avionics_system_description(&infos[0], &infos[1], &infos[2], &infos[3], infos.get(4))?;
     let path = dir.join(format!("{controller_id}_avionics.ssp"));
     let file = std::fs::File::create(&path).map_err(|e| format!("{}: {e}", path.display()))?;
     let mut zip = zip::ZipWriter::new(file);
@@ -844,7 +830,7 @@ mod tests {
 
     #[test]
     fn design_model_is_the_plants_declared_airframe_bound_on_the_controller_only() {
-        let ssd = system_description(&plant(), &controller()).unwrap();
+        let ssd = system_description(&plant(), &controller(), None).unwrap();
         // 79 airframe parameters, the first the mass of 9 kg (thesis App. C.1.1)
         assert!(DESIGN_AIRFRAME.len() > 70, "{}", DESIGN_AIRFRAME.len());
         assert_eq!(DESIGN_AIRFRAME[0], ("mass", 9.0));
@@ -861,12 +847,12 @@ mod tests {
         // a controller without a design model is refused, not silently left on its defaults
         let mut c = controller();
         c.ports.retain(|p| p.name != "mass");
-        assert!(system_description(&plant(), &c).unwrap_err().contains("mass"));
+        assert!(system_description(&plant(), &c, None).unwrap_err().contains("mass"));
     }
 
     #[test]
     fn ssd_declares_only_connected_inputs_and_binds_the_mission() {
-        let ssd = system_description(&plant(), &controller()).unwrap();
+        let ssd = system_description(&plant(), &controller(), None).unwrap();
         assert!(ssd.contains(r#"<ssd:Connector name="pos_d" kind="input">"#));
         assert!(!ssd.contains("wind_n"), "undriven plant input declared");
         assert!(!ssd.contains("ref_offset_n"), "unconnected controller input declared");
@@ -900,7 +886,7 @@ mod tests {
     #[test]
     fn avionics_system_wires_the_chain_by_name() {
         let (sensors, ekf, controller) = avionics();
-        let ssd = avionics_system_description(&plant(), &sensors, &ekf, &controller).unwrap();
+        let ssd = avionics_system_description(&plant(), &sensors, &ekf, &controller, None).unwrap();
         for (from, to, name) in [
             ("plant", "sensors", "pos_d"),
             ("sensors", "estimator", "gps_height"),
@@ -920,7 +906,7 @@ mod tests {
     fn avionics_system_refuses_an_undriven_estimator_input() {
         let (sensors, mut ekf, controller) = avionics();
         ekf.ports.push(port("mag_x", "input", "Real"));
-        let e = avionics_system_description(&plant(), &sensors, &ekf, &controller).unwrap_err();
+        let e = avionics_system_description(&plant(), &sensors, &ekf, &controller, None).unwrap_err();
         assert!(e.contains("mag_x"), "{e}");
     }
 
@@ -946,7 +932,7 @@ mod tests {
 
     #[test]
     fn atmosphere_is_wired_by_name_and_bound_calm() {
-        let ssd = system_description_with(&plant(), &controller(), Some(&atmosphere())).unwrap();
+        let ssd = system_description(&plant(), &controller(), Some(&atmosphere())).unwrap();
         for (from, to, name) in [("plant", "atmosphere", "pos_d"), ("atmosphere", "plant", "wind_n")] {
             let c = format!(
                 r#"<ssd:Connection startElement="{from}" startConnector="{name}" endElement="{to}" endConnector="{name}"/>"#
@@ -969,11 +955,13 @@ mod tests {
         assert_eq!(value_of("turbulence_intensity"), (true, "0".to_string()));
         assert_eq!(value_of("gust_amplitude_n"), (false, "0.0".to_string()));
         // without the atmosphere the plant's wind inputs stay undeclared
-        assert!(!system_description(&plant(), &controller()).unwrap().contains("wind_n"));
+        assert!(!system_description(&plant(), &controller(), None)
+            .unwrap()
+            .contains("wind_n"));
         // an atmosphere input no plant output drives is refused
         let mut a = atmosphere();
         a.ports.push(port("humidity", "input", "Real"));
-        assert!(system_description_with(&plant(), &controller(), Some(&a))
+        assert!(system_description(&plant(), &controller(), Some(&a))
             .unwrap_err()
             .contains("humidity"));
     }
@@ -982,7 +970,7 @@ mod tests {
     fn missing_mission_parameter_is_an_error() {
         let mut c = controller();
         c.ports.retain(|p| p.name != "t_level");
-        assert!(system_description(&plant(), &c).unwrap_err().contains("t_level"));
+        assert!(system_description(&plant(), &c, None).unwrap_err().contains("t_level"));
     }
 
     #[test]
