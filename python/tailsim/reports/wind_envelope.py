@@ -61,10 +61,11 @@ def section(d: dict) -> list[str]:
         "ground 10 m below the start). Steady horizontal wind from each bearing (clockwise from north, the "
         f"mission's heading: 0° a headwind in level flight), stepping in at {w['step_time']:g} s, or present from "
         "t = 0 through the atmosphere (uniform profile, moderate Dryden turbulence, W20 = 30 kt, seed 1 + the "
-        f"bearing's index). **Held**: the flight completes (and lands) and stays within {w['held_max_error']:g} m "
-        "of the controller's own reference (up to the touchdown). Each cell: largest distance to the reference (m), "
-        "✓ held, ✗ lost (did not complete), ~ completed beyond the limit; for the landing mission also the "
-        "distance from the target at rest (m) / touchdown speed (m/s). "
+        f"bearing's index). **Held**: the flight completes (the landing mission: lands within "
+        f"{w['held_max_error']:g} m of the target) and stays within {w['held_max_error']:g} m of the controller's "
+        "own reference throughout. Each cell: largest distance to the reference (m), ✓ held, ✗ lost (did not "
+        "complete), ~ completed beyond the limit; for the landing mission also the distance from the target at "
+        "rest (m) / touchdown speed (m/s) where it landed. "
         f"{len(w['cells'])} flights in {w['wall_time_s']:.0f} s on {w['threads']} threads.",
         "",
     ]
@@ -84,7 +85,7 @@ def section(d: dict) -> list[str]:
                     for c in row:
                         m = "✓" if c["held"] else ("~" if c["completed"] else "✗")
                         text = f"{m} {_err(c['max_error'])}"
-                        if mission == "takeoff_landing" and c["completed"]:
+                        if mission == "takeoff_landing" and c["touchdown_speed"] is not None:
                             text += f" ({_err(c['landing_distance'])}/{_err(c['touchdown_speed'])})"
                         marks.append(text)
                     out.append(f"| {k} | {s:g} | {held}/{len(row)} | " + " | ".join(marks) + " |")
