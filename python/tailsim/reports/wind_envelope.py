@@ -121,7 +121,7 @@ def plot(folder: str | pathlib.Path) -> pathlib.Path | None:
                 r, q = speeds.index(c["speed"]), bearings.index(c["bearing_deg"])
                 grid[r, q] = 2 if c["held"] else (1 if c["completed"] else 0)
                 e = c["max_error"]
-                label = "✗" if not c["completed"] else _err(e)
+                label = _err(e) if c["completed"] else f"✗ {_err(e)}"
                 ax.text(q, r, label, ha="center", va="center", fontsize=7)
             ax.imshow(grid, cmap=cmap, vmin=0, vmax=2, aspect="auto", origin="lower")
             ax.set_xticks(range(len(bearings)), [f"{b:g}" for b in bearings], fontsize=7)
