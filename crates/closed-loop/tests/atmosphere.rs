@@ -64,7 +64,10 @@ fn turbulence_is_seeded_and_jacobi_flies_it_one_step_late() {
         ..atmosphere::Params::default()
     };
     let gs = run(Wind::Atmosphere(p), Ordering::GaussSeidel, MeasuredWind::HeldInput, 3.0);
-    same(&gs, &run(Wind::Atmosphere(p), Ordering::GaussSeidel, MeasuredWind::HeldInput, 3.0));
+    same(
+        &gs,
+        &run(Wind::Atmosphere(p), Ordering::GaussSeidel, MeasuredWind::HeldInput, 3.0),
+    );
     let other = run(
         Wind::Atmosphere(atmosphere::Params { seed: 12, ..p }),
         Ordering::GaussSeidel,
@@ -72,7 +75,11 @@ fn turbulence_is_seeded_and_jacobi_flies_it_one_step_late() {
         3.0,
     );
     assert!(gs.samples.iter().zip(&other.samples).all(|(a, b)| a.wind != b.wind));
-    let spread = gs.samples.iter().map(|s| (s.wind - gs.samples[0].wind).norm()).fold(0.0, f64::max);
+    let spread = gs
+        .samples
+        .iter()
+        .map(|s| (s.wind - gs.samples[0].wind).norm())
+        .fold(0.0, f64::max);
     assert!(spread > 0.1, "{spread}");
     // Jacobi: the wind flown from t is the atmosphere's output of the previous point.
     let j = run(Wind::Atmosphere(p), Ordering::Jacobi, MeasuredWind::HeldInput, 3.0);
