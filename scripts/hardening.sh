@@ -1,14 +1,22 @@
 #!/usr/bin/env bash
-# Long-run hardening of the FMU libraries (issue 7). Not part of scripts/test.sh,
+# Long-run hardening of the FMU libraries. Not part of scripts/test.sh,
 # which runs the short versions (cargo test -p fmi-fuzz: 2500 fuzz sequences,
 # 64-thread check, 10 000-cycle RSS check; pytest test_conformance/test_interop).
 #
 #   scripts/hardening.sh [FUZZ_SECONDS]        default 600
+#   scripts/hardening.sh calls [N]             only the fuzz, until N FMI calls (default 10^7)
+#                                              over all units: calls, calls/s, violations,
+#                                              FMI functions and states exercised; exit 1 on
+#                                              any violation → target/hardening/calls.txt
 #
 # Environment: TAILSITTER_FMUS=a,b narrows the FMUs (default: all five, fmi-fuzz ALL_MODELS);
 # HARDENING_SKIP_DIST=1 skips `cargo xtask dist`; FUZZ_SEED sets the fuzz seed;
 # VALGRIND_CYCLES (default 5) cycles per FMU under valgrind; RSS_CYCLES (default 100000)
 # light and RSS_FULL_CYCLES (default 5000; ~40 ms each for the LQR FMU) full cycles.
+#
+# Both modes write the sequence about to run to target/hardening/fuzz-progress.txt: if the
+# process dies (abort, crash), that file and the stderr line of the signal handler give the
+# `fmi-fuzz fuzz --replay 0x… --max-calls N` command that runs the failing sequence alone.
 #
 # Steps and what each reports:
 #  1. long call-sequence fuzz through the C ABI: sequences, FMI calls, reset and restore
@@ -21,6 +29,11 @@
 #  4. 64 instances stepped concurrently vs. sequentially (the cargo test, with output)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+MODE=full
+if [ "${1:-}" = calls ]; then
+    MODE=calls
+    CALLS="${2:-10000000}"
+fi
 SECONDS_FUZZ="${1:-600}"
 OUT=target/hardening
 mkdir -p "$OUT"
@@ -31,8 +44,19 @@ fi
 cargo build --release -p fmi-fuzz --bin fmi-fuzz
 BIN=target/release/fmi-fuzz
 
+if [ "$MODE" = calls ]; then
+    echo "== fuzz until ${CALLS} FMI calls (seed ${FUZZ_SEED:-24301})"
+    status=0
+    "$BIN" fuzz --calls "$CALLS" --seconds 31536000 --seed "${FUZZ_SEED:-24301}" --coverage \
+        --progress "$OUT/fuzz-progress.txt" > "$OUT/calls.txt" || status=$?
+    grep -E "calls/s|^coverage:|^fmi-fuzz:|^  tailsitter|VIOLATION|×" "$OUT/calls.txt"
+    [ "$status" = 0 ] && echo "== done: 0 violations (table of (function, state, status) counts in $OUT/calls.txt)"
+    exit "$status"
+fi
+
 echo "== 1. fuzz for ${SECONDS_FUZZ} s"
-"$BIN" fuzz --seconds "$SECONDS_FUZZ" --seed "${FUZZ_SEED:-24301}" --coverage | tee "$OUT/fuzz.txt"
+"$BIN" fuzz --seconds "$SECONDS_FUZZ" --seed "${FUZZ_SEED:-24301}" --coverage \
+    --progress "$OUT/fuzz-progress.txt" | tee "$OUT/fuzz.txt"
 
 echo "== 2. valgrind memcheck (${VALGRIND_CYCLES:-5} cycles per FMU)"
 valgrind --tool=memcheck --leak-check=full --show-leak-kinds=definite,indirect,possible \

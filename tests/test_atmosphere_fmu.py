@@ -135,9 +135,9 @@ def test_plant_and_atmosphere_connect_by_name(plant, atmosphere):
     a = started(atmosphere, "wind", log, ints={"turbulence_intensity": 1}, wind_speed=5.0, wind_from=1.5 * math.pi)
     for k in range(100):
         t = k * H
-        atmosphere.set(a, **dict(zip(INPUTS, plant.get(p, *INPUTS))))
+        atmosphere.set(a, **dict(zip(INPUTS, plant.get(p, *INPUTS), strict=True)))
         a.doStep(t, H)
-        plant.set(p, **dict(zip(WIND, atmosphere.get(a, *WIND))))
+        plant.set(p, **dict(zip(WIND, atmosphere.get(a, *WIND), strict=True)))
         p.doStep(t, H)
     wn, we, wd = atmosphere.get(a, *WIND)
     assert 0 < we < 15 and abs(wn) < 10 and abs(wd) < 10, (wn, we, wd)

@@ -133,8 +133,17 @@ def test_wiring_by_name_and_shared_parameters(fmus):
         assert s.variables[name].unit == e.variables[name].unit, name
     for name in ["mag_x", "mag_y", "mag_z"]:
         assert s.variables[name].unit == e.variables[name].unit == "Gauss"
-    # The estimator's magnetometer σ is the sensors' σ through their 8 Hz filter at 50 Hz.
-    assert e.start("sigma_mag") == pytest.approx(s.start("mag_std") * 0.5764)
+    # The estimator's measurement σ's are those the sensors deliver (Table D.1).
+    for sensor_name, ekf_name in [
+        ("mag_std", "sigma_mag"),
+        ("accel_std", "sigma_accel"),
+        ("gyro_std", "sigma_gyro"),
+        ("pitot_std", "sigma_pitot_dp"),
+        ("gps_height_std", "sigma_gps_height"),
+        ("gps_latlon_std", "sigma_gps_latlon"),
+        ("gps_vel_std", "sigma_gps_vel"),
+    ]:
+        assert e.start(ekf_name) == pytest.approx(s.start(sensor_name), rel=1e-12), ekf_name
     bad = AvionicsLoop(
         fmus["tailsitter_plant"],
         fmus["tailsitter_sensors"],

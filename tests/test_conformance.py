@@ -20,8 +20,9 @@ from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
 
 from fmu_util import LogRecorder, fmu_path
+from tailsim import declarations
 
-ALL = ["tailsitter_plant", "tailsitter_lqr", "tailsitter_tsd", "tailsitter_sensors", "tailsitter_ekf", "tailsitter_atmosphere"]
+ALL = list(declarations.MODELS)
 MODELS = [m.strip() for m in os.environ.get("TAILSITTER_FMUS", "").split(",") if m.strip()] or ALL
 FMUTOOL = Path(sys.executable).with_name("fmutool")
 

@@ -56,7 +56,7 @@ def test_parameter_overrides_reach_both_fmus(fmus, controller):
         fmus["tailsitter_plant"], fmus[controller], controller_params={"v_level": 22.0, "t_level": 12.0}
     ).run(stop_time=20.0)
     level = (r.time > 15.0) & (r.time < 20.0)
-    # The tuned controllers' reference (flight_mission::profile) reaches V_L through the
+    # The tuned controllers' reference (guidance::profile) reaches V_L through the
     # point-mass response after the thrust-limited front transition (overshoot ≈ 0.3 m/s
     # decaying at k_V = 1.5 /s), the thesis's within rounding: both far from the default 25.
     assert np.all(np.abs(r["ref_airspeed"][level] - 22.0) < 0.01)

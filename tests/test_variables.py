@@ -6,8 +6,9 @@ from __future__ import annotations
 import pytest
 
 from fmu_util import LogRecorder
+from tailsim import declarations
 
-FMUS = ["tailsitter_plant", "tailsitter_lqr", "tailsitter_tsd", "tailsitter_sensors", "tailsitter_ekf", "tailsitter_atmosphere"]
+FMUS = list(declarations.MODELS)
 
 
 def getter(slave, v):

@@ -1,5 +1,6 @@
-//! Hashes the source of every crate whose code decides the campaign results
-//! (physics, mission, closed loop and its mission criteria, both controllers, this crate) into
+//! Hashes the source of every crate whose code decides the sweep results
+//! (physics, mission, guidance, closed loop and its mission criteria, both controllers, the
+//! declarations their parameter defaults are generated from, this crate) into
 //! `RESULTS_SOURCE_HASH`, part of every cache key: editing any of them
 //! invalidates the cached results instead of serving stale ones.
 
@@ -8,11 +9,16 @@ use std::path::{Path, PathBuf};
 const SOURCES: &[&str] = &[
     "../tailsitter-physics/src",
     "../flight-mission/src",
+    "../guidance/src",
     "../closed-loop/src",
     "../lqr-control/src",
     "../lqr-control/resources",
     "../tsd-control/src",
-    "../../modelDescription/fragments/mission_criteria.json",
+    "../../modelDescription/fragments",
+    "../../modelDescription/tailsitter_plant.json",
+    "../../modelDescription/tailsitter_lqr.json",
+    "../../modelDescription/tailsitter_tsd.json",
+    "../../modelDescription/src/defaults.rs",
     "src",
 ];
 

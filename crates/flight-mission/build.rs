@@ -1,7 +1,9 @@
 //! Generates from `modelDescription/fragments/controller_interface.json`, the
 //! single source of the controller ports and the mission parameters:
 //! - `OUT_DIR/mission_generated.rs`: `impl Default for MissionParams` and
-//!   `MissionParams::named_values` (group `mission`);
+//!   `MissionParams::named_values` (group `mission`, table
+//!   `model_description::defaults::CRATES`);
+//! - `OUT_DIR/presets_generated.rs`: `PRESETS`, the named missions (`presets`);
 //! - `OUT_DIR/measurement_generated.rs`: `Measurement::first_non_finite`, naming
 //!   the port of a non-finite value (group `measurement`).
 
@@ -14,13 +16,7 @@ fn main() {
     let file = "fragments/controller_interface.json";
     let (decls, sources) =
         model_description::load_declarations(&dir, file).unwrap_or_else(|e| panic!("declaration {file}: {e}"));
-    let text = model_description::rust::group_defaults(
-        &decls,
-        "mission",
-        "MissionParams",
-        &format!("modelDescription/{file}"),
-    );
-    std::fs::write(out.join("mission_generated.rs"), text).expect("write mission_generated.rs");
+    model_description::defaults::build();
     let check = model_description::rust::group_first_non_finite(
         &decls,
         "measurement",
@@ -28,6 +24,9 @@ fn main() {
         &format!("modelDescription/{file}"),
     );
     std::fs::write(out.join("measurement_generated.rs"), check).expect("write measurement_generated.rs");
+    let presets = model_description::load_presets(&dir).unwrap_or_else(|e| panic!("mission presets: {e}"));
+    let text = model_description::rust::mission_presets(&presets, &format!("modelDescription/{file}"));
+    std::fs::write(out.join("presets_generated.rs"), text).expect("write presets_generated.rs");
     for s in sources {
         println!("cargo:rerun-if-changed={}", s.display());
     }

@@ -1,7 +1,7 @@
 //! Generates from the plant's declaration (`modelDescription/tailsitter_plant.json`,
 //! the single source of every parameter, default and port name) into `OUT_DIR`:
 //! - `airframe_generated.rs`: `impl Default for Airframe` (the declared start values)
-//!   and `Airframe::named_values` (group `airframe`);
+//!   and `Airframe::named_values` (group `airframe`, table `model_description::defaults::CRATES`);
 //! - `input_names.rs`: `INPUT_NAMES`, the plant's command inputs (group `command`).
 
 use std::path::PathBuf;
@@ -13,9 +13,7 @@ fn main() {
     let file = "tailsitter_plant.json";
     let (decls, sources) =
         model_description::load_declarations(&dir, file).unwrap_or_else(|e| panic!("declaration {file}: {e}"));
-    let source = format!("modelDescription/{file}");
-    let airframe = model_description::rust::group_defaults(&decls, "airframe", "Airframe", &source);
-    std::fs::write(out.join("airframe_generated.rs"), airframe).expect("write airframe_generated.rs");
+    model_description::defaults::build();
     let names = model_description::rust::group_names(
         &decls,
         "command",

@@ -116,6 +116,9 @@ impl Binding for EkfBinding {
     fn config(v: &Variables) -> Result<EstimatorParams, ParamError> {
         let mut p = v.estimator();
         p.tuning.gps_reset_after = v.gps_reset_after.max(1) as u32;
+        if v.app_d_configuration {
+            p = p.app_d();
+        }
         // One gravity for the navigation equations and the airframe's motor model.
         p.airframe.gravity = p.earth.gravity;
         Ok(p)

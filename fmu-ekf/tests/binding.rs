@@ -101,17 +101,28 @@ fn ports_are_named_like_the_plant_sensor_and_controller_ports() {
 }
 
 #[test]
-fn parameter_defaults_are_the_libraries() {
-    // The declared defaults build exactly the library's default parameters.
+fn airframe_start_values_are_the_plants() {
+    // The estimator's copy of the airframe parameters builds the plant's default airframe.
     let v = Variables::with_start_values();
     let p = <tailsitter_ekf::EkfBinding as controller_fmu::Binding>::config(&v).unwrap();
-    let d = EstimatorParams::default();
-    assert_eq!(p.noise, d.noise);
-    assert_eq!(p.process, d.process);
-    assert_eq!(p.tuning, d.tuning);
-    let (e, de) = (p.earth, d.earth);
-    assert!((e.ref_latitude - de.ref_latitude).abs() < 1e-15 && (e.mag_declination - de.mag_declination).abs() < 1e-15);
     assert_eq!(p.airframe, Airframe::default());
+}
+
+/// `app_d_configuration` selects [`EstimatorParams::app_d`] over the individual parameters.
+#[test]
+fn app_d_configuration_overrides_the_extras_and_the_sigmas() {
+    let mut v = Variables::with_start_values();
+    v.sigma_mag = 0.3;
+    v.app_d_configuration = true;
+    let p = <tailsitter_ekf::EkfBinding as controller_fmu::Binding>::config(&v).unwrap();
+    assert_eq!(p.noise.sigma_mag, 0.02);
+    assert!(!p.prediction.model && !p.tuning.relative_to_start);
+    assert!(!p.filter.compensate && !p.tuning.sideslip_pseudo_measurement);
+    let d = EstimatorParams::default().app_d();
+    assert_eq!(
+        (p.noise, p.filter, p.prediction, p.tuning),
+        (d.noise, d.filter, d.prediction, d.tuning)
+    );
 }
 
 /// Deterministic pseudo-noise for the binding tests (the statistics are tested in the library).
@@ -162,8 +173,8 @@ impl Sim {
         v.imu_gyro_p = self.x[idx::P] + 0.028 * n.next();
         v.imu_gyro_q = self.x[idx::Q] + 0.028 * n.next();
         v.imu_gyro_r = self.x[idx::R] + 0.028 * n.next();
-        // The magnetometer and pitot σ's the estimator assumes by default: those the
-        // sensor model delivers through its 8 Hz filter (0.02 G × 0.5764; pitot ≈ 0.2 m/s).
+        // The magnetometer σ the estimator assumes by default: the one the sensor model
+        // delivers (Table D.1, 0.02 G); pitot ≈ 0.2 m/s.
         let m = c * EstimatorParams::default().earth.mag_ned();
         let sm = EstimatorParams::default().noise.sigma_mag;
         v.mag_x = m.x + sm * n.next();

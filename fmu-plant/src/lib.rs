@@ -142,7 +142,7 @@ impl PlantModel {
 
     /// The commanded inputs `u` of the physics, in `tailsitter_physics::idx` order.
     fn inputs(vars: &Variables) -> tailsitter_physics::InputVector {
-        closed_loop::plant_inputs(&vars.command())
+        flight_mission::plant_inputs(&vars.command())
     }
 
     /// Write every output from the state and the current inputs, and the Model Exchange
@@ -160,7 +160,7 @@ impl PlantModel {
         let (y, dx) = self
             .plant
             .outputs_and_derivatives(&self.x, &Self::inputs(vars), &vars.wind());
-        vars.set_measurement(&closed_loop::measurement(&self.x, &y));
+        vars.set_measurement(&flight_mission::measurement(&self.x, &y));
         vars.set_outputs(&y);
         vars.stall_fraction = y.stall_fraction;
         vars.aero_regime = f64::from(y.aero_regime.index());

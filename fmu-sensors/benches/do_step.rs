@@ -1,7 +1,7 @@
 //! `fmi2DoStep` of the sensor FMU over a 20 ms communication step at the default
-//! rates (accelerometer and gyro 200 Hz, magnetometer and pitot 50 Hz, GPS 4 Hz),
-//! and with the accelerometers at the thesis's 1 kHz, called through the same
-//! generic C-ABI functions the exported symbols use. Issue bar: ≤ 5 µs per step.
+//! rates (accelerometers at the thesis's 1 kHz, gyro 200 Hz, magnetometer and pitot
+//! 50 Hz, GPS 4 Hz), and with the accelerometers at 200 Hz, called through the same
+//! generic C-ABI functions the exported symbols use.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use fmi2_export::ffi;
@@ -12,15 +12,15 @@ use tailsitter_sensors::{vr, SensorsModel};
 fn bench(c: &mut Criterion) {
     // The layer's shared test host (a recording logger; doStep logs nothing here).
     let host = fmi2_export::test_host::Host::new();
-    for (label, imu_rate) in [("default_rates", 200.0), ("imu_1kHz", 1000.0)] {
+    for (label, accel_rate) in [("accel_200Hz", 200.0), ("default_rates", 1000.0)] {
         // SAFETY: the host outlives the instance, freed below.
         let inst = unsafe { host.initializing::<SensorsModel>("bench") };
         // SAFETY: live instance in Initialization Mode.
         unsafe {
-            let rates = [imu_rate, imu_rate];
-            let rate_vrs = [vr::accel_rate, vr::gyro_rate];
+            let rates = [accel_rate];
+            let rate_vrs = [vr::accel_rate];
             assert_eq!(
-                ffi::set_real::<SensorsModel>(inst, rate_vrs.as_ptr(), 2, rates.as_ptr()),
+                ffi::set_real::<SensorsModel>(inst, rate_vrs.as_ptr(), 1, rates.as_ptr()),
                 fmi2Status_fmi2OK
             );
             assert_eq!(ffi::exit_initialization_mode::<SensorsModel>(inst), fmi2Status_fmi2OK);

@@ -33,12 +33,6 @@ mod tests {
     use fmi2_export::{FmuModel, Logger, StateReader, StateWriter, VariableStore};
 
     #[test]
-    fn declared_start_values_are_the_library_defaults() {
-        let vars = Variables::with_start_values();
-        assert_eq!(vars.tsd(), tsd_control::TsdParams::default());
-    }
-
-    #[test]
     fn initialization_holds_the_trim_command_and_steps_hold_between_samples() {
         let mut vars = Variables::with_start_values();
         let mut model = TsdModel::new(&vars);
@@ -114,12 +108,12 @@ mod tests {
         let mut log = Logger::null();
         let zero = nalgebra::Vector3::zeros();
         let u = commands(&vars);
-        vars.set_measurement(&closed_loop::measure(&plant, &x, &u, &zero));
+        vars.set_measurement(&flight_mission::measure(&plant, &x, &u, &zero));
         model.initialize(&mut vars, 0.0, &mut log).unwrap();
         let h = 0.02;
         for k in 0..750 {
             let u = commands(&vars);
-            vars.set_measurement(&closed_loop::measure(&plant, &x, &u, &zero));
+            vars.set_measurement(&flight_mission::measure(&plant, &x, &u, &zero));
             model.do_step(&mut vars, k as f64 * h, h, &mut log).unwrap();
             plant.advance(&mut x, &commands(&vars), &zero, h).unwrap();
         }

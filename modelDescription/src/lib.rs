@@ -16,6 +16,7 @@
 //! packager runs the first and the last. A reviewable copy of each XML is kept in
 //! `modelDescription/generated/` and a test fails when it drifts.
 
+pub mod defaults;
 pub mod html;
 pub mod python;
 pub mod rust;
@@ -444,6 +445,26 @@ pub fn load_declarations(dir: &Path, file: &str) -> Result<(Vec<VariableDecl>, V
     let mut decls = Vec::new();
     collect(dir, &root, &mut sources, &mut groups, &mut decls, 0)?;
     Ok((decls, sources))
+}
+
+/// The named missions of the controller interface (`presets` of
+/// `fragments/controller_interface.json`): name, description and the mission parameters
+/// it sets over their declared starts, each checked to be a declared `mission` parameter.
+pub fn load_presets(dir: &Path) -> Result<Vec<(String, Preset)>, DeclError> {
+    let file = "fragments/controller_interface.json";
+    let root = read_decl(&dir.join(file), &mut Vec::new())?;
+    let (decls, _) = load_declarations(dir, file)?;
+    for (name, preset) in &root.presets {
+        for key in preset.values.keys() {
+            if !decls
+                .iter()
+                .any(|d| &d.name == key && d.group.as_deref() == Some("mission"))
+            {
+                return err(format!("{file}: preset '{name}' sets '{key}', not a mission parameter"));
+            }
+        }
+    }
+    Ok(root.presets.into_iter().collect())
 }
 
 fn read_decl(path: &Path, sources: &mut Vec<PathBuf>) -> Result<DeclFile, DeclError> {

@@ -6,7 +6,8 @@
 //! - `ssp`: write the SSP 1.0 closed-loop systems `dist/<controller>.ssp` from the packaged FMUs
 //!   (`dist` writes them too);
 //! - `regen`: rewrite the reviewed copies `modelDescription/generated/<id>.xml`, the
-//!   variable references `modelDescription/generated/<id>.md` and the Python
+//!   variable references `modelDescription/generated/<id>.md`, the generated Rust
+//!   parameter defaults `modelDescription/generated/*_generated.rs` and the Python
 //!   declarations module `python/tailsim/declarations.py`.
 
 mod ssp;
@@ -16,40 +17,65 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// FMUs this workspace can package: (crate, modelIdentifier, Markdown files
-/// rendered into documentation/index.html: the FMU's readme, then its library's equations).
-const FMUS: &[(&str, &str, &[&str])] = &[
-    (
-        "fmu-plant",
-        "tailsitter_plant",
-        &["fmu-plant/README.md", "crates/tailsitter-physics/README.md"],
-    ),
-    (
-        "fmu-lqr",
-        "tailsitter_lqr",
-        &["fmu-lqr/README.md", "crates/lqr-control/README.md"],
-    ),
-    (
-        "fmu-tsd",
-        "tailsitter_tsd",
-        &["fmu-tsd/README.md", "crates/tsd-control/README.md"],
-    ),
-    (
-        "fmu-sensors",
-        "tailsitter_sensors",
-        &["fmu-sensors/README.md", "crates/sensor-model/README.md"],
-    ),
-    (
-        "fmu-ekf",
-        "tailsitter_ekf",
-        &["fmu-ekf/README.md", "crates/state-estimator/README.md"],
-    ),
-    (
-        "fmu-atmosphere",
-        "tailsitter_atmosphere",
-        &["fmu-atmosphere/README.md", "crates/atmosphere/README.md"],
-    ),
-];
+/// An FMU this workspace packages: every `fmu-<name>` crate with a `[package.metadata.fmu]`
+/// table in its Cargo.toml is one, with
+/// modelIdentifier `tailsitter_<name>` (declared in `modelDescription/tailsitter_<name>.json`)
+/// and the Markdown rendered into its documentation/index.html: the crate's README, then the
+/// files listed under `[package.metadata.fmu] documentation` in its Cargo.toml (its
+/// library's equations). A new FMU is found by its crate alone.
+struct FmuCrate {
+    krate: String,
+    id: String,
+    docs: Vec<PathBuf>,
+}
+
+/// The FMU crates of the workspace (`cargo metadata`), the plant first, then by name.
+fn fmus() -> Result<Vec<FmuCrate>, String> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let out = Command::new(cargo)
+        .args([
+            "metadata",
+            "--no-deps",
+            "--format-version",
+            "1",
+            "--locked",
+            "--offline",
+        ])
+        .current_dir(workspace_root())
+        .output()
+        .map_err(|e| format!("cargo metadata: {e}"))?;
+    if !out.status.success() {
+        return Err(format!("cargo metadata: {}", String::from_utf8_lossy(&out.stderr)));
+    }
+    let meta: serde_json::Value =
+        serde_json::from_slice(&out.stdout).map_err(|e| format!("cargo metadata output: {e}"))?;
+    let mut found = Vec::new();
+    for p in meta["packages"].as_array().into_iter().flatten() {
+        // An FMU crate says so with its `[package.metadata.fmu]` table.
+        if p["metadata"]["fmu"].is_null() {
+            continue;
+        }
+        let name = p["name"].as_str().unwrap_or_default();
+        let short = name
+            .strip_prefix("fmu-")
+            .ok_or_else(|| format!("{name}: an FMU crate is named fmu-<name>"))?;
+        let dir = PathBuf::from(p["manifest_path"].as_str().unwrap_or_default())
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_default();
+        let mut docs = vec![dir.join("README.md")];
+        for d in p["metadata"]["fmu"]["documentation"].as_array().into_iter().flatten() {
+            docs.push(dir.join(d.as_str().ok_or("[package.metadata.fmu] documentation: not a string")?));
+        }
+        found.push(FmuCrate {
+            krate: format!("fmu-{short}"),
+            id: format!("tailsitter_{}", short.replace('-', "_")),
+            docs,
+        });
+    }
+    found.sort_by_key(|f| (f.id != ssp::PLANT, f.id.clone()));
+    Ok(found)
+}
 
 #[derive(Parser)]
 #[command(about = "Tail-sitter FMU project tasks")]
@@ -78,7 +104,7 @@ enum Task {
         #[arg(long, default_value = "dist")]
         out: PathBuf,
     },
-    /// Regenerate modelDescription/generated/<id>.xml from the declarations.
+    /// Regenerate modelDescription/generated/ (XML, variable references, Rust defaults) from the declarations.
     Regen,
 }
 
@@ -155,7 +181,7 @@ fn main() {
 fn regen() -> Result<(), String> {
     let dir = workspace_root().join("modelDescription/generated");
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
-    for (_, id, _) in FMUS {
+    for FmuCrate { id, .. } in &fmus()? {
         let model = load(id)?;
         let files = [
             (format!("{id}.xml"), model_description::xml::model_description(&model)),
@@ -170,6 +196,14 @@ fn regen() -> Result<(), String> {
             println!("wrote {}", path.display());
         }
     }
+    let declarations = workspace_root().join("modelDescription");
+    for c in model_description::defaults::CRATES {
+        let (text, _) =
+            model_description::defaults::generate(&declarations, c).map_err(|e| format!("{}: {e}", c.file))?;
+        let path = dir.join(c.out);
+        std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+        println!("wrote {}", path.display());
+    }
     let root = workspace_root();
     let path = root.join(model_description::python::MODULE_PATH);
     let text =
@@ -182,14 +216,12 @@ fn regen() -> Result<(), String> {
 
 fn dist(only: &[String], out: &Path, platforms: &[Platform]) -> Result<(), String> {
     let root = workspace_root();
-    let selected: Vec<_> = FMUS
-        .iter()
-        .filter(|(_, id, _)| only.is_empty() || only.iter().any(|o| o == id))
-        .collect();
+    let all = fmus()?;
+    let selected: Vec<_> = all.iter().filter(|f| only.is_empty() || only.contains(&f.id)).collect();
     if selected.is_empty() {
         return Err(format!(
             "no FMU matches {only:?}; known: {:?}",
-            FMUS.iter().map(|f| f.1).collect::<Vec<_>>()
+            all.iter().map(|f| &f.id).collect::<Vec<_>>()
         ));
     }
     if platforms.is_empty() {
@@ -200,7 +232,7 @@ fn dist(only: &[String], out: &Path, platforms: &[Platform]) -> Result<(), Strin
     }
     let out = absolute(out);
     std::fs::create_dir_all(&out).map_err(|e| e.to_string())?;
-    for (_, id, docs) in selected {
+    for FmuCrate { id, docs, .. } in selected {
         let model = load(id)?;
         let mut binaries = Vec::new();
         for platform in platforms {
@@ -209,9 +241,8 @@ fn dist(only: &[String], out: &Path, platforms: &[Platform]) -> Result<(), Strin
             binaries.push((platform.archive_path(id), bytes));
         }
         let mut readme = String::new();
-        for doc in *docs {
-            let path = root.join(doc);
-            let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        for path in docs {
+            let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
             readme.push_str(&text);
             readme.push_str("\n\n");
         }
@@ -233,15 +264,15 @@ fn dist(only: &[String], out: &Path, platforms: &[Platform]) -> Result<(), Strin
 }
 
 /// `cargo build --release` of the selected FMU crates for one platform.
-fn build(root: &Path, selected: &[&(&str, &str, &[&str])], platform: Platform) -> Result<(), String> {
+fn build(root: &Path, selected: &[&FmuCrate], platform: Platform) -> Result<(), String> {
     let mut cargo = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
     cargo.current_dir(root).args(["build", "--release", "--locked"]);
     if platform == Platform::Win64 {
         win64_environment(&mut cargo)?;
         cargo.args(["--target", WIN64_TARGET]);
     }
-    for (krate, _, _) in selected {
-        cargo.args(["-p", krate]);
+    for f in selected {
+        cargo.args(["-p", &f.krate]);
     }
     let status = cargo.status().map_err(|e| format!("running cargo: {e}"))?;
     if !status.success() {

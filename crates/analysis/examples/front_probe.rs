@@ -6,7 +6,8 @@
 use analysis::controllers::Kind;
 use analysis::envelope_transitions::{fly_mission, measure, ROTATION_TOLERANCE};
 use closed_loop::{Ordering, Sample, Trace};
-use flight_mission::{MissionParams, PointMass, Profile, ProfileLimits};
+use flight_mission::MissionParams;
+use guidance::{PointMass, Profile, ProfileLimits};
 use tailsitter_physics::Airframe;
 
 fn gamma_deg(s: &Sample) -> f64 {
@@ -19,7 +20,7 @@ fn main() {
         .skip(1)
         .map(|s| s.parse().expect("t1 t2 (s)"))
         .collect();
-    let f = MissionParams::fast();
+    let f = MissionParams::fast_limited();
     let (t1, t2) = if a.len() >= 2 {
         (a[0], a[1])
     } else {

@@ -4,7 +4,7 @@
 //! the start): the default and the fast mission, hover wind steps, the analysis's gust
 //! sweep; plus the force and moment coefficients of both models over α = 0…180°. (The
 //! parameter sweep of Table 5.1 is flown on both models by the robustness sweep itself,
-//! [`crate::campaign`].) Data only: `aero_models.json` and three CSV files;
+//! [`crate::sweep`].) Data only: `aero_models.json` and three CSV files;
 //! `python -m tailsim.analysis_report` renders them (`tailsim.aero_report`).
 
 use std::fmt::Write as _;
@@ -40,9 +40,10 @@ pub struct Case {
 /// vertical phase held for 40 s, 30 s flown) in a wind stepping at 5 s to 5 or 7 m/s from
 /// the north (head-on to the wing: α → 90° of the free stream) or the east (side wind).
 pub fn cases(mission: &MissionParams) -> Vec<Case> {
+    let preset = MissionParams::fast();
     let fast = MissionParams {
-        t_transition_1: 3.0,
-        t_transition_2: 4.0,
+        t_transition_1: preset.t_transition_1,
+        t_transition_2: preset.t_transition_2,
         ..*mission
     };
     let hover = MissionParams {

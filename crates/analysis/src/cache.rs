@@ -1,9 +1,9 @@
-//! Result cache: one JSON-lines file per campaign in the output folder, each line
+//! Result cache: one JSON-lines file per sweep in the output folder, each line
 //! `{"key": <16 hex digits>, "value": <result>}`. The key is an FNV-1a 64-bit hash (stable
 //! across Rust versions, unlike `DefaultHasher`) of a text describing every input of the
 //! job (plant airframe, controller and its parameters, job parameters, [`CODE_VERSION`]).
 //! A re-run only computes jobs whose key is not in the file; lines are appended as jobs
-//! finish, so an interrupted campaign resumes where it stopped.
+//! finish, so an interrupted sweep resumes where it stopped.
 
 use serde::{de::DeserializeOwned, Serialize};
 use std::collections::HashMap;

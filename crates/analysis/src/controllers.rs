@@ -1,4 +1,4 @@
-//! The two controllers of the thesis behind one type, so campaigns treat them alike.
+//! The two controllers of the thesis behind one type, so the sweeps treat them alike.
 
 use flight_mission::{ControlError, ControllerInput, ControllerOutput, MissionParams, ParamError, SampledUnit};
 use lqr_control::{LqrConfig, LqrController};

@@ -1,7 +1,7 @@
 //! Issue 16, goal 1: the transitions on the global aerodynamics (the plant's default
 //! `aero_model` = 1), both controllers, Gauss-Seidel and Jacobi, flown natively
 //! ([`closed_loop::fly`]); the minimum transition times of the α- and thrust-limited
-//! point-mass profile ([`flight_mission::profile`]) against thrust-to-weight; and the
+//! point-mass profile ([`guidance::profile`]) against thrust-to-weight; and the
 //! fastest transitions each controller flies with α ≤ 15°. Written as the key
 //! `envelope_transitions` of `report.json` (rendered by `tailsim.report_envelope`).
 //!
@@ -17,7 +17,8 @@
 //!   there to the end of the window.
 
 use closed_loop::{fly, Ordering, Scenario, Trace};
-use flight_mission::{MissionParams, PointMass, Profile, ProfileLimits};
+use flight_mission::MissionParams;
+use guidance::{PointMass, Profile, ProfileLimits};
 use lqr_control::{LqrController, LqrParams};
 use serde_json::{json, Value};
 use tailsitter_physics::{Airframe, Plant};
@@ -29,11 +30,11 @@ use crate::controllers::Kind;
 pub const SETTLE_WINDOW: f64 = 2.0;
 /// Tolerance of the rotation time (rad): 5°.
 pub const ROTATION_TOLERANCE: f64 = 5.0 * std::f64::consts::PI / 180.0;
-/// The α bound of the issue (rad): 15°.
+/// The α bound of the transition envelope (rad): 15°.
 pub const ALPHA_BOUND: f64 = 15.0 * std::f64::consts::PI / 180.0;
 
 /// (T1, T2) of the measured missions: the thesis's default, the thesis's fast TSD mission,
-/// the fast mission of issue 16, and shorter ones for the fastest flyable.
+/// the short transitions of preset `fast_limited`, and shorter ones for the fastest flyable.
 pub const TIMINGS: [(f64, f64); 7] = [
     (5.0, 10.0),
     (3.0, 4.0),
@@ -71,7 +72,7 @@ pub struct TransitionRun {
 }
 
 impl TransitionRun {
-    /// Inside every bound of the issue: α ≤ 15°, altitude deviation < 1 m per transition,
+    /// Inside every bound of the transition envelope: α ≤ 15°, altitude deviation < 1 m per transition,
     /// position error < 2 m, completed.
     pub fn meets_goal(&self) -> bool {
         self.completed
@@ -197,7 +198,7 @@ pub fn runs() -> Vec<TransitionRun> {
         for configuration in [0, 1] {
             for (ordering, oname) in [(Ordering::GaussSeidel, "Gauss-Seidel"), (Ordering::Jacobi, "Jacobi")] {
                 for (t1, t2) in TIMINGS {
-                    // The thesis configuration only on the issue's three timings.
+                    // The thesis configuration only on the three envelope timings.
                     if configuration == 1 && t1 < 2.0 {
                         continue;
                     }
@@ -235,7 +236,7 @@ pub fn runs() -> Vec<TransitionRun> {
 /// The point mass of the default airframe with thrust-to-weight `tw`.
 pub fn point_mass(tw: f64) -> PointMass {
     let af = Airframe::default();
-    let mut pm = flight_mission::PointMass::from_level_trim(&af, MissionParams::default().v_level).expect("level trim");
+    let mut pm = guidance::PointMass::from_level_trim(&af, MissionParams::default().v_level).expect("level trim");
     pm.thrust_max = tw * af.mass * af.gravity;
     pm
 }
@@ -425,10 +426,10 @@ mod tests {
         assert!(at(1.7, 15.0).back < at(1.7, 12.0).back);
     }
 
-    /// The tuned LQR flies the fast mission inside the issue's bounds (Gauss-Seidel).
+    /// The tuned LQR flies the fast mission inside the envelope bounds (Gauss-Seidel).
     #[test]
     fn tuned_lqr_flies_the_fast_mission_inside_the_bounds() {
-        let f = MissionParams::fast();
+        let f = MissionParams::fast_limited();
         let trace = fly_mission(Kind::Lqr, 0, Ordering::GaussSeidel, f.t_transition_1, f.t_transition_2).unwrap();
         let r = measure(&trace, f.t_transition_1, f.t_transition_2);
         assert!(r.meets_goal(), "{r:?}");
@@ -441,7 +442,7 @@ mod tests {
     /// (tsd-control README, "Front transition: normal-loop feed-forward").
     #[test]
     fn tuned_tsd_flies_the_fast_and_3_4_s_missions_inside_the_bounds() {
-        let f = MissionParams::fast();
+        let f = MissionParams::fast_limited();
         for (t1, t2) in [(5.0, 10.0), (3.0, 4.0), (f.t_transition_1, f.t_transition_2)] {
             for ordering in [Ordering::GaussSeidel, Ordering::Jacobi] {
                 let trace = fly_mission(Kind::Tsd, 0, ordering, t1, t2).unwrap();
@@ -459,7 +460,7 @@ mod tests {
     /// (tsd-control README, "Front transition: preview in path axes").
     #[test]
     fn both_controllers_rotate_the_fast_front_transition_within_two_seconds() {
-        let f = MissionParams::fast();
+        let f = MissionParams::fast_limited();
         for kind in Kind::ALL {
             for ordering in [Ordering::GaussSeidel, Ordering::Jacobi] {
                 let trace = fly_mission(kind, 0, ordering, f.t_transition_1, f.t_transition_2).unwrap();

@@ -9,9 +9,9 @@
 
 use std::path::PathBuf;
 
-use analysis::campaign::{run, Config};
 use analysis::closed::Condition;
 use analysis::controllers::Kind;
+use analysis::sweep::{run, Config};
 use clap::{Parser, Subcommand};
 
 #[derive(Parser)]

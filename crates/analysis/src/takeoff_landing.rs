@@ -1,6 +1,6 @@
 //! Take-off-to-landing mission (issue 16): both controllers start at rest on the gear
 //! (plant `initial_condition = 2`), spin up, take off, fly the thesis's mission (both
-//! transitions) and land on a target point ([`flight_mission::ground`]), on the global
+//! transitions) and land on a target point ([`guidance::ground`]), on the global
 //! aerodynamic model (the plant FMU's default) with the ground plane, Gauss-Seidel and
 //! Jacobi. Writes the key `takeoff_landing` of `report.json` (rendered by
 //! `python/tailsim/report_takeoff.py`).
@@ -15,7 +15,8 @@
 //!   rise of the CG above its touchdown height.
 
 use closed_loop::{fly, Ordering, Scenario, Trace, N_PHASES};
-use flight_mission::{GroundPhases, MissionParams, Phase, SampledUnit};
+use flight_mission::{MissionParams, Phase, SampledUnit};
+use guidance::GroundPhases;
 use nalgebra::Vector3;
 use serde::Serialize;
 use tailsitter_physics::{dcm_earth_to_body, idx, AeroModel, Airframe, Ground, Plant, StateVector};
@@ -361,8 +362,8 @@ pub fn report(kinds: &[Kind]) -> Report {
 }
 
 /// The `takeoff_landing` value of `report.json`: the flights of the configured controllers
-/// with the nonlinear campaigns (`cfg.robustness`), else null.
-pub fn report_value(cfg: &crate::campaign::Config) -> serde_json::Value {
+/// with the nonlinear sweeps (`cfg.robustness`), else null.
+pub fn report_value(cfg: &crate::sweep::Config) -> serde_json::Value {
     if !cfg.robustness || cfg.controllers.is_empty() {
         return serde_json::Value::Null;
     }

@@ -1,10 +1,10 @@
-//! The method on systems with known answers, and the campaign tables from actual runs.
+//! The method on systems with known answers, and the sweep tables from actual runs.
 
-use analysis::campaign::{run, Config};
 use analysis::closed::{closed_loop_poles, poles_of_map, Analysable, Condition, OperatingPoint};
 use analysis::controllers::Kind;
 use analysis::linalg::{eigenvalues, match_poles, z_to_s, C64};
 use analysis::sensitivity::{factors, nominal_index, track};
+use analysis::sweep::{run, Config};
 use flight_mission::{
     Command, ControlError, ControllerInput, ControllerOutput, Diagnostics, ParamError, Phase, SampledUnit,
 };
@@ -387,7 +387,7 @@ fn tiny_campaign_tables_come_from_runs_and_are_cached() {
 /// * the global model is the thesis's inside attached flow, so a flight that never left
 ///   attached flow on either model is identical on both, and any flight that differs left it
 ///   (stall fraction > 0 on one of the models).
-fn robustness_on_both_models(results: &[analysis::campaign::RobustnessResult]) {
+fn robustness_on_both_models(results: &[analysis::sweep::RobustnessResult]) {
     use closed_loop::{fly, MissionCheck, Scenario};
     use flight_mission::MissionParams;
     use tailsitter_physics::AeroModel;

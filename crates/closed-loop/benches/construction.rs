@@ -13,7 +13,8 @@
 
 use closed_loop::{fly, Scenario};
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use flight_mission::{MissionParams, PointMass, Profile, ProfileLimits};
+use flight_mission::MissionParams;
+use guidance::{PointMass, Profile, ProfileLimits};
 use lqr_control::trajectory::{Trajectory, TrajectoryOptions};
 use lqr_control::{LqrController, LqrParams};
 use tailsitter_physics::{Airframe, Plant};

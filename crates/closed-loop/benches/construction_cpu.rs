@@ -4,7 +4,8 @@
 //! `cargo bench -p closed-loop --bench construction_cpu [-- RUNS]`
 
 use closed_loop::{fly, Scenario};
-use flight_mission::{MissionParams, PointMass, Profile, ProfileLimits};
+use flight_mission::MissionParams;
+use guidance::{PointMass, Profile, ProfileLimits};
 use lqr_control::trajectory::{Trajectory, TrajectoryOptions};
 use lqr_control::{LqrController, LqrParams};
 use std::hint::black_box;

@@ -50,11 +50,7 @@ fn summary<C: FlightController>(name: &str, model: AeroModel, scenario: &Scenari
 
 fn all<C: FlightController>(make: &dyn Fn(&MissionParams) -> C) {
     let default = MissionParams::default();
-    let fast = MissionParams {
-        t_transition_1: 3.0,
-        t_transition_2: 4.0,
-        ..Default::default()
-    };
+    let fast = MissionParams::fast();
     let hover = MissionParams {
         t_vertical_1: 40.0,
         ..Default::default()

@@ -5,11 +5,12 @@
 //!
 //! Frames: NED earth axes for positions, velocities and wind; SI units.
 
+pub use flight_mission::{measure, measurement, plant_inputs};
 use flight_mission::{Command, ControllerInput, Diagnostics, FlightController, Measurement, MissionParams, Notice};
 use std::sync::OnceLock;
 
 use nalgebra::Vector3;
-use tailsitter_physics::{idx, InputVector, Outputs, Plant, StateVector};
+use tailsitter_physics::{idx, InputVector, Plant, StateVector};
 
 pub mod wind_source;
 pub use wind_source::{PointWind, WindSource};
@@ -234,15 +235,11 @@ impl Scenario {
         }
     }
 
-    /// A violent manoeuvre for accuracy and speed checks: the fast mission of the
-    /// thesis-era timings (T1 = 3 s, T2 = 4 s, α up to ≈ 44° on the LQR) with a 1 − cos
+    /// A violent manoeuvre for accuracy and speed checks: the fast mission (preset `fast`,
+    /// T1 = 3 s, T2 = 4 s, α up to ≈ 44° on the LQR) with a 1 − cos
     /// gust of 6 m/s (north, up) over 2 s at t = 12 s and 5 m reference steps at 20 s and 23 s.
     pub fn violent_manoeuvre() -> Self {
-        let mut s = Self::mission(MissionParams {
-            t_transition_1: 3.0,
-            t_transition_2: 4.0,
-            ..MissionParams::default()
-        });
+        let mut s = Self::mission(MissionParams::fast());
         s.wind = Wind::OneMinusCosine {
             t_start: 12.0,
             duration: 2.0,
@@ -265,50 +262,6 @@ impl Scenario {
         }
         offset
     }
-}
-
-/// What the controller would measure: the plant outputs of the same names.
-pub fn measure(plant: &Plant, x: &StateVector, u: &InputVector, wind: &Vector3<f64>) -> Measurement {
-    measurement(x, &plant.outputs(x, u, wind))
-}
-
-/// The plant outputs grouped as a [`Measurement`], from the state and the
-/// computed outputs: what the plant FMU writes to its output ports.
-pub fn measurement(x: &StateVector, y: &Outputs) -> Measurement {
-    Measurement {
-        pos_ned: Vector3::new(x[idx::POS_N], x[idx::POS_E], x[idx::POS_D]),
-        vel_ned: y.vel_ned,
-        vel_body: Vector3::new(x[idx::U], x[idx::V], x[idx::W]),
-        rates: Vector3::new(x[idx::P], x[idx::Q], x[idx::R]),
-        quat: x.fixed_rows::<4>(idx::Q1).into_owned(),
-        airspeed: y.airspeed,
-        alpha: y.alpha,
-        beta: y.beta,
-        thrust: x[idx::THRUST],
-        surfaces: [
-            x[idx::ELEVATOR],
-            x[idx::AILERON],
-            x[idx::RUDDER],
-            x[idx::FLAP_COLLECTIVE],
-            x[idx::FLAP_DIFFERENTIAL],
-            x[idx::VERTICAL_FLAP],
-        ],
-        specific_force_body: y.specific_force_body,
-        induced_velocity: y.induced_velocity,
-    }
-}
-
-/// The plant input vector of a command.
-pub fn plant_inputs(c: &Command) -> InputVector {
-    let mut u = InputVector::zeros();
-    u[idx::THRUST_CMD] = c.thrust;
-    u[idx::ELEVATOR_CMD] = c.elevator;
-    u[idx::AILERON_CMD] = c.aileron;
-    u[idx::RUDDER_CMD] = c.rudder;
-    u[idx::FLAP_COLLECTIVE_CMD] = c.flap_collective;
-    u[idx::FLAP_DIFFERENTIAL_CMD] = c.flap_differential;
-    u[idx::VERTICAL_FLAP_CMD] = c.vertical_flap;
-    u
 }
 
 /// The closed loop at one communication point.

@@ -154,7 +154,8 @@ pub unsafe fn set_debug_logging<M: FmuModel>(
         call::<M>(c, "fmi2SetDebugLogging", mask::ANY, |inst| {
             let on = logging_on != 0;
             let cats = slice(categories, n_categories, "categories")?;
-            let mut names = Vec::with_capacity(cats.len());
+            // Grown while reading, never sized from the host's count alone.
+            let mut names = Vec::new();
             for &p in cats {
                 let name = c_str(p).ok_or_else(|| Fmi2Error::error("a category name is NULL"))?;
                 let name = name
@@ -451,7 +452,8 @@ pub unsafe fn set_string<M: FmuModel>(
         call::<M>(c, "fmi2SetString", mask::SET, |inst| {
             let vrs = slice(vr, nvr, "vr")?;
             let ptrs = slice(value, nvr, "value")?;
-            let mut strs = Vec::with_capacity(nvr);
+            // Grown while reading, never sized from the host's count alone.
+            let mut strs = Vec::new();
             for (r, &p) in vrs.iter().zip(ptrs) {
                 let s = c_str(p).ok_or_else(|| Fmi2Error::error(format!("value for value reference {r} is NULL")))?;
                 let s = s
@@ -501,8 +503,7 @@ pub unsafe fn set_fmu_state<M: FmuModel>(c: fmi2Component, state: fmi2FMUstate) 
                     "the FMU state belongs to an instance of the other interface (Model Exchange vs Co-Simulation)",
                 ));
             }
-            inst.restore(snap);
-            Ok(())
+            inst.restore(snap)
         })
     }
 }

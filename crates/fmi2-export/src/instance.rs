@@ -236,6 +236,21 @@ impl Machine {
         if !(start_time.is_finite() && time.is_finite() && stop.is_finite() && tol.is_finite()) {
             return Err(StateError::invalid("non-finite time in FMU state"));
         }
+        // What fmi2SetupExperiment refuses, a restored state may not bring either.
+        if let Some(stop) = m.stop_time {
+            if stop < start_time {
+                return Err(StateError::invalid(format!(
+                    "stopTime = {stop} before startTime = {start_time} in FMU state"
+                )));
+            }
+        }
+        if let Some(tol) = m.tolerance {
+            if tol <= 0.0 {
+                return Err(StateError::invalid(format!(
+                    "tolerance = {tol} in FMU state must be > 0"
+                )));
+            }
+        }
         let me_state = matches!(m.state, EventMode | ContinuousTimeMode);
         let cs_state = matches!(m.state, StepComplete | StepFailed | StepCanceled);
         if (me_state && !m.model_exchange) || (cs_state && m.model_exchange) {
@@ -285,12 +300,16 @@ impl<M: FmuModel> Snapshot<M> {
         state::seal(M::GUID, w.as_bytes())
     }
 
+    /// The inverse of [`Self::serialize`]. The checksum only proves the bytes are
+    /// intact, not that they came from this FMU: every restored variable is checked as
+    /// fmi2Set* would check it ([`check_restored_variables`]) before the model sees it.
     pub fn deserialize(bytes: &[u8]) -> Result<Self, StateError> {
         let payload = state::open(M::GUID, bytes)?;
         let mut r = StateReader::new(payload);
         let machine = Machine::read(&mut r)?;
         let mut vars = M::Vars::with_start_values();
         vars.read_state(&mut r)?;
+        check_restored_variables(&vars)?;
         let mut model = M::new(&vars);
         model.read_state(&mut r)?;
         r.finish()?;
@@ -301,6 +320,61 @@ impl<M: FmuModel> Snapshot<M> {
             vars,
         })
     }
+}
+
+/// Check every variable of a restored FMU state as fmi2SetReal / fmi2SetInteger would
+/// check a value set by the host, so that a state can bring no value the host could not
+/// have set:
+/// - parameters and inputs (the values the model is configured and driven by): a Real
+///   finite, a Real or Integer within its declared `[min, max]`;
+/// - constants: their start value (they cannot be set at all);
+/// - calculated parameters, outputs, locals and the independent variable: anything (the
+///   model computes them; a state captured after a failed or diverging step legitimately
+///   holds non-finite outputs). Booleans and Strings have no range.
+///
+/// The error names the variable, its value and the range.
+pub fn check_restored_variables<V: VariableStore>(vars: &V) -> Result<(), StateError> {
+    let start = V::with_start_values();
+    for spec in V::VARIABLES {
+        let vr = spec.value_reference;
+        let value = match spec.value_type {
+            ValueType::Real => vars.get_real(vr),
+            ValueType::Integer => vars.get_integer(vr).map(f64::from),
+            ValueType::Boolean | ValueType::String => None,
+        };
+        if spec.variability == Variability::Constant {
+            let same = match spec.value_type {
+                ValueType::Real => vars.get_real(vr).map(f64::to_bits) == start.get_real(vr).map(f64::to_bits),
+                ValueType::Integer => vars.get_integer(vr) == start.get_integer(vr),
+                ValueType::Boolean => vars.get_boolean(vr) == start.get_boolean(vr),
+                ValueType::String => vars.get_string(vr) == start.get_string(vr),
+            };
+            if !same {
+                return Err(StateError::invalid(format!(
+                    "restored constant {} (value reference {vr}) differs from its declared value",
+                    spec.name
+                )));
+            }
+            continue;
+        }
+        if !matches!(spec.causality, Causality::Parameter | Causality::Input) {
+            continue;
+        }
+        let Some(value) = value else { continue };
+        if !value.is_finite() {
+            return Err(StateError::invalid(format!(
+                "restored variable {} (value reference {vr}): value {value} is not finite",
+                spec.name
+            )));
+        }
+        if value < spec.min || value > spec.max {
+            return Err(StateError::invalid(format!(
+                "restored variable {} (value reference {vr}): value {value} outside [{}, {}]",
+                spec.name, spec.min, spec.max
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// One FMU instance.
@@ -469,15 +543,19 @@ impl<M: FmuModel> Instance<M> {
     }
 
     /// fmi2GetString: pointers stay valid until the next fmi2GetString / Reset / FreeInstance.
+    /// Nothing is sized from `nvr` before the value references are read (a host's count
+    /// alone must not decide an allocation).
     pub fn get_strings(&mut self, vrs: &[u32], out: &mut [*const std::os::raw::c_char]) -> Fmi2Result {
-        let mut strings = Vec::with_capacity(vrs.len());
-        {
-            let mut tmp: Vec<String> = vec![String::new(); vrs.len()];
-            self.get_values(vrs, &mut tmp, ValueType::String, |v, vr| {
-                v.get_string(vr).map(str::to_string)
-            })?;
-            for s in tmp {
-                strings.push(crate::logger::to_cstring(&s));
+        debug_assert_eq!(vrs.len(), out.len());
+        let mut strings = Vec::new();
+        if !vrs.is_empty() {
+            self.refresh()?;
+            for vr in vrs {
+                let spec = Self::spec_for(*vr, ValueType::String)?;
+                let s = self.vars.get_string(*vr).ok_or_else(|| {
+                    Fmi2Error::error(format!("value reference {vr} ({}) has no String value", spec.name))
+                })?;
+                strings.push(crate::logger::to_cstring(s));
             }
         }
         for (slot, s) in out.iter_mut().zip(&strings) {
@@ -708,9 +786,14 @@ impl<M: FmuModel> Instance<M> {
         Ok(())
     }
 
-    pub fn restore(&mut self, snap: &Snapshot<M>) {
+    /// fmi2SetFMUstate: the variables are checked again ([`check_restored_variables`]; a
+    /// state from fmi2GetFMUstate or fmi2DeSerializeFMUstate passes) before anything is
+    /// overwritten, so a refused state leaves the instance as it was.
+    pub fn restore(&mut self, snap: &Snapshot<M>) -> Fmi2Result {
+        check_restored_variables(&snap.vars)?;
         self.machine = snap.machine;
         self.model.clone_from(&snap.model);
         self.vars.clone_from(&snap.vars);
+        Ok(())
     }
 }

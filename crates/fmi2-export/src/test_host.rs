@@ -181,3 +181,84 @@ impl Host {
         self.messages().iter().any(|m| parts.iter().all(|p| m.contains(p)))
     }
 }
+
+/// What [`restore_forged`] observed.
+#[derive(Debug)]
+pub struct ForgedRestore {
+    /// fmi2DeSerializeFMUstate of the forged buffer: status and the messages it logged.
+    pub deserialize: (fmi2Status, Vec<String>),
+    /// fmi2SetFMUstate of a state altered the same way in memory: status and messages.
+    pub set_state: (fmi2Status, Vec<String>),
+    /// Every Real of the instance bit-identical before and after both calls.
+    pub unchanged: bool,
+}
+
+/// Restore a state in which the Real variable `name` holds `forged`, the two ways a host
+/// can: (1) a serialized state of an initialised instance of `M` whose `name` was set to
+/// `marker` (a value that occurs once in the payload), the marker replaced by `forged` and
+/// the buffer re-sealed with a valid checksum — what a corrupted store or a fuzzer hands to
+/// fmi2DeSerializeFMUstate; (2) that value written into a state from fmi2GetFMUstate,
+/// then fmi2SetFMUstate. Panics if the set-up calls fail.
+pub fn restore_forged<M: FmuModel>(name: &str, marker: f64, forged: f64) -> ForgedRestore {
+    use crate::fmi_sys::fmi2::{fmi2FMUstate, fmi2Status_fmi2OK as OK};
+    use crate::{ValueType, VariableStore};
+    let spec = M::Vars::VARIABLES
+        .iter()
+        .find(|s| s.name == name && s.value_type == ValueType::Real)
+        .unwrap_or_else(|| panic!("{name} is not a Real of {}", M::MODEL_IDENTIFIER));
+    let vr = spec.value_reference;
+    let reals: Vec<u32> = M::Vars::VARIABLES
+        .iter()
+        .filter(|s| s.value_type == ValueType::Real)
+        .map(|s| s.value_reference)
+        .collect();
+    let host = Host::new();
+    // SAFETY: the instance lives within this function and `host` outlives it; every
+    // pointer passed points to live memory of the stated length.
+    unsafe {
+        let c = host.initializing::<M>("forged");
+        assert_eq!(ffi::set_real::<M>(c, &vr, 1, &marker), OK, "{:?}", host.messages());
+        assert_eq!(ffi::exit_initialization_mode::<M>(c), OK, "{:?}", host.messages());
+        let mut st: fmi2FMUstate = std::ptr::null_mut();
+        assert_eq!(ffi::get_fmu_state::<M>(c, &mut st), OK);
+        let mut size = 0;
+        assert_eq!(ffi::serialized_fmu_state_size::<M>(c, st, &mut size), OK);
+        let mut buf = vec![0u8; size];
+        assert_eq!(ffi::serialize_fmu_state::<M>(c, st, buf.as_mut_ptr().cast(), size), OK);
+        let mut payload = crate::state::open(M::GUID, &buf).expect("own state").to_vec();
+        let needle = marker.to_le_bytes();
+        let hits: Vec<usize> = (0..payload.len().saturating_sub(7))
+            .filter(|&i| payload[i..i + 8] == needle)
+            .collect();
+        assert_eq!(hits.len(), 1, "marker {marker} must occur once in the payload");
+        payload[hits[0]..hits[0] + 8].copy_from_slice(&forged.to_le_bytes());
+        let forged_bytes = crate::state::seal(M::GUID, &payload);
+
+        let read = |c| {
+            let mut v = vec![0.0; reals.len()];
+            assert_eq!(ffi::get_real::<M>(c, reals.as_ptr(), reals.len(), v.as_mut_ptr()), OK);
+            v.iter().map(|x: &f64| x.to_bits()).collect::<Vec<u64>>()
+        };
+        let before = read(c);
+        let from = host.len();
+        let mut restored: fmi2FMUstate = std::ptr::null_mut();
+        let s = ffi::deserialize_fmu_state::<M>(c, forged_bytes.as_ptr().cast(), forged_bytes.len(), &mut restored);
+        let deserialize = (s, host.since(from).into_iter().map(|r| r.message).collect());
+        if !restored.is_null() {
+            assert_eq!(ffi::free_fmu_state::<M>(c, &mut restored), OK);
+        }
+        let snap = &mut *st.cast::<crate::Snapshot<M>>();
+        assert!(snap.vars.set_real(vr, forged));
+        let from = host.len();
+        let s = ffi::set_fmu_state::<M>(c, st);
+        let set_state = (s, host.since(from).into_iter().map(|r| r.message).collect());
+        let unchanged = read(c) == before;
+        assert_eq!(ffi::free_fmu_state::<M>(c, &mut st), OK);
+        ffi::free_instance::<M>(c);
+        ForgedRestore {
+            deserialize,
+            set_state,
+            unchanged,
+        }
+    }
+}

@@ -803,3 +803,82 @@ fn corrupt_truncated_and_foreign_buffers_are_rejected() {
         fmi2FreeInstance(c);
     }
 }
+
+/// `bytes` (a serialized state of the toy) with the first f64 equal to `from` in its
+/// payload replaced by `to`, re-sealed with a valid checksum (what a corrupting or
+/// malicious host can produce).
+fn reseal_replacing(bytes: &[u8], from: f64, to: &[u8]) -> Vec<u8> {
+    let mut payload = fmi2_export::state::open(TOY_GUID, bytes).unwrap().to_vec();
+    let needle = from.to_le_bytes();
+    let at = payload
+        .windows(8)
+        .position(|w| w == needle)
+        .expect("the marker value is in the payload");
+    payload[at..at + to.len()].copy_from_slice(to);
+    fmi2_export::state::seal(TOY_GUID, &payload)
+}
+
+#[test]
+fn restored_parameters_and_inputs_are_checked_like_set_values() {
+    let host = Host::new();
+    let c = instantiate(&host, "toy1");
+    unsafe {
+        // Marker values, to find the variables in the payload.
+        assert_eq!(set_real(c, vr::TAU, 1.234_567), OK);
+        assert_eq!(set_real(c, vr::X0, 0.765_432_1), OK);
+        assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 1, 10.0), OK);
+        assert_eq!(fmi2EnterInitializationMode(c), OK);
+        assert_eq!(fmi2ExitInitializationMode(c), OK);
+        run_steps(c, 0, 3, input);
+        assert_eq!(set_real(c, vr::U, 4.321_987), OK);
+        let mut st: fmi2FMUstate = null_mut();
+        assert_eq!(fmi2GetFMUstate(c, &mut st), OK);
+        let bytes = serialize(c, st);
+        let expected = run_steps(c, 3, 5, input);
+
+        let cases: [(f64, f64, &[&str]); 5] = [
+            (1.234_567, 2e10, &["tau", "20000000000", "outside [0.01, 100]"]),
+            (1.234_567, f64::NAN, &["tau", "NaN", "not finite"]),
+            (1.234_567, -0.0, &["tau", "outside [0.01, 100]"]),
+            (4.321_987, 11.0, &["u (value reference 0)", "outside [-10, 10]"]),
+            (4.321_987, f64::NEG_INFINITY, &["variable u", "-inf", "not finite"]),
+        ];
+        for (from, to, parts) in cases {
+            let forged = reseal_replacing(&bytes, from, &to.to_le_bytes());
+            let n = host.messages().len();
+            let (status, st) = deserialize(c, &forged);
+            assert_eq!(status, ERROR, "{parts:?}");
+            assert!(st.is_null());
+            let new = &host.messages()[n..];
+            assert!(
+                new.iter()
+                    .any(|m| m.starts_with("fmi2DeSerializeFMUstate: ") && parts.iter().all(|p| m.contains(p))),
+                "{parts:?} not in {new:?}"
+            );
+        }
+        // An unbounded parameter takes any finite value, but not a non-finite one.
+        let forged = reseal_replacing(&bytes, 0.765_432_1, &1e300f64.to_le_bytes());
+        let (status, mut ok) = deserialize(c, &forged);
+        assert_eq!(status, OK, "{:?}", host.messages());
+        assert_eq!(fmi2FreeFMUstate(c, &mut ok), OK);
+        let forged = reseal_replacing(&bytes, 0.765_432_1, &f64::INFINITY.to_le_bytes());
+        assert_eq!(deserialize(c, &forged).0, ERROR);
+        assert!(host.logged(&["x0", "inf", "not finite"]));
+
+        // fmi2SetFMUstate checks the same: a state altered in memory is refused and the
+        // instance keeps its state.
+        let snap = &mut *st.cast::<fmi2_export::Snapshot<Toy>>();
+        snap.vars.mode = 7;
+        let before = get_real(c, vr::Y).to_bits();
+        assert_eq!(fmi2SetFMUstate(c, st), ERROR);
+        assert!(host.logged(&["fmi2SetFMUstate", "mode", "7", "outside [0, 2]"]));
+        assert_eq!(get_real(c, vr::Y).to_bits(), before);
+        assert_eq!(get_int(c, vr::STEPS), 8);
+        // Repaired, it restores and continues bit-identically.
+        snap.vars.mode = 0;
+        assert_eq!(fmi2SetFMUstate(c, st), OK);
+        assert_eq!(run_steps(c, 3, 5, input), expected);
+        assert_eq!(fmi2FreeFMUstate(c, &mut st), OK);
+        fmi2FreeInstance(c);
+    }
+}

@@ -1,10 +1,13 @@
-//! Print the reference trajectory as CSV (t, V, α, θ, q, N, E, h, T, T_c, δe).
+//! Print the reference trajectory as CSV (t, V, α, θ, q, N, E, h, T, T_c, δe): the tuned
+//! configuration's, or with `thesis` that of `configuration = 1` (closed forms on the cosine
+//! blends, T_c = T).
 use flight_mission::MissionParams;
 use lqr_control::trajectory::{Trajectory, TrajectoryMode, TrajectoryOptions};
 use tailsitter_physics::Airframe;
 
 fn main() {
-    let mode = if std::env::args().any(|a| a == "thesis") {
+    let thesis = std::env::args().any(|a| a == "thesis");
+    let mode = if thesis {
         TrajectoryMode::Thesis
     } else {
         TrajectoryMode::ForceBalance
@@ -14,6 +17,8 @@ fn main() {
         &MissionParams::default(),
         &TrajectoryOptions {
             mode,
+            limited_path: !thesis,
+            thrust_lead: !thesis,
             ..Default::default()
         },
     )

@@ -12,8 +12,12 @@ use crate::{LqrController, COMMAND_NAMES};
 /// Switches and tuning of the integrators (from [`crate::LqrParams::effective`]).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct IntegratorSwitches {
-    /// Limit of the airspeed-error integrator |∫ΔV dt| (m).
+    /// Limit of the airspeed-error integrator |∫ΔV dt| (m), applied with `integrator_clamp`.
     pub integrator_limit: f64,
+    /// Clamp the airspeed integrator to ±`integrator_limit` (off: printed, no limit).
+    pub integrator_clamp: bool,
+    /// Do not integrate further into a thrust limit (off: printed).
+    pub integrator_freeze: bool,
     /// Leak λ of the airspeed integrator (1/s); 0 in the thesis configuration (3.2.12–3.2.14).
     pub integrator_leak: f64,
     /// Limit of each position-error integrator (m·s).
@@ -69,18 +73,21 @@ impl LqrController {
     }
 
     /// Airspeed integrator x_I(k+1) = e^{−λ T_s} x_I(k) + T_s (V − V_t) (3.2.12–3.2.14, leak
-    /// λ), with anti-windup: not integrated further into a thrust limit (`thrust_saturated`,
-    /// the direction of the thrust's saturation), clamped to `integrator_limit`, only finite
-    /// values committed.
+    /// λ), with anti-windup where switched on: not integrated further into a thrust limit
+    /// (`integrator_freeze`; `thrust_saturated` is the direction of the thrust's saturation),
+    /// clamped to ±`integrator_limit` (`integrator_clamp`); only finite values committed.
     fn integrate_airspeed(&mut self, x: &X, xt: &X, thrust_saturated: f64, sw: &IntegratorSwitches) {
         let dv = x[ix::V] - xt[ix::V];
         // Negative airspeed error asks for more thrust (K row of T_c on x_I is negative).
         let pushes_up = dv < 0.0;
-        if !(thrust_saturated > 0.0 && pushes_up || thrust_saturated < 0.0 && !pushes_up) {
-            let lim = sw.integrator_limit;
+        let into_limit = thrust_saturated > 0.0 && pushes_up || thrust_saturated < 0.0 && !pushes_up;
+        if !(sw.integrator_freeze && into_limit) {
             let ts = self.mission.sample_time;
             let decay = (-sw.integrator_leak * ts).exp();
-            let next = (decay * self.integrator + ts * dv).clamp(-lim, lim);
+            let mut next = decay * self.integrator + ts * dv;
+            if sw.integrator_clamp {
+                next = next.clamp(-sw.integrator_limit, sw.integrator_limit);
+            }
             if next.is_finite() {
                 self.integrator = next;
             }

@@ -3,7 +3,8 @@
 //! x_p = x − x_t (3.2.1) augmented with the integrators (3.2.12–3.2.14) — the vector the
 //! gain K multiplies.
 
-use flight_mission::{Measurement, VerticalReference};
+use flight_mission::Measurement;
+use guidance::VerticalReference;
 use nalgebra::{SVector, Vector3};
 
 use crate::model::{self, ix, state_of, wrap_pi, EulerRep, I_POS, NA, NX, X};

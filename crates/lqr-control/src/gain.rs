@@ -1,7 +1,7 @@
 //! The gain schedule of Fig. 3.2 (§3.1.3, §3.2.4): every T_l = `relinearisation_period` and
 //! at every Euler-set switch the model for control is relinearised (3.2.7–3.2.9), augmented
 //! with the integrators (3.2.12–3.2.14), discretised by a zero-order hold (in place of
-//! 3.2.10–3.2.11) and the gain K solved from the Riccati equation (3.1.3–3.1.5: the
+//! 3.2.10–3.2.11; the printed first order with `discretisation` 1) and the gain K solved from the Riccati equation (3.1.3–3.1.5: the
 //! steady-state DARE, warm-started, or the thesis's backward iteration).
 
 use flight_mission::{Measurement, Notice, Phase};
@@ -76,7 +76,24 @@ struct Design<const N: usize> {
     warm: bool,
 }
 
-/// ZOH discretisation of (A, B) over `ts` (`M` = N + NU), gain by the DARE (`riccati_method`
+/// Discretisation of (A, B) over `ts`: the exact zero-order hold (`discretisation` 0,
+/// `M` = N + NU) or the printed first order Φ = I + A T_s, Γ = B T_s (1, 3.2.10–3.2.11; on
+/// the integrator-augmented A this is the corrected (3.2.13): Φ_I = [1 − λT_s, T_s H_I; 0 Φ],
+/// Γ_I = [0; Γ]).
+fn discretise<const N: usize, const M: usize>(
+    a: &SMatrix<f64, N, N>,
+    b: &SMatrix<f64, N, NU>,
+    ts: f64,
+    params: &LqrParams,
+) -> (SMatrix<f64, N, N>, SMatrix<f64, N, NU>) {
+    if params.discretisation == 1 {
+        (SMatrix::<f64, N, N>::identity() + a * ts, b * ts)
+    } else {
+        discretise_zoh::<N, NU, M>(a, b, ts)
+    }
+}
+
+/// Discretisation of (A, B) over `ts` ([`discretise`]), gain by the DARE (`riccati_method`
 /// 0, [`dare_gain`]) or the backward iteration (1, 3.1.3–3.1.5 over `riccati_horizon`), and
 /// the stability check of Φ − ΓK against `limit`.
 #[allow(clippy::too_many_arguments)]
@@ -90,7 +107,7 @@ fn design<const N: usize, const M: usize>(
     limit: f64,
     warm: Option<&SMatrix<f64, N, N>>,
 ) -> Result<Design<N>, RiccatiError> {
-    let (phi, gamma) = discretise_zoh::<N, NU, M>(a, b, ts);
+    let (phi, gamma) = discretise::<N, M>(a, b, ts, params);
     let q = SMatrix::<f64, N, N>::from_diagonal(q_diag);
     let (k, p, warm) = if params.riccati_method == 0 {
         dare_gain(&phi, &gamma, &q, r, warm)?
@@ -166,13 +183,14 @@ fn dare_warm<const N: usize>(
 }
 
 /// The design on the [∫ΔV; x] block embedded in the full [∫ΔV; x; ∫Δp] one: the inert
-/// position integrators' gain columns are zero and their Φ block e^{−T_s} I.
-fn embed_inert(d: Design<NR>, ts: f64) -> GainSolution {
+/// position integrators' gain columns are zero and their Φ block e^{−T_s} I (first order:
+/// (1 − T_s) I).
+fn embed_inert(d: Design<NR>, ts: f64, first_order: bool) -> GainSolution {
     let mut k = Gain::zeros();
     k.fixed_view_mut::<NU, NR>(0, 0).copy_from(&d.k);
     let mut phi = SMatrix::<f64, NA, NA>::zeros();
     phi.fixed_view_mut::<NR, NR>(0, 0).copy_from(&d.phi);
-    let inert = (-ts).exp();
+    let inert = if first_order { 1.0 - ts } else { (-ts).exp() };
     for j in NR..NA {
         phi[(j, j)] = inert;
     }
@@ -257,7 +275,7 @@ impl LqrController {
             limit,
             warm,
         )?;
-        Ok(embed_inert(d, ts))
+        Ok(embed_inert(d, ts, self.params.discretisation == 1))
     }
 
     /// The continuous model for control augmented with the integrators, (A, B) over
@@ -371,7 +389,7 @@ impl LqrController {
     /// nose, α, β ≈ 0, and the air-data wind is zero).
     pub(crate) fn wind_in_air_data(&self, m: &Measurement) -> bool {
         (m.alpha.abs() > HOVER_WIND_AIR_ANGLE || m.beta.abs() > HOVER_WIND_AIR_ANGLE)
-            && flight_mission::weathervane::air_data_wind(m).xy().norm() >= self.weathervane.params().engage_speed
+            && guidance::weathervane::air_data_wind(m).xy().norm() >= self.weathervane.params().engage_speed
     }
 
     /// Warm start of the DARE in Euler set `rep`: the previous solutions in the same set,

@@ -3,7 +3,7 @@
 //!
 //! * [`model`]: the full-state Euler model for control (§2.4, candidate 2 of §3.2.3) on the
 //!   physics crate's force model, linearised analytically (3.2.7–3.2.9).
-//! * [`linalg`]: zero-order-hold discretisation (replacing (3.2.10–3.2.11)), the steady-state
+//! * [`linalg`]: zero-order-hold discretisation (the tuned alternative to (3.2.10–3.2.11)), the steady-state
 //!   DARE by structured doubling, the thesis's N-step backward iteration (3.1.3–3.1.5).
 //! * [`trajectory`]: the reference trajectory of §3.3.
 //! * [`weights`]: Table 3.4 weights per phase (3.4.1–3.4.3), blended between phases.
@@ -30,9 +30,9 @@ pub use gain::{
 use std::ops::ControlFlow;
 
 use flight_mission::{
-    Command, ControlError, ControllerInput, ControllerOutput, GroundPhases, MissionParams, ParamError, SampledUnit,
-    Weathervane, WeathervaneParams,
+    Command, ControlError, ControllerInput, ControllerOutput, MissionParams, ParamError, SampledUnit,
 };
+use guidance::{GroundPhases, Weathervane, WeathervaneParams};
 use nalgebra::{SMatrix, Vector3};
 use tailsitter_physics::Airframe;
 
@@ -88,7 +88,7 @@ pub struct LqrParams {
     pub weight_blend_time: f64,
     /// Reference 3-2-1 pitch above which the 2-3-1 Euler set is used (rad).
     pub euler_switch_pitch: f64,
-    /// Limit of the airspeed-error integrator |∫ΔV dt| (m).
+    /// Limit of the airspeed-error integrator |∫ΔV dt| (m), applied with `integrator_clamp`.
     pub integrator_limit: f64,
     /// Leak λ of the airspeed integrator, ẋ_I = V − V_t − λ x_I (1/s). Must be > 0 with the
     /// DARE (`riccati_method` 0): with λ = 0 the integrator minus the along-track position
@@ -126,8 +126,37 @@ pub struct LqrParams {
     /// [`Self::effective`]): backward iteration over `riccati_horizon`, airspeed-integrator
     /// leak 0, Table 3.4 verbatim (weight set 0, switched without blending), the closed-form trajectory (3.3.x), the
     /// no-wind reference, airspeed integral only, and the reference re-anchored at the
-    /// measured position at the start of every mission segment (§3.5.1).
+    /// measured position at the start of every mission segment (§3.5.1); the switches below
+    /// at −1 take the configuration's form (thesis: the printed one).
     pub configuration: i32,
+    /// Discretisation of the model for control (docs/THESIS.md D-3.3): 0 = exact zero-order
+    /// hold, 1 = the printed first-order form Φ ≈ I + F T_s, Γ ≈ G T_s (3.2.10–3.2.11), with
+    /// the integrator augmentation of the corrected (3.2.13); −1 = follow `configuration`
+    /// (0 tuned → 0, 1 thesis → 1). Likewise for the switches below: −1 = the configuration's
+    /// default, 0 / 1 override it.
+    pub discretisation: i32,
+    /// Clamp of the airspeed integrator to ±`integrator_limit` (D-3.5): 1 = on, 0 = off (the
+    /// printed 3.2.12–3.2.14 have no limit); −1 = follow `configuration` (tuned on, thesis
+    /// off).
+    pub integrator_clamp: i32,
+    /// Freeze of the airspeed integrator while it integrates further into a thrust limit
+    /// (D-3.5): 1 = on, 0 = off (printed); −1 = follow `configuration` (tuned on, thesis off).
+    pub integrator_freeze: i32,
+    /// Thrust command of the trajectory (D-3.15): 1 = T_c = T + τ_T Ṫ (the command leads the
+    /// lagged thrust state, 2.3.16), 0 = T_c = T, the printed thrust of (3.3.13–3.3.14); −1 =
+    /// follow `configuration` (tuned 1, thesis 0).
+    pub thrust_lead: i32,
+}
+
+/// The configuration-following switches of [`LqrParams`]: (name, value, default with
+/// `configuration` 0 (tuned), default with 1 (thesis)).
+fn following_switches(p: &mut LqrParams) -> [(&'static str, &mut i32, i32, i32); 4] {
+    [
+        ("discretisation", &mut p.discretisation, 0, 1),
+        ("integrator_clamp", &mut p.integrator_clamp, 1, 0),
+        ("integrator_freeze", &mut p.integrator_freeze, 1, 0),
+        ("thrust_lead", &mut p.thrust_lead, 1, 0),
+    ]
 }
 
 impl LqrParams {
@@ -137,10 +166,14 @@ impl LqrParams {
     /// weight set 0 (Table 3.4 verbatim) switched at the phase boundaries without blending
     /// (§3.4), trajectory mode 0 (closed forms 3.3.3–3.3.17),
     /// no wind compensation and no position integrators (the thesis has neither).
+    ///
+    /// The switches `discretisation`, `integrator_clamp`, `integrator_freeze` and
+    /// `thrust_lead` follow the configuration when −1 (thesis: the printed forms, 0 / 1 as
+    /// documented on each) and keep an explicit 0 or 1 in either configuration.
     pub fn effective(&self) -> Result<Self, ControlError> {
-        match self.configuration {
-            0 => Ok(self.clone()),
-            1 => Ok(Self {
+        let mut p = match self.configuration {
+            0 => self.clone(),
+            1 => Self {
                 riccati_method: 1,
                 integrator_leak: 0.0,
                 weight_set: 0,
@@ -149,11 +182,27 @@ impl LqrParams {
                 wind_compensation: 0,
                 position_integral: 0,
                 ..self.clone()
-            }),
-            c => Err(ControlError(format!(
-                "configuration = {c}: expected 0 (tuned) or 1 (thesis)"
-            ))),
+            },
+            c => {
+                return Err(ControlError(format!(
+                    "configuration = {c}: expected 0 (tuned) or 1 (thesis)"
+                )))
+            }
+        };
+        let thesis = p.configuration == 1;
+        for (name, v, tuned, printed) in following_switches(&mut p) {
+            *v = match *v {
+                -1 if thesis => printed,
+                -1 => tuned,
+                0 | 1 => *v,
+                x => {
+                    return Err(ControlError(format!(
+                        "{name} = {x}: expected -1 (follow configuration), 0 or 1"
+                    )))
+                }
+            };
         }
+        Ok(p)
     }
 
     /// Whether the reference is re-anchored at the measured position at the start of every
@@ -164,30 +213,9 @@ impl LqrParams {
     }
 }
 
-impl Default for LqrParams {
-    fn default() -> Self {
-        Self {
-            relinearisation_period: 0.2,
-            riccati_method: 0,
-            riccati_horizon: 200,
-            r_scale: 1.0,
-            weight_set: 1,
-            weight_blend_time: 1.0,
-            euler_switch_pitch: 50f64.to_radians(),
-            integrator_limit: 10.0,
-            integrator_leak: 0.1,
-            position_integral: 0,
-            position_integrator_limit: 50.0,
-            position_integrator_leak: 0.0,
-            wind_compensation: 1,
-            wind_filter_time: 0.3,
-            trajectory_mode: 1,
-            alpha_max: 15f64.to_radians(),
-            turn_radius: 0.0,
-            configuration: 0,
-        }
-    }
-}
+// `impl Default for LqrParams`: the start values of group `lqr` of
+// modelDescription/tailsitter_lqr.json, generated by build.rs.
+include!(concat!(env!("OUT_DIR"), "/lqr_params_generated.rs"));
 
 /// Counters of the gain computations (for reports and benchmarks).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -232,7 +260,7 @@ pub struct LqrController {
     weathervane: Weathervane,
     /// Integrated horizontal position error in wind (N, E, 0) (m) (README, "Hover in wind").
     wind_shift: Vector3<f64>,
-    /// Take-off and landing phases around the mission (flight_mission::ground).
+    /// Take-off and landing phases around the mission (guidance::ground).
     ground: GroundPhases,
     /// Whether the last sample flew a take-off / landing reference (position integrators on).
     ground_active: bool,
@@ -280,6 +308,8 @@ impl LqrParams {
             },
             integrator: IntegratorSwitches {
                 integrator_limit: self.integrator_limit,
+                integrator_clamp: self.integrator_clamp != 0,
+                integrator_freeze: self.integrator_freeze != 0,
                 integrator_leak: self.integrator_leak,
                 position_integrator_limit: self.position_integrator_limit,
                 position_integrator_leak: self.position_integrator_leak,
@@ -331,6 +361,7 @@ impl LqrController {
                 turn_radius: params.turn_radius,
                 // The thesis configuration flies the thesis's cosine blends (3.3.1–3.3.6).
                 limited_path: params.configuration == 0,
+                thrust_lead: params.thrust_lead != 0,
             },
         )
         .map_err(ControlError)?;

@@ -5,9 +5,8 @@
 //! the estimated wind (hover-in-wind position shift, wind trim, wind-consistent air data).
 use std::ops::ControlFlow;
 
-use flight_mission::{
-    Command, ControllerInput, ControllerOutput, Diagnostics, GroundMode, Measurement, Phase, VerticalReference,
-};
+use flight_mission::{Command, ControllerInput, ControllerOutput, Diagnostics, Measurement, Phase};
+use guidance::{GroundMode, VerticalReference};
 use nalgebra::{Matrix3, Vector3};
 use tailsitter_physics::Surfaces;
 
@@ -56,7 +55,7 @@ pub(crate) struct Reference {
 }
 
 impl LqrController {
-    /// Take-off and landing around the mission (flight_mission::ground): the offset of the
+    /// Take-off and landing around the mission (guidance::ground): the offset of the
     /// mission reference and the vertical reference of the take-off / landing phases; on the
     /// gear (`Break`) the idle output (no gain computation, no integration: no wind-up).
     /// Anchors the origin at the take-off point and, into or out of the take-off / landing
@@ -388,7 +387,7 @@ impl LqrController {
         Vector3::new(v, v_b.z.atan2(v_b.x), (v_b.y / v).clamp(-1.0, 1.0).asin())
     }
 
-    /// The reference point of a take-off / landing reference (flight_mission::ground): the
+    /// The reference point of a take-off / landing reference (guidance::ground): the
     /// mission's vertical attitude (nose up, belly north) and rates, the position relative
     /// to the origin, airspeed |v|, and the vertical trim inputs with the thrust
     /// `T = m (g + a_up) + (T_trim − m g) · climb/V_V` (weight, the reference acceleration and

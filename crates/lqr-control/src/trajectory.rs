@@ -37,7 +37,8 @@
 
 use std::sync::Arc;
 
-use flight_mission::{HeadingRef, MissionParams, Phase, PointMass, Profile, ProfileLimits};
+use flight_mission::{MissionParams, Phase};
+use guidance::{HeadingRef, PointMass, Profile, ProfileLimits};
 use nalgebra::{Matrix3, Vector3, Vector4};
 use tailsitter_physics::{quat_from_euler_321, Airframe, Surfaces};
 
@@ -72,17 +73,23 @@ pub struct TrajectoryOptions {
     /// Turn radius ρ (m) of the level segment (3.3.18–3.3.21); 0 = straight, < 0 left.
     pub turn_radius: f64,
     /// V and γ of the α- and thrust-limited point-mass profile
-    /// ([`flight_mission::profile`]) instead of the thesis's cosine blends.
+    /// ([`guidance::profile`]) instead of the thesis's cosine blends.
     pub limited_path: bool,
+    /// Thrust command T_c = T + τ_T Ṫ leading the lagged thrust state (2.3.16); off: T_c = T,
+    /// the printed (3.3.13–3.3.14) (docs/THESIS.md D-3.15).
+    pub thrust_lead: bool,
 }
 
 impl Default for TrajectoryOptions {
+    /// The options of the default [`crate::LqrParams`] (`trajectory_mode` 1, `configuration` 0).
     fn default() -> Self {
+        let p = crate::LqrParams::default();
         Self {
             mode: TrajectoryMode::ForceBalance,
-            alpha_max: 15f64.to_radians(),
-            turn_radius: 0.0,
+            alpha_max: p.alpha_max,
+            turn_radius: p.turn_radius,
             limited_path: true,
+            thrust_lead: true,
         }
     }
 }
@@ -186,7 +193,7 @@ fn path(m: &MissionParams, profile: Option<&Profile>, t: f64) -> (Phase, [f64; 5
     let dv = m.v_level - m.v_vertical;
     let r = match phase {
         Phase::Vertical1 | Phase::Vertical2 => [m.v_vertical, 0.0, FRAC_PI_2, 0.0, 0.0],
-        // Take-off and landing: flown from flight_mission::ground, never a mission time.
+        // Take-off and landing: flown from guidance::ground, never a mission time.
         Phase::OnGround | Phase::TakeOff | Phase::Approach | Phase::Descent | Phase::Flare | Phase::Landed => {
             [m.v_vertical, 0.0, FRAC_PI_2, 0.0, 0.0]
         }
@@ -673,9 +680,12 @@ fn thesis_point(af: &Airframe, k: &PointKinematics, alpha: f64, p: &mut TrajPoin
 }
 
 /// Positions by integrating the path velocity (3.3.9–3.3.12, trapezoidal rule) and the
-/// thrust command leading the state by the lag, T_c = T + τ_T Ṫ (2.3.16), clamped to the
-/// thrust range; in the `Thesis` mode α back to the kinematic `alphas`.
-fn positions_and_commands(af: &Airframe, mode: TrajectoryMode, pts: &mut [TrajPoint], alphas: &[f64]) {
+/// thrust command, with `thrust_lead` leading the state by the lag, T_c = T + τ_T Ṫ (2.3.16),
+/// else T_c = T (3.3.13–3.3.14), clamped to the thrust range; in the `Thesis` mode α back to
+/// the kinematic `alphas`.
+fn positions_and_commands(af: &Airframe, opt: &TrajectoryOptions, pts: &mut [TrajPoint], alphas: &[f64]) {
+    let mode = opt.mode;
+    let lead = if opt.thrust_lead { af.tau_thrust } else { 0.0 };
     let thrusts: Vec<f64> = pts.iter().map(|p| p.thrust).collect();
     let tdot = derivative(&thrusts);
     let mut pos = Vector3::zeros();
@@ -690,7 +700,7 @@ fn positions_and_commands(af: &Airframe, mode: TrajectoryMode, pts: &mut [TrajPo
         }
         let p = &mut pts[i];
         p.pos_neh = pos;
-        p.u[0] = (p.thrust + af.tau_thrust * tdot[i]).clamp(af.thrust_min, af.thrust_max);
+        p.u[0] = (p.thrust + lead * tdot[i]).clamp(af.thrust_min, af.thrust_max);
         if mode == TrajectoryMode::Thesis {
             p.alpha = alphas[i];
         }
@@ -757,7 +767,7 @@ impl Trajectory {
                 }
             }
         }
-        positions_and_commands(af, opt.mode, &mut pts, &alphas);
+        positions_and_commands(af, opt, &mut pts, &alphas);
         if pts
             .iter()
             .any(|p| !(p.v.is_finite() && p.u.iter().all(|x| x.is_finite()) && p.pos_neh.iter().all(|x| x.is_finite())))
@@ -949,7 +959,7 @@ mod tests {
     #[test]
     fn fast_construction_equals_the_slow_reference() {
         let af = Airframe::default();
-        let fast = MissionParams::fast();
+        let fast = MissionParams::fast_limited();
         let slow_turns = MissionParams {
             t_transition_1: 3.0,
             t_transition_2: 4.0,

@@ -149,7 +149,7 @@ pub fn load_set(json: &str, index: usize) -> Result<WeightSet, String> {
 fn table_index(phase: Phase) -> usize {
     match phase {
         Phase::Vertical1 | Phase::Vertical2 => 0,
-        // Take-off and landing (flight_mission::ground): vertical flight.
+        // Take-off and landing (guidance::ground): vertical flight.
         Phase::OnGround | Phase::TakeOff | Phase::Approach | Phase::Descent | Phase::Flare | Phase::Landed => 0,
         Phase::TransitionToLevel => 1,
         Phase::Level => 2,

@@ -1118,11 +1118,17 @@ impl Ekf {
         set(&mut phi, ix::VEL, ix::GYRO_BIAS, &(af * r0 * h2));
         set(&mut phi, ix::ATT, ix::GYRO_BIAS, &(-r0 * h));
 
-        // Discrete process noise: white specific-force / rate noise held over the step, with
-        // the IMU's per-sample σ converted to a density σ²·T_imu, plus the model-error densities.
+        // Discrete process noise: the IMU samples' noise (Table D.1 σ per delivered sample) as
+        // white noise of density σ²·T_imu, T_imu its correlation time at this step
+        // ([`crate::AnalogFilter::noise_correlation_time`]), plus the model-error densities.
         let n = &pr.noise;
-        let qa = (n.sigma_accel.powi(2) * n.imu_period + pr.process.accel_model.powi(2)) * imu_inflation;
-        let qg = (n.sigma_gyro.powi(2) * n.imu_period + pr.process.gyro_model.powi(2)) * imu_inflation;
+        let t_imu = if n.imu_period > 0.0 {
+            n.imu_period
+        } else {
+            pr.filter.noise_correlation_time(h)
+        };
+        let qa = (n.sigma_accel.powi(2) * t_imu + pr.process.accel_model.powi(2)) * imu_inflation;
+        let qg = (n.sigma_gyro.powi(2) * t_imu + pr.process.gyro_model.powi(2)) * imu_inflation;
         let mut p = phi * s.cov * phi.transpose();
         for k in 0..3 {
             p[(ix::POS + k, ix::POS + k)] += qa * h * h * h / 3.0;
@@ -1321,10 +1327,11 @@ impl Ekf {
     }
 
     /// Zero-sideslip pseudo-measurement: e_yᵀ C (v − w) = 0 with σ = σ_β V̄, above
-    /// `sideslip_min_airspeed`. Synthetic: a gated-out value is skipped, not counted.
+    /// `sideslip_min_airspeed`, when `sideslip_pseudo_measurement`. Synthetic: a gated-out
+    /// value is skipped, not counted.
     fn fuse_sideslip(&mut self) {
         let t = &self.params.tuning;
-        if t.sigma_sideslip <= 0.0 {
+        if !t.sideslip_pseudo_measurement || t.sigma_sideslip <= 0.0 {
             return;
         }
         let s = &self.state;

@@ -13,39 +13,24 @@ pub struct SensorNoise {
     pub sigma_gps_height: f64,
     /// GPS velocity σ per NED axis (m/s) (Table D.1: 0.5 m/s).
     pub sigma_gps_vel: f64,
-    /// Accelerometer σ per axis and sample (m/s²) (Table D.1: 0.1414 m/s²).
+    /// Accelerometer σ per axis of the delivered samples (m/s²) (Table D.1: 0.1414 m/s²).
     pub sigma_accel: f64,
-    /// Rate-gyro σ per axis and sample (rad/s) (Table D.1: 27.925e-3 rad/s).
+    /// Rate-gyro σ per axis of the delivered samples (rad/s) (Table D.1: 27.925e-3 rad/s).
     pub sigma_gyro: f64,
-    /// Magnetometer σ per axis (Gauss): Table D.1's 0.02 Gauss before the sensors' 8 Hz
-    /// Butterworth × its noise gain at 50 Hz (0.5764, the sensors' `mag_noise_gain`).
+    /// Magnetometer σ per axis of the delivered samples (Gauss) (Table D.1: 0.02 Gauss).
     pub sigma_mag: f64,
-    /// σ of the pitot's differential pressure as the estimator sees it (Pa): the sensors'
-    /// `pitot_std` 1 Pa × `pitot_noise_gain` 0.5764. With Δp = ½ρ₀u|u| the airspeed σ is
-    /// σ_Δp/(ρ₀|u|) (ρ₀ = 1.225 kg/m³, the sensors' indication density).
+    /// σ of the pitot's delivered differential pressure (Pa): the sensors' `pitot_std`
+    /// (1 Pa). With Δp = ½ρ₀u|u| the airspeed σ is σ_Δp/(ρ₀|u|) (ρ₀ = 1.225 kg/m³, the
+    /// sensors' indication density).
     pub sigma_pitot_dp: f64,
     /// Pitot model-error σ (m/s), added in quadrature: the reading lags the body-x airspeed
     /// by the filter's delay (≈ 28 ms: 0.14 m/s at 5 m/s²) and the air density may differ
     /// from ρ₀.
     pub sigma_pitot: f64,
-    /// Period of the IMU samples (s): converts the per-sample σ to a noise density (20 ms).
+    /// Correlation time T_imu of the IMU samples' noise (s): σ²·T_imu is the density of the
+    /// white noise the strapdown integrates. 0 (default): derived from the sensors' filter at
+    /// the estimator's step, [`AnalogFilter::noise_correlation_time`].
     pub imu_period: f64,
-}
-
-impl Default for SensorNoise {
-    fn default() -> Self {
-        Self {
-            sigma_gps_latlon: 6.2832e-7,
-            sigma_gps_height: 4.0,
-            sigma_gps_vel: 0.5,
-            sigma_accel: 0.1414,
-            sigma_gyro: 27.925e-3,
-            sigma_mag: 0.02 * 0.5764,
-            sigma_pitot_dp: 0.5764,
-            sigma_pitot: 0.2,
-            imu_period: 0.02,
-        }
-    }
 }
 
 /// Process noise beyond the IMU's own noise.
@@ -62,18 +47,6 @@ pub struct ProcessNoise {
     pub accel_bias_walk: f64,
     /// Wind random walk (m/s/√s).
     pub wind_walk: f64,
-}
-
-impl Default for ProcessNoise {
-    fn default() -> Self {
-        Self {
-            accel_model: 0.01,
-            gyro_model: 0.0005,
-            gyro_bias_walk: 1e-4,
-            accel_bias_walk: 1e-3,
-            wind_walk: 0.1,
-        }
-    }
 }
 
 /// Reference point of the local NED frame and the Earth's fields there.
@@ -95,20 +68,6 @@ pub struct Earth {
     pub mag_inclination: f64,
     /// Gravitational acceleration (m/s²), as the plant's `gravity` (9.81).
     pub gravity: f64,
-}
-
-impl Default for Earth {
-    fn default() -> Self {
-        Self {
-            ref_latitude: (-33.93f64).to_radians(),
-            ref_longitude: 18.86f64.to_radians(),
-            ref_height: 0.0,
-            mag_field_total: 0.2513,
-            mag_declination: (-26.61f64).to_radians(),
-            mag_inclination: (-64.73f64).to_radians(),
-            gravity: 9.81,
-        }
-    }
 }
 
 impl SensorNoise {
@@ -153,6 +112,8 @@ pub struct Tuning {
     pub sigma_sideslip: f64,
     /// Airspeed above which the zero-sideslip pseudo-measurement is fused (m/s).
     pub sideslip_min_airspeed: f64,
+    /// Fuse the zero-sideslip pseudo-measurement (an extra beyond App. D.4) (–).
+    pub sideslip_pseudo_measurement: bool,
     /// After this many consecutive rejected GPS position (or velocity) fixes the filter
     /// resets that block to the GPS: the filter, not the GPS, has lost track.
     pub gps_reset_after: u32,
@@ -165,23 +126,6 @@ pub struct Tuning {
     pub relative_to_start: bool,
 }
 
-impl Default for Tuning {
-    fn default() -> Self {
-        Self {
-            init_std_wind: 3.0,
-            init_std_gyro_bias: 0.005,
-            init_std_accel_bias: 0.05,
-            init_std_pos_no_gps: 50.0,
-            init_std_vel_no_gps: 5.0,
-            pitot_min_airspeed: 1.0,
-            sigma_sideslip: 0.1,
-            sideslip_min_airspeed: 10.0,
-            gps_reset_after: 8,
-            relative_to_start: true,
-        }
-    }
-}
-
 /// The avionics' analogue low-pass filter on the IMU, magnetometer and pitot channels
 /// (thesis App. D.3: second-order Butterworth), as the sensor model's `filter_enabled`,
 /// `filter_bandwidth`. The estimator compensates its group delay (see [`AnalogFilter::delay`]).
@@ -191,34 +135,50 @@ pub struct AnalogFilter {
     pub enabled: bool,
     /// −3 dB frequency f_c of the Butterworth (Hz) (8 Hz).
     pub bandwidth: f64,
+    /// Compensate the filter's group delay (an extra beyond App. D.4) (–): else the samples
+    /// are taken as undelayed (only `latency` is compensated).
+    pub compensate: bool,
     /// Transport delay of the measurement inputs (s) (0): the age of the latest sample at
     /// the communication point beyond the filter's delay, e.g. one communication step when
     /// a Jacobi master gives the estimator the sensors' outputs of the previous step.
     pub latency: f64,
 }
 
-impl Default for AnalogFilter {
-    fn default() -> Self {
-        Self {
-            enabled: true,
-            bandwidth: 8.0,
-            latency: 0.0,
-        }
-    }
-}
-
 impl AnalogFilter {
     /// Low-frequency group delay of the second-order Butterworth (s):
     /// H(s) = Ω²/(s² + √2Ωs + Ω²) has phase −atan(√2Ωω/(Ω² − ω²)) ≈ −√2 ω/Ω for ω ≪ Ω, so
-    /// τ = √2/Ω = √2/(2π f_c) (28.1 ms at 8 Hz; 0 when the filter is off), plus the
-    /// transport `latency`.
+    /// τ = √2/Ω = √2/(2π f_c) (28.1 ms at 8 Hz; 0 when the filter is off or not
+    /// compensated), plus the transport `latency`.
     pub fn delay(&self) -> f64 {
-        let filter = if self.enabled {
+        let filter = if self.enabled && self.compensate {
             std::f64::consts::SQRT_2 / (2.0 * std::f64::consts::PI * self.bandwidth)
         } else {
             0.0
         };
         filter + self.latency
+    }
+}
+
+impl AnalogFilter {
+    /// Correlation time (s) of the delivered noise as the estimator samples it, one sample
+    /// per step `h`: T = h Σ_{k∈ℤ} ρ(kh), so that σ²T is the density of the white noise with
+    /// the same low-frequency spectrum (what the strapdown integrates). Through the
+    /// Butterworth (ζ = 1/√2, a = Ω/√2) the normalised autocorrelation is
+    /// ρ(τ) = e^{−a|τ|}(cos aτ + sin a|τ|) (white input); with z = e^{(−1+i)ah} the sum is
+    /// 1 + 2(Re + Im)(z/(1 − z)). T → ∫ρ dτ = 1/(2B_n) = √2/(π f_c) (56.3 ms at 8 Hz) for
+    /// h ≪ 1/f_c (B_n = π f_c/(2√2), the noise bandwidth), 56.35 ms at h = 20 ms; h
+    /// without the filter (independent samples, each held over its step).
+    pub fn noise_correlation_time(&self, h: f64) -> f64 {
+        if !self.enabled || h.is_nan() || h <= 0.0 {
+            return h.max(0.0);
+        }
+        let ah = std::f64::consts::PI * std::f64::consts::SQRT_2 * self.bandwidth * h;
+        let r = (-ah).exp();
+        let (zr, zi) = (r * ah.cos(), r * ah.sin());
+        // z/(1 − z) = z(1 − z̄)/|1 − z|².
+        let d = (1.0 - zr).powi(2) + zi * zi;
+        let (sr, si) = ((zr * (1.0 - zr) - zi * zi) / d, zi / d);
+        h * (1.0 + 2.0 * (sr + si))
     }
 }
 
@@ -246,15 +206,10 @@ pub struct Prediction {
     pub aero_model: i32,
 }
 
-impl Default for Prediction {
-    fn default() -> Self {
-        Self {
-            model: true,
-            lead: 0.0,
-            aero_model: 1,
-        }
-    }
-}
+// `impl Default` of SensorNoise, ProcessNoise, Earth, Tuning, AnalogFilter and Prediction:
+// the start values of group `estimator` of modelDescription/tailsitter_ekf.json, generated
+// by build.rs.
+include!(concat!(env!("OUT_DIR"), "/estimator_params_generated.rs"));
 
 /// Everything the estimator needs besides the measurements.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -273,6 +228,26 @@ pub struct EstimatorParams {
 }
 
 impl EstimatorParams {
+    /// The App.-D-faithful configuration (thesis App. D.4): the measurement variances of
+    /// Table D.1 (GPS, accelerometers, rate gyros, magnetometer) and every extra beyond
+    /// D.4 off — the model prediction over the delays, the start-relative position, the
+    /// compensation of the sensors' filter delay, the zero-sideslip pseudo-measurement.
+    /// Everything else (process noise, pitot, priors, the airframe) is kept.
+    pub fn app_d(mut self) -> Self {
+        let table_d1 = SensorNoise::default();
+        self.noise.sigma_gps_latlon = table_d1.sigma_gps_latlon;
+        self.noise.sigma_gps_height = table_d1.sigma_gps_height;
+        self.noise.sigma_gps_vel = table_d1.sigma_gps_vel;
+        self.noise.sigma_accel = table_d1.sigma_accel;
+        self.noise.sigma_gyro = table_d1.sigma_gyro;
+        self.noise.sigma_mag = table_d1.sigma_mag;
+        self.prediction.model = false;
+        self.tuning.relative_to_start = false;
+        self.filter.compensate = false;
+        self.tuning.sideslip_pseudo_measurement = false;
+        self
+    }
+
     /// Every value finite and in its domain; the error names the parameter.
     pub fn validate(&self) -> Result<(), String> {
         let positive = [
@@ -284,7 +259,6 @@ impl EstimatorParams {
             ("sigma_mag", self.noise.sigma_mag),
             ("sigma_pitot", self.noise.sigma_pitot),
             ("sigma_pitot_dp", self.noise.sigma_pitot_dp),
-            ("imu_period", self.noise.imu_period),
             ("mag_field_total", self.earth.mag_field_total),
             ("gravity", self.earth.gravity),
             ("init_std_wind", self.tuning.init_std_wind),
@@ -299,6 +273,7 @@ impl EstimatorParams {
             }
         }
         let non_negative = [
+            ("imu_period", self.noise.imu_period),
             ("accel_model_noise", self.process.accel_model),
             ("gyro_model_noise", self.process.gyro_model),
             ("gyro_bias_walk", self.process.gyro_bias_walk),
@@ -357,5 +332,49 @@ impl EstimatorParams {
             ));
         }
         self.airframe.validate().map_err(|e| e.to_string())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The closed form of T = h Σ ρ(kh) against the brute-force sum, its limits (h without
+    /// the filter; √2/(π f_c) = 1/(2B_n) for h ≪ 1/f_c) and the value at the 20 ms step.
+    #[test]
+    fn imu_noise_correlation_time() {
+        let f = AnalogFilter::default();
+        let rho = |tau: f64| {
+            let a = 2.0 * std::f64::consts::PI * f.bandwidth / std::f64::consts::SQRT_2;
+            (-a * tau.abs()).exp() * ((a * tau).cos() + (a * tau.abs()).sin())
+        };
+        for h in [0.001, 0.005, 0.02, 0.05] {
+            let brute = h * (1.0 + 2.0 * (1..100_000).map(|k| rho(k as f64 * h)).sum::<f64>());
+            let t = f.noise_correlation_time(h);
+            assert!((t - brute).abs() < 1e-12, "{h}: {t} vs {brute}");
+        }
+        let limit = std::f64::consts::SQRT_2 / (std::f64::consts::PI * f.bandwidth);
+        assert!((f.noise_correlation_time(1e-5) / limit - 1.0).abs() < 1e-6);
+        let t20 = f.noise_correlation_time(0.02);
+        assert!((t20 - 0.05635).abs() < 5e-5, "{t20}");
+        let off = AnalogFilter { enabled: false, ..f };
+        assert_eq!(off.noise_correlation_time(0.02), 0.02);
+        // The compensation switch does not change the noise.
+        let uncompensated = AnalogFilter { compensate: false, ..f };
+        assert_eq!(uncompensated.noise_correlation_time(0.02), t20);
+        assert_eq!(uncompensated.delay(), 0.0);
+    }
+
+    #[test]
+    fn app_d_turns_every_extra_off_and_keeps_table_d1() {
+        let mut tuned = EstimatorParams::default();
+        tuned.noise.sigma_mag = 0.5;
+        let p = tuned.app_d();
+        assert!(!p.prediction.model && !p.tuning.relative_to_start);
+        assert!(!p.filter.compensate && !p.tuning.sideslip_pseudo_measurement);
+        assert_eq!(p.noise.sigma_mag, 0.02);
+        assert_eq!(p.noise.sigma_accel, 0.1414);
+        assert_eq!(p.noise.sigma_gyro, 27.925e-3);
+        assert!(p.validate().is_ok());
     }
 }

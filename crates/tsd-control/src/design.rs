@@ -102,9 +102,11 @@ struct ModelPoint {
     kappa: f64,
     /// V̄ floored at `min_airspeed` (m/s).
     v: f64,
-    /// q̄ = ½ρV̄², q̄_s = ½ρ(V̄ + 2w)² (Pa).
+    /// q̄ = ½ρV̄², q̄_s = ½ρ(V̄ + 2w)² (Pa) (q̄_s = q̄ with `slipstream_in_design` off).
     qbar: f64,
     qbar_s: f64,
+    /// The switches of the models (D-4.1, D-4.2, D-4.4).
+    dev: Deviations,
     /// q̄S/(2V̄) per unit rate derivative: (2.3.5) without dividing by V̄ (kg/s).
     kr: f64,
     /// Thrust T ≥ 0 (N) and cos α.
@@ -203,7 +205,7 @@ impl TsdController {
     /// (4.2.1–4.2.31) with q̄ = ½ρV̄² and q̄_s = ½ρ(V̄ + 2w)², poles of Table 4.3 blended in
     /// airspeed, gains by pole placement. `Err` names a loop whose gains are not finite.
     pub fn design(&self, fc: &FlightCondition) -> Result<LoopDesign, &'static str> {
-        let mp = self.model_point(fc);
+        let mp = self.model_point(fc, Deviations::of(&self.params));
         let (guidance, guidance_lateral, guidance_feedback_limit) = self.guidance_design(fc, mp.sched);
         let axial = self.axial_design(mp.sched);
         let normal = self.normal_design(fc, &mp)?;
@@ -254,7 +256,7 @@ impl TsdController {
     }
 
     /// Airspeed, schedule variable, frame weight, dynamic pressures and coefficients at `fc`.
-    fn model_point(&self, fc: &FlightCondition) -> ModelPoint {
+    fn model_point(&self, fc: &FlightCondition, dev: Deviations) -> ModelPoint {
         let p = &self.params;
         let af = &self.airframe;
         let v = fc.airspeed.max(p.min_airspeed);
@@ -263,7 +265,11 @@ impl TsdController {
         // wind"; κ = 0 in still air hover anyway, axial airspeed < 4 m/s).
         let kappa = self.frame_weight(fc.axial_airspeed) * (1.0 - fc.hover_wind);
         let rho = af.air_density;
-        let vs = v + 2.0 * fc.induced_velocity.max(0.0);
+        let vs = if dev.slipstream_in_design {
+            v + 2.0 * fc.induced_velocity.max(0.0)
+        } else {
+            v
+        };
         let (rn, rv) = self.mixing_ratios(fc.alpha);
         ModelPoint {
             sched,
@@ -271,6 +277,7 @@ impl TsdController {
             v,
             qbar: 0.5 * rho * v * v,
             qbar_s: 0.5 * rho * vs * vs,
+            dev,
             kr: 0.25 * rho * v * af.wing_area,
             thrust: fc.thrust.max(0.0),
             cos_alpha: fc.alpha.cos(),
@@ -341,8 +348,8 @@ impl TsdController {
     }
 
     /// Normal loop (4.2.9–4.2.17) in (C_W, Q′, E_C) with the mixed actuator δm (Table 4.1).
-    /// Z_α = V̄ a11 includes the thrust's normal component −T sin α of (2.5.28): in vertical
-    /// flight it is the main normal force. Switch `hover_wind_design` (through
+    /// Z_α = V̄ a11 includes the thrust's normal component −T sin α of (2.5.28) with
+    /// `normal_thrust_term` (D-4.1): in vertical flight it is the main normal force. Switch `hover_wind_design` (through
     /// `fc.hover_wind`): in hover in a strong crossflow the poles are slowed by
     /// HOVER_WIND_NORMAL_POLE_FACTOR (README, "Hover in a span-wise wind").
     fn normal_design(&self, fc: &FlightCondition, mp: &ModelPoint) -> Result<NormalDesign, &'static str> {
@@ -351,7 +358,13 @@ impl TsdController {
         let (s_ref, c_ref) = (af.wing_area, af.mean_chord);
         let (c, v, iyy) = (&mp.c, mp.v, af.i_yy);
         let blend = |a: f64, b: f64| lerp(a, b, mp.sched);
-        let z_alpha = -(mp.qbar * s_ref * c.c_L_alpha + mp.thrust * mp.cos_alpha) / af.mass;
+        // D-4.1 (`normal_thrust_term`): printed a11 = −q̄S C_Lα/(m V̄) without the thrust.
+        let thrust_term = if mp.dev.normal_thrust_term {
+            mp.thrust * mp.cos_alpha
+        } else {
+            0.0
+        };
+        let z_alpha = -(mp.qbar * s_ref * c.c_L_alpha + thrust_term) / af.mass;
         let a11_n = z_alpha / v;
         let a21_n = mp.qbar * s_ref * c_ref * c.c_m_alpha / iyy;
         let a22 = mp.kr * c_ref * c_ref * c.c_m_q / iyy;
@@ -375,7 +388,8 @@ impl TsdController {
     }
 
     /// Roll rate (4.2.21–4.2.26) with the NVD loop (4.3.7–4.3.11): ailerons (free stream)
-    /// and differential flaps (slip-stream) deflected together. Switch `hover_wind_design`
+    /// and, with `roll_differential_flaps` (D-4.4), differential flaps (slip-stream)
+    /// deflected together. Switch `hover_wind_design`
     /// (through `fc.hover_wind`): a slower roll-rate pair in hover in wind (README, "Hover in
     /// a span-wise wind").
     fn roll_design(&self, fc: &FlightCondition, mp: &ModelPoint) -> Result<RollDesign, &'static str> {
@@ -386,7 +400,8 @@ impl TsdController {
         let a21_r = mp.qbar * s_ref * b_ref * c.c_l_beta / ixx;
         let a22_r = mp.kr * b_ref * b_ref * c.c_l_p / ixx;
         let a23_r = mp.kr * b_ref * b_ref * c.c_l_r / ixx;
-        let b21 = s_ref * b_ref * (mp.qbar * c.c_l_da + mp.qbar_s * c.c_l_dfd) / ixx;
+        let flaps = if mp.dev.roll_differential_flaps { 1.0 } else { 0.0 };
+        let b21 = s_ref * b_ref * (mp.qbar * c.c_l_da + flaps * mp.qbar_s * c.c_l_dfd) / ixx;
         let r_scale = lerp(1.0, HOVER_WIND_ROLL_POLE_FACTOR, fc.hover_wind);
         let poly = gains::char_poly_3(
             blend(p.nvd_pole_vertical, p.nvd_pole_level),
@@ -402,13 +417,21 @@ impl TsdController {
     }
 
     /// Directional loop (4.2.27–4.2.31) in (B_W, R′, E_B) with the mixed actuator δR
-    /// (Table 4.2): Y_β = V̄ a11 with the thrust term −T cos α sin β.
+    /// (Table 4.2): Y_β = V̄ a11, with the thrust term −T cos α sin β under
+    /// `lateral_thrust_term` (D-4.2).
     fn directional_design(&self, mp: &ModelPoint) -> Result<DirectionalDesign, &'static str> {
         let p = &self.params;
         let af = &self.airframe;
         let (s_ref, b_ref, izz, c) = (af.wing_area, af.wing_span, af.i_zz, &mp.c);
         let blend = |a: f64, b: f64| lerp(a, b, mp.sched);
-        let y_beta = (mp.qbar * s_ref * c.c_Y_beta - mp.thrust * mp.cos_alpha) / af.mass;
+        let flaps = if mp.dev.roll_differential_flaps { 1.0 } else { 0.0 };
+        // D-4.2 (`lateral_thrust_term`): printed a11 = q̄S C_yβ/(m V̄) without the thrust.
+        let thrust_term = if mp.dev.lateral_thrust_term {
+            mp.thrust * mp.cos_alpha
+        } else {
+            0.0
+        };
+        let y_beta = (mp.qbar * s_ref * c.c_Y_beta - thrust_term) / af.mass;
         let a11_l = y_beta / mp.v;
         let a31 = mp.qbar * s_ref * b_ref * c.c_n_beta / izz;
         let a33 = mp.kr * b_ref * b_ref * c.c_n_r / izz;
@@ -426,7 +449,7 @@ impl TsdController {
             gains,
             a32: mp.kr * b_ref * b_ref * c.c_n_p / izz,
             a33,
-            b31: s_ref * b_ref * (mp.qbar * c.c_n_da + mp.qbar_s * c.c_n_dfd) / izz,
+            b31: s_ref * b_ref * (mp.qbar * c.c_n_da + flaps * mp.qbar_s * c.c_n_dfd) / izz,
             b32,
             weathercock: 0.5 * af.air_density * s_ref * b_ref * c.c_n_beta / izz,
         })

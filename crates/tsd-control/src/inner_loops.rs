@@ -32,7 +32,7 @@ pub(crate) struct LoopLaws {
 
 impl TsdController {
     /// The four inner-loop laws at the sample; `sigma_ahead` is the previewed Σ^RE of the
-    /// normal loop's feed-forward ([`crate::guidance::feedforward`]), `roll_error` the NVD
+    /// normal loop's feed-forward ([`crate::guidance_law::feedforward`]), `roll_error` the NVD
     /// error φ (4.3.5). Switches: `normal_feedforward`, `weathercock_feedforward`.
     pub(crate) fn inner_loops(
         &self,

@@ -4,6 +4,7 @@
 
 use crate::axes::LoopAxes;
 use crate::design::LoopDesign;
+use crate::deviations::Deviations;
 use crate::inner_loops::{directional_linearisation, LoopLaws};
 use crate::nvd::AccelCommands;
 use crate::SampleSignals;
@@ -13,7 +14,9 @@ use crate::SampleSignals;
 /// yaw): the command is recovered as u_I/b with the current control effectiveness b, so
 /// a trim held by an integrator stays trimmed when the dynamic pressure over the surfaces
 /// changes (e.g. the slip-stream when thrust comes on) — integrators in the natural units
-/// of a gain-scheduled loop.
+/// of a gain-scheduled loop. With `integrators_as_accelerations` off (D-4.24, the printed
+/// loops) each holds the integral E of its loop error (E_A, E_C, E_P, E_B) and contributes
+/// −K_E E with the current K_E.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub(crate) struct Integrators {
     pub thrust: f64,
@@ -34,7 +37,7 @@ pub(crate) struct VirtualCommands {
 impl Integrators {
     /// Bumpless start: the integrators such that the first command equals the measured
     /// actuator state (the plant's trim; thrust and δe, δa, δr of the surfaces).
-    pub fn bumpless_start(&mut self, s: &SampleSignals, laws: &LoopLaws) {
+    pub fn bumpless_start(&mut self, s: &SampleSignals, laws: &LoopLaws, as_accel: bool) {
         let (meas, d) = (s.meas, &s.d);
         let sf = meas.surfaces; // δe, δa, δr, δfc, δfd, δv
         let da_now = sf[1];
@@ -43,27 +46,57 @@ impl Integrators {
         self.normal = d.b2 * (sf[0] - laws.dm_p);
         self.roll = d.roll_model.3 * (da_now - laws.da_p);
         self.directional = d.b32 * (sf[2] - (laws.dr_state + dr_f0));
+        if !as_accel {
+            // u_I = b·δ_I = −b K_E E.
+            self.thrust /= -d.axial.1;
+            self.normal /= -d.b2 * d.normal_gains[2];
+            self.roll /= -d.roll_model.3 * d.roll_gains.1;
+            self.directional /= -d.b32 * d.directional_gains[2];
+        }
+    }
+
+    /// The integrators' contributions (T, δm, δA, δR) to the virtual commands.
+    fn contributions(&self, d: &LoopDesign, as_accel: bool) -> [f64; 4] {
+        if as_accel {
+            [
+                self.thrust,
+                self.normal / d.b2,
+                self.roll / d.roll_model.3,
+                self.directional / d.b32,
+            ]
+        } else {
+            [
+                -d.axial.1 * self.thrust,
+                -d.normal_gains[2] * self.normal,
+                -d.roll_gains.1 * self.roll,
+                -d.directional_gains[2] * self.directional,
+            ]
+        }
     }
 
     /// The virtual commands: each loop law plus its integrator, T_c (4.2.8), δm (4.2.15),
     /// δA (4.2.22) and δR = −K_B B_W − K_R R′ − K_E E_B + δR_f + δR_w (4.2.29) with δR_f
     /// at the aileron command clamped to ±`lim`.
-    pub fn commands(&self, s: &SampleSignals, laws: &LoopLaws, lim: f64) -> VirtualCommands {
+    pub fn commands(&self, s: &SampleSignals, laws: &LoopLaws, lim: f64, as_accel: bool) -> VirtualCommands {
         let d = &s.d;
-        let da = laws.da_p + self.roll / d.roll_model.3;
+        let c = self.contributions(d, as_accel);
+        let da = laws.da_p + c[2];
         let dr_f = directional_linearisation(d, laws, s.axes.p_s, da.clamp(-lim, lim));
         VirtualCommands {
-            thrust: laws.thrust_p + self.thrust,
-            dm: laws.dm_p + self.normal / d.b2,
+            thrust: laws.thrust_p + c[0],
+            dm: laws.dm_p + c[1],
             da,
-            dr: laws.dr_state + self.directional / d.b32 + dr_f + laws.weathercock_ff,
+            dr: laws.dr_state + c[3] + dr_f + laws.weathercock_ff,
         }
     }
 
     /// One integration step of every loop with back-calculation anti-windup (§4.2.1):
     /// u_I ← u_I + b·(−T_s K_E e + k_aw (u_sat − u)), k_aw = min(1, `antiwindup_gain`·T_s),
     /// b the control effectiveness, e the loop errors of [`loop_errors`]. Only finite values
-    /// are committed.
+    /// are committed. `dev`: with `antiwindup_all_loops` off (D-4.14) only the axial loop
+    /// has the tracking term (§4.2.1); with `integrators_as_accelerations` off (D-4.24)
+    /// E ← E + T_s e − k_aw (u_sat − u)/K_E.
+    #[allow(clippy::too_many_arguments)]
     pub fn anti_windup_step(
         &mut self,
         d: &LoopDesign,
@@ -72,17 +105,40 @@ impl Integrators {
         u_sat: &VirtualCommands,
         ts: f64,
         antiwindup_gain: f64,
+        dev: Deviations,
     ) {
         let kaw = (antiwindup_gain * ts).min(1.0);
-        let step = |u_i: &mut f64, b: f64, ke: f64, e: f64, u: f64, u_sat: f64| {
-            let next = *u_i + b * (-ts * ke * e + kaw * (u_sat - u));
+        let kaw_surfaces = if dev.antiwindup_all_loops { kaw } else { 0.0 };
+        let as_accel = dev.integrators_as_accelerations;
+        let step = |u_i: &mut f64, b: f64, ke: f64, e: f64, u: f64, u_sat: f64, kaw: f64| {
+            let next = if as_accel {
+                *u_i + b * (-ts * ke * e + kaw * (u_sat - u))
+            } else {
+                *u_i + ts * e - kaw * (u_sat - u) / ke
+            };
             if next.is_finite() {
                 *u_i = next;
             }
         };
-        step(&mut self.thrust, 1.0, d.axial.1, e[0], u.thrust, u_sat.thrust);
-        step(&mut self.normal, d.b2, d.normal_gains[2], e[1], u.dm, u_sat.dm);
-        step(&mut self.roll, d.roll_model.3, d.roll_gains.1, e[2], u.da, u_sat.da);
+        step(&mut self.thrust, 1.0, d.axial.1, e[0], u.thrust, u_sat.thrust, kaw);
+        step(
+            &mut self.normal,
+            d.b2,
+            d.normal_gains[2],
+            e[1],
+            u.dm,
+            u_sat.dm,
+            kaw_surfaces,
+        );
+        step(
+            &mut self.roll,
+            d.roll_model.3,
+            d.roll_gains.1,
+            e[2],
+            u.da,
+            u_sat.da,
+            kaw_surfaces,
+        );
         step(
             &mut self.directional,
             d.b32,
@@ -90,6 +146,7 @@ impl Integrators {
             e[3],
             u.dr,
             u_sat.dr,
+            kaw_surfaces,
         );
     }
 }

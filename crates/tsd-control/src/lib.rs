@@ -36,7 +36,8 @@
 //! accelerations) → `design` (gain schedule of every loop) → `guidance` (4.3.24) → `nvd`
 //! (decomposition 4.3.27–4.3.30, NVD error 4.3.5) → `inner_loops` (axial, normal, roll,
 //! directional laws) → `integrators` (bumpless start, anti-windup) → `mixing` (surface
-//! allocation, saturation); `deviations` holds the thesis-vs-tuned switch of each stage.
+//! allocation, saturation); `deviations` holds the thesis-vs-tuned switches, one parameter
+//! per deviation of docs/THESIS.md (−1 follow `configuration`, 0 printed, 1 deviation).
 //!
 //! Frames: earth NED, body (x nose, y right wing, z belly), wind axes (x along the air
 //! velocity, z in the plane of symmetry). Units SI, angles rad.
@@ -45,7 +46,7 @@ mod axes;
 mod design;
 mod deviations;
 pub mod gains;
-mod guidance;
+mod guidance_law;
 mod inner_loops;
 mod integrators;
 mod mixing;
@@ -69,15 +70,15 @@ use nvd::AccelCommands;
 use reference::{ReferenceSignals, ReferenceStage};
 
 use flight_mission::{
-    ControlError, ControllerInput, ControllerOutput, Diagnostics, GroundPhases, Measurement, MissionParams, ParamError,
-    SampledUnit, Weathervane, WeathervaneParams,
+    ControlError, ControllerInput, ControllerOutput, Diagnostics, Measurement, MissionParams, ParamError, SampledUnit,
 };
+use guidance::{GroundPhases, Weathervane, WeathervaneParams};
 use nalgebra::Vector3;
 use tailsitter_physics::Airframe;
 
 /// Number of f64 values written by [`TsdController::save`]: the loops' six, the
 /// weathervane's and the take-off / landing phases'.
-pub const STATE_LEN: usize = 6 + flight_mission::weathervane::WEATHERVANE_STATE_LEN + GroundPhases::SAVED_LEN;
+pub const STATE_LEN: usize = 6 + guidance::weathervane::WEATHERVANE_STATE_LEN + GroundPhases::SAVED_LEN;
 
 /// Internal signals of the last sample, for tests, plots and tuning.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -159,7 +160,7 @@ pub struct TsdController {
     trajectory: Trajectory,
     integrators: Integrators,
     initialized: bool,
-    /// Take-off and landing phases around the mission (flight_mission::ground).
+    /// Take-off and landing phases around the mission (guidance::ground).
     ground: GroundPhases,
     /// Bit mask of the saturated commands at the last sample (notices on new saturation only).
     saturated: u32,
@@ -197,8 +198,8 @@ impl TsdController {
         // configuration the quarter loops of §4.3.3.
         let dev = Deviations::of(&params);
         let trajectory = if dev.limited_profile {
-            let pm = flight_mission::PointMass::from_level_trim(&airframe, mission.v_level)?;
-            let profile = flight_mission::Profile::new(&mission, &pm, &flight_mission::ProfileLimits::of(&mission))?;
+            let pm = guidance::PointMass::from_level_trim(&airframe, mission.v_level)?;
+            let profile = guidance::Profile::new(&mission, &pm, &guidance::ProfileLimits::of(&mission))?;
             Trajectory::limited(mission, airframe.gravity, profile)
         } else {
             Trajectory::new(mission, airframe.gravity)
@@ -304,9 +305,7 @@ impl TsdController {
         } else {
             0
         };
-        let mut rest = v[6 + flight_mission::weathervane::WEATHERVANE_STATE_LEN..]
-            .iter()
-            .copied();
+        let mut rest = v[6 + guidance::weathervane::WEATHERVANE_STATE_LEN..].iter().copied();
         self.ground
             .restore(&mut || rest.next())
             .ok_or_else(|| ControlError("truncated TSD controller state".into()))?;
@@ -376,25 +375,31 @@ impl SampledUnit for TsdController {
         let d = self.scheduled_design(meas, &r, &air, input.t)?;
         let s = SampleSignals { meas, r, air, axes, d };
         // Outer loop (Fig. 4.2): guidance (4.3.24), decomposition and NVD (4.3.1–4.3.30).
-        let (sigma_ff, sigma_ahead) = guidance::feedforward(&self.trajectory, &r, self.params.feedforward_lead);
+        let (sigma_ff, sigma_ahead) = guidance_law::feedforward(&self.trajectory, &r, self.params.feedforward_lead);
         let pos_error = meas.pos_ned - r.ref_pos;
         let vel_error = meas.vel_ned - r.reference.vel;
-        let sigma = guidance::command(&s.d, &r.reference, &pos_error, &vel_error, &sigma_ff);
+        let sigma = guidance_law::command(&s.d, &r.reference, &pos_error, &vel_error, &sigma_ff);
         let cmd = self.decompose(&sigma, &s.axes, &r);
         // Inner loops (Fig. 4.1, §4.2), their integrators, mixing and saturation.
         let laws = self.inner_loops(&s, &sigma_ahead, cmd.roll_error, dev);
         if !self.initialized {
-            self.integrators.bumpless_start(&s, &laws);
+            self.integrators
+                .bumpless_start(&s, &laws, dev.integrators_as_accelerations);
             self.initialized = true;
         }
-        let u = self.integrators.commands(&s, &laws, self.airframe.deflection_limit);
-        let (command, u_sat) = mixing::allocate(&u, s.d.mixing, &self.airframe);
+        let u = self.integrators.commands(
+            &s,
+            &laws,
+            self.airframe.deflection_limit,
+            dev.integrators_as_accelerations,
+        );
+        let (command, u_sat) = mixing::allocate(&u, s.d.mixing, dev.roll_differential_flaps, &self.airframe);
         if !command.is_finite() {
             return Err(Self::err(format!("non-finite command at t = {} s", input.t)));
         }
         let e = integrators::loop_errors(&s.axes, &cmd, &laws);
         let (ts, gain) = (self.mission.sample_time, self.params.antiwindup_gain);
-        self.integrators.anti_windup_step(&s.d, e, &u, &u_sat, ts, gain);
+        self.integrators.anti_windup_step(&s.d, e, &u, &u_sat, ts, gain, dev);
         // Diagnostics.
         let notice = self.saturation_notice(&u, s.d.mixing);
         self.internals = Internals::of(&s, &sigma, &cmd, &u);

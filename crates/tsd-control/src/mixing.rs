@@ -9,12 +9,26 @@ use crate::{TsdController, COMMAND_NAMES};
 use flight_mission::{Command, Notice};
 use tailsitter_physics::Airframe;
 
+/// Table 4.1: lift coefficients of the elevator and the collective flaps (per rad).
+pub const TABLE_4_1_LIFT: (f64, f64) = (1.246, 0.748);
+/// Table 4.2: side-force coefficients of the rudder and the vertical flaps (per rad).
+pub const TABLE_4_2_SIDE_FORCE: (f64, f64) = (1.008, 0.312);
+
 impl TsdController {
     /// Mixing ratios (r_n, r_v): δfc = r_n·δm, δe = δm (4.2.12–4.2.13, Table 4.1) and
     /// δv = r_v·δR, δr = δR (Table 4.2), r = −k·(force of the main surface)/(force of the
     /// flap) so that the mixed actuator's force is −(k − 1) times the main surface's, of
     /// opposite sign, and the right-half-plane zero of (4.2.11) moves to the left (4.2.14).
+    /// With `alpha_dependent_mixing` off (D-4.5, D-4.6) the printed constants: Table 4.1's
+    /// C_Lδe/C_Lδfc = 1.246/0.748 and Table 4.2's C_Yδr/C_Yδv = 1.008/0.312, times the factors
+    /// (1.1: r = −1.833, r_v = −3.554).
     pub fn mixing_ratios(&self, alpha: f64) -> (f64, f64) {
+        if !crate::deviations::Deviations::of(&self.params).alpha_dependent_mixing {
+            return (
+                -self.params.flap_mixing_factor * TABLE_4_1_LIFT.0 / TABLE_4_1_LIFT.1,
+                -self.params.vertical_flap_mixing_factor * TABLE_4_2_SIDE_FORCE.0 / TABLE_4_2_SIDE_FORCE.1,
+            );
+        }
         let c = self.airframe.coefficients(alpha);
         let rn = -self.params.flap_mixing_factor * c.c_L_de / c.c_L_dfc;
         let rv = -self.params.vertical_flap_mixing_factor * c.c_Y_dr / c.c_Y_dv;
@@ -24,7 +38,8 @@ impl TsdController {
     /// Notice of the first command (in [`COMMAND_NAMES`] order) that saturates at this
     /// sample and did not at the last one; remembers this sample's saturations.
     pub(crate) fn saturation_notice(&mut self, u: &VirtualCommands, mixing: (f64, f64)) -> Option<Notice> {
-        let mask = saturation_mask(u, mixing, &self.airframe);
+        let diff_flaps = crate::deviations::Deviations::of(&self.params).roll_differential_flaps;
+        let mask = saturation_mask(u, mixing, diff_flaps, &self.airframe);
         let fresh = mask & !self.saturated;
         self.saturated = mask;
         (fresh != 0).then(|| Notice::Saturated(COMMAND_NAMES[fresh.trailing_zeros() as usize]))
@@ -33,7 +48,13 @@ impl TsdController {
 
 /// The actuator command of the virtual commands `u` with the mixing ratios (r_n, r_v), each
 /// clamped, and the saturated virtual commands (T, δm, δA, δR) the anti-windup tracks.
-pub(crate) fn allocate(u: &VirtualCommands, (rn, rv): (f64, f64), af: &Airframe) -> (Command, VirtualCommands) {
+/// `diff_flaps` (D-4.4): the differential flaps follow δA; otherwise they stay at 0.
+pub(crate) fn allocate(
+    u: &VirtualCommands,
+    (rn, rv): (f64, f64),
+    diff_flaps: bool,
+    af: &Airframe,
+) -> (Command, VirtualCommands) {
     let lim = af.deflection_limit;
     let sat = VirtualCommands {
         thrust: u.thrust.clamp(af.thrust_min, af.thrust_max),
@@ -47,14 +68,14 @@ pub(crate) fn allocate(u: &VirtualCommands, (rn, rv): (f64, f64), af: &Airframe)
         aileron: sat.da,
         rudder: sat.dr,
         flap_collective: (rn * u.dm).clamp(-lim, lim),
-        flap_differential: sat.da,
+        flap_differential: if diff_flaps { sat.da } else { 0.0 },
         vertical_flap: (rv * u.dr).clamp(-lim, lim),
     };
     (command, sat)
 }
 
 /// Bit mask of the commands outside their limits, in [`COMMAND_NAMES`] order.
-fn saturation_mask(u: &VirtualCommands, (rn, rv): (f64, f64), af: &Airframe) -> u32 {
+fn saturation_mask(u: &VirtualCommands, (rn, rv): (f64, f64), diff_flaps: bool, af: &Airframe) -> u32 {
     let lim = af.deflection_limit;
     let values = [
         (u.thrust, af.thrust_min, af.thrust_max),
@@ -62,7 +83,7 @@ fn saturation_mask(u: &VirtualCommands, (rn, rv): (f64, f64), af: &Airframe) -> 
         (u.da, -lim, lim),
         (u.dr, -lim, lim),
         (rn * u.dm, -lim, lim),
-        (u.da, -lim, lim),
+        (if diff_flaps { u.da } else { 0.0 }, -lim, lim),
         (rv * u.dr, -lim, lim),
     ];
     let mut mask = 0u32;

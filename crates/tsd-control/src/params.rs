@@ -113,7 +113,8 @@ pub struct TsdParams {
     pub guidance_pole_re_level: f64,
     /// Guidance pair, imaginary part, level flight (1/s).
     pub guidance_pole_im_level: f64,
-    /// Integrator anti-windup tracking gain of every loop (§4.2.1: 50) (1/s).
+    /// Integrator anti-windup tracking gain (§4.2.1: 50), on every inner loop or on the axial
+    /// loop only (`antiwindup_all_loops`) (1/s).
     pub antiwindup_gain: f64,
     /// Factor k of the elevator/collective-flap mixing r = −k·C_Lδe/C_Lδfc (4.2.12: 1.1).
     pub flap_mixing_factor: f64,
@@ -141,57 +142,81 @@ pub struct TsdParams {
     /// (servo, thrust and the specific-acceleration poles) at the acceleration steps of the
     /// unsmoothed trajectory (§4.3.3) (s).
     pub feedforward_lead: f64,
-    /// 0 = tuned (these parameters as given), 1 = thesis: the wind axes at every speed
-    /// (`wind_frame_speed_low` = 0, `wind_frame_speed_high` = 1e-6 m/s, §4.2) and no
-    /// feed-forward preview (`feedforward_lead` = 0, (4.3.24)); see [`Self::effective`].
+    /// 0 = tuned (every deviation switch on), 1 = the thesis as printed (every switch off):
+    /// the default of each switch below that is −1; a switch set to 0 or 1 overrides it
+    /// (see [`Self::effective`], docs/THESIS.md).
     pub configuration: i32,
+    /// Switch (D-4.22, docs/THESIS.md): reference: the α- and thrust-limited point-mass profile (1) instead of the quarter loops of (4.3.31–4.3.40) (0). −1 = follow `configuration`.
+    pub limited_profile: i32,
+    /// Switch (D-X.1, docs/THESIS.md): reference: the weathervane turns the prescribed normal vector in hover (1) or not (0). −1 = follow `configuration`.
+    pub weathervane_heading: i32,
+    /// Switch (D-4.25, docs/THESIS.md): gain schedule: hover in wind designed at α = 0 and 1.3 V̄, path frame kept, roll and normal poles slowed (1); the measured condition (0). −1 = follow `configuration`.
+    pub hover_wind_design: i32,
+    /// Switch (D-4.25, docs/THESIS.md): guidance (4.3.24): in hover the poles blended on the axial airspeed (1) or on V̄ (0). −1 = follow `configuration`.
+    pub guidance_axial_schedule: i32,
+    /// Switch (D-4.25, docs/THESIS.md): guidance (4.3.24): off the hover, Table 4.3's level pair across the path (1) or one pair (0). −1 = follow `configuration`.
+    pub guidance_lateral_pair: i32,
+    /// Switch (D-4.25, docs/THESIS.md): guidance (4.3.24): the feedback −K_P e_P − K_V e_V bounded in norm (1) or not (0). −1 = follow `configuration`.
+    pub guidance_feedback_bound: i32,
+    /// Switch (D-4.25, docs/THESIS.md): normal loop (4.2.15): steady state at the reference's normal acceleration fed forward (1) or not (0). −1 = follow `configuration`.
+    pub normal_feedforward: i32,
+    /// Switch (D-4.25, docs/THESIS.md): directional loop (4.2.29): weathercock moment of the sideslip fed forward (1) or not (0). −1 = follow `configuration`.
+    pub weathercock_feedforward: i32,
+    /// Switch (D-4.17, docs/THESIS.md): loop frame: the reference-path frame below `wind_frame_speed_low/high` (1) or the wind axes at every airspeed, §4.2 (0). −1 = follow `configuration`.
+    pub low_speed_path_frame: i32,
+    /// Switch (D-4.18, docs/THESIS.md): guidance: Σ^RE read `feedforward_lead` ahead (1) or at the sample, (4.3.24) (0). −1 = follow `configuration`.
+    pub feedforward_preview: i32,
+    /// Switch (D-4.16, docs/THESIS.md): guidance: the level-flight pair `guidance_pole_*_level` as given (1) or Table 4.3's −0.75 ± 0.45i (0). −1 = follow `configuration`.
+    pub tuned_level_guidance: i32,
+    /// Switch (D-4.1, docs/THESIS.md): normal loop: Z_α = −(q̄S C_Lα + T cos α)/m (1) or the printed a11 = −q̄S C_Lα/(m V̄) of (4.2.17) (0). −1 = follow `configuration`.
+    pub normal_thrust_term: i32,
+    /// Switch (D-4.2, docs/THESIS.md): directional loop: Y_β = (q̄S C_Yβ − T cos α)/m (1) or the printed a11 = q̄S C_yβ/(m V̄) of (4.2.31) (0). −1 = follow `configuration`.
+    pub lateral_thrust_term: i32,
+    /// Switch (D-4.3, docs/THESIS.md): b2, b21, b31, b32 with the slip-stream q̄_s = ½ρ(V̄ + 2w)² on the surfaces behind the propellers (1) or the free-stream q̄ on every surface (0). −1 = follow `configuration`.
+    pub slipstream_in_design: i32,
+    /// Switch (D-4.4, docs/THESIS.md): roll loop through ailerons and differential flaps together (1) or the ailerons δA alone, (4.2.26) (0). −1 = follow `configuration`.
+    pub roll_differential_flaps: i32,
+    /// Switch (D-4.5, D-4.6, docs/THESIS.md): mixing ratios −k C_Lδe(α)/C_Lδfc(α), −k C_Yδr(α)/C_Yδv(α) (1) or the printed constants of Tables 4.1, 4.2, −k·1.246/0.748 and −k·1.008/0.312 (0). −1 = follow `configuration`.
+    pub alpha_dependent_mixing: i32,
+    /// Switch (D-4.14, docs/THESIS.md): back-calculation anti-windup on every inner loop (1) or on the axial loop only, §4.2.1 (0). −1 = follow `configuration`.
+    pub antiwindup_all_loops: i32,
+    /// Switch (D-4.19, docs/THESIS.md): computed normal vector blended over `normal_vector_blend_time` and faded below `min_normal_accel` (1) or switched at the ends of level flight, §4.3.2.1 (0). −1 = follow `configuration`.
+    pub normal_vector_blend: i32,
+    /// Switch (D-4.24, docs/THESIS.md): integrators stored as control accelerations b·δ (1) or as the integrals E of the printed loops, command −K_E E (0). −1 = follow `configuration`.
+    pub integrators_as_accelerations: i32,
 }
 
-impl Default for TsdParams {
-    /// Table 4.3 of the thesis, §4.2.1 (anti-windup 50) and (4.2.12) (mixing 1.1).
-    fn default() -> Self {
-        Self {
-            axial_pole_1_vertical: -10.0,
-            axial_pole_2_vertical: -15.0,
-            axial_pole_1_level: -10.0,
-            axial_pole_2_level: -15.0,
-            roll_pole_re_vertical: -5.5,
-            roll_pole_im_vertical: 3.3,
-            roll_pole_re_level: -9.0,
-            roll_pole_im_level: 4.5,
-            normal_pole_real_vertical: -8.5,
-            normal_pole_re_vertical: -7.2,
-            normal_pole_im_vertical: 3.0,
-            normal_pole_real_level: -14.0,
-            normal_pole_re_level: -15.0,
-            normal_pole_im_level: 5.0,
-            directional_pole_real_vertical: -5.0,
-            directional_pole_re_vertical: -3.5,
-            directional_pole_im_vertical: 1.75,
-            directional_pole_real_level: -10.0,
-            directional_pole_re_level: -7.0,
-            directional_pole_im_level: 3.5,
-            nvd_pole_vertical: -0.5,
-            nvd_pole_level: -3.5,
-            guidance_pole_re_vertical: -0.5,
-            guidance_pole_im_vertical: 0.2,
-            guidance_pole_re_level: -2.0,
-            guidance_pole_im_level: 1.0,
-            antiwindup_gain: 50.0,
-            flap_mixing_factor: 1.1,
-            vertical_flap_mixing_factor: 1.1,
-            min_airspeed: 2.0,
-            normal_vector_blend_time: 1.0,
-            min_normal_accel: 2.0,
-            wind_frame_speed_low: 4.0,
-            wind_frame_speed_high: 10.0,
-            feedforward_lead: 0.1,
-            configuration: 0,
-        }
-    }
-}
+// `impl Default for TsdParams` (Table 4.3 of the thesis, §4.2.1 anti-windup 50, (4.2.12)
+// mixing 1.1): the start values of group `tsd` of modelDescription/tailsitter_tsd.json,
+// generated by build.rs.
+include!(concat!(env!("OUT_DIR"), "/tsd_params_generated.rs"));
 
 impl TsdParams {
+    /// The deviation switches with their names, in declaration order.
+    pub fn switches(&self) -> [(&'static str, i32); 19] {
+        [
+            ("limited_profile", self.limited_profile),
+            ("weathervane_heading", self.weathervane_heading),
+            ("hover_wind_design", self.hover_wind_design),
+            ("guidance_axial_schedule", self.guidance_axial_schedule),
+            ("guidance_lateral_pair", self.guidance_lateral_pair),
+            ("guidance_feedback_bound", self.guidance_feedback_bound),
+            ("normal_feedforward", self.normal_feedforward),
+            ("weathercock_feedforward", self.weathercock_feedforward),
+            ("low_speed_path_frame", self.low_speed_path_frame),
+            ("feedforward_preview", self.feedforward_preview),
+            ("tuned_level_guidance", self.tuned_level_guidance),
+            ("normal_thrust_term", self.normal_thrust_term),
+            ("lateral_thrust_term", self.lateral_thrust_term),
+            ("slipstream_in_design", self.slipstream_in_design),
+            ("roll_differential_flaps", self.roll_differential_flaps),
+            ("alpha_dependent_mixing", self.alpha_dependent_mixing),
+            ("antiwindup_all_loops", self.antiwindup_all_loops),
+            ("normal_vector_blend", self.normal_vector_blend),
+            ("integrators_as_accelerations", self.integrators_as_accelerations),
+        ]
+    }
+
     /// Every parameter with its name, in declaration order.
     pub fn named_values(&self) -> [(&'static str, f64); 35] {
         [
@@ -233,27 +258,84 @@ impl TsdParams {
         ]
     }
 
-    /// The parameters the controller flies with: `self` for `configuration` 0 (tuned); for
-    /// 1 (thesis) the thesis's vertical-flight frame, the wind axes at every speed (§4.2:
-    /// the low-speed path frame is a deviation of this repository), and the feed-forward
-    /// Σ^RE taken at the sample time (4.3.24), no preview, and Table 4.3's level-flight
-    /// guidance poles (−0.75 ± 0.45i).
-    pub fn effective(&self) -> Result<Self, ParamError> {
-        match self.configuration {
-            0 => Ok(*self),
-            1 => Ok(Self {
-                wind_frame_speed_low: 0.0,
-                wind_frame_speed_high: 1e-6,
-                feedforward_lead: 0.0,
-                // Table 4.3, level-flight guidance (the tuned default is faster, issue 16).
-                guidance_pole_re_level: TABLE_4_3_GUIDANCE_LEVEL.0,
-                guidance_pole_im_level: TABLE_4_3_GUIDANCE_LEVEL.1,
-                ..*self
-            }),
-            c => Err(ParamError(format!(
-                "configuration = {c}: expected 0 (tuned) or 1 (thesis)"
-            ))),
+    /// Whether switch value `switch` (−1 follow `configuration`, 0 printed, 1 addition)
+    /// turns its deviation on: −1 gives the `configuration`'s choice — on for 0 (tuned), off
+    /// for 1 (the thesis as printed) — and 0 / 1 force it.
+    pub fn switch_on(&self, switch: i32) -> bool {
+        match switch {
+            -1 => self.configuration == 0,
+            s => s == 1,
         }
+    }
+
+    /// The parameters the controller flies with: every switch resolved to 0 (printed) or 1
+    /// (deviation) — `configuration` gives the default of each (0 tuned: all 1; 1 thesis:
+    /// all 0 except `slipstream_in_design`, the thesis's own reading, docs/THESIS.md D-4.3),
+    /// a switch set to 0 or 1 overrides it — and the parameters the switches stand
+    /// for set to their printed values where a switch is 0: `low_speed_path_frame` 0 → the
+    /// wind axes at every airspeed (`wind_frame_speed_low/high` = 0 / 1e-6 m/s, §4.2);
+    /// `feedforward_preview` 0 → `feedforward_lead` = 0 ((4.3.24) at the sample);
+    /// `tuned_level_guidance` 0 → Table 4.3's level guidance −0.75 ± 0.45i;
+    /// `normal_vector_blend` 0 → `normal_vector_blend_time` = `min_normal_accel` = 0.
+    pub fn effective(&self) -> Result<Self, ParamError> {
+        if !matches!(self.configuration, 0 | 1) {
+            return Err(ParamError(format!(
+                "configuration = {}: expected 0 (tuned) or 1 (thesis)",
+                self.configuration
+            )));
+        }
+        for (name, value) in self.switches() {
+            if !(-1..=1).contains(&value) {
+                return Err(ParamError(format!(
+                    "{name} = {value}: expected -1 (follow configuration), 0 (printed) or 1 (deviation)"
+                )));
+            }
+        }
+        let on = |s: i32| i32::from(self.switch_on(s));
+        let mut p = Self {
+            limited_profile: on(self.limited_profile),
+            weathervane_heading: on(self.weathervane_heading),
+            hover_wind_design: on(self.hover_wind_design),
+            guidance_axial_schedule: on(self.guidance_axial_schedule),
+            guidance_lateral_pair: on(self.guidance_lateral_pair),
+            guidance_feedback_bound: on(self.guidance_feedback_bound),
+            normal_feedforward: on(self.normal_feedforward),
+            weathercock_feedforward: on(self.weathercock_feedforward),
+            low_speed_path_frame: on(self.low_speed_path_frame),
+            feedforward_preview: on(self.feedforward_preview),
+            tuned_level_guidance: on(self.tuned_level_guidance),
+            normal_thrust_term: on(self.normal_thrust_term),
+            lateral_thrust_term: on(self.lateral_thrust_term),
+            // D-4.3: the thesis's controller computes the induced velocity (App. D.1, §2.3.4),
+            // so q̄_s is its reading of the print too: on in both configurations.
+            slipstream_in_design: if self.slipstream_in_design == -1 {
+                1
+            } else {
+                self.slipstream_in_design
+            },
+            roll_differential_flaps: on(self.roll_differential_flaps),
+            alpha_dependent_mixing: on(self.alpha_dependent_mixing),
+            antiwindup_all_loops: on(self.antiwindup_all_loops),
+            normal_vector_blend: on(self.normal_vector_blend),
+            integrators_as_accelerations: on(self.integrators_as_accelerations),
+            ..*self
+        };
+        if p.low_speed_path_frame == 0 {
+            p.wind_frame_speed_low = 0.0;
+            p.wind_frame_speed_high = 1e-6;
+        }
+        if p.feedforward_preview == 0 {
+            p.feedforward_lead = 0.0;
+        }
+        if p.tuned_level_guidance == 0 {
+            p.guidance_pole_re_level = TABLE_4_3_GUIDANCE_LEVEL.0;
+            p.guidance_pole_im_level = TABLE_4_3_GUIDANCE_LEVEL.1;
+        }
+        if p.normal_vector_blend == 0 {
+            p.normal_vector_blend_time = 0.0;
+            p.min_normal_accel = 0.0;
+        }
+        Ok(p)
     }
 
     /// All finite; every pole's real part negative (stable design); anti-windup gain,
@@ -297,5 +379,56 @@ impl TsdParams {
             )));
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `configuration` picks the default of every switch left at −1 (0: all on; 1: all off but
+    /// `slipstream_in_design`); a switch set to 0 or 1 overrides it; other values are errors.
+    #[test]
+    fn configuration_picks_the_switch_defaults_and_a_switch_overrides() {
+        let tuned = TsdParams::default().effective().unwrap();
+        assert!(tuned.switches().iter().all(|(_, v)| *v == 1), "{:?}", tuned.switches());
+        assert_eq!(tuned.wind_frame_speed_low, TsdParams::default().wind_frame_speed_low);
+        let thesis = TsdParams {
+            configuration: 1,
+            ..TsdParams::default()
+        };
+        let e = thesis.effective().unwrap();
+        for (name, v) in e.switches() {
+            assert_eq!(v, i32::from(name == "slipstream_in_design"), "{name}");
+        }
+        assert_eq!((e.wind_frame_speed_low, e.feedforward_lead), (0.0, 0.0));
+        assert_eq!((e.normal_vector_blend_time, e.min_normal_accel), (0.0, 0.0));
+        assert_eq!(
+            (e.guidance_pole_re_level, e.guidance_pole_im_level),
+            TABLE_4_3_GUIDANCE_LEVEL
+        );
+        let one = TsdParams {
+            normal_thrust_term: 1,
+            low_speed_path_frame: 1,
+            ..thesis
+        }
+        .effective()
+        .unwrap();
+        assert_eq!((one.normal_thrust_term, one.lateral_thrust_term), (1, 0));
+        assert_eq!(one.wind_frame_speed_low, TsdParams::default().wind_frame_speed_low);
+        let off = TsdParams {
+            slipstream_in_design: 0,
+            feedforward_preview: 0,
+            ..TsdParams::default()
+        }
+        .effective()
+        .unwrap();
+        assert_eq!((off.slipstream_in_design, off.feedforward_lead), (0, 0.0));
+        assert_eq!(off.limited_profile, 1);
+        let bad = TsdParams {
+            antiwindup_all_loops: 2,
+            ..TsdParams::default()
+        };
+        assert!(bad.effective().unwrap_err().0.contains("antiwindup_all_loops"));
     }
 }

@@ -1,11 +1,12 @@
 //! Reference stage (Fig. 4.2, the trajectory input of the outer loop): the kinematic reference of §4.3.3
 //! (position, velocity, specific acceleration Σ^RE (4.3.35–4.3.36), flight-path angle), or
-//! the take-off and landing phases around it (`flight_mission::ground`), and the heading of
+//! the take-off and landing phases around it (`guidance::ground`), and the heading of
 //! the weathervane that turns the prescribed normal vector of §4.3.2.1.
 
 use crate::trajectory::Reference;
 use crate::TsdController;
-use flight_mission::{Command, ControllerInput, ControllerOutput, Diagnostics, GroundMode, Measurement, Phase};
+use flight_mission::{Command, ControllerInput, ControllerOutput, Diagnostics, Measurement, Phase};
+use guidance::GroundMode;
 use nalgebra::Vector3;
 
 /// The reference signals of one flying sample.
@@ -77,7 +78,7 @@ impl TsdController {
         // vector turned about the earth's down axis by ψ_w; zero in still air and in the
         // take-off and landing phases (their own vertical reference).
         let heading = if sigma_ground.is_some() {
-            flight_mission::HeadingRef::default()
+            guidance::HeadingRef::default()
         } else {
             self.weathervane.update(&self.mission, t_mission, meas)
         };

@@ -21,7 +21,8 @@
 //!   phase boundary; a vertical climb at V_V precedes and follows the loops.
 
 use core::f64::consts::FRAC_PI_2;
-use flight_mission::{MissionParams, Phase, Profile};
+use flight_mission::{MissionParams, Phase};
+use guidance::Profile;
 use nalgebra::Vector3;
 
 /// The reference at one instant.
@@ -58,7 +59,7 @@ impl Reference {
 /// The kinematic trajectory of a mission.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Trajectory {
-    /// The α- and thrust-limited point-mass path ([`flight_mission::profile`])
+    /// The α- and thrust-limited point-mass path ([`guidance::profile`])
     /// replacing the quarter loops, if set.
     profile: Option<Profile>,
     mission: MissionParams,
@@ -147,7 +148,7 @@ impl Trajectory {
         match phase {
             Phase::Vertical1 => self.climb(phase, tau, self.starts[0]),
             Phase::Vertical2 => self.climb(phase, tau, self.starts[4]),
-            // Take-off and landing: flown from flight_mission::ground, never a mission time.
+            // Take-off and landing: flown from guidance::ground, never a mission time.
             Phase::OnGround | Phase::TakeOff | Phase::Approach | Phase::Descent | Phase::Flare | Phase::Landed => {
                 self.climb(phase, tau, self.starts[4])
             }
@@ -309,8 +310,8 @@ mod tests {
     /// two are the same vector.
     #[test]
     fn preview_is_resolved_in_the_path_axes() {
-        let m = MissionParams::fast();
-        let pm = flight_mission::PointMass {
+        let m = MissionParams::fast_limited();
+        let pm = guidance::PointMass {
             mass: 9.0,
             gravity: 9.81,
             air_density: 1.225,
@@ -320,7 +321,7 @@ mod tests {
             k_induced: 1.0 / (core::f64::consts::PI * 0.8 * 4.29),
             thrust_max: 150.0,
         };
-        let profile = Profile::new(&m, &pm, &flight_mission::ProfileLimits::of(&m)).unwrap();
+        let profile = Profile::new(&m, &pm, &guidance::ProfileLimits::of(&m)).unwrap();
         let tr = Trajectory::limited(m, 9.81, profile);
         let s = m.phase_starts();
         let lead = 0.1;

@@ -12,11 +12,12 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
+from .. import controllers
 from ..metrics import PHASES
 from .sampling import TABLE_5_1, CampaignSpec
 
 Z95 = 1.959963984540054  # standard normal 97.5 % quantile
-COLORS = {"lqr": "tab:blue", "tsd": "tab:red"}
+COLORS = controllers.COLORS
 
 
 # --- statistics ---------------------------------------------------------------------------

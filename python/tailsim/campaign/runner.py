@@ -30,14 +30,13 @@ from typing import Any
 import numpy as np
 from fmpy.fmi1 import FMICallException
 
-from .. import declarations, fmilog
+from .. import controllers, declarations, fmilog
 from ..masters import AvionicsLoop, ClosedLoop, Fmu, NonFinite, pos_error
 from .sampling import CONFIGURATIONS, CampaignSpec, plant_parameters, wind_function
 
 FMU_NAMES = {
     "plant": "tailsitter_plant",
-    "lqr": "tailsitter_lqr",
-    "tsd": "tailsitter_tsd",
+    **controllers.NAMES,
     "sensors": "tailsitter_sensors",
     "ekf": "tailsitter_ekf",
 }

@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from .. import declarations
+from .. import controllers, declarations
 
 # Thesis Table 5.1: (column name, symbol, plant-FMU parameters, uncertainty class).
 # The plant interpolates each stability/control derivative between α = 0 and
@@ -73,16 +73,16 @@ TABLE_5_1: tuple[Uncertain, ...] = tuple(
 )
 assert len(TABLE_5_1) == 25
 
-#: Configuration axes (issue 15). A configuration is the controller parameters it sets
+#: Configuration axes. A configuration is the controller parameters it sets
 #: (the controller FMUs' `configuration`: 0 = tuned, the default; 1 = the thesis's
 #: configuration as printed, see the parameter's description). A state source is what the
 #: controller flies on: `perfect` = the plant's outputs; `avionics` = the estimate of
 #: `tailsitter_ekf` fed by `tailsitter_sensors` (tailsim.masters.avionics, Gauss-Seidel), the
 #: sensors seeded with the sample's `noise_seed`.
-CONTROLLERS = ("lqr", "tsd")
+CONTROLLERS = controllers.KEYS
 CONFIGURATIONS: dict[str, dict[str, dict[str, int]]] = {
-    "tuned": {"lqr": {}, "tsd": {}},
-    "thesis": {"lqr": {"configuration": 1}, "tsd": {"configuration": 1}},
+    "tuned": {k: {} for k in CONTROLLERS},
+    "thesis": {k: {"configuration": 1} for k in CONTROLLERS},
 }
 #: The controller FMUs' `configuration` value of each configuration (the native campaign's input).
 CONFIGURATION_INDEX = {"tuned": 0, "thesis": 1}

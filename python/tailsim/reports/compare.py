@@ -15,15 +15,15 @@ import time
 
 import numpy as np
 
-from .. import declarations
+from .. import controllers, declarations
 from ..campaign import section as campaign_section
 from ..masters import ClosedLoop, Fmu, RunResult, pos_error, step
 from ..metrics import CRITERIA, PHASES, mission_metrics, phase_starts, step_settling
 from . import analysis as analysis_report
 from .markdown import fmt, markdown_to_html
 
-NAMES = {"lqr": "tailsitter_lqr", "tsd": "tailsitter_tsd"}
-COLORS = {"lqr": "tab:blue", "tsd": "tab:red"}
+NAMES = controllers.NAMES
+COLORS = controllers.COLORS
 # The mission parameters every controller declares (modelDescription/fragments/controller_interface.json).
 DURATIONS = list(declarations.PHASE_DURATIONS)
 MISSION = [*DURATIONS, "v_level"]
@@ -146,7 +146,7 @@ def analysis_section(out: pathlib.Path) -> list[str]:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="tailsim.reports.compare", description=__doc__.split("\n\n")[0])
-    ap.add_argument("--controller", choices=["lqr", "tsd", "both"], default="both")
+    ap.add_argument("--controller", choices=[*controllers.KEYS, "both"], default="both")
     ap.add_argument("--dist", default="dist", help="folder with the .fmu files")
     ap.add_argument("--out", default="out", help="output folder")
     ap.add_argument("--fast-t1", type=float, default=FAST["t_transition_1"], help="T1 of the fast mission [s]")
@@ -161,7 +161,7 @@ def main(argv: list[str] | None = None) -> int:
     out = pathlib.Path(args.out)
     (out / "csv").mkdir(parents=True, exist_ok=True)
     dist = pathlib.Path(args.dist)
-    keys = ["lqr", "tsd"] if args.controller == "both" else [args.controller]
+    keys = list(controllers.KEYS) if args.controller == "both" else [args.controller]
     plant = Fmu(dist / "tailsitter_plant.fmu")
     ctrls = {k: Fmu(dist / f"{NAMES[k]}.fmu") for k in keys}
     defaults = mission_defaults(list(ctrls.values()))

@@ -28,7 +28,7 @@ def section(d: dict) -> list[str]:
         "controllers (configuration 0) fly the α- and thrust-limited point-mass profile "
         f"(|α_ref| ≤ {shortest(round(e['profile_alpha_max_deg'], 6))}°, T_ref ≤ "
         f"{shortest(e['profile_thrust_fraction'])} T_max; "
-        "derivation in `crates/flight-mission/README.md`); the thesis configuration (1) flies the thesis's "
+        "derivation in `crates/guidance/README.md`); the thesis configuration (1) flies the thesis's "
         "transitions unchanged. Altitude deviation: max |h − h_ref| from the start of a transition to "
         f"{shortest(e['settle_window_s'])} s after its end; max α: largest |α| from the first transition to "
         f"{shortest(e['settle_window_s'])} s after the second; rotation: time until the flown flight-path angle stays "

@@ -17,7 +17,7 @@
 
 use crate::*;
 use fmi_sys::fmi2::*;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::ffi::{c_char, c_void};
 use std::time::Instant;
 
@@ -27,6 +27,8 @@ pub struct Config {
     pub seed: u64,
     /// Stop after this many sequences…
     pub sequences: u64,
+    /// …or once this many FMI calls were issued (checked between sequences)…
+    pub max_total_calls: u64,
     /// …or at this instant, whichever comes first.
     pub deadline: Option<Instant>,
     /// Calls per sequence (uniform in 1..=max_calls).
@@ -35,6 +37,10 @@ pub struct Config {
     /// models (the LQR FMU builds its trajectory and gains in every instantiate
     /// and reset) get fewer sequences in the short run.
     pub per_fmu_cap: BTreeMap<String, u64>,
+    /// Before each sequence, overwrite this file with the sequence's index, FMU and
+    /// seed-state ([`crate::progress`]): after a crash or abort it names the sequence
+    /// to replay. `None`: only the in-memory marker the abort handler prints.
+    pub progress_file: Option<std::path::PathBuf>,
 }
 
 impl Default for Config {
@@ -42,9 +48,11 @@ impl Default for Config {
         Self {
             seed: 1,
             sequences: 1000,
+            max_total_calls: u64::MAX,
             deadline: None,
             max_calls: 40,
             per_fmu_cap: BTreeMap::new(),
+            progress_file: None,
         }
     }
 }
@@ -102,6 +110,68 @@ impl Report {
         }
     }
 
+    /// The FMI functions called at least once, and the states they were called in
+    /// (from the coverage keys "function @ state").
+    pub fn functions_and_states(&self) -> (BTreeSet<String>, BTreeSet<String>) {
+        let mut functions = BTreeSet::new();
+        let mut states = BTreeSet::new();
+        for key in self.coverage.keys() {
+            let (f, st) = key.split_once(" @ ").unwrap_or((key, ""));
+            if f == "fmi2GetTypesPlatform/Version" {
+                functions.insert("fmi2GetTypesPlatform".to_string());
+                functions.insert("fmi2GetVersion".to_string());
+            } else {
+                functions.insert(f.to_string());
+            }
+            states.insert(st.to_string());
+        }
+        (functions, states)
+    }
+
+    /// One line each: FMI 2.0 functions exercised (and any never called), the states
+    /// the calls were made in.
+    pub fn print_coverage_summary(&self) {
+        let (functions, states) = self.functions_and_states();
+        let missing: Vec<&str> = FMI2_FUNCTIONS
+            .iter()
+            .copied()
+            .filter(|f| !functions.contains(*f))
+            .collect();
+        // FMI states (Co-Simulation, "ME …" Model Exchange) vs. other call contexts
+        // (fmi2Instantiate argument variants, foreign components, "any").
+        let fmi = |st: &str| {
+            let st = st.strip_prefix("ME ").unwrap_or(st);
+            matches!(
+                st,
+                "Instantiated"
+                    | "InitializationMode"
+                    | "StepComplete"
+                    | "StepInProgress"
+                    | "StepFailed"
+                    | "StepCanceled"
+                    | "Terminated"
+                    | "EventMode"
+                    | "ContinuousTimeMode"
+            )
+        };
+        let (in_states, contexts): (Vec<&String>, Vec<&String>) = states.iter().partition(|s| fmi(s));
+        let join = |v: &[&String]| v.iter().map(|s| s.as_str()).collect::<Vec<_>>().join(", ");
+        println!(
+            "coverage: {} of the {} FMI 2.0 functions called (never: {}); calls in {} FMI states: {}; \
+             other call contexts: {}",
+            FMI2_FUNCTIONS.len() - missing.len(),
+            FMI2_FUNCTIONS.len(),
+            if missing.is_empty() {
+                "none".to_string()
+            } else {
+                missing.join(", ")
+            },
+            in_states.len(),
+            join(&in_states),
+            join(&contexts)
+        );
+    }
+
     pub fn print_coverage(&self) {
         println!(
             "{:<52} {:>9} {:>9} {:>9} {:>9}",
@@ -112,6 +182,54 @@ impl Report {
         }
     }
 }
+
+/// Every function of the FMI 2.0 C API (common, Co-Simulation, Model Exchange).
+pub const FMI2_FUNCTIONS: [&str; 44] = [
+    "fmi2GetTypesPlatform",
+    "fmi2GetVersion",
+    "fmi2SetDebugLogging",
+    "fmi2Instantiate",
+    "fmi2FreeInstance",
+    "fmi2SetupExperiment",
+    "fmi2EnterInitializationMode",
+    "fmi2ExitInitializationMode",
+    "fmi2Terminate",
+    "fmi2Reset",
+    "fmi2GetReal",
+    "fmi2GetInteger",
+    "fmi2GetBoolean",
+    "fmi2GetString",
+    "fmi2SetReal",
+    "fmi2SetInteger",
+    "fmi2SetBoolean",
+    "fmi2SetString",
+    "fmi2GetFMUstate",
+    "fmi2SetFMUstate",
+    "fmi2FreeFMUstate",
+    "fmi2SerializedFMUstateSize",
+    "fmi2SerializeFMUstate",
+    "fmi2DeSerializeFMUstate",
+    "fmi2GetDirectionalDerivative",
+    "fmi2SetRealInputDerivatives",
+    "fmi2GetRealOutputDerivatives",
+    "fmi2DoStep",
+    "fmi2CancelStep",
+    "fmi2GetStatus",
+    "fmi2GetRealStatus",
+    "fmi2GetIntegerStatus",
+    "fmi2GetBooleanStatus",
+    "fmi2GetStringStatus",
+    "fmi2EnterEventMode",
+    "fmi2NewDiscreteStates",
+    "fmi2EnterContinuousTimeMode",
+    "fmi2CompletedIntegratorStep",
+    "fmi2SetTime",
+    "fmi2SetContinuousStates",
+    "fmi2GetDerivatives",
+    "fmi2GetEventIndicators",
+    "fmi2GetContinuousStates",
+    "fmi2GetNominalsOfContinuousStates",
+];
 
 /// Mirror of the state-machine fields an FMU state captures.
 #[derive(Debug, Clone, Copy)]
@@ -257,9 +375,26 @@ pub struct Fuzzer<'a> {
     rng: Rng,
     report: Report,
     donors: Vec<Donor<'a>>,
-    /// Serialized states per FMU (bytes, mirror at serialization).
+    /// Serialized states per FMU (bytes, mirror at serialization), of the current
+    /// sequence only (so that a sequence depends on its seed-state alone).
     banks: Vec<Vec<(Vec<u8>, Mirror)>>,
+    /// Index of the current sequence (1-based) and the RNG state it started from.
     seq: u64,
+    seq_state: u64,
+    /// Print every call, its status and its log records (replay).
+    verbose: bool,
+    /// The run's `Config::max_calls` (for the replay hint).
+    max_calls: usize,
+}
+
+/// The RNG state sequence `index` of a run with `seed` starts from: a pure function
+/// of both, so that any sequence can be replayed alone (`fmi-fuzz fuzz --replay`).
+pub fn sequence_state(seed: u64, index: u64) -> u64 {
+    // splitmix64 of (seed, index); never 0 (xorshift's fixed point).
+    let mut z = seed ^ index.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    (z ^ (z >> 31)) | 1
 }
 
 /// The instance under test in one sequence.
@@ -307,35 +442,84 @@ impl<'a> Fuzzer<'a> {
             donors,
             banks: fmus.iter().map(|_| Vec::new()).collect(),
             seq: 0,
+            seq_state: 0,
+            verbose: false,
+            max_calls: 0,
         }
     }
 
+    /// Run sequences 1, 2, … of `cfg.seed` until a limit is reached. Sequence `i` starts
+    /// from [`sequence_state`]`(seed, i)`: its first draw picks the FMU (a sequence whose
+    /// FMU has reached its cap is skipped), the rest drives the calls.
     pub fn run(mut self, cfg: &Config) -> Report {
-        while self.report.sequences < cfg.sequences && cfg.deadline.is_none_or(|d| Instant::now() < d) {
-            let t0 = Instant::now();
-            let open: Vec<usize> = (0..self.fmus.len())
-                .filter(|&i| {
-                    let id = &self.fmus[i].id;
-                    cfg.per_fmu_cap
-                        .get(id)
-                        .is_none_or(|cap| self.report.per_fmu.get(id).map_or(0, |e| e.0) < *cap)
-                })
-                .collect();
-            if open.is_empty() {
+        let mut progress = crate::progress::Progress::new(cfg.progress_file.as_deref(), cfg.seed, cfg.max_calls);
+        self.max_calls = cfg.max_calls;
+        let mut index = 0u64;
+        while self.report.sequences < cfg.sequences
+            && self.report.calls < cfg.max_total_calls
+            && cfg.deadline.is_none_or(|d| Instant::now() < d)
+        {
+            let open = (0..self.fmus.len()).any(|i| !self.capped(cfg, i));
+            if !open {
                 break;
             }
-            let f = *self.rng.pick(&open);
-            let id = self.sequence(f, cfg.max_calls);
+            index += 1;
+            let state = sequence_state(cfg.seed, index);
+            self.rng = Rng::from_state(state);
+            let f = self.rng.below(self.fmus.len());
+            if self.capped(cfg, f) {
+                continue;
+            }
+            progress.mark(index, state, &self.fmus[f].id);
+            let t0 = Instant::now();
+            let id = self.sequence(index, state, f, cfg.max_calls);
             let entry = self.report.per_fmu.entry(id).or_default();
             entry.0 += 1;
             entry.1 += t0.elapsed().as_secs_f64();
             self.report.sequences += 1;
         }
+        progress.finish();
+        self.free_donors();
+        self.report
+    }
+
+    /// Run the one sequence that starts from RNG state `state` (as logged by a run, or
+    /// [`sequence_state`] of a seed and an index), printing every call, its status and
+    /// what the FMU logged.
+    pub fn replay(mut self, index: u64, state: u64, max_calls: usize) -> Report {
+        self.verbose = true;
+        self.max_calls = max_calls;
+        self.rng = Rng::from_state(state);
+        let f = self.rng.below(self.fmus.len());
+        println!(
+            "replay: sequence {index}, seed-state {state:#x}, FMU {}",
+            self.fmus[f].id
+        );
+        let mut progress = crate::progress::Progress::new(None, 0, max_calls);
+        progress.mark(index, state, &self.fmus[f].id);
+        let t0 = Instant::now();
+        let id = self.sequence(index, state, f, max_calls);
+        let entry = self.report.per_fmu.entry(id).or_default();
+        entry.0 += 1;
+        entry.1 += t0.elapsed().as_secs_f64();
+        self.report.sequences += 1;
+        progress.finish();
+        self.free_donors();
+        self.report
+    }
+
+    fn capped(&self, cfg: &Config, f: usize) -> bool {
+        let id = &self.fmus[f].id;
+        cfg.per_fmu_cap
+            .get(id)
+            .is_some_and(|cap| self.report.per_fmu.get(id).map_or(0, |e| e.0) >= *cap)
+    }
+
+    fn free_donors(&mut self) {
         for d in &mut self.donors {
             let mut st = d.state;
             assert_eq!(d.inst.free_state(&mut st), OK);
         }
-        self.report
     }
 
     fn violation(&mut self, fmu: &Fmu, what: String) {
@@ -354,8 +538,8 @@ impl<'a> Fuzzer<'a> {
             .or_default() += 1;
         if self.report.first_violations.len() < 40 {
             self.report.first_violations.push(format!(
-                "[{} seq {} seed-state {:#x}] {what}",
-                fmu.id, self.seq, self.rng.0
+                "[{} seq {} seed-state {:#x}: replay with `fmi-fuzz fuzz --replay {:#x} --max-calls {}`] {what}",
+                fmu.id, self.seq, self.seq_state, self.seq_state, self.max_calls
             ));
         }
     }
@@ -375,6 +559,12 @@ impl<'a> Fuzzer<'a> {
     ) {
         self.count(func, state.name(), got);
         let new = live.inst.host.since(log_from);
+        if self.verbose {
+            println!("    {detail} → expected {expect:?}");
+            for r in &new {
+                println!("      log [{}] {}", status_name(r.status), r.message);
+            }
+        }
         if !expect.admits(got) {
             self.violation(
                 fmu,
@@ -413,6 +603,9 @@ impl<'a> Fuzzer<'a> {
 
     fn count(&mut self, func: &str, state: &str, got: fmi2Status) {
         self.report.calls += 1;
+        if self.verbose {
+            println!("  {func} @ {state}: {}", status_name(got));
+        }
         let slot = self.report.coverage.entry(format!("{func} @ {state}")).or_default();
         if let Some(n) = slot.get_mut(got as usize) {
             *n += 1;
@@ -424,9 +617,13 @@ impl<'a> Fuzzer<'a> {
         (!others.is_empty()).then(|| *self.rng.pick(&others))
     }
 
-    /// One random sequence on a random FMU; returns its id.
-    fn sequence(&mut self, f: usize, max_calls: usize) -> String {
-        self.seq += 1;
+    /// One random sequence on FMU `f`; returns its id.
+    fn sequence(&mut self, index: u64, state: u64, f: usize, max_calls: usize) -> String {
+        self.seq = index;
+        self.seq_state = state;
+        for bank in &mut self.banks {
+            bank.clear();
+        }
         let fmu: &'a Fmu = &self.fmus[f];
         let logging_on = self.rng.chance(0.5);
         let mut live = Live::new(fmu, &format!("fuzz{}", self.seq), logging_on);
@@ -436,6 +633,9 @@ impl<'a> Fuzzer<'a> {
         for _ in 0..n {
             let t0 = Instant::now();
             let op = self.rng.below(100);
+            if self.verbose {
+                println!("op {op}:");
+            }
             self.op(op, f, fmu, &mut live, &mut states, &mut fake);
             let dt = t0.elapsed().as_secs_f64();
             if dt > 1.0 && self.report.slow_calls.len() < 20 {
@@ -1404,7 +1604,16 @@ impl<'a> Fuzzer<'a> {
             self.rng.pick(&self.banks[f]).clone()
         };
         let mut null_out = false;
-        let (bytes, expect, mirror, label): (Vec<u8>, Expect, Option<Mirror>, String) = match self.rng.below(12) {
+        let (bytes, expect, mirror, label): (Vec<u8>, Expect, Option<Mirror>, String) = match self.rng.below(13) {
+            12 => match self.forge_variable(fmu, &own) {
+                // A parameter or input forged, re-sealed: refused exactly when fmi2Set* would
+                // refuse the value (crates/fmi2-export/README.md, FMU state).
+                Some((b, refused, label)) => {
+                    let expect = if refused { Expect::Error } else { Expect::OkOrError };
+                    (b, expect, (!refused).then_some(mirror), label)
+                }
+                None => (own, Expect::Ok, Some(mirror), "intact".into()),
+            },
             0 => {
                 let n = self.rng.below(own.len());
                 (own[..n].to_vec(), Expect::Error, None, format!("truncated to {n}"))
@@ -1492,6 +1701,78 @@ impl<'a> Fuzzer<'a> {
                 fmu,
                 format!("fmi2DeSerializeFMUstate failed ({label}) but wrote a state"),
             );
+        }
+    }
+
+    /// `own` (a serialized state of `fmu`) with one Real or Integer parameter or input
+    /// replaced by a value from the edges of its range (or beyond: non-finite, huge,
+    /// just outside), re-sealed with a valid checksum. Returns the buffer, whether
+    /// fmi2Set* would refuse the value, and a label; `None` if the payload does not have
+    /// the declared layout (machine fields, then every variable in declaration order).
+    fn forge_variable(&mut self, fmu: &Fmu, own: &[u8]) -> Option<(Vec<u8>, bool, String)> {
+        const MACHINE_BYTES: usize = 38;
+        let env = open(own)?;
+        let mut payload = env.payload.clone();
+        let mut at = MACHINE_BYTES;
+        let mut slots = Vec::new();
+        for v in &fmu.vars {
+            let len = match v.ty {
+                VarType::Real => 8,
+                VarType::Integer => 4,
+                VarType::Boolean => 1,
+                VarType::String => 4 + u32::from_le_bytes(payload.get(at..at + 4)?.try_into().ok()?) as usize,
+            };
+            let bounded = matches!(v.causality, Causality::Parameter | Causality::Input)
+                && v.variability != Variability::Constant
+                && matches!(v.ty, VarType::Real | VarType::Integer);
+            if bounded {
+                slots.push((v, at));
+            }
+            at += len;
+        }
+        if at > payload.len() || slots.is_empty() {
+            return None;
+        }
+        let (v, at) = *self.rng.pick(&slots);
+        let (lo, hi) = (v.min, v.max);
+        let above = if hi.is_finite() {
+            hi + hi.abs().max(1.0) * 1e-6
+        } else {
+            1e300
+        };
+        let below = if lo.is_finite() {
+            lo - lo.abs().max(1.0) * 1e-6
+        } else {
+            -1e300
+        };
+        let inside = self.rng.in_range(lo, hi);
+        if v.ty == VarType::Real {
+            let x = *self.rng.pick(&[
+                f64::NAN,
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+                2e10,
+                -2e10,
+                f64::MAX,
+                above,
+                below,
+                inside,
+            ]);
+            payload[at..at + 8].copy_from_slice(&x.to_le_bytes());
+            let refused = !x.is_finite() || x < lo || x > hi;
+            Some((seal(&env.head, &payload), refused, format!("forged {} = {x}", v.name)))
+        } else {
+            let clamp = |x: f64| x.clamp(f64::from(i32::MIN), f64::from(i32::MAX)) as i32;
+            let x = *self.rng.pick(&[
+                i32::MIN,
+                i32::MAX,
+                clamp(lo.max(-1e6) - 1.0),
+                clamp(hi.min(1e6) + 1.0),
+                clamp(inside.round()),
+            ]);
+            payload[at..at + 4].copy_from_slice(&x.to_le_bytes());
+            let refused = f64::from(x) < lo || f64::from(x) > hi;
+            Some((seal(&env.head, &payload), refused, format!("forged {} = {x}", v.name)))
         }
     }
 

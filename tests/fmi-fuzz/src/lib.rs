@@ -17,6 +17,7 @@
 //! `tailsitter_tsd`); `TAILSITTER_FMUS=tailsitter_plant,...` narrows the set.
 
 pub mod fuzz;
+pub mod progress;
 
 use fmi_sys::fmi2::*;
 use libloading::Library;
@@ -652,6 +653,14 @@ pub struct Rng(u64);
 impl Rng {
     pub fn new(seed: u64) -> Self {
         Self(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1)
+    }
+    /// Continue from a state as [`Rng::state`] returned it (0 is mapped to 1).
+    pub fn from_state(state: u64) -> Self {
+        Self(state.max(1))
+    }
+    /// The current state.
+    pub fn state(&self) -> u64 {
+        self.0
     }
     pub fn next_u64(&mut self) -> u64 {
         let mut x = self.0;

@@ -23,6 +23,7 @@ fn random_call_sequences_keep_every_invariant() {
         max_calls: 40,
         // ~0.1 s per LQR sequence (its initialisation builds the trajectory and gains, ~40 ms).
         per_fmu_cap: [("tailsitter_lqr".to_string(), env("FMI_FUZZ_LQR_SEQUENCES", 120))].into(),
+        ..Default::default()
     };
     let t0 = Instant::now();
     let report = Fuzzer::new(&fmus, seed).run(&cfg);
@@ -59,6 +60,7 @@ fn random_call_sequences_keep_every_invariant() {
         deadline: None,
         max_calls: 40,
         per_fmu_cap: Default::default(),
+        ..Default::default()
     };
     let report = Fuzzer::new(&plant, seed).run(&me_cfg);
     report.print();

@@ -15,6 +15,7 @@ fn random_call_sequences_on_the_sensor_fmu_keep_every_invariant() {
         deadline: None,
         max_calls: 40,
         per_fmu_cap: Default::default(),
+        ..Default::default()
     };
     let report = Fuzzer::new(&fmus, seed).run(&cfg);
     report.print();

@@ -1,5 +1,5 @@
 //! α- and thrust-limited flight-path profile of the mission (issue 16; derivation in
-//! `crates/flight-mission/README.md`).
+//! `crates/guidance/README.md`).
 //!
 //! The thesis's transition references (§3.3: cosine blends of V and γ; §4.3.3: quarter
 //! loops at linearly changing speed) prescribe V(t) and γ(t) independently, so a short
@@ -33,7 +33,7 @@
 
 use std::sync::Arc;
 
-use crate::{MissionParams, ParamError, Phase};
+use flight_mission::{MissionParams, ParamError, Phase};
 
 /// Table step of the profile (s).
 pub const PROFILE_STEP: f64 = 0.01;
@@ -481,7 +481,7 @@ mod tests {
     /// 2.04 s.
     #[test]
     fn the_fast_front_transition_rotates_within_two_seconds() {
-        let m = MissionParams::fast();
+        let m = MissionParams::fast_limited();
         let p = Profile::new(&m, &airframe(), &ProfileLimits::of(&m)).unwrap();
         let s = m.phase_starts();
         let rotation = p.settle_time(s[1], s[3], 0.0, 5f64.to_radians()).unwrap();

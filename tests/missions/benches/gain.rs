@@ -5,7 +5,7 @@
 //! warm-started from the previous period's solution (`relinearisation_warm_…`); the default
 //! mission flown natively (plant + LQR through `closed-loop`, Gauss-Seidel, 20 ms).
 //!
-//! `cargo bench -p lqr-control --bench gain`
+//! `cargo bench -p missions --bench gain`
 
 use closed_loop::{fly, Scenario};
 use criterion::{criterion_group, criterion_main, Criterion};

@@ -1,6 +1,6 @@
 //! Print a closed-loop time series of the TSD controller (debugging and tuning aid).
 //!
-//! `cargo run --release -p tsd-control --example tsd_trace -- <case> [every_s]`
+//! `cargo run --release -p missions --example tsd_trace -- <case> [every_s]`
 //! with case one of `default`, `fast` (3/4 s), `fast2` / `fast2j` (2/3 s, Gauss-Seidel / Jacobi), `jacobi`, `vstep-n`, `vstep-e`, `lstep-d`, `lstep-e`, `hover`
 //! (40 s of vertical flight); a constant wind with `TSD_WIND=n,e,d` (m/s, NED).
 

@@ -7,7 +7,7 @@
 //! position diverged after 8 s (380 m at 30 s). The blend now uses the axial airspeed
 //! V̄ cos α cos β (README, "Low-speed frame").
 //!
-//! `cargo test --release -p tsd-control --test wind -- --nocapture` prints the numbers.
+//! `cargo test --release -p missions --test tsd_wind -- --nocapture` prints the numbers.
 
 use closed_loop::{fly, MissionCheck, Scenario, Trace, Wind};
 use flight_mission::MissionParams;

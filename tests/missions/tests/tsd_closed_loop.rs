@@ -3,7 +3,7 @@
 //! (Gauss-Seidel: the controller samples the plant outputs at t, then the plant
 //! advances 20 ms). The plant starts in its trimmed 3 m/s vertical climb.
 //!
-//! Run with `cargo test --release -p tsd-control -- --nocapture` to see the numbers.
+//! Run with `cargo test --release -p missions --test tsd_closed_loop -- --nocapture` to see the numbers.
 
 use closed_loop::{fly, MissionCheck, Ordering, Scenario, Trace};
 use flight_mission::MissionParams;
@@ -74,11 +74,7 @@ fn default_mission_gauss_seidel() {
 
 #[test]
 fn fast_mission_gauss_seidel() {
-    let mission = MissionParams {
-        t_transition_1: 3.0,
-        t_transition_2: 4.0,
-        ..Default::default()
-    };
+    let mission = MissionParams::fast();
     let (trace, check) = run(mission, Ordering::GaussSeidel);
     report(
         "fast mission (T1 = 3 s, T2 = 4 s), Gauss-Seidel",
@@ -247,33 +243,41 @@ fn default_mission_with_perturbed_plant() {
     assert!(failures.is_empty(), "{failures:?}");
 }
 
+/// configuration = 1, the TSD as printed (docs/THESIS.md D-4.x): at the project's V_V = 3 m/s
+/// the wind-axes loops are unstable in the climb (normal and directional integrator modes,
+/// `examples/thesis_switches.rs`), so a 5 s final vertical is flown but a 30 s one is lost; at
+/// V_V = 8 m/s the printed design holds it.
 #[test]
-fn thesis_configuration_fails_in_vertical_flight_as_documented() {
-    // configuration = 1: the wind axes at every airspeed and no feed-forward preview. At
-    // 3 m/s the wind axes turn as fast as the body ((C_W + g₁)/V̄), the time-scale
-    // separation fails and the aircraft cannot hold vertical flight once disturbed: the
-    // transitions and level flight are flown, vertical flight 2 is lost (README).
-    let mission = MissionParams::default();
+fn thesis_configuration_holds_vertical_flight_only_at_a_fast_climb() {
     let plant = plant();
-    let x0 = climb_trim(&plant, mission.v_vertical);
     let params = tsd_control::TsdParams {
         configuration: 1,
         ..Default::default()
     };
-    let mut ctl = TsdController::new(Airframe::default(), mission, params).unwrap();
-    let trace = fly(&plant, x0, &mut ctl, &Scenario::mission(mission));
-    let check = MissionCheck::of(&trace, &mission, level_trim_theta(&plant, mission.v_level));
-    print!("thesis configuration:\n{check}");
-    let e = check.phase_errors;
-    // Undisturbed trimmed climb: exact.
-    assert!(e[0].max < 1e-6, "{:?}", e[0]);
-    // Transitions and level flight within the criteria's spirit: a few metres.
-    for (k, p) in e.iter().enumerate().take(4).skip(1) {
-        assert!(p.max < 3.0, "phase {k}: {p:?}");
+    let mut finals = Vec::new();
+    for v_vertical in [3.0, 8.0] {
+        let mission = MissionParams {
+            v_vertical,
+            t_vertical_2: 30.0,
+            ..MissionParams::default()
+        };
+        let x0 = climb_trim(&plant, mission.v_vertical);
+        let mut ctl = TsdController::new(Airframe::default(), mission, params).unwrap();
+        let trace = fly(&plant, x0, &mut ctl, &Scenario::mission(mission));
+        let check = MissionCheck::of(&trace, &mission, level_trim_theta(&plant, mission.v_level));
+        print!("thesis configuration, V_V = {v_vertical} m/s, 30 s final vertical:\n{check}");
+        let e = check.phase_errors;
+        // Undisturbed trimmed climb: exact.
+        assert!(e[0].max < 1e-6, "{:?}", e[0]);
+        // Transitions and level flight: a few metres.
+        for (k, p) in e.iter().enumerate().take(4).skip(1) {
+            assert!(p.max < 3.0, "phase {k}: {p:?}");
+        }
+        finals.push((check.final_pitch_error.to_degrees(), e[4].max));
     }
-    // The documented failure: not back to vertical at the end (criterion: within 10°).
-    assert!(!check.passed());
-    assert!(check.final_pitch_error > 10f64.to_radians(), "{check}");
+    // 3 m/s: lost (measured 176° off vertical); 8 m/s: held (0.0°, 0.98 m).
+    assert!(finals[0].0 > 30.0, "{finals:?}");
+    assert!(finals[1].0 < 2.0 && finals[1].1 < 2.0, "{finals:?}");
 }
 
 /// The guidance feedback of the tuned configuration is bounded by GUIDANCE_FEEDBACK_LIMIT; the

@@ -45,7 +45,7 @@
 
 use nalgebra::Vector3;
 
-use crate::{Measurement, MissionParams, Phase};
+use flight_mission::{Measurement, MissionParams, Phase};
 
 /// Time of the cosine ramp of the sink rate at the start of the descent (s).
 pub const DESCENT_RAMP_TIME: f64 = 2.0;

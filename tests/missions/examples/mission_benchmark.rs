@@ -2,7 +2,7 @@
 //! writes the trajectory (t, N, E, D, full precision) as CSV for before/after comparisons
 //! and prints the CPU time of one whole mission (median over `runs`).
 //!
-//! `cargo run --release -p lqr-control --example mission_benchmark -- [default|violent] [out.csv|-] [runs=5] [plant integration step (s)|-] [relinearisation period T_l (s)]`
+//! `cargo run --release -p missions --example mission_benchmark -- [default|violent] [out.csv|-] [runs=5] [plant integration step (s)|-] [relinearisation period T_l (s)]`
 //!
 //! The last argument overrides the LQR's `relinearisation_period` (default 0.2 s, the
 //! thesis's T_l): e.g. `1e9` relinearises only at the start, which gives the mission's cost

@@ -15,7 +15,7 @@
 //! and strong-crossflow normal poles): 8 m/s from the east drifted 23 m (Gauss-Seidel) and 41 m
 //! (Jacobi) before the heading had turned, from the west under Jacobi it tumbled (101 m).
 //!
-//! `cargo test --release -p tsd-control --test hover_wind_step -- --nocapture` prints the numbers.
+//! `cargo test --release -p missions --test hover_wind_step -- --nocapture` prints the numbers.
 
 use closed_loop::{fly, plant_inputs, Ordering, Scenario, Wind};
 use flight_mission::MissionParams;

@@ -1,6 +1,6 @@
 //! Scan one tuning parameter over values and print the mission metrics (tuning aid).
 //!
-//! `cargo run --release -p tsd-control --example tsd_scan -- <param> <v1> <v2> ...`
+//! `cargo run --release -p missions --example tsd_scan -- <param> <v1> <v2> ...`
 //!
 //! With `TSD_SCAN_WIND=1` it also hovers 35 s (vertical flight) in a constant 5 m/s wind
 //! from N, E, S, W, NE and flies the default mission in a 3 m/s crosswind (from the east),

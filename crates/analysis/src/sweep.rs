@@ -1,4 +1,4 @@
-//! Campaign runner: jobs in parallel on all cores (rayon), deterministic (each job is a
+//! Sweep runner: jobs in parallel on all cores (rayon), deterministic (each job is a
 //! pure function of its inputs; results are collected in job order), progress bars
 //! (indicatif), cached ([`crate::cache`]), and the report's data: CSV and JSON into the
 //! output folder. Rust writes data only; `python -m tailsim.analysis_report <out>` renders
@@ -50,14 +50,14 @@ pub struct Config {
     pub gusts: bool,
     /// Show progress bars.
     pub progress: bool,
-    /// Fly the hover-in-wind campaign of issue 16 ([`crate::envelope_hover`]).
+    /// Fly the hover-in-wind sweep ([`crate::envelope_hover`]).
     pub envelope_hover: bool,
     /// The mission.
     pub mission: MissionParams,
 }
 
 impl Config {
-    /// The full campaign of the issue into `out`.
+    /// The full analysis into `out`.
     pub fn full(out: impl Into<PathBuf>) -> Self {
         Self {
             out: out.into(),
@@ -239,7 +239,7 @@ pub struct GustResult {
     pub largest_bounded: f64,
 }
 
-/// Everything the campaign produced.
+/// Everything the sweeps produced.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Summary {
     /// Open-loop modes (level, vertical).
@@ -262,7 +262,7 @@ pub struct Summary {
     pub jobs: usize,
 }
 
-/// Run the campaign and write the report into `cfg.out`.
+/// Run the sweeps and write the report into `cfg.out`.
 pub fn run(cfg: &Config) -> std::io::Result<Summary> {
     let start = Instant::now();
     std::fs::create_dir_all(&cfg.out)?;

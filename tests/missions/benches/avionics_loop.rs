@@ -1,4 +1,4 @@
-//! The whole avionics loop natively (no FMI): plant (RK4, 2 ms) → sensor model (200 Hz IMU,
+//! The whole avionics loop natively (no FMI): plant (RK4, 2 ms) → sensor model (1 kHz accel., 200 Hz gyro,
 //! 50 Hz magnetometer and pitot, 4 Hz GPS, 8 Hz Butterworth) → estimator (with the model
 //! prediction) → controller → plant, Gauss-Seidel at 20 ms, over the 35 s default mission.
 //! Real-time factor = 35 s / the time per mission (issue 14's target: ≥ 200×).

@@ -39,7 +39,7 @@
 
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
-use crate::{Measurement, MissionParams, Phase};
+use flight_mission::{Measurement, MissionParams, Phase};
 
 /// Time constant of the tuned wind estimate (s).
 const FILTER_TIME: f64 = 4.0;
