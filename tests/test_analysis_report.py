@@ -118,6 +118,7 @@ def test_every_plot_is_drawn_and_embedded(rendered):
     expected |= {"envelope_fastest"}
     expected |= {f"closed_loop_poles_{c}" for c in d["conditions"]}
     expected |= {"takeoff_landing"} if d.get("takeoff_landing") else set()
+    expected |= {"wind_envelope"} if (DATA / "wind_envelope.json").exists() else set()
     expected |= {f"loci_{k}_{c}_{kind}" for k in d["controllers"] for c in d["conditions"] for kind in ("pitch", "all")}
     assert {p.stem for p in folder.glob("*.png")} == expected
     html = (folder / "report.html").read_text()
@@ -245,3 +246,21 @@ def test_robustness_changes_say_what_changed_and_why():
         "Why: nothing changed — every flight stayed in attached flow, where the global model is the thesis's."
     )
     assert not any("nominal airframe" in x for x in robustness_changes(d, same, nominal=False))
+
+
+def test_wind_envelope_section_counts_the_held_cells(rendered):
+    """wind_envelope.md (from `analysis wind-envelope`): per mission and wind form one row per
+    controller and speed with the held count of the data's summary and one cell per bearing."""
+    folder, _ = rendered
+    w = json.loads((DATA / "wind_envelope.json").read_text())
+    text = (folder / "wind_envelope.md").read_text()
+    blocks = text.split("\n### ")[1:]
+    titles = {"default": "default mission", "takeoff_landing": "take-off to landing"}
+    forms = {"step": "stepping in", "turbulent": "turbulence"}
+    for s in w["summary"]:
+        block = next(b for b in blocks if b.startswith(titles[s["mission"]]) and forms[s["wind"]] in b.splitlines()[0])
+        row = next(line for line in block.splitlines() if line.startswith(f"| {s['controller']} | {s['speed']:g} | "))
+        cells = [c.strip() for c in row.strip("|").split("|")]
+        assert cells[2] == f"{s['held']}/{s['cells']}", row
+        assert len(cells) == 3 + len(w["bearings_deg"])
+        assert sum(c.startswith("✓") for c in cells[3:]) == s["held"]

@@ -16,6 +16,9 @@
     output as a connector so the whole state is recorded.
 - libcosim (libcosimpy 0.0.6, `CosimExecution.from_ssp_file`) reads the bindings, the
   default experiment and the OSP step-size annotation, and flies it.
+
+With dist/tailsitter_atmosphere.fmu the systems hold a third component, `atmosphere`, wired
+by name to the plant and bound calm: the flight is the same, bit for bit, as without it.
 """
 
 from __future__ import annotations
@@ -33,6 +36,10 @@ from tailsim.metrics import CRITERIA, declared_mission, level_window, phase_star
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 DIST = ROOT / "dist"
 CONTROLLERS = ["tailsitter_lqr", "tailsitter_tsd"]
+ATMOSPHERE = "tailsitter_atmosphere"
+# The systems hold the atmosphere when its FMU was packaged.
+HAS_ATMOSPHERE = (DIST / f"{ATMOSPHERE}.fmu").exists()
+COMPONENTS = ["controller", "plant"] + (["atmosphere"] if HAS_ATMOSPHERE else [])
 # The SSP binds the controllers' declared mission defaults.
 MISSION = declared_mission()
 NS = {
@@ -75,12 +82,9 @@ def test_archive_holds_the_packaged_fmus(controller):
     """resources/*.fmu are byte-identical to dist/*.fmu (else the SSP is stale: `cargo xtask ssp`)."""
     with zipfile.ZipFile(ssp_path(controller)) as z:
         names = set(z.namelist())
-        assert names == {
-            "SystemStructure.ssd",
-            "resources/tailsitter_plant.fmu",
-            f"resources/{controller}.fmu",
-        }
-        for fmu in ("tailsitter_plant", controller):
+        fmus = ["tailsitter_plant", controller] + ([ATMOSPHERE] if HAS_ATMOSPHERE else [])
+        assert names == {"SystemStructure.ssd"} | {f"resources/{f}.fmu" for f in fmus}
+        for fmu in fmus:
             assert z.read(f"resources/{fmu}.fmu") == (DIST / f"{fmu}.fmu").read_bytes(), (
                 f"{controller}.ssp holds a stale {fmu}.fmu: run `cargo xtask ssp`"
             )
@@ -92,31 +96,38 @@ def test_ssd_passes_fmpy_schema_and_wires_by_name(controller):
 
     ssd = read_ssd(str(ssp_path(controller)), validate=True)  # raises on schema errors
     comps = {c.name: c for c in ssd.system.elements}
-    assert set(comps) == {"plant", "controller"}
+    assert set(comps) == set(COMPONENTS)
     assert comps["plant"].source == "resources/tailsitter_plant.fmu"
     assert comps["controller"].source == f"resources/{controller}.fmu"
 
     with zipfile.ZipFile(ssp_path(controller)) as z:
         plant_vars = variables(model_description(z.read("resources/tailsitter_plant.fmu")))
         ctrl_vars = variables(model_description(z.read(f"resources/{controller}.fmu")))
-    # Every connection joins equal names: plant output -> controller input, controller output -> plant input.
+        atm_vars = variables(model_description(z.read(f"resources/{ATMOSPHERE}.fmu"))) if HAS_ATMOSPHERE else {}
+    of = {"plant": plant_vars, "controller": ctrl_vars, "atmosphere": atm_vars}
+    # Every connection joins equal names: plant output -> controller input, controller output -> plant input,
+    # and with the atmosphere plant output -> atmosphere input, atmosphere output -> plant input.
+    pairs = {("plant", "controller"), ("controller", "plant"), ("plant", "atmosphere"), ("atmosphere", "plant")}
     wired = set()
     for c in ssd.system.connections:
         assert c.startConnector == c.endConnector
-        assert (c.startElement, c.endElement) in {("plant", "controller"), ("controller", "plant")}
-        src = plant_vars if c.startElement == "plant" else ctrl_vars
-        dst = ctrl_vars if c.startElement == "plant" else plant_vars
+        assert (c.startElement, c.endElement) in pairs
+        src, dst = of[c.startElement], of[c.endElement]
         assert src[c.startConnector][0] == "output" and dst[c.endConnector][0] == "input"
         assert src[c.startConnector][1] == dst[c.endConnector][1]
         wired.add((c.endElement, c.endConnector))
     expected = {("controller", n) for n, (caus, _) in ctrl_vars.items() if caus == "input" and n in plant_vars}
     expected |= {("plant", n) for n, (caus, _) in ctrl_vars.items() if caus == "output" and n in plant_vars}
+    if HAS_ATMOSPHERE:
+        expected |= {("atmosphere", n) for n, (caus, _) in atm_vars.items() if caus == "input"}
+        expected |= {("plant", n) for n in ("wind_n", "wind_e", "wind_d")}
+        assert {n for n, (caus, _) in atm_vars.items() if caus == "input"} <= set(plant_vars)
     assert wired == expected
     assert {n for n, (caus, _) in plant_vars.items() if caus == "input" and n.endswith("_cmd")} <= {
         n for e, n in wired if e == "plant"
     }
     # Connector kinds and types match the FMUs (SSP 1.0: the kind must match the causality).
-    for comp, fmu_vars in (("plant", plant_vars), ("controller", ctrl_vars)):
+    for comp, fmu_vars in ((c, of[c]) for c in COMPONENTS):
         for conn in ssd_root(controller).iterfind(f".//ssd:Component[@name='{comp}']/ssd:Connectors/ssd:Connector", NS):
             caus, kind = fmu_vars[conn.get("name")]
             assert conn.get("kind") == caus
@@ -202,10 +213,7 @@ def test_swapping_the_controller_swaps_one_component():
     assert plant_xml(lqr) == plant_xml(tsd)
     assert rest(lqr) == rest(tsd)
     for root in (lqr, tsd):
-        assert [c.get("name") for c in root.iterfind("ssd:System/ssd:Elements/ssd:Component", NS)] == [
-            "controller",
-            "plant",
-        ]
+        assert [c.get("name") for c in root.iterfind("ssd:System/ssd:Elements/ssd:Component", NS)] == COMPONENTS
 
 
 def fmpy_parameter_set(path: pathlib.Path):
@@ -263,7 +271,7 @@ def test_libcosim_from_ssp_file_flies_the_default_mission(controller):
 
     log_output_level(CosimLogLevel.ERROR)
     execution = CosimExecution.from_ssp_file(str(ssp_path(controller)))
-    assert execution.num_slaves() == 2
+    assert execution.num_slaves() == len(COMPONENTS)
     plant = execution.slave_index_from_instance_name("plant")
     ctrl = execution.slave_index_from_instance_name("controller")
     assert plant is not None and ctrl is not None
@@ -288,3 +296,56 @@ def test_libcosim_from_ssp_file_flies_the_default_mission(controller):
     assert window.sum() == 250  # 5 s of 0.02 s steps
     assert np.max(np.abs(v[window] - MISSION["v_level"])) <= CRITERIA["level_airspeed_error_max"]
     assert np.all(np.isfinite(v))
+
+
+def without_atmosphere(path: pathlib.Path, out: pathlib.Path) -> pathlib.Path:
+    """A copy of the SSP without the atmosphere component, its connections and its FMU (the
+    system as written before the atmosphere existed)."""
+    with zipfile.ZipFile(path) as z:
+        root = etree.fromstring(z.read("SystemStructure.ssd"))
+        system = root.find("ssd:System", NS)
+        elements = system.find("ssd:Elements", NS)
+        elements.remove(elements.find("ssd:Component[@name='atmosphere']", NS))
+        for c in list(system.find("ssd:Connections", NS)):
+            if "atmosphere" in (c.get("startElement"), c.get("endElement")):
+                system.find("ssd:Connections", NS).remove(c)
+        plant = elements.find("ssd:Component[@name='plant']/ssd:Connectors", NS)
+        for conn in list(plant):
+            if conn.get("name") in ("wind_n", "wind_e", "wind_d"):
+                plant.remove(conn)
+        with zipfile.ZipFile(out, "w") as o:
+            o.writestr("SystemStructure.ssd", etree.tostring(root, xml_declaration=True, encoding="UTF-8"))
+            for name in z.namelist():
+                if name.startswith("resources/") and ATMOSPHERE not in name:
+                    o.writestr(name, z.read(name))
+    return out
+
+
+@pytest.mark.skipif(not HAS_ATMOSPHERE, reason="no atmosphere FMU packaged")
+@pytest.mark.parametrize("controller", CONTROLLERS)
+def test_calm_atmosphere_leaves_the_flight_unchanged(controller, tmp_path):
+    """fmpy simulate_ssp: the system with the atmosphere at its bound (calm) parameters flies
+    the same values, bit for bit, as the system without it; a wind set in the atmosphere's
+    parameter set reaches the plant's wind inputs."""
+    from fmpy.ssp.simulation import simulate_ssp
+
+    path = ssp_path(controller)
+    bare = without_atmosphere(path, tmp_path / "bare.ssp")
+    with_atm = simulate_ssp(str(path), stop_time=6.0, step_size=0.02, parameter_set=fmpy_parameter_set(path))
+    without = simulate_ssp(str(bare), stop_time=6.0, step_size=0.02, parameter_set=fmpy_parameter_set(bare))
+    shared = [n for n in without.dtype.names if n != "time"]
+    assert len(shared) > 20
+    for name in shared:
+        assert np.array_equal(with_atm[name], without[name]), name
+    assert not np.any(with_atm["plant.wind_n"]) and not np.any(with_atm["atmosphere.wind_e"])
+    # 5 m/s from the east, uniform: the plant's wind_e input is -5 m/s (Jacobi: from the second step).
+    windy = fmpy_parameter_set(path)
+    for p in windy.parameters:
+        if p.name == "atmosphere.wind_speed":
+            p.value = "5.0"
+        if p.name == "atmosphere.wind_from":
+            p.value = repr(math.pi / 2)
+        if p.name == "atmosphere.wind_profile":
+            p.value = "0"
+    r = simulate_ssp(str(path), stop_time=1.0, step_size=0.02, parameter_set=windy)
+    assert np.allclose(r["plant.wind_e"][1:], -5.0, rtol=0, atol=1e-12)

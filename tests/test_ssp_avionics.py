@@ -1,7 +1,8 @@
 """The SSP 1.0 systems with avionics in the loop, dist/<controller>_avionics.ssp (written
 by `cargo xtask ssp` / `cargo xtask dist` when the sensor and estimator FMUs are there):
 plant → sensors → estimator → controller → plant and controller → estimator, every
-connection explicit and by name. Structure and schema under fmpy, flights under fmpy's
+connection explicit and by name, plus the atmosphere (plant ↔ atmosphere by name, bound
+calm) when its FMU was packaged. Structure and schema under fmpy, flights under fmpy's
 simulate_ssp and libcosim (both Jacobi masters: see tests/test_ssp.py for their limits).
 """
 
@@ -26,6 +27,8 @@ ELEMENTS = {
     "sensors": "tailsitter_sensors",
     "estimator": "tailsitter_ekf",
 }
+if (DIST / "tailsitter_atmosphere.fmu").exists():
+    ELEMENTS["atmosphere"] = "tailsitter_atmosphere"
 # Allowed connection directions (start element, end element).
 FLOWS = {
     ("plant", "sensors"),
@@ -33,6 +36,8 @@ FLOWS = {
     ("estimator", "controller"),
     ("controller", "plant"),
     ("controller", "estimator"),
+    ("plant", "atmosphere"),
+    ("atmosphere", "plant"),
 }
 
 
@@ -74,7 +79,7 @@ def test_avionics_ssd_is_valid_and_wires_every_input_by_name(controller):
         wired.add((c.endElement, c.endConnector))
     # Every estimator input (measurements and commands), every sensor input, every plant
     # command and every controller input the estimator provides is driven.
-    for elem in ("estimator", "sensors"):
+    for elem in [e for e in ("estimator", "sensors", "atmosphere") if e in vars_]:
         for n, (caus, _) in vars_[elem].items():
             if caus == "input":
                 assert (elem, n) in wired, (elem, n)
@@ -95,7 +100,7 @@ def test_libcosim_loads_and_runs_the_avionics_system(controller):
 
     log_output_level(CosimLogLevel.ERROR)
     execution = CosimExecution.from_ssp_file(str(ssp_path(controller)))
-    assert execution.num_slaves() == 4
+    assert execution.num_slaves() == len(ELEMENTS) + 1
     for name in ("plant", "sensors", "estimator", "controller"):
         assert execution.slave_index_from_instance_name(name) is not None, name
     assert execution.simulate_until(35 * 10**9)
@@ -145,7 +150,7 @@ def test_libcosim_flies_the_avionics_system(controller):
 
     log_output_level(CosimLogLevel.ERROR)
     execution = CosimExecution.from_ssp_file(str(ssp_path(controller)))
-    assert execution.num_slaves() == 4
+    assert execution.num_slaves() == len(ELEMENTS) + 1
     plant = execution.slave_index_from_instance_name("plant")
     ctrl = execution.slave_index_from_instance_name("controller")
     pv = {v.name.decode(): v.reference for v in execution.slave_variables(plant)}

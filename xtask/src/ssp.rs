@@ -10,6 +10,11 @@
 //!   annotation giving libcosim its fixed base step (0.02 s = `sample_time`); tools that do not know
 //!   the annotation ignore it.
 //! - `resources/tailsitter_plant.fmu`, `resources/<controller>.fmu`: the packaged FMUs, verbatim.
+//! - with `dist/tailsitter_atmosphere.fmu` present, a third component `atmosphere`
+//!   (`resources/tailsitter_atmosphere.fmu`) wired by name too: plant `pos_n/e/d`, `airspeed` →
+//!   atmosphere, atmosphere `wind_n/e/d` → plant, its parameters bound to their declared defaults
+//!   (no wind, no turbulence, no gust: the closed loop flies as without it, bit for bit). A user
+//!   sets wind and turbulence in that parameter set. The avionics systems get it likewise.
 //!
 //! The SSD is the same for every controller except the controller component's source and the
 //! connections it needs (a controller reads the subset of plant outputs it declares as inputs):
@@ -46,6 +51,25 @@ pub static MISSION: LazyLock<Vec<(&'static str, f64)>> = LazyLock::new(|| {
         .map(|d| match d.start {
             Some(model_description::Start::Number(x)) => (&*d.name.leak(), x),
             other => panic!("mission parameter {} has start {other:?}", d.name),
+        })
+        .collect()
+});
+
+/// The atmosphere of the systems (a component when its FMU is in the folder).
+pub const ATMOSPHERE: &str = "tailsitter_atmosphere";
+
+/// The atmosphere's parameters (group `params` of `modelDescription/tailsitter_atmosphere.json`)
+/// with their declared defaults: calm air.
+pub static ATMOSPHERE_PARAMS: LazyLock<Vec<(&'static str, f64)>> = LazyLock::new(|| {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../modelDescription");
+    let (decls, _) = model_description::load_declarations(&dir, &format!("{ATMOSPHERE}.json"))
+        .unwrap_or_else(|e| panic!("atmosphere declaration: {e}"));
+    decls
+        .into_iter()
+        .filter(|d| d.group.as_deref() == Some("params") && d.causality == model_description::Causality::Parameter)
+        .map(|d| match d.start {
+            Some(model_description::Start::Number(x)) => (&*d.name.leak(), x),
+            other => panic!("atmosphere parameter {} has start {other:?}", d.name),
         })
         .collect()
 });
@@ -145,6 +169,8 @@ pub fn write_all(dir: &Path) -> Result<Vec<PathBuf>, String> {
     if !plant_fmu.exists() {
         return Err(format!("{} missing: run `cargo xtask dist` first", plant_fmu.display()));
     }
+    let atmosphere_fmu = dir.join(format!("{ATMOSPHERE}.fmu"));
+    let atmosphere_fmu = atmosphere_fmu.exists().then_some(atmosphere_fmu);
     let mut written = Vec::new();
     for id in CONTROLLERS {
         let controller_fmu = dir.join(format!("{id}.fmu"));
@@ -153,7 +179,7 @@ pub fn write_all(dir: &Path) -> Result<Vec<PathBuf>, String> {
             continue;
         }
         let path = dir.join(format!("{id}.ssp"));
-        write_ssp(&path, &plant_fmu, &controller_fmu)?;
+        write_ssp(&path, &plant_fmu, &controller_fmu, atmosphere_fmu.as_deref())?;
         println!("wrote {}", path.display());
         written.push(path);
     }
@@ -171,23 +197,37 @@ pub fn write_all(dir: &Path) -> Result<Vec<PathBuf>, String> {
     Ok(written)
 }
 
-/// Write one SSP archive: the SSD and both FMUs under `resources/`.
-pub fn write_ssp(path: &Path, plant_fmu: &Path, controller_fmu: &Path) -> Result<(), String> {
+/// Write one SSP archive: the SSD and the FMUs (plant, controller, the atmosphere if given)
+/// under `resources/`.
+pub fn write_ssp(
+    path: &Path,
+    plant_fmu: &Path,
+    controller_fmu: &Path,
+    atmosphere_fmu: Option<&Path>,
+) -> Result<(), String> {
     let read = |p: &Path| std::fs::read(p).map_err(|e| format!("{}: {e}", p.display()));
     let (plant_bytes, controller_bytes) = (read(plant_fmu)?, read(controller_fmu)?);
     let plant = fmu_info(&plant_bytes).map_err(|e| format!("{}: {e}", plant_fmu.display()))?;
     let controller = fmu_info(&controller_bytes).map_err(|e| format!("{}: {e}", controller_fmu.display()))?;
-    let ssd = system_description(&plant, &controller)?;
+    let atmosphere_bytes = atmosphere_fmu.map(read).transpose()?;
+    let atmosphere = match (&atmosphere_bytes, atmosphere_fmu) {
+        (Some(b), Some(p)) => Some(fmu_info(b).map_err(|e| format!("{}: {e}", p.display()))?),
+        _ => None,
+    };
+    let ssd = system_description(&plant, &controller, atmosphere.as_ref())?;
     let file = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let mut zip = zip::ZipWriter::new(file);
     let deflated = zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
     // The FMUs are zip archives already: store them.
     let stored = zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Stored);
-    let entries = [
+    let mut entries = vec![
         ("SystemStructure.ssd".to_string(), ssd.into_bytes(), deflated),
         (resource(&plant.model_identifier), plant_bytes, stored),
         (resource(&controller.model_identifier), controller_bytes, stored),
     ];
+    if let (Some(info), Some(bytes)) = (atmosphere, atmosphere_bytes) {
+        entries.push((resource(&info.model_identifier), bytes, stored));
+    }
     for (name, bytes, options) in entries {
         zip.start_file(name.as_str(), options)
             .map_err(|e| format!("{name}: {e}"))?;
@@ -413,9 +453,47 @@ fn controller_sets(controller: &FmuInfo) -> Result<Vec<ParamSet>, String> {
     ])
 }
 
-/// SystemStructure.ssd of the closed loop.
-pub fn system_description(plant: &FmuInfo, controller: &FmuInfo) -> Result<String, String> {
-    let links = connections(plant, controller)?;
+/// The atmosphere's links by name (plant → atmosphere, atmosphere → plant) and its parameter
+/// set `atmosphere` (the declared defaults, [`ATMOSPHERE_PARAMS`]: calm). Every atmosphere
+/// input must be a plant output.
+fn atmosphere_element(plant: &FmuInfo, atmosphere: &FmuInfo) -> Result<(Vec<Connection>, Vec<ParamSet>), String> {
+    let mut links = links_between(plant, "plant", atmosphere, "atmosphere")?;
+    links.extend(links_between(atmosphere, "atmosphere", plant, "plant")?);
+    let undriven: Vec<_> = atmosphere
+        .with("input")
+        .filter(|p| !links.iter().any(|c| c.end == "atmosphere" && c.name == p.name))
+        .map(|p| p.name.as_str())
+        .collect();
+    if !undriven.is_empty() {
+        return Err(format!(
+            "{} does not drive atmosphere inputs {undriven:?}",
+            plant.model_identifier
+        ));
+    }
+    let values: Vec<_> = ATMOSPHERE_PARAMS
+        .iter()
+        .map(|(n, v)| match atmosphere.port(n).map(|p| p.kind.as_str()) {
+            Some("Integer") => (*n, "Integer", format!("{}", *v as i64)),
+            _ => (*n, "Real", real(*v)),
+        })
+        .collect();
+    Ok((links, vec![("atmosphere", bindings(atmosphere, &values)?)]))
+}
+
+/// SystemStructure.ssd of the closed loop, with the atmosphere component if given.
+pub fn system_description(
+    plant: &FmuInfo,
+    controller: &FmuInfo,
+    atmosphere: Option<&FmuInfo>,
+) -> Result<String, String> {
+    let mut links = connections(plant, controller)?;
+    let atmosphere = atmosphere
+        .map(|a| atmosphere_element(plant, a))
+        .transpose()?
+        .zip(atmosphere);
+    if let Some(((l, _), _)) = &atmosphere {
+        links.extend(l.iter().cloned());
+    }
     let inputs_of =
         |end: &str| -> Vec<&str> { links.iter().filter(|c| c.end == end).map(|c| c.name.as_str()).collect() };
     let (plant_inputs, controller_inputs) = (inputs_of("plant"), inputs_of("controller"));
@@ -434,15 +512,14 @@ pub fn system_description(plant: &FmuInfo, controller: &FmuInfo) -> Result<Strin
         "Tail-sitter closed loop: {} flying {} (docs/DESIGN.md section 2 port wiring by name, section 3 mission).",
         controller.model_identifier, plant.model_identifier
     );
-    write_ssd(
-        &name,
-        &description,
-        &[
-            ("controller", controller, controller_inputs, controller_parameters),
-            ("plant", plant, plant_inputs, vec![("plant", plant_parameters)]),
-        ],
-        &links,
-    )
+    let mut elements = vec![
+        ("controller", controller, controller_inputs, controller_parameters),
+        ("plant", plant, plant_inputs, vec![("plant", plant_parameters)]),
+    ];
+    if let Some(((_, sets), fmu)) = atmosphere {
+        elements.push(("atmosphere", fmu, inputs_of("atmosphere"), sets));
+    }
+    write_ssd(&name, &description, &elements, &links)
 }
 
 /// The estimator and sensors of the avionics systems `dist/<controller>_avionics.ssp`.
@@ -477,18 +554,27 @@ fn links_between(
 
 /// SystemStructure.ssd of avionics in the loop: plant → sensors → estimator → controller →
 /// plant and controller → estimator (the commands), every connection explicit and by name.
-/// The sensors and the estimator keep their (equal) defaults of the shared parameters.
+/// The sensors and the estimator keep their (equal) defaults of the shared parameters; the
+/// atmosphere, if given, is wired and bound as in the closed loop.
 pub fn avionics_system_description(
     plant: &FmuInfo,
     sensors: &FmuInfo,
     ekf: &FmuInfo,
     controller: &FmuInfo,
+    atmosphere: Option<&FmuInfo>,
 ) -> Result<String, String> {
     let mut links = links_between(plant, "plant", sensors, "sensors")?;
     links.extend(links_between(sensors, "sensors", ekf, "estimator")?);
     links.extend(links_between(ekf, "estimator", controller, "controller")?);
     links.extend(links_between(controller, "controller", plant, "plant")?);
     links.extend(links_between(controller, "controller", ekf, "estimator")?);
+    let atmosphere = atmosphere
+        .map(|a| atmosphere_element(plant, a))
+        .transpose()?
+        .zip(atmosphere);
+    if let Some(((l, _), _)) = &atmosphere {
+        links.extend(l.iter().cloned());
+    }
     for (fmu, id) in [(plant, "plant"), (ekf, "estimator")] {
         let undriven: Vec<_> = fmu
             .with("input")
@@ -537,22 +623,21 @@ pub fn avionics_system_description(
         "Tail-sitter with avionics in the loop: {} flying {} on the estimates of {} from {} (port wiring by name).",
         controller.model_identifier, plant.model_identifier, ekf.model_identifier, sensors.model_identifier
     );
-    write_ssd(
-        &name,
-        &description,
-        &[
-            ("controller", controller, inputs_of("controller"), controller_parameters),
-            (
-                "estimator",
-                ekf,
-                inputs_of("estimator"),
-                vec![("estimator", estimator_parameters)],
-            ),
-            ("sensors", sensors, inputs_of("sensors"), Vec::new()),
-            ("plant", plant, inputs_of("plant"), vec![("plant", plant_parameters)]),
-        ],
-        &links,
-    )
+    let mut elements = vec![
+        ("controller", controller, inputs_of("controller"), controller_parameters),
+        (
+            "estimator",
+            ekf,
+            inputs_of("estimator"),
+            vec![("estimator", estimator_parameters)],
+        ),
+        ("sensors", sensors, inputs_of("sensors"), Vec::new()),
+        ("plant", plant, inputs_of("plant"), vec![("plant", plant_parameters)]),
+    ];
+    if let Some(((_, sets), fmu)) = atmosphere {
+        elements.push(("atmosphere", fmu, inputs_of("atmosphere"), sets));
+    }
+    write_ssd(&name, &description, &elements, &links)
 }
 
 /// Write `<dir>/<controller>_avionics.ssp` (plant, sensors, estimator, controller).
@@ -561,9 +646,12 @@ pub fn write_avionics_ssp(dir: &Path, controller_id: &str) -> Result<PathBuf, St
         let p = dir.join(format!("{id}.fmu"));
         std::fs::read(&p).map_err(|e| format!("{}: {e}", p.display()))
     };
-    let bytes = [read(PLANT)?, read(SENSORS)?, read(ESTIMATOR)?, read(controller_id)?];
+    let mut bytes = vec![read(PLANT)?, read(SENSORS)?, read(ESTIMATOR)?, read(controller_id)?];
+    if dir.join(format!("{ATMOSPHERE}.fmu")).exists() {
+        bytes.push(read(ATMOSPHERE)?);
+    }
     let infos = bytes.iter().map(|b| fmu_info(b)).collect::<Result<Vec<_>, _>>()?;
-    let ssd = avionics_system_description(&infos[0], &infos[1], &infos[2], &infos[3])?;
+    let ssd = avionics_system_description(&infos[0], &infos[1], &infos[2], &infos[3], infos.get(4))?;
     let path = dir.join(format!("{controller_id}_avionics.ssp"));
     let file = std::fs::File::create(&path).map_err(|e| format!("{}: {e}", path.display()))?;
     let mut zip = zip::ZipWriter::new(file);
@@ -742,7 +830,7 @@ mod tests {
 
     #[test]
     fn design_model_is_the_plants_declared_airframe_bound_on_the_controller_only() {
-        let ssd = system_description(&plant(), &controller()).unwrap();
+        let ssd = system_description(&plant(), &controller(), None).unwrap();
         // 79 airframe parameters, the first the mass of 9 kg (thesis App. C.1.1)
         assert!(DESIGN_AIRFRAME.len() > 70, "{}", DESIGN_AIRFRAME.len());
         assert_eq!(DESIGN_AIRFRAME[0], ("mass", 9.0));
@@ -759,12 +847,12 @@ mod tests {
         // a controller without a design model is refused, not silently left on its defaults
         let mut c = controller();
         c.ports.retain(|p| p.name != "mass");
-        assert!(system_description(&plant(), &c).unwrap_err().contains("mass"));
+        assert!(system_description(&plant(), &c, None).unwrap_err().contains("mass"));
     }
 
     #[test]
     fn ssd_declares_only_connected_inputs_and_binds_the_mission() {
-        let ssd = system_description(&plant(), &controller()).unwrap();
+        let ssd = system_description(&plant(), &controller(), None).unwrap();
         assert!(ssd.contains(r#"<ssd:Connector name="pos_d" kind="input">"#));
         assert!(!ssd.contains("wind_n"), "undriven plant input declared");
         assert!(!ssd.contains("ref_offset_n"), "unconnected controller input declared");
@@ -798,7 +886,7 @@ mod tests {
     #[test]
     fn avionics_system_wires_the_chain_by_name() {
         let (sensors, ekf, controller) = avionics();
-        let ssd = avionics_system_description(&plant(), &sensors, &ekf, &controller).unwrap();
+        let ssd = avionics_system_description(&plant(), &sensors, &ekf, &controller, None).unwrap();
         for (from, to, name) in [
             ("plant", "sensors", "pos_d"),
             ("sensors", "estimator", "gps_height"),
@@ -818,15 +906,71 @@ mod tests {
     fn avionics_system_refuses_an_undriven_estimator_input() {
         let (sensors, mut ekf, controller) = avionics();
         ekf.ports.push(port("mag_x", "input", "Real"));
-        let e = avionics_system_description(&plant(), &sensors, &ekf, &controller).unwrap_err();
+        let e = avionics_system_description(&plant(), &sensors, &ekf, &controller, None).unwrap_err();
         assert!(e.contains("mag_x"), "{e}");
+    }
+
+    fn atmosphere() -> FmuInfo {
+        let mut ports = vec![port("pos_d", "input", "Real"), port("wind_n", "output", "Real")];
+        for (n, _) in ATMOSPHERE_PARAMS.iter() {
+            let kind = if matches!(
+                *n,
+                "wind_profile" | "turbulence_model" | "turbulence_intensity" | "seed"
+            ) {
+                "Integer"
+            } else {
+                "Real"
+            };
+            ports.push(port(n, "parameter", kind));
+        }
+        FmuInfo {
+            model_identifier: ATMOSPHERE.into(),
+            ports,
+            units: vec![],
+        }
+    }
+
+    #[test]
+    fn atmosphere_is_wired_by_name_and_bound_calm() {
+        let ssd = system_description(&plant(), &controller(), Some(&atmosphere())).unwrap();
+        for (from, to, name) in [("plant", "atmosphere", "pos_d"), ("atmosphere", "plant", "wind_n")] {
+            let c = format!(
+                r#"<ssd:Connection startElement="{from}" startConnector="{name}" endElement="{to}" endConnector="{name}"/>"#
+            );
+            assert!(ssd.contains(&c), "{c} missing");
+        }
+        let set = ssd
+            .find(r#"<ssv:ParameterSet version="1.0" name="atmosphere">"#)
+            .expect("atmosphere set");
+        let value_of = |name: &str| {
+            let at = ssd[set..]
+                .find(&format!(r#"<ssv:Parameter name="{name}">"#))
+                .unwrap_or_else(|| panic!("{name} not bound"));
+            let rest = &ssd[set + at..];
+            let v = rest.find("value=\"").expect("value") + 7;
+            let (kind, value) = (&rest[..v], &rest[v..v + rest[v..].find('"').expect("quote")]);
+            (kind.contains("ssv:Integer"), value.to_string())
+        };
+        assert_eq!(value_of("wind_speed"), (false, "0.0".to_string()));
+        assert_eq!(value_of("turbulence_intensity"), (true, "0".to_string()));
+        assert_eq!(value_of("gust_amplitude_n"), (false, "0.0".to_string()));
+        // without the atmosphere the plant's wind inputs stay undeclared
+        assert!(!system_description(&plant(), &controller(), None)
+            .unwrap()
+            .contains("wind_n"));
+        // an atmosphere input no plant output drives is refused
+        let mut a = atmosphere();
+        a.ports.push(port("humidity", "input", "Real"));
+        assert!(system_description(&plant(), &controller(), Some(&a))
+            .unwrap_err()
+            .contains("humidity"));
     }
 
     #[test]
     fn missing_mission_parameter_is_an_error() {
         let mut c = controller();
         c.ports.retain(|p| p.name != "t_level");
-        assert!(system_description(&plant(), &c).unwrap_err().contains("t_level"));
+        assert!(system_description(&plant(), &c, None).unwrap_err().contains("t_level"));
     }
 
     #[test]

@@ -20,3 +20,4 @@ pub mod sensitivity;
 pub mod sweep;
 pub mod takeoff_landing;
 pub mod transition_bound;
+pub mod wind_envelope;

@@ -66,6 +66,99 @@ enum Cmd {
     /// The Monte-Carlo campaign's jobs flown natively (`python -m tailsim.campaign_native`
     /// writes them): one JSON job per line in, one JSON row per line out, in job order.
     CampaignJobs(CampaignJobs),
+    /// Wind envelope over whole missions (wind_envelope.json, wind_envelope.csv): both
+    /// tuned controllers, steady wind stepping in and turbulent from the start, every
+    /// speed and bearing (`analysis::wind_envelope`).
+    WindEnvelope(WindEnvelopeArgs),
+    /// One native flight of the default mission through the atmosphere, as CSV (for the
+    /// comparison with the FMU master: tests/test_master_atmosphere.py).
+    WindTrace(WindTraceArgs),
+}
+
+#[derive(clap::Args, Clone)]
+struct WindTraceArgs {
+    /// "lqr" or "tsd".
+    #[arg(long, default_value = "tsd")]
+    controller: String,
+    /// "gauss-seidel" or "jacobi".
+    #[arg(long, default_value = "gauss-seidel")]
+    ordering: String,
+    /// Steady wind speed at the reference height (m/s) and the bearing it comes from (deg).
+    #[arg(long, default_value_t = 0.0)]
+    speed: f64,
+    #[arg(long, default_value_t = 0.0)]
+    from_deg: f64,
+    /// `wind_profile`, `turbulence_intensity`, `seed`, `origin_height` of the atmosphere.
+    #[arg(long, default_value_t = 1)]
+    profile: i32,
+    #[arg(long, default_value_t = 0)]
+    intensity: i32,
+    #[arg(long, default_value_t = 1)]
+    seed: i32,
+    #[arg(long, default_value_t = 0.0)]
+    origin_height: f64,
+    /// Stop time (s).
+    #[arg(long, default_value_t = 5.0)]
+    stop: f64,
+    /// CSV file.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+fn wind_trace(a: &WindTraceArgs) -> Result<(), String> {
+    use closed_loop::Ordering;
+    let kind = match a.controller.as_str() {
+        "lqr" => Kind::Lqr,
+        "tsd" => Kind::Tsd,
+        other => return Err(format!("controller '{other}': lqr or tsd")),
+    };
+    let ordering = match a.ordering.as_str() {
+        "gauss-seidel" => Ordering::GaussSeidel,
+        "jacobi" => Ordering::Jacobi,
+        other => return Err(format!("ordering '{other}': gauss-seidel or jacobi")),
+    };
+    let params = atmosphere::Params {
+        wind_speed: a.speed,
+        wind_from: a.from_deg.to_radians(),
+        wind_profile: a.profile,
+        turbulence_intensity: a.intensity,
+        seed: a.seed,
+        origin_height: a.origin_height,
+        ..atmosphere::Params::default()
+    };
+    let csv = analysis::wind_envelope::trace_csv(kind, ordering, params, a.stop)?;
+    std::fs::write(&a.out, csv).map_err(|e| format!("{}: {e}", a.out.display()))
+}
+
+#[derive(clap::Args, Clone)]
+struct WindEnvelopeArgs {
+    /// Output folder.
+    #[arg(long, default_value = "out/analysis")]
+    out: PathBuf,
+    /// Threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// The default mission only (not the take-off-to-landing mission).
+    #[arg(long)]
+    default_only: bool,
+}
+
+fn wind_envelope(a: &WindEnvelopeArgs) -> Result<(), String> {
+    use analysis::wind_envelope::{run, MissionKind};
+    let missions: &[MissionKind] = if a.default_only {
+        &[MissionKind::Default]
+    } else {
+        &[MissionKind::Default, MissionKind::TakeoffLanding]
+    };
+    let start = std::time::Instant::now();
+    let cells = run(&a.out, &Kind::ALL, missions)?;
+    eprintln!(
+        "wrote {}/wind_envelope.json: {} flights in {:.1} s",
+        a.out.display(),
+        cells.len(),
+        start.elapsed().as_secs_f64()
+    );
+    Ok(())
 }
 
 #[derive(clap::Args, Clone)]
@@ -148,6 +241,23 @@ fn main() {
         Cmd::Linear(c) => (c, false, false, false),
         Cmd::Nonlinear(c) => (c, true, true, false),
         Cmd::Aero(c) => (c, false, false, true),
+        Cmd::WindEnvelope(a) => {
+            if let Some(t) = a.threads {
+                let _ = rayon::ThreadPoolBuilder::new().num_threads(t).build_global();
+            }
+            if let Err(e) = wind_envelope(&a) {
+                eprintln!("wind envelope failed: {e}");
+                std::process::exit(1);
+            }
+            return;
+        }
+        Cmd::WindTrace(a) => {
+            if let Err(e) = wind_trace(&a) {
+                eprintln!("wind trace failed: {e}");
+                std::process::exit(1);
+            }
+            return;
+        }
         Cmd::CampaignJobs(a) => {
             if let Some(t) = a.threads {
                 let _ = rayon::ThreadPoolBuilder::new().num_threads(t).build_global();

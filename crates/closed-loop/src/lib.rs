@@ -12,6 +12,9 @@ use std::sync::OnceLock;
 use nalgebra::Vector3;
 use tailsitter_physics::{idx, InputVector, Plant, StateVector};
 
+pub mod wind_source;
+pub use wind_source::{PointWind, WindSource};
+
 /// The acceptance criteria of a flown mission, read from
 /// `modelDescription/fragments/mission_criteria.json` (compiled in): the one source the
 /// Python metrics and reports (`tailsim.metrics.CRITERIA`) read too.
@@ -106,6 +109,10 @@ pub enum Wind {
         duration: f64,
         amplitude: Vector3<f64>,
     },
+    /// The atmosphere of the `tailsitter_atmosphere` FMU (steady wind with a height profile,
+    /// Dryden turbulence, 1 − cos gust), run by [`fly`] on the plant's position and airspeed
+    /// ([`wind_source`]: the timing of a co-simulation master).
+    Atmosphere(atmosphere::Params),
 }
 
 /// Air-mass velocity, NED (m/s), of a horizontal wind of `speed` (m/s) blowing *from* the
@@ -177,6 +184,9 @@ impl Wind {
                     }
                     .at(t)
             }
+            // Stateful: [`fly`] runs it ([`WindSource`]); here only its steady wind at the
+            // reference height.
+            Wind::Atmosphere(p) => wind_from(p.wind_from, p.wind_speed),
         }
     }
 }
@@ -500,16 +510,24 @@ pub fn fly<C: FlightController>(plant: &Plant, x0: StateVector, controller: &mut
     let mut x = x0;
     let mut held: Option<flight_mission::ControllerOutput> = None;
     let mut previous_command: Option<Command> = None;
+    let mut source = match WindSource::new(scenario, plant, &x0) {
+        Ok(s) => s,
+        Err(e) => {
+            trace.failure = Some(e);
+            return trace;
+        }
+    };
     for k in 0..=n {
         let t = k as f64 * h;
-        let wind = scenario.wind.at(t);
         let u_now = previous_command
             .map(|c| plant_inputs(&c))
             .unwrap_or_else(InputVector::zeros);
-        let measured_wind = match scenario.measured_wind {
-            MeasuredWind::Current => wind,
-            MeasuredWind::HeldInput if k > 0 => scenario.wind.at((k - 1) as f64 * h),
-            MeasuredWind::HeldInput => wind,
+        let (wind, measured_wind) = match source.at(k, t, h, plant, &x, &u_now) {
+            Ok(w) => (w.flown, w.measured),
+            Err(e) => {
+                trace.failure = Some(e);
+                break;
+            }
         };
         let measurement = measure(plant, &x, &u_now, &measured_wind);
         if clock.take(t) || held.is_none() {

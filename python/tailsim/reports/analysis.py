@@ -21,6 +21,7 @@ from . import aero as aero_report
 from . import envelope as report_envelope
 from . import hover as report_hover
 from . import takeoff as report_takeoff
+from . import wind_envelope as report_wind
 from .markdown import fmt_or_dash, fmt_pole, markdown_to_html, shortest
 
 OPEN_LOOP_NOTES = (
@@ -46,9 +47,9 @@ SENSITIVITY_NOTES = (
 
 def load(folder: str | pathlib.Path) -> dict:
     """`report.json` of an analysis output folder, with `aero_models.json` (if written)
-    under the key `aero_models`."""
+    under the key `aero_models` and `wind_envelope.json` (if written) under `wind_envelope`."""
     d = json.loads((pathlib.Path(folder) / "report.json").read_text())
-    return aero_report.load_into(d, folder)
+    return report_wind.load_into(aero_report.load_into(d, folder), folder)
 
 
 def _rows(header: str, rule: str, lines: list[str]) -> list[str]:
@@ -319,6 +320,7 @@ SECTIONS = {
     "envelope_hover.md": report_hover.section,
     "envelope_transitions.md": report_envelope.section,
     "takeoff_landing.md": report_takeoff.section,
+    "wind_envelope.md": report_wind.section,
 }
 
 
@@ -356,6 +358,7 @@ def write(folder: str | pathlib.Path, with_plots: bool = True) -> pathlib.Path:
         analysis_plots.main(folder)
         aero_report.plot(folder)
         report_takeoff.plot(folder)
+        report_wind.plot(folder)
     md = markdown(d)
     pngs = plots(folder)
     if pngs:
