@@ -66,6 +66,8 @@ enum Cmd {
     /// The Monte-Carlo campaign's jobs flown natively (`python -m tailsim.campaign_native`
     /// writes them): one JSON job per line in, one JSON row per line out, in job order.
     CampaignJobs(CampaignJobs),
+    /// The thesis reproduction (reproduction.json): Table 5.1 etc. with configuration 1.
+    Reproduction(Common),
 }
 
 #[derive(clap::Args, Clone)]
@@ -113,6 +115,21 @@ fn main() {
         Cmd::Linear(c) => (c, false, false, false),
         Cmd::Nonlinear(c) => (c, true, true, false),
         Cmd::Aero(c) => (c, false, false, true),
+        Cmd::Reproduction(c) => {
+            let cfg = analysis::reproduction::Config {
+                n: c.n.max(2),
+                params: c.params,
+                mission: Default::default(),
+            };
+            if let Some(t) = c.threads {
+                let _ = rayon::ThreadPoolBuilder::new().num_threads(t).build_global();
+            }
+            if let Err(e) = analysis::reproduction::run(&c.out, &cfg, !c.quiet) {
+                eprintln!("reproduction failed: {e}");
+                std::process::exit(1);
+            }
+            return;
+        }
         Cmd::CampaignJobs(a) => {
             if let Some(t) = a.threads {
                 let _ = rayon::ThreadPoolBuilder::new().num_threads(t).build_global();
