@@ -39,7 +39,7 @@ use crate::modes;
 use crate::sensitivity::{self, Param, SensitivityRow};
 
 /// The configurations compared: (value of `configuration`, name).
-pub const CONFIGURATIONS: [(i32, &str); 2] = [(1, "thesis"), (0, "tuned")];
+pub const CONFIGURATIONS: [(i32, &str); 2] = [(1, "cfg1"), (0, "cfg0")];
 
 /// Thesis Table 4.4 (achieved TSD poles, upper half): (loop, vertical, level).
 #[allow(clippy::type_complexity)]
@@ -404,7 +404,7 @@ pub fn run(out: &Path, cfg: &Config, progress: bool) -> std::io::Result<Value> {
     }
     let thesis_holds = params.iter().filter(|p| p.thesis.0 < p.thesis.1).count();
     let n_params = params.len();
-    let c1_holds = counts.get("thesis").and_then(|v| v.as_u64()).unwrap_or(0) as usize;
+    let c1_holds = counts.get("cfg1").and_then(|v| v.as_u64()).unwrap_or(0) as usize;
     conclusions.push(json!({
         "claim": "Across the board LQR is less sensitive to parameter changes",
         "measure": "parameters with LQR < TSD",
@@ -529,9 +529,9 @@ pub fn run(out: &Path, cfg: &Config, progress: bool) -> std::io::Result<Value> {
     let num = |v: &Value, k: &str| v.get(k).and_then(Value::as_f64).unwrap_or(f64::NAN);
     let yes = |v: &Value, k: &str| v.get(k).and_then(Value::as_bool).unwrap_or(false);
     let (l5, t5, t34) = (
-        mf("lqr_thesis_default"),
-        mf("tsd_thesis_default"),
-        mf("tsd_thesis_fast"),
+        mf("lqr_cfg1_default"),
+        mf("tsd_cfg1_default"),
+        mf("tsd_cfg1_fast"),
     );
     let mut claims = Vec::new();
     claims.push(json!({
@@ -584,8 +584,8 @@ pub fn run(out: &Path, cfg: &Config, progress: bool) -> std::io::Result<Value> {
         "claim": "Table 5.1 values (sensitivity per parameter)",
         "where": "§5.2.1, Table 5.1",
         "figure": format!("configuration 1 mean over parameters: LQR {ml:.1} % (thesis {:.1} %), TSD {mt:.1} % (thesis {:.1} %); Spearman ρ LQR {:.2}, TSD {:.2}",
-            thesis_mean(Kind::Lqr), thesis_mean(Kind::Tsd), sp("lqr_thesis"), sp("tsd_thesis")),
-        "verdict": verdict(sp("lqr_thesis") > 0.7 && sp("tsd_thesis") > 0.7, sp("lqr_thesis") > 0.4 || sp("tsd_thesis") > 0.4),
+            thesis_mean(Kind::Lqr), thesis_mean(Kind::Tsd), sp("lqr_cfg1"), sp("tsd_cfg1")),
+        "verdict": verdict(sp("lqr_cfg1") > 0.7 && sp("tsd_cfg1") > 0.7, sp("lqr_cfg1") > 0.4 || sp("tsd_cfg1") > 0.4),
     }));
     for c in &conclusions {
         let v = c.get("verdict").cloned().unwrap_or(Value::Null);
@@ -615,7 +615,7 @@ pub fn run(out: &Path, cfg: &Config, progress: bool) -> std::io::Result<Value> {
     // Table 4.4 verdict: share of placed loops (guidance excluded, not in Table 4.4) within
     // 20 % of the thesis's achieved pole.
     let (mut close, mut all_rows) = (0usize, 0usize);
-    if let Some(list) = t44.get("thesis").and_then(Value::as_array) {
+    if let Some(list) = t44.get("cfg1").and_then(Value::as_array) {
         for cond in list {
             for r in cond.get("rows").and_then(Value::as_array).into_iter().flatten() {
                 if let Some(d) = r.get("ours_vs_thesis_pct").and_then(Value::as_f64) {
@@ -628,7 +628,7 @@ pub fn run(out: &Path, cfg: &Config, progress: bool) -> std::io::Result<Value> {
         }
     }
     let stable = |cond: usize| {
-        t44.get("thesis")
+        t44.get("cfg1")
             .and_then(|l| l.get(cond))
             .and_then(|c| c.get("stable"))
             .and_then(Value::as_bool)
@@ -672,7 +672,7 @@ pub fn run(out: &Path, cfg: &Config, progress: bool) -> std::io::Result<Value> {
         "figure": format!("mean Table 5.1 entry, configuration 1: TSD/LQR = {:.2} (thesis {:.2})", mt / ml, thesis_mean(Kind::Tsd) / thesis_mean(Kind::Lqr)),
         "verdict": verdict(mt / ml > 1.5, mt > ml),
     }));
-    let l34 = mf("lqr_thesis_fast");
+    let l34 = mf("lqr_cfg1_fast");
     claims.push(json!({
         "claim": "TSD flies trajectories faster and with smaller errors than LQR",
         "where": "§6.2.6",
