@@ -528,11 +528,7 @@ pub fn run(out: &Path, cfg: &Config, progress: bool) -> std::io::Result<Value> {
     let mf = |k: &str| missions.get(k).cloned().unwrap_or(Value::Null);
     let num = |v: &Value, k: &str| v.get(k).and_then(Value::as_f64).unwrap_or(f64::NAN);
     let yes = |v: &Value, k: &str| v.get(k).and_then(Value::as_bool).unwrap_or(false);
-    let (l5, t5, t34) = (
-        mf("lqr_cfg1_default"),
-        mf("tsd_cfg1_default"),
-        mf("tsd_cfg1_fast"),
-    );
+    let (l5, t5, t34) = (mf("lqr_cfg1_default"), mf("tsd_cfg1_default"), mf("tsd_cfg1_fast"));
     let mut claims = Vec::new();
     claims.push(json!({
         "claim": "Both controllers fly the mission with 5 s and 10 s transitions",
@@ -648,7 +644,12 @@ pub fn run(out: &Path, cfg: &Config, progress: bool) -> std::io::Result<Value> {
     claims.push(json!({
         "claim": "Open-loop level-flight modes (Tables 3.2/3.3)",
         "where": "§3.4.2, Tables 3.2/3.3",
-        "figure": format!("{stable_modes} of {} modes with the thesis's stability (the airframe's numbers the thesis omits are chosen here, docs/THESIS.md §4)", modes_rows.len()),
+        "figure": format!("{stable_modes} of {} modes with the thesis's stability; ω_n ours / thesis: {} (the airframe numbers the thesis omits are chosen here, docs/THESIS.md §4)",
+            modes_rows.len(),
+            modes_rows.iter().map(|r| format!("{} {:.2} / {:.2}",
+                r.get("mode").and_then(Value::as_str).unwrap_or(""),
+                r.get("ours_omega_n").and_then(Value::as_f64).unwrap_or(f64::NAN),
+                r.get("thesis_omega_n").and_then(Value::as_f64).unwrap_or(f64::NAN))).collect::<Vec<_>>().join(", ")),
         "verdict": verdict(false, stable_modes >= 3),
     }));
     // §6.2.6 restated on the thesis's setting.
