@@ -576,12 +576,36 @@ pub fn run(out: &Path, cfg: &Config, progress: bool) -> std::io::Result<Value> {
             / n_params.max(1) as f64
     };
     let (ml, mt) = (mean_of(Kind::Lqr, 1), mean_of(Kind::Tsd, 1));
+    // Median of ours (configuration 1) / thesis over the parameters with a thesis value.
+    let median_ratio = |kind: Kind| {
+        let mut v: Vec<f64> = idx
+            .iter()
+            .filter_map(|&i| {
+                let th = if kind == Kind::Lqr {
+                    params[i].thesis.0
+                } else {
+                    params[i].thesis.1
+                };
+                let o = rms(i, kind, 1);
+                (th > 0.0 && o.is_finite()).then_some(o / th)
+            })
+            .collect();
+        v.sort_by(f64::total_cmp);
+        if v.is_empty() {
+            f64::NAN
+        } else {
+            0.5 * (v[(v.len() - 1) / 2] + v[v.len() / 2])
+        }
+    };
+    let (rl, rt) = (median_ratio(Kind::Lqr), median_ratio(Kind::Tsd));
+    let near = |r: f64| (0.5..=2.0).contains(&r);
     claims.push(json!({
         "claim": "Table 5.1 values (sensitivity per parameter)",
         "where": "§5.2.1, Table 5.1",
-        "figure": format!("configuration 1 mean over parameters: LQR {ml:.1} % (thesis {:.1} %), TSD {mt:.1} % (thesis {:.1} %); Spearman ρ LQR {:.2}, TSD {:.2}",
+        "figure": format!("configuration 1 mean over parameters: LQR {ml:.1} % (thesis {:.1} %), TSD {mt:.1} % (thesis {:.1} %); median ours/thesis LQR {rl:.2}, TSD {rt:.2}; Spearman ρ LQR {:.2}, TSD {:.2}",
             thesis_mean(Kind::Lqr), thesis_mean(Kind::Tsd), sp("lqr_cfg1"), sp("tsd_cfg1")),
-        "verdict": verdict(sp("lqr_cfg1") > 0.7 && sp("tsd_cfg1") > 0.7, sp("lqr_cfg1") > 0.4 || sp("tsd_cfg1") > 0.4),
+        "median_ratio": {"lqr": rl, "tsd": rt},
+        "verdict": verdict(sp("lqr_cfg1") > 0.7 && sp("tsd_cfg1") > 0.7 && near(rl) && near(rt), sp("lqr_cfg1") > 0.4 || sp("tsd_cfg1") > 0.4),
     }));
     for c in &conclusions {
         let v = c.get("verdict").cloned().unwrap_or(Value::Null);
