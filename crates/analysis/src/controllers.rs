@@ -98,3 +98,22 @@ impl Analysable for AnyController {
         }
     }
 }
+
+impl Kind {
+    /// The controller in `configuration` (0 tuned, 1 the thesis as printed, docs/THESIS.md
+    /// §1), every deviation switch following it, the nominal airframe as its model.
+    pub fn make_configured(self, mission: &MissionParams, configuration: i32) -> Result<AnyController, ParamError> {
+        Ok(match self {
+            Kind::Lqr => {
+                let mut c = LqrConfig::with_mission(*mission);
+                c.params.configuration = configuration;
+                AnyController::Lqr(Box::new(SampledUnit::build(&c)?))
+            }
+            Kind::Tsd => {
+                let mut c = TsdConfig::with_mission(*mission);
+                c.params.configuration = configuration;
+                AnyController::Tsd(Box::new(SampledUnit::build(&c)?))
+            }
+        })
+    }
+}

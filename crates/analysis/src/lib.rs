@@ -15,6 +15,7 @@ pub mod envelope_transitions;
 pub mod linalg;
 pub mod modes;
 pub mod native_campaign;
+pub mod reproduction;
 pub mod robust;
 pub mod sensitivity;
 pub mod sweep;

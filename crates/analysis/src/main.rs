@@ -73,6 +73,8 @@ enum Cmd {
     /// One native flight of the default mission through the atmosphere, as CSV (for the
     /// comparison with the FMU master: tests/test_master_atmosphere.py).
     WindTrace(WindTraceArgs),
+    /// The thesis reproduction (reproduction.json): Table 5.1 etc. with configuration 1.
+    Reproduction(Common),
 }
 
 #[derive(clap::Args, Clone)]
@@ -254,6 +256,21 @@ fn main() {
         Cmd::WindTrace(a) => {
             if let Err(e) = wind_trace(&a) {
                 eprintln!("wind trace failed: {e}");
+                std::process::exit(1);
+            }
+            return;
+        }
+        Cmd::Reproduction(c) => {
+            let cfg = analysis::reproduction::Config {
+                n: c.n,
+                params: c.params,
+                mission: Default::default(),
+            };
+            if let Some(t) = c.threads {
+                let _ = rayon::ThreadPoolBuilder::new().num_threads(t).build_global();
+            }
+            if let Err(e) = analysis::reproduction::run(&c.out, &cfg, !c.quiet) {
+                eprintln!("reproduction failed: {e}");
                 std::process::exit(1);
             }
             return;

@@ -20,6 +20,7 @@ import pathlib
 from . import aero as aero_report
 from . import envelope as report_envelope
 from . import hover as report_hover
+from . import reproduction as report_reproduction
 from . import takeoff as report_takeoff
 from . import wind_envelope as report_wind
 from .markdown import fmt_or_dash, fmt_pole, markdown_to_html, shortest
@@ -49,7 +50,7 @@ def load(folder: str | pathlib.Path) -> dict:
     """`report.json` of an analysis output folder, with `aero_models.json` (if written)
     under the key `aero_models` and `wind_envelope.json` (if written) under `wind_envelope`."""
     d = json.loads((pathlib.Path(folder) / "report.json").read_text())
-    return report_wind.load_into(aero_report.load_into(d, folder), folder)
+    return report_reproduction.load_into(report_wind.load_into(aero_report.load_into(d, folder), folder), folder)
 
 
 def _rows(header: str, rule: str, lines: list[str]) -> list[str]:
@@ -321,6 +322,7 @@ SECTIONS = {
     "envelope_transitions.md": report_envelope.section,
     "takeoff_landing.md": report_takeoff.section,
     "wind_envelope.md": report_wind.section,
+    "reproduction.md": report_reproduction.section,
 }
 
 
