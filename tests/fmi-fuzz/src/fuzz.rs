@@ -89,6 +89,25 @@ impl Report {
         (self.coverage.len(), outcomes)
     }
 
+    /// The checks every short test run makes: no invariant violated, every sequence's
+    /// reset checked, and more than half of them a state restore.
+    pub fn assert_sound(&self) {
+        assert_eq!(self.violations, 0, "invariant violations (see output)");
+        assert_eq!(self.reset_checks, self.sequences);
+        assert!(
+            self.restore_checks > self.sequences / 2,
+            "restore checks {}",
+            self.restore_checks
+        );
+    }
+
+    /// Every "fmi2Function @ state" of `must` was called at least once.
+    pub fn assert_covers(&self, must: &[&str]) {
+        for must in must {
+            assert!(self.coverage.contains_key(*must), "{must} never exercised");
+        }
+    }
+
     pub fn print(&self) {
         let (pairs, outcomes) = self.coverage_summary();
         println!(
