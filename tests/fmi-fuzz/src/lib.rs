@@ -472,38 +472,26 @@ impl Instance<'_> {
             )
         }
     }
-    pub fn get_reals(&mut self, vrs: &[u32]) -> (fmi2Status, Vec<f64>) {
-        let mut out = vec![0.0; vrs.len()];
+    /// One fmi2Get{Real,Integer,Boolean} call over `vrs`.
+    fn get_values<T: Copy + Default>(
+        &mut self,
+        vrs: &[u32],
+        get: Option<unsafe extern "C" fn(fmi2Component, *const fmi2ValueReference, usize, *mut T) -> fmi2Status>,
+    ) -> (fmi2Status, Vec<T>) {
+        let mut out = vec![T::default(); vrs.len()];
+        let get = get.expect("fmi2Get* resolved at load time");
         // SAFETY: live instance, arrays of equal length.
-        let s = unsafe {
-            ffi!(
-                self.fmu.api,
-                get_real(self.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr())
-            )
-        };
+        let s = unsafe { get(self.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr()) };
         (s, out)
+    }
+    pub fn get_reals(&mut self, vrs: &[u32]) -> (fmi2Status, Vec<f64>) {
+        self.get_values(vrs, self.fmu.api.get_real)
     }
     pub fn get_integers(&mut self, vrs: &[u32]) -> (fmi2Status, Vec<i32>) {
-        let mut out = vec![0; vrs.len()];
-        // SAFETY: live instance, arrays of equal length.
-        let s = unsafe {
-            ffi!(
-                self.fmu.api,
-                get_integer(self.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr())
-            )
-        };
-        (s, out)
+        self.get_values(vrs, self.fmu.api.get_integer)
     }
     pub fn get_booleans(&mut self, vrs: &[u32]) -> (fmi2Status, Vec<i32>) {
-        let mut out = vec![0; vrs.len()];
-        // SAFETY: live instance, arrays of equal length.
-        let s = unsafe {
-            ffi!(
-                self.fmu.api,
-                get_boolean(self.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr())
-            )
-        };
-        (s, out)
+        self.get_values(vrs, self.fmu.api.get_boolean)
     }
     pub fn get_strings(&mut self, vrs: &[u32]) -> (fmi2Status, Vec<String>) {
         let mut out = vec![std::ptr::null(); vrs.len()];
