@@ -291,24 +291,7 @@ impl Fmu {
     /// (typically a GUID mismatch: the library is older than `modelDescription/`).
     pub fn instance(&self, name: &str, logging_on: bool) -> Instance<'_> {
         self.instantiate(name, logging_on).unwrap_or_else(|| {
-            let host = Host::new();
-            let cname = CString::new(name).expect("no NUL");
-            let guid = CString::new(self.guid.as_str()).expect("no NUL");
-            // SAFETY: valid arguments; a non-NULL result is freed at once.
-            let c = unsafe {
-                ffi!(
-                    self.api,
-                    instantiate(
-                        cname.as_ptr(),
-                        fmi2Type_fmi2CoSimulation,
-                        guid.as_ptr(),
-                        c"".as_ptr(),
-                        &*host.callbacks,
-                        0,
-                        1
-                    )
-                )
-            };
+            let (host, c) = self.instantiate_raw(name, c"", true);
             if !c.is_null() {
                 // SAFETY: live component.
                 unsafe { ffi!(self.api, free_instance(c)) };
@@ -323,10 +306,17 @@ impl Fmu {
 
     /// Instantiate with this model's GUID and a fresh recording host.
     pub fn instantiate(&self, name: &str, logging_on: bool) -> Option<Instance<'_>> {
+        let (host, c) = self.instantiate_raw(name, c"file:///nonexistent", logging_on);
+        (!c.is_null()).then_some(Instance { fmu: self, c, host })
+    }
+
+    /// fmi2Instantiate (Co-Simulation, this model's GUID) logging into a fresh host; the
+    /// component may be NULL. The host owns the callbacks: keep it while the component lives.
+    fn instantiate_raw(&self, name: &str, resources: &std::ffi::CStr, logging_on: bool) -> (Host, fmi2Component) {
         let host = Host::new();
         let cname = CString::new(name).expect("no NUL");
         let guid = CString::new(self.guid.as_str()).expect("no NUL");
-        // SAFETY: valid arguments; the callbacks outlive the instance (owned by it).
+        // SAFETY: valid arguments; the callbacks are boxed in `host`, returned with the component.
         let c = unsafe {
             ffi!(
                 self.api,
@@ -334,14 +324,14 @@ impl Fmu {
                     cname.as_ptr(),
                     fmi2Type_fmi2CoSimulation,
                     guid.as_ptr(),
-                    c"file:///nonexistent".as_ptr(),
+                    resources.as_ptr(),
                     &*host.callbacks,
                     0,
                     i32::from(logging_on)
                 )
             )
         };
-        (!c.is_null()).then_some(Instance { fmu: self, c, host })
+        (host, c)
     }
 }
 
