@@ -4,9 +4,11 @@ logger that records every message (formatted by fmpy's C logger proxy)."""
 from __future__ import annotations
 
 import pathlib
+from collections.abc import Callable
 from ctypes import byref
 from dataclasses import dataclass, field
 
+import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
 from fmpy.logging import addLoggerProxy
@@ -73,3 +75,27 @@ class Unpacked:
 
     def set(self, slave: FMU2Slave, **values: float) -> None:
         slave.setReal([self.vr[n] for n in values], list(values.values()))
+
+
+def assert_state_continues_bit_identically(
+    start: Callable[[str], FMU2Slave], lead_in: Callable[[FMU2Slave], object], run_on: Callable[[FMU2Slave], list]
+) -> None:
+    """An FMU state taken after `lead_in` continues bit-identically: `run_on` from it gives
+    the same outputs again after fmi2SetFMUstate, and in a fresh instance of `start` (a
+    name: a running instance) after fmi2SerializeFMUstate / fmi2DeSerializeFMUstate."""
+    s = start("state")
+    lead_in(s)
+    state = s.getFMUstate()
+    blob = s.serializeFMUstate(state)
+    reference = run_on(s)
+    s.setFMUstate(state)
+    assert np.array_equal(run_on(s), reference)
+    other = start("state2")
+    restored = other.deSerializeFMUstate(blob)
+    other.setFMUstate(restored)
+    assert np.array_equal(run_on(other), reference)
+    other.freeFMUstate(restored)
+    s.freeFMUstate(state)
+    for x in (s, other):
+        x.terminate()
+        x.freeInstance()

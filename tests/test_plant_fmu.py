@@ -10,7 +10,7 @@ import pytest
 from fmpy import simulate_fmu
 from fmpy.validation import validate_fmu
 
-from fmu_util import ROOT, LogRecorder
+from fmu_util import ROOT, LogRecorder, assert_state_continues_bit_identically
 
 OUTPUTS = ["pos_n", "pos_e", "pos_d", "vel_d", "theta", "airspeed", "alpha", "thrust", "elevator", "q"]
 
@@ -119,26 +119,11 @@ def test_two_instances_are_independent(plant):
 
 
 def test_fmu_state_get_set_and_serialize_continue_bit_identically(plant):
-    s = plant.slave("state")
-    manoeuvre(plant, s)
-    run(plant, s, 0.0, 0.3, 0.02)
-    state = s.getFMUstate()
-    blob = s.serializeFMUstate(state)
-    original = run(plant, s, 0.3, 0.8, 0.02)
+    def lead_in(s):
+        manoeuvre(plant, s)
+        run(plant, s, 0.0, 0.3, 0.02)
 
-    s.setFMUstate(state)
-    restored = run(plant, s, 0.3, 0.8, 0.02)
-    assert np.array_equal(original, restored)
-
-    other = plant.slave("other")  # a fresh instance receiving the serialized state
-    other_state = other.deSerializeFMUstate(blob)
-    other.setFMUstate(other_state)
-    assert np.array_equal(original, run(plant, other, 0.3, 0.8, 0.02))
-    s.freeFMUstate(state)
-    other.freeFMUstate(other_state)
-    for x in (s, other):
-        x.terminate()
-        x.freeInstance()
+    assert_state_continues_bit_identically(plant.slave, lead_in, lambda s: run(plant, s, 0.3, 0.8, 0.02))
 
 
 def test_corrupt_serialized_state_is_rejected(plant):

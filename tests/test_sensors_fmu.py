@@ -1,6 +1,6 @@
-"""The sensor FMU `tailsitter_sensors` (issue 14, part 1) through fmpy: the
-conformance checks and the every-variable test of the other FMUs applied to it,
-plus its own behaviour through the real C ABI: plant → sensors wired by name,
+"""The sensor FMU `tailsitter_sensors` (issue 14, part 1) through fmpy (the conformance
+checks and the every-variable test run over it with every FMU: test_conformance.py,
+test_variables.py): its own behaviour through the real C ABI: plant → sensors wired by name,
 reset mid-run, FMU state (get/set and serialised) continuing bit-identically,
 bad input and parameters as FMI errors with finite outputs."""
 
@@ -11,9 +11,7 @@ import math
 import numpy as np
 import pytest
 
-import test_conformance as conformance
-import test_variables as variables
-from fmu_util import LogRecorder, Unpacked
+from fmu_util import LogRecorder, Unpacked, assert_state_continues_bit_identically
 
 ID = "tailsitter_sensors"
 H = 0.02
@@ -56,36 +54,6 @@ TRUTH = [
 @pytest.fixture(scope="module")
 def sensors(tmp_path_factory) -> Unpacked:
     return Unpacked(ID, tmp_path_factory.mktemp("sensors"))
-
-
-# ----------------------------------------------------- the shared suites, for this FMU
-def test_fmpy_validate_reports_nothing():
-    conformance.test_fmpy_validate_reports_nothing(ID)
-
-
-def test_fmutool_check_passes():
-    conformance.test_fmutool_check_passes(ID)
-
-
-def test_archive_holds_binary_and_documentation():
-    conformance.test_archive_holds_binary_and_documentation(ID)
-
-
-def test_metadata_present():
-    conformance.test_metadata_present(ID)
-
-
-def test_wrong_guid_is_refused_at_instantiate(tmp_path):
-    conformance.test_wrong_guid_is_refused_at_instantiate(ID, tmp_path)
-
-
-def test_every_variable_as_declared(fmus, monkeypatch):
-    # fmpy's getBoolean returns the C fmi2Boolean (0/1), and pytest.approx(True) does not
-    # equal 1: compare Boolean start values as integers (this is the first FMU with a
-    # Boolean parameter; the shared helper can adopt the same conversion).
-    start_of = variables.start_of
-    monkeypatch.setattr(variables, "start_of", lambda v: int(start_of(v)) if v.type == "Boolean" else start_of(v))
-    variables.test_every_variable_as_declared(fmus, ID)
 
 
 # ----------------------------------------------------------------- its own behaviour
@@ -155,23 +123,11 @@ def test_reset_mid_run_repeats_the_run(sensors):
 
 
 def test_fmu_state_and_serialisation_continue_bit_identically(sensors):
-    s = sensors.slave("state")
-    sensors.set(s, airspeed=15.0, q=-0.05)
-    run(sensors, s, 23)
-    state = s.getFMUstate()
-    blob = s.serializeFMUstate(state)
-    reference = run(sensors, s, 80, 23 * H)
-    s.setFMUstate(state)
-    assert run(sensors, s, 80, 23 * H) == reference
-    other = sensors.slave("state2")
-    restored = other.deSerializeFMUstate(blob)
-    other.setFMUstate(restored)
-    assert run(sensors, other, 80, 23 * H) == reference
-    other.freeFMUstate(restored)
-    s.freeFMUstate(state)
-    for x in (s, other):
-        x.terminate()
-        x.freeInstance()
+    def lead_in(s):
+        sensors.set(s, airspeed=15.0, q=-0.05)
+        run(sensors, s, 23)
+
+    assert_state_continues_bit_identically(sensors.slave, lead_in, lambda s: run(sensors, s, 80, 23 * H))
 
 
 def test_bad_input_is_an_fmi_error_naming_the_input(sensors):
