@@ -106,7 +106,7 @@ pub struct ForcesMoments {
 /// Columns of `DCM^BW` (A.2.7): the wind axes x_w, y_w, z_w in body components, of the
 /// velocity `v` (body components). Returns (x_w, y_w, z_w, sin α, cos α).
 #[inline]
-fn wind_axes(v: &Vector3<f64>, speed: f64) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>, f64, f64) {
+pub(crate) fn wind_axes(v: &Vector3<f64>, speed: f64) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>, f64, f64) {
     if speed < AIRSPEED_EPS {
         return (Vector3::x(), Vector3::y(), Vector3::z(), 0.0, 1.0);
     }
