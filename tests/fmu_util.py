@@ -13,9 +13,16 @@ from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
 from fmpy.logging import addLoggerProxy
 
+from tailsim import declarations
+
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 DIST = ROOT / "dist"
 STATUS = ["OK", "Warning", "Discard", "Error", "Fatal", "Pending"]
+#: The plant's continuous states (Model Exchange) in state order: its variables declared
+#: with a derivative `der_<name>`.
+PLANT_STATES = [n.removeprefix("der_") for n in declarations.VARIABLES["tailsitter_plant"] if n.startswith("der_")]
+#: The plant's states but the flaps' (states of the global model only, idle elsewhere).
+PLANT_STATES_BUT_FLAPS = [n for n in PLANT_STATES if "flap" not in n]
 
 
 def fmu_path(model_identifier: str) -> pathlib.Path:

@@ -12,43 +12,17 @@ import numpy as np
 import pytest
 
 from fmu_util import LogRecorder, Unpacked, assert_state_continues_bit_identically
+from tailsim import declarations
 
 ID = "tailsitter_sensors"
 H = 0.02
-ANALOG = [
-    "imu_accel_x",
-    "imu_accel_y",
-    "imu_accel_z",
-    "imu_gyro_p",
-    "imu_gyro_q",
-    "imu_gyro_r",
-    "mag_x",
-    "mag_y",
-    "mag_z",
-    "pitot_airspeed",
-]
-GPS = ["gps_latitude", "gps_longitude", "gps_height", "gps_vel_n", "gps_vel_e", "gps_vel_d"]
-TRUTH = [
-    "pos_n",
-    "pos_e",
-    "pos_d",
-    "vel_n",
-    "vel_e",
-    "vel_d",
-    "p",
-    "q",
-    "r",
-    "quat_1",
-    "quat_2",
-    "quat_3",
-    "quat_4",
-    "airspeed",
-    "alpha",
-    "beta",
-    "accel_x",
-    "accel_y",
-    "accel_z",
-]
+_DECLARED = declarations.VARIABLES[ID]
+_REAL_OUTPUTS = [n for n, v in _DECLARED.items() if v.causality == "output" and v.type == "Real"]
+#: The analogue channels (IMU, magnetometer, pitot) and the GPS's Real outputs, as declared.
+ANALOG = [n for n in _REAL_OUTPUTS if not n.startswith("gps_")]
+GPS = [n for n in _REAL_OUTPUTS if n.startswith("gps_")]
+#: The true state (plant outputs of the same names): every input.
+TRUTH = [n for n, v in _DECLARED.items() if v.causality == "input"]
 
 
 @pytest.fixture(scope="module")
