@@ -2,6 +2,7 @@
 //! parameters as errors with finite outputs, FMU state continuing bit-identically,
 //! the step cost.
 
+use fmi2_export::test_host::assert_initialization_fails;
 use fmi2_export::{FmuModel, Logger, StateReader, StateWriter, VariableStore};
 use tailsitter_atmosphere::{AtmosphereModel, Variables};
 
@@ -50,28 +51,10 @@ fn non_finite_input_is_an_error_and_outputs_stay_finite() {
 
 #[test]
 fn bad_parameters_fail_initialization_with_the_reason() {
-    for (set, what) in [
-        (
-            Box::new(|v: &mut Variables| v.wind_speed = f64::NAN) as Box<dyn Fn(&mut Variables)>,
-            "wind_speed",
-        ),
-        (
-            Box::new(|v: &mut Variables| v.turbulence_intensity = 4),
-            "turbulence_intensity",
-        ),
-        (Box::new(|v: &mut Variables| v.wind_profile = -1), "wind_profile"),
-        (
-            Box::new(|v: &mut Variables| v.turbulence_sample_time = 0.0),
-            "turbulence_sample_time",
-        ),
-    ] {
-        let mut v = Variables::with_start_values();
-        set(&mut v);
-        let mut m = AtmosphereModel::new(&v);
-        let e = m.initialize(&mut v, 0.0, &mut Logger::null()).unwrap_err();
-        assert!(e.message.contains(what), "{what}: {e}");
-        assert!(m.do_step(&mut v, 0.0, 0.02, &mut Logger::null()).is_err());
-    }
+    assert_initialization_fails::<AtmosphereModel>(|v| v.wind_speed = f64::NAN, "wind_speed");
+    assert_initialization_fails::<AtmosphereModel>(|v| v.turbulence_intensity = 4, "turbulence_intensity");
+    assert_initialization_fails::<AtmosphereModel>(|v| v.wind_profile = -1, "wind_profile");
+    assert_initialization_fails::<AtmosphereModel>(|v| v.turbulence_sample_time = 0.0, "turbulence_sample_time");
 }
 
 #[test]

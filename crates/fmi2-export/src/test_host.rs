@@ -262,3 +262,19 @@ pub fn restore_forged<M: FmuModel>(name: &str, marker: f64, forged: f64) -> Forg
         }
     }
 }
+
+/// A model `M` whose start values `set` changes fails `initialize` with an error whose
+/// message contains `what`, and a step after the failed initialisation is an error, not a
+/// panic.
+pub fn assert_initialization_fails<M: FmuModel>(set: impl FnOnce(&mut M::Vars), what: &str) {
+    use crate::{Logger, VariableStore};
+    let mut v = M::Vars::with_start_values();
+    set(&mut v);
+    let mut m = M::new(&v);
+    let e = m
+        .initialize(&mut v, 0.0, &mut Logger::null())
+        .err()
+        .unwrap_or_else(|| panic!("{what}: initialisation succeeded"));
+    assert!(e.message.contains(what), "{what}: {e}");
+    assert!(m.do_step(&mut v, 0.0, 0.02, &mut Logger::null()).is_err());
+}
