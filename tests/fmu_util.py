@@ -106,3 +106,15 @@ def assert_state_continues_bit_identically(
     for x in (s, other):
         x.terminate()
         x.freeInstance()
+
+
+def assert_refused(log: LogRecorder, call: Callable[..., object], what: str, *args, **kwargs) -> None:
+    """`call(*args, **kwargs)` fails (an FMI error raised by fmpy) and `log` holds an error
+    naming `what`."""
+    try:
+        call(*args, **kwargs)
+    except Exception:
+        pass
+    else:
+        raise AssertionError(f"{what}: the call succeeded")
+    assert any(what in m for m in log.errors()), (what, log.messages)
