@@ -78,36 +78,44 @@ fn write_all(w: &mut W, model: &Model) -> Result<()> {
 /// as the Reference FMUs do. No event indicators, no time events: the model is smooth
 /// between input changes, which the importer handles at its communication points.
 fn model_exchange(w: &mut W, model: &Model) -> Result<()> {
-    w.create_element("ModelExchange")
-        .with_attributes([
-            ("modelIdentifier", model.model_identifier.as_str()),
-            ("needsExecutionTool", "false"),
-            ("completedIntegratorStepNotNeeded", "true"),
-            ("canBeInstantiatedOnlyOncePerProcess", "false"),
-            ("canNotUseMemoryManagementFunctions", "true"),
-            ("canGetAndSetFMUstate", "true"),
-            ("canSerializeFMUstate", "true"),
-            ("providesDirectionalDerivative", "false"),
-        ])
-        .write_empty()?;
-    Ok(())
+    interface(
+        w,
+        "ModelExchange",
+        model,
+        &[("completedIntegratorStepNotNeeded", "true")],
+    )
 }
 
 fn co_simulation(w: &mut W, model: &Model) -> Result<()> {
-    w.create_element("CoSimulation")
-        .with_attributes([
-            ("modelIdentifier", model.model_identifier.as_str()),
-            ("needsExecutionTool", "false"),
+    interface(
+        w,
+        "CoSimulation",
+        model,
+        &[
             ("canHandleVariableCommunicationStepSize", "true"),
             ("canInterpolateInputs", "false"),
             ("maxOutputDerivativeOrder", "0"),
             ("canRunAsynchronuously", "false"),
-            ("canBeInstantiatedOnlyOncePerProcess", "false"),
-            ("canNotUseMemoryManagementFunctions", "true"),
-            ("canGetAndSetFMUstate", "true"),
-            ("canSerializeFMUstate", "true"),
-            ("providesDirectionalDerivative", "false"),
-        ])
+        ],
+    )
+}
+
+/// One interface element: the model identifier, `specific` capabilities, then those both
+/// interfaces share (many instances, the FMU's own memory management, FMU states).
+fn interface(w: &mut W, element: &str, model: &Model, specific: &[(&str, &str)]) -> Result<()> {
+    let head = [
+        ("modelIdentifier", model.model_identifier.as_str()),
+        ("needsExecutionTool", "false"),
+    ];
+    let shared = [
+        ("canBeInstantiatedOnlyOncePerProcess", "false"),
+        ("canNotUseMemoryManagementFunctions", "true"),
+        ("canGetAndSetFMUstate", "true"),
+        ("canSerializeFMUstate", "true"),
+        ("providesDirectionalDerivative", "false"),
+    ];
+    w.create_element(element)
+        .with_attributes(head.into_iter().chain(specific.iter().copied()).chain(shared))
         .write_empty()?;
     Ok(())
 }
