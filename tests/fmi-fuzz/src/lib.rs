@@ -581,16 +581,22 @@ pub fn cycle(fmu: &Fmu, steps: usize) -> bool {
     for k in 0..steps {
         ok &= inst.step(k as f64 * h, h) == OK;
     }
+    ok &= state_round_trip(&mut inst, |inst| inst.snapshot_bits().0.iter().all(|s| *s == OK));
+    ok &= inst.terminate() == OK;
+    ok
+}
+
+/// Get the FMU state, serialize it, deserialize and set the copy, run `then` (its result
+/// counts), free both states: true if every status was OK.
+fn state_round_trip(inst: &mut Instance<'_>, then: impl FnOnce(&mut Instance<'_>) -> bool) -> bool {
     let (s, mut state) = inst.get_state();
-    ok &= s == OK;
+    let mut ok = s == OK;
     let (s, bytes) = inst.serialize(state);
     ok &= s == OK;
     let (s, mut restored) = inst.deserialize(&bytes);
     ok &= s == OK && inst.set_state(restored) == OK;
-    let (s, _) = inst.snapshot_bits();
-    ok &= s.iter().all(|s| *s == OK);
+    ok &= then(inst);
     ok &= inst.free_state(&mut restored) == OK && inst.free_state(&mut state) == OK;
-    ok &= inst.terminate() == OK;
     ok
 }
 
@@ -602,13 +608,7 @@ pub fn light_cycle(fmu: &Fmu) -> bool {
         return false;
     };
     let mut ok = inst.setup(0.0, None) == OK;
-    let (s, mut state) = inst.get_state();
-    ok &= s == OK;
-    let (s, bytes) = inst.serialize(state);
-    ok &= s == OK;
-    let (s, mut restored) = inst.deserialize(&bytes);
-    ok &= s == OK && inst.set_state(restored) == OK;
-    ok &= inst.free_state(&mut restored) == OK && inst.free_state(&mut state) == OK;
+    ok &= state_round_trip(&mut inst, |_| true);
     ok
 }
 
