@@ -2,8 +2,8 @@
 //! parameters as errors with finite outputs, FMU state continuing bit-identically,
 //! the step cost.
 
-use fmi2_export::test_host::assert_initialization_fails;
-use fmi2_export::{FmuModel, Logger, StateReader, StateWriter, VariableStore};
+use fmi2_export::test_host::{assert_initialization_fails, assert_state_round_trip};
+use fmi2_export::{FmuModel, Logger, VariableStore};
 use tailsitter_atmosphere::{AtmosphereModel, Variables};
 
 fn outputs(v: &Variables) -> [u64; 3] {
@@ -71,30 +71,7 @@ fn fmu_state_round_trip_continues_bit_identically() {
         v.pos_d = -0.2 * k as f64;
         m.do_step(&mut v, k as f64 * 0.02, 0.02, &mut log).unwrap();
     }
-    let mut w = StateWriter::new();
-    m.write_state(&mut w);
-    let bytes = w.into_bytes();
-    let saved_vars = v.clone();
-    let mut reference = Vec::new();
-    for k in 33..200 {
-        v.pos_d = -0.2 * k as f64;
-        m.do_step(&mut v, k as f64 * 0.02, 0.02, &mut log).unwrap();
-        reference.push(outputs(&v));
-    }
-    let mut v2 = saved_vars;
-    let mut m2 = AtmosphereModel::new(&v2);
-    let mut r = StateReader::new(&bytes);
-    m2.read_state(&mut r).unwrap();
-    r.finish().unwrap();
-    for (i, k) in (33..200).enumerate() {
-        v2.pos_d = -0.2 * k as f64;
-        m2.do_step(&mut v2, k as f64 * 0.02, 0.02, &mut log).unwrap();
-        assert_eq!(outputs(&v2), reference[i], "step {k}");
-    }
-    for n in 0..bytes.len() {
-        let mut m3 = AtmosphereModel::new(&v2);
-        assert!(m3.read_state(&mut StateReader::new(&bytes[..n])).is_err(), "{n}");
-    }
+    assert_state_round_trip(&mut m, &mut v, 33..200, 0.02, |v, k| v.pos_d = -0.2 * k as f64, outputs);
 }
 
 #[test]

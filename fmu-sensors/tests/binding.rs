@@ -1,8 +1,8 @@
 //! The FMU binding through `FmuModel` (no C layer): start values, bad input and
 //! parameters as errors with finite outputs, FMU state continuing bit-identically.
 
-use fmi2_export::test_host::assert_initialization_fails;
-use fmi2_export::{FmuModel, Logger, StateReader, StateWriter, VariableStore};
+use fmi2_export::test_host::{assert_initialization_fails, assert_state_round_trip};
+use fmi2_export::{FmuModel, Logger, VariableStore};
 use tailsitter_sensors::{SensorsModel, Variables};
 
 /// The Real outputs: the GPS's six, then the ten analogue channels.
@@ -122,30 +122,7 @@ fn fmu_state_round_trip_continues_bit_identically() {
     for k in 0..33 {
         m.do_step(&mut v, k as f64 * 0.02, 0.02, &mut log).unwrap();
     }
-    let mut w = StateWriter::new();
-    m.write_state(&mut w);
-    let bytes = w.into_bytes();
-    let saved_vars = v.clone();
-    let mut reference = Vec::new();
-    for k in 33..200 {
-        m.do_step(&mut v, k as f64 * 0.02, 0.02, &mut log).unwrap();
-        reference.push(outputs(&v));
-    }
-    // Restore into a fresh instance (as fmi2DeSerializeFMUstate does: variables, then model state).
-    let mut v2 = saved_vars;
-    let mut m2 = SensorsModel::new(&v2);
-    let mut r = StateReader::new(&bytes);
-    m2.read_state(&mut r).unwrap();
-    r.finish().unwrap();
-    for (i, k) in (33..200).enumerate() {
-        m2.do_step(&mut v2, k as f64 * 0.02, 0.02, &mut log).unwrap();
-        assert_eq!(outputs(&v2), reference[i], "step {k}");
-    }
-    // Truncated buffers are errors, never panics.
-    for n in 0..bytes.len() {
-        let mut m3 = SensorsModel::new(&v2);
-        assert!(m3.read_state(&mut StateReader::new(&bytes[..n])).is_err(), "{n}");
-    }
+    assert_state_round_trip(&mut m, &mut v, 33..200, 0.02, |_, _| {}, outputs);
 }
 
 #[test]
