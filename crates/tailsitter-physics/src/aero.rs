@@ -103,6 +103,14 @@ pub struct ForcesMoments {
     pub slipstream_speed: f64,
 }
 
+impl ForcesMoments {
+    /// Force then moment, body axes: (X, Y, Z, L, M, N).
+    pub fn wrench(&self) -> [f64; 6] {
+        let (f, m) = (&self.force_body, &self.moment_body);
+        [f.x, f.y, f.z, m.x, m.y, m.z]
+    }
+}
+
 /// Columns of `DCM^BW` (A.2.7): the wind axes x_w, y_w, z_w in body components, of the
 /// velocity `v` (body components). Returns (x_w, y_w, z_w, sin α, cos α).
 #[inline]
