@@ -4,16 +4,25 @@ logger that records every message (formatted by fmpy's C logger proxy)."""
 from __future__ import annotations
 
 import pathlib
+from collections.abc import Callable
 from ctypes import byref
 from dataclasses import dataclass, field
 
+import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
 from fmpy.logging import addLoggerProxy
 
+from tailsim import declarations
+
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 DIST = ROOT / "dist"
 STATUS = ["OK", "Warning", "Discard", "Error", "Fatal", "Pending"]
+#: The plant's continuous states (Model Exchange) in state order: its variables declared
+#: with a derivative `der_<name>`.
+PLANT_STATES = [n.removeprefix("der_") for n in declarations.VARIABLES["tailsitter_plant"] if n.startswith("der_")]
+#: The plant's states but the flaps' (states of the global model only, idle elsewhere).
+PLANT_STATES_BUT_FLAPS = [n for n in PLANT_STATES if "flap" not in n]
 
 
 def fmu_path(model_identifier: str) -> pathlib.Path:
@@ -73,3 +82,39 @@ class Unpacked:
 
     def set(self, slave: FMU2Slave, **values: float) -> None:
         slave.setReal([self.vr[n] for n in values], list(values.values()))
+
+
+def assert_state_continues_bit_identically(
+    start: Callable[[str], FMU2Slave], lead_in: Callable[[FMU2Slave], object], run_on: Callable[[FMU2Slave], list]
+) -> None:
+    """An FMU state taken after `lead_in` continues bit-identically: `run_on` from it gives
+    the same outputs again after fmi2SetFMUstate, and in a fresh instance of `start` (a
+    name: a running instance) after fmi2SerializeFMUstate / fmi2DeSerializeFMUstate."""
+    s = start("state")
+    lead_in(s)
+    state = s.getFMUstate()
+    blob = s.serializeFMUstate(state)
+    reference = run_on(s)
+    s.setFMUstate(state)
+    assert np.array_equal(run_on(s), reference)
+    other = start("state2")
+    restored = other.deSerializeFMUstate(blob)
+    other.setFMUstate(restored)
+    assert np.array_equal(run_on(other), reference)
+    other.freeFMUstate(restored)
+    s.freeFMUstate(state)
+    for x in (s, other):
+        x.terminate()
+        x.freeInstance()
+
+
+def assert_refused(log: LogRecorder, call: Callable[..., object], what: str, *args, **kwargs) -> None:
+    """`call(*args, **kwargs)` fails (an FMI error raised by fmpy) and `log` holds an error
+    naming `what`."""
+    try:
+        call(*args, **kwargs)
+    except Exception:
+        pass
+    else:
+        raise AssertionError(f"{what}: the call succeeded")
+    assert any(what in m for m in log.errors()), (what, log.messages)

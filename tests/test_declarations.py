@@ -1,8 +1,9 @@
-"""The generated declarations module (tailsim.declarations, `cargo xtask regen`):
-it agrees with the packaged FMUs, and no module of python/tailsim restates what it
-carries (lists of phase-duration, phase or command names, the command limits, the
-mission presets) by hand. The Rust test `python_declarations_module_matches_generated`
-(modelDescription/tests/declarations.rs) checks the committed module is the generator's."""
+"""The declarations module (tailsim.declarations, loading the data `declarations.json`
+that `cargo xtask regen` writes): it agrees with the packaged FMUs, and no module of
+python/tailsim restates what it carries (lists of phase-duration, phase or command
+names, the command limits, the mission presets) by hand. The Rust test
+`python_declarations_data_matches_generated` (modelDescription/tests/declarations.rs)
+checks the committed data is the generator's."""
 
 import ast
 import math
@@ -13,7 +14,7 @@ from fmu_util import ROOT
 from tailsim import declarations as D
 
 PACKAGE = ROOT / "python" / "tailsim"
-MODULES = sorted(p for p in PACKAGE.rglob("*.py") if p.name != "declarations.py")
+MODULES = sorted(PACKAGE.rglob("*.py"))
 
 
 @pytest.mark.parametrize("identifier", D.MODELS)

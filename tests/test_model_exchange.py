@@ -19,30 +19,12 @@ import pytest
 from fmpy import read_model_description
 from fmpy.fmi2 import FMU2Model, fmi2False
 
-from fmu_util import fmu_path
+from fmu_util import PLANT_STATES_BUT_FLAPS, fmu_path
 from tailsim import ClosedLoop
 
 CONTROLLERS = ["tailsitter_lqr", "tailsitter_tsd"]
 RTOL = 1e-9
-COMPARED = [
-    "pos_n",
-    "pos_e",
-    "pos_d",
-    "u",
-    "v",
-    "w",
-    "quat_1",
-    "quat_2",
-    "quat_3",
-    "quat_4",
-    "p",
-    "q",
-    "r",
-    "thrust",
-    "elevator",
-    "aileron",
-    "rudder",
-]
+COMPARED = PLANT_STATES_BUT_FLAPS
 # ME (CVode, rtol 1e-9) vs CS (RK4, 2 ms): both integrate the same right-hand side over
 # the same 20 ms sample intervals with the same held commands. RK4's local error
 # ~ (2 ms)^5 f^(5) and CVode's tolerance-controlled error are both far below 1e-6 per

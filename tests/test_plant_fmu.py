@@ -10,7 +10,7 @@ import pytest
 from fmpy import simulate_fmu
 from fmpy.validation import validate_fmu
 
-from fmu_util import ROOT, LogRecorder
+from fmu_util import ROOT, LogRecorder, assert_refused, assert_state_continues_bit_identically
 
 OUTPUTS = ["pos_n", "pos_e", "pos_d", "vel_d", "theta", "airspeed", "alpha", "thrust", "elevator", "q"]
 
@@ -119,26 +119,11 @@ def test_two_instances_are_independent(plant):
 
 
 def test_fmu_state_get_set_and_serialize_continue_bit_identically(plant):
-    s = plant.slave("state")
-    manoeuvre(plant, s)
-    run(plant, s, 0.0, 0.3, 0.02)
-    state = s.getFMUstate()
-    blob = s.serializeFMUstate(state)
-    original = run(plant, s, 0.3, 0.8, 0.02)
+    def lead_in(s):
+        manoeuvre(plant, s)
+        run(plant, s, 0.0, 0.3, 0.02)
 
-    s.setFMUstate(state)
-    restored = run(plant, s, 0.3, 0.8, 0.02)
-    assert np.array_equal(original, restored)
-
-    other = plant.slave("other")  # a fresh instance receiving the serialized state
-    other_state = other.deSerializeFMUstate(blob)
-    other.setFMUstate(other_state)
-    assert np.array_equal(original, run(plant, other, 0.3, 0.8, 0.02))
-    s.freeFMUstate(state)
-    other.freeFMUstate(other_state)
-    for x in (s, other):
-        x.terminate()
-        x.freeInstance()
+    assert_state_continues_bit_identically(plant.slave, lead_in, lambda s: run(plant, s, 0.3, 0.8, 0.02))
 
 
 def test_corrupt_serialized_state_is_rejected(plant):
@@ -164,17 +149,11 @@ def test_corrupt_serialized_state_is_rejected(plant):
 def test_bad_input_gives_errors_not_crashes(plant):
     log = LogRecorder()
     s = plant.slave("bad", log)
-    with pytest.raises(Exception):
-        plant.set(s, thrust_cmd=float("nan"))
-    assert any("thrust_cmd" in m for m in log.errors()), log.messages
+    assert_refused(log, lambda: plant.set(s, thrust_cmd=float("nan")), "thrust_cmd")
     log.clear()
-    with pytest.raises(Exception):
-        s.getReal([999_999])
-    assert any("999999" in m for m in log.errors()), log.messages
+    assert_refused(log, lambda: s.getReal([999_999]), "999999")
     log.clear()
-    with pytest.raises(Exception):  # a fixed parameter after initialisation
-        plant.set(s, mass=10.0)
-    assert any("mass" in m for m in log.errors()), log.messages
+    assert_refused(log, lambda: plant.set(s, mass=10.0), "mass")  # a fixed parameter after initialisation
     with pytest.raises(Exception):  # an output
         plant.set(s, pos_n=1.0)
     # the NaN was not applied: the instance still flies the trim
@@ -188,9 +167,7 @@ def test_bad_input_gives_errors_not_crashes(plant):
 def test_illegal_call_order_is_an_error(plant):
     log = LogRecorder()
     s = plant.slave("order", log, init=False)
-    with pytest.raises(Exception):
-        s.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.02)
-    assert any("fmi2DoStep" in m for m in log.errors()), log.messages
+    assert_refused(log, lambda: s.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.02), "fmi2DoStep")
     s.setupExperiment(startTime=0.0)
     s.enterInitializationMode()
     s.exitInitializationMode()
@@ -206,9 +183,7 @@ def test_illegal_call_order_is_an_error(plant):
 def test_out_of_range_parameter_is_rejected_at_set(plant):
     log = LogRecorder()
     s = plant.slave("range", log, init=False)
-    with pytest.raises(Exception):
-        plant.set(s, mass=-1.0)
-    assert any("mass" in m for m in log.errors())
+    assert_refused(log, lambda: plant.set(s, mass=-1.0), "mass")
     s.freeInstance()
 
 
@@ -221,7 +196,5 @@ def test_divergence_is_reported_as_an_error(plant):
     plant.set(s, i_xx=1e-4, i_yy=1e-4, i_zz=1e-4)  # featherweight inertia
     s.exitInitializationMode()
     plant.set(s, aileron_cmd=0.4, elevator_cmd=0.4, rudder_cmd=0.4)
-    with pytest.raises(Exception):
-        run(plant, s, 0.0, 10.0, 0.02)
-    assert any("envelope" in m for m in log.errors()), log.messages
+    assert_refused(log, lambda: run(plant, s, 0.0, 10.0, 0.02), "envelope")
     s.freeInstance()

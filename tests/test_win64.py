@@ -28,7 +28,7 @@ import zipfile
 import numpy as np
 import pytest
 
-from fmu_util import fmu_path
+from fmu_util import PLANT_STATES_BUT_FLAPS, fmu_path
 from tailsim import ClosedLoop, Fmu
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -197,25 +197,7 @@ def win64_fmus(tmp_path_factory):
 # model the LQR's back transition stalls (α ≈ 52°), a far more sensitive flight: 1.0e-8
 # (u, m/s). 1e-7 in SI units keeps a 10× margin, far below anything physical.
 WIN64_TOL = 1e-7
-COMPARED = [
-    "pos_n",
-    "pos_e",
-    "pos_d",
-    "u",
-    "v",
-    "w",
-    "p",
-    "q",
-    "r",
-    "quat_1",
-    "quat_2",
-    "quat_3",
-    "quat_4",
-    "thrust",
-    "elevator",
-    "aileron",
-    "rudder",
-]
+COMPARED = PLANT_STATES_BUT_FLAPS
 
 
 # fmpy's TCP remoting server listens on one fixed port: one remoted FMU per host at a

@@ -2,7 +2,8 @@
 //! parameters as errors with finite outputs, FMU state continuing bit-identically,
 //! the step cost.
 
-use fmi2_export::{FmuModel, Logger, StateReader, StateWriter, VariableStore};
+use fmi2_export::test_host::{assert_initialization_fails, assert_state_round_trip};
+use fmi2_export::{FmuModel, Logger, VariableStore};
 use tailsitter_atmosphere::{AtmosphereModel, Variables};
 
 fn outputs(v: &Variables) -> [u64; 3] {
@@ -50,28 +51,10 @@ fn non_finite_input_is_an_error_and_outputs_stay_finite() {
 
 #[test]
 fn bad_parameters_fail_initialization_with_the_reason() {
-    for (set, what) in [
-        (
-            Box::new(|v: &mut Variables| v.wind_speed = f64::NAN) as Box<dyn Fn(&mut Variables)>,
-            "wind_speed",
-        ),
-        (
-            Box::new(|v: &mut Variables| v.turbulence_intensity = 4),
-            "turbulence_intensity",
-        ),
-        (Box::new(|v: &mut Variables| v.wind_profile = -1), "wind_profile"),
-        (
-            Box::new(|v: &mut Variables| v.turbulence_sample_time = 0.0),
-            "turbulence_sample_time",
-        ),
-    ] {
-        let mut v = Variables::with_start_values();
-        set(&mut v);
-        let mut m = AtmosphereModel::new(&v);
-        let e = m.initialize(&mut v, 0.0, &mut Logger::null()).unwrap_err();
-        assert!(e.message.contains(what), "{what}: {e}");
-        assert!(m.do_step(&mut v, 0.0, 0.02, &mut Logger::null()).is_err());
-    }
+    assert_initialization_fails::<AtmosphereModel>(|v| v.wind_speed = f64::NAN, "wind_speed");
+    assert_initialization_fails::<AtmosphereModel>(|v| v.turbulence_intensity = 4, "turbulence_intensity");
+    assert_initialization_fails::<AtmosphereModel>(|v| v.wind_profile = -1, "wind_profile");
+    assert_initialization_fails::<AtmosphereModel>(|v| v.turbulence_sample_time = 0.0, "turbulence_sample_time");
 }
 
 #[test]
@@ -88,30 +71,7 @@ fn fmu_state_round_trip_continues_bit_identically() {
         v.pos_d = -0.2 * k as f64;
         m.do_step(&mut v, k as f64 * 0.02, 0.02, &mut log).unwrap();
     }
-    let mut w = StateWriter::new();
-    m.write_state(&mut w);
-    let bytes = w.into_bytes();
-    let saved_vars = v.clone();
-    let mut reference = Vec::new();
-    for k in 33..200 {
-        v.pos_d = -0.2 * k as f64;
-        m.do_step(&mut v, k as f64 * 0.02, 0.02, &mut log).unwrap();
-        reference.push(outputs(&v));
-    }
-    let mut v2 = saved_vars;
-    let mut m2 = AtmosphereModel::new(&v2);
-    let mut r = StateReader::new(&bytes);
-    m2.read_state(&mut r).unwrap();
-    r.finish().unwrap();
-    for (i, k) in (33..200).enumerate() {
-        v2.pos_d = -0.2 * k as f64;
-        m2.do_step(&mut v2, k as f64 * 0.02, 0.02, &mut log).unwrap();
-        assert_eq!(outputs(&v2), reference[i], "step {k}");
-    }
-    for n in 0..bytes.len() {
-        let mut m3 = AtmosphereModel::new(&v2);
-        assert!(m3.read_state(&mut StateReader::new(&bytes[..n])).is_err(), "{n}");
-    }
+    assert_state_round_trip(&mut m, &mut v, 33..200, 0.02, |v, k| v.pos_d = -0.2 * k as f64, outputs);
 }
 
 #[test]

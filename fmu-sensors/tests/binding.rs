@@ -1,10 +1,12 @@
 //! The FMU binding through `FmuModel` (no C layer): start values, bad input and
 //! parameters as errors with finite outputs, FMU state continuing bit-identically.
 
-use fmi2_export::{FmuModel, Logger, StateReader, StateWriter, VariableStore};
+use fmi2_export::test_host::{assert_initialization_fails, assert_state_round_trip};
+use fmi2_export::{FmuModel, Logger, VariableStore};
 use tailsitter_sensors::{SensorsModel, Variables};
 
-fn outputs(v: &Variables) -> Vec<u64> {
+/// The Real outputs: the GPS's six, then the ten analogue channels.
+fn reals(v: &Variables) -> [f64; 16] {
     [
         v.gps_latitude,
         v.gps_longitude,
@@ -23,10 +25,14 @@ fn outputs(v: &Variables) -> Vec<u64> {
         v.mag_z,
         v.pitot_airspeed,
     ]
-    .iter()
-    .map(|x| x.to_bits())
-    .chain([v.gps_fix_count as u64, v.gps_valid as u64])
-    .collect()
+}
+
+fn outputs(v: &Variables) -> Vec<u64> {
+    reals(v)
+        .iter()
+        .map(|x| x.to_bits())
+        .chain([v.gps_fix_count as u64, v.gps_valid as u64])
+        .collect()
 }
 
 fn started() -> (Variables, SensorsModel) {
@@ -83,23 +89,10 @@ fn non_finite_input_is_an_error_and_outputs_stay_finite() {
 
 #[test]
 fn bad_parameters_fail_initialization_with_the_reason() {
-    for (set, what) in [
-        (
-            Box::new(|v: &mut Variables| v.filter_bandwidth = 30.0) as Box<dyn Fn(&mut Variables)>,
-            "filter_bandwidth",
-        ),
-        (Box::new(|v: &mut Variables| v.fault_mode = 3), "fault_mode"),
-        (Box::new(|v: &mut Variables| v.gyro_std = f64::NAN), "gyro_std"),
-        (Box::new(|v: &mut Variables| v.quat_1 = 0.7), "quaternion"),
-    ] {
-        let mut v = Variables::with_start_values();
-        set(&mut v);
-        let mut m = SensorsModel::new(&v);
-        let e = m.initialize(&mut v, 0.0, &mut Logger::null()).unwrap_err();
-        assert!(e.message.contains(what), "{what}: {e}");
-        // Nothing to step: an error, not a panic.
-        assert!(m.do_step(&mut v, 0.0, 0.02, &mut Logger::null()).is_err());
-    }
+    assert_initialization_fails::<SensorsModel>(|v| v.filter_bandwidth = 30.0, "filter_bandwidth");
+    assert_initialization_fails::<SensorsModel>(|v| v.fault_mode = 3, "fault_mode");
+    assert_initialization_fails::<SensorsModel>(|v| v.gyro_std = f64::NAN, "gyro_std");
+    assert_initialization_fails::<SensorsModel>(|v| v.quat_1 = 0.7, "quaternion");
 }
 
 #[test]
@@ -129,30 +122,7 @@ fn fmu_state_round_trip_continues_bit_identically() {
     for k in 0..33 {
         m.do_step(&mut v, k as f64 * 0.02, 0.02, &mut log).unwrap();
     }
-    let mut w = StateWriter::new();
-    m.write_state(&mut w);
-    let bytes = w.into_bytes();
-    let saved_vars = v.clone();
-    let mut reference = Vec::new();
-    for k in 33..200 {
-        m.do_step(&mut v, k as f64 * 0.02, 0.02, &mut log).unwrap();
-        reference.push(outputs(&v));
-    }
-    // Restore into a fresh instance (as fmi2DeSerializeFMUstate does: variables, then model state).
-    let mut v2 = saved_vars;
-    let mut m2 = SensorsModel::new(&v2);
-    let mut r = StateReader::new(&bytes);
-    m2.read_state(&mut r).unwrap();
-    r.finish().unwrap();
-    for (i, k) in (33..200).enumerate() {
-        m2.do_step(&mut v2, k as f64 * 0.02, 0.02, &mut log).unwrap();
-        assert_eq!(outputs(&v2), reference[i], "step {k}");
-    }
-    // Truncated buffers are errors, never panics.
-    for n in 0..bytes.len() {
-        let mut m3 = SensorsModel::new(&v2);
-        assert!(m3.read_state(&mut StateReader::new(&bytes[..n])).is_err(), "{n}");
-    }
+    assert_state_round_trip(&mut m, &mut v, 33..200, 0.02, |_, _| {}, outputs);
 }
 
 #[test]
@@ -200,29 +170,11 @@ fn delivered_noise_is_table_d1() {
             fixes = v.gps_fix_count;
             continue;
         }
-        let a = [
-            v.imu_accel_x,
-            v.imu_accel_y,
-            v.imu_accel_z,
-            v.imu_gyro_p,
-            v.imu_gyro_q,
-            v.imu_gyro_r,
-            v.mag_x,
-            v.mag_y,
-            v.mag_z,
-            v.pitot_airspeed,
-        ];
+        let r = reals(&v);
+        let (g, a) = r.split_at(6);
         a.iter().zip(analog.iter_mut()).for_each(|(x, s)| s.push(*x));
         if v.gps_fix_count != fixes {
             fixes = v.gps_fix_count;
-            let g = [
-                v.gps_latitude,
-                v.gps_longitude,
-                v.gps_height,
-                v.gps_vel_n,
-                v.gps_vel_e,
-                v.gps_vel_d,
-            ];
             g.iter().zip(gps.iter_mut()).for_each(|(x, s)| s.push(*x));
         }
     }

@@ -1,17 +1,20 @@
-//! The Python declarations module `python/tailsim/declarations.py`: every model's
+//! The Python declarations data `python/tailsim/declarations.json`: every model's
 //! variables (name, type, causality, variability, unit, start, min, max, description)
 //! and default experiment, and from the controller interface
 //! (`fragments/controller_interface.json`) the commands and their limits (the plant's
 //! `thrust_min`, `thrust_max`, `deflection_limit`), the phases, the mission parameters
 //! and the mission presets. Written by `cargo xtask regen`; a test in
-//! `tests/declarations.rs` fails when the committed copy differs.
+//! `tests/declarations.rs` fails when the committed copy differs. The hand-written
+//! module `python/tailsim/declarations.py` loads it into the package's public names
+//! (`MODELS`, `VARIABLES`, `COMMANDS`, `mission()`, ...): data, not generated code.
 
 use crate::{load, read_decl, Causality, DeclError, DeclFile, Model, Start, VarType};
 use std::fmt::Write;
 use std::path::Path;
 
-/// Path of the module, relative to the workspace root.
-pub const MODULE_PATH: &str = "python/tailsim/declarations.py";
+/// Path of the generated data, relative to the workspace root (the entry point's name
+/// is kept from when the generator wrote the Python module itself).
+pub const MODULE_PATH: &str = "python/tailsim/declarations.json";
 /// The controller interface fragment, relative to the declarations folder.
 pub const INTERFACE: &str = "fragments/controller_interface.json";
 /// The plant model and its parameters that bound the commands.
@@ -37,7 +40,7 @@ pub fn model_ids(dir: &Path) -> Result<Vec<String>, DeclError> {
     Ok(ids)
 }
 
-/// The module text for the declarations in `dir`.
+/// The JSON text of the declarations in `dir` (written to [`MODULE_PATH`]).
 pub fn declarations_module(dir: &Path, version: &str) -> Result<String, DeclError> {
     let models = model_ids(dir)?
         .iter()
@@ -47,60 +50,36 @@ pub fn declarations_module(dir: &Path, version: &str) -> Result<String, DeclErro
     render(&models, &interface)
 }
 
-/// A Python string literal, quoted as `ruff format` quotes it (double quotes unless
-/// the text holds more double than single quotes).
-fn py_str(s: &str) -> String {
-    let quote = if s.matches('"').count() > s.matches('\'').count() {
-        '\''
-    } else {
-        '"'
-    };
-    let mut out = String::with_capacity(s.len() + 2);
-    out.push(quote);
-    for c in s.chars() {
-        match c {
-            '\\' => out.push_str("\\\\"),
-            '\n' => out.push_str("\\n"),
-            '\t' => out.push_str("\\t"),
-            c if c == quote => {
-                out.push('\\');
-                out.push(c);
-            }
-            c if (c as u32) < 0x20 => {
-                let _ = write!(out, "\\x{:02x}", c as u32);
-            }
-            c => out.push(c),
-        }
-    }
-    out.push(quote);
-    out
+/// A JSON string.
+fn js(s: &str) -> String {
+    serde_json::to_string(s).expect("a string serialises")
 }
 
-fn py_float(x: f64) -> String {
+/// A JSON number; the non-finite ones as Python's `json` reads them.
+fn jf(x: f64) -> String {
     if x.is_finite() {
         format!("{x:?}")
     } else if x.is_nan() {
-        "math.nan".into()
+        "NaN".into()
     } else if x > 0.0 {
-        "math.inf".into()
+        "Infinity".into()
     } else {
-        "-math.inf".into()
+        "-Infinity".into()
     }
 }
 
-fn py_opt_float(x: Option<f64>) -> String {
-    x.map_or_else(|| "None".into(), py_float)
+fn jf_opt(x: Option<f64>) -> String {
+    x.map_or_else(|| "null".into(), jf)
 }
 
-fn py_start(ty: VarType, start: &Option<Start>) -> String {
+fn j_start(ty: VarType, start: &Option<Start>) -> String {
     match (ty, start) {
-        (_, None) => "None".into(),
-        (VarType::Boolean, Some(Start::Bool(b))) => (if *b { "True" } else { "False" }).into(),
-        (VarType::Boolean, Some(Start::Number(x))) => (if *x != 0.0 { "True" } else { "False" }).into(),
+        (_, None) => "null".into(),
+        (VarType::Boolean, Some(Start::Number(x))) => (*x != 0.0).to_string(),
         (VarType::Integer, Some(Start::Number(x))) => format!("{}", *x as i64),
-        (_, Some(Start::Number(x))) => py_float(*x),
-        (_, Some(Start::Bool(b))) => (if *b { "True" } else { "False" }).into(),
-        (_, Some(Start::Text(s))) => py_str(s),
+        (_, Some(Start::Number(x))) => jf(*x),
+        (_, Some(Start::Bool(b))) => b.to_string(),
+        (_, Some(Start::Text(s))) => js(s),
     }
 }
 
@@ -128,115 +107,100 @@ fn start_of(model: &Model, name: &str) -> Result<f64, DeclError> {
     }
 }
 
-/// A multi-line tuple of strings (trailing comma: `ruff format` keeps it exploded).
-fn tuple_of(out: &mut String, name: &str, doc: &str, items: &[String]) {
-    let _ = writeln!(out, "#: {doc}\n{name} = (");
-    for item in items {
-        let _ = writeln!(out, "    {},", py_str(item));
+/// Writes the `"key": {...}` members of one JSON object, one a line at `indent`, in order.
+fn object(out: &mut String, key: &str, indent: &str, members: impl IntoIterator<Item = (String, String)>) {
+    let body: Vec<String> = members
+        .into_iter()
+        .map(|(k, v)| format!("{indent}  {}: {v}", js(&k)))
+        .collect();
+    if body.is_empty() {
+        let _ = write!(out, "{indent}{}: {{}}", js(key));
+    } else {
+        let _ = write!(out, "{indent}{}: {{\n{}\n{indent}}}", js(key), body.join(",\n"));
     }
-    out.push_str(")\n\n");
 }
 
-/// Render the module from the loaded models and the controller interface.
+/// A JSON array of strings, on one line.
+fn strings<S: AsRef<str>>(items: &[S]) -> String {
+    let items: Vec<String> = items.iter().map(|s| js(s.as_ref())).collect();
+    format!("[{}]", items.join(", "))
+}
+
+/// Render the data from the loaded models and the controller interface: one JSON
+/// object whose members the loader `python/tailsim/declarations.py` turns into its
+/// public names (`models` into `MODELS`, `DEFAULT_EXPERIMENTS` and `VARIABLES`, the
+/// others into the upper-case name of the same words).
 pub fn render(models: &[Model], interface: &DeclFile) -> Result<String, DeclError> {
+    let mut members: Vec<String> = Vec::new();
     let mut out = String::new();
-    out.push_str(
-        "\"\"\"The FMUs' declared interfaces (modelDescription/*.json), for the Python masters and reports.\n\
-         \n\
-         Generated by `cargo xtask regen` (modelDescription/src/python.rs): do not edit.\n\
-         \"\"\"\n\
-         \n\
-         # Generated by cargo xtask regen - do not edit.\n\
-         \n\
-         from __future__ import annotations\n\
-         \n\
-         from typing import NamedTuple\n\
-         \n\
-         \n\
-         class Variable(NamedTuple):\n    \"\"\"One declared variable, as in modelDescription.xml.\"\"\"\n\n    \
-         name: str\n    type: str\n    causality: str\n    variability: str\n    unit: str | None\n    \
-         start: float | int | bool | str | None\n    min: float | None\n    max: float | None\n    \
-         description: str\n\n\n\
-         class DefaultExperiment(NamedTuple):\n    start_time: float\n    stop_time: float\n    step_size: float\n\n\n",
-    );
-    let ids: Vec<String> = models.iter().map(|m| m.model_identifier.clone()).collect();
-    tuple_of(&mut out, "MODELS", "The model identifiers.", &ids);
-
-    out.push_str("#: Default experiment of each model.\nDEFAULT_EXPERIMENTS: dict[str, DefaultExperiment] = {\n");
-    for m in models {
+    let model_json = |m: &Model| {
         let e = &m.default_experiment;
-        let _ = writeln!(
-            out,
-            "    {}: DefaultExperiment({}, {}, {}),",
-            py_str(&m.model_identifier),
-            py_float(e.start_time),
-            py_float(e.stop_time),
-            py_float(e.step_size)
+        let mut s = format!(
+            "{{\n      \"default_experiment\": [{}, {}, {}],\n      \"variables\": [\n",
+            jf(e.start_time),
+            jf(e.stop_time),
+            jf(e.step_size)
         );
-    }
-    out.push_str("}\n\n");
-
-    out.push_str(
-        "#: The variables of each model by name, in declaration (value reference) order.\n\
-         VARIABLES: dict[str, dict[str, Variable]] = {\n",
+        let vars: Vec<String> = m
+            .variables
+            .iter()
+            .map(|v| {
+                let d = &v.decl;
+                format!(
+                    "        [{}, {}, {}, {}, {}, {}, {}, {}, {}]",
+                    js(&d.name),
+                    js(type_name(d.var_type)),
+                    js(d.causality.as_str()),
+                    js(v.variability.as_str()),
+                    d.unit.as_deref().map_or_else(|| "null".into(), js),
+                    j_start(d.var_type, &d.start),
+                    jf_opt(d.min),
+                    jf_opt(d.max),
+                    js(&d.description),
+                )
+            })
+            .collect();
+        s.push_str(&vars.join(",\n"));
+        s.push_str("\n      ]\n    }");
+        s
+    };
+    object(
+        &mut out,
+        "models",
+        "  ",
+        models.iter().map(|m| (m.model_identifier.clone(), model_json(m))),
     );
-    for m in models {
-        let _ = writeln!(out, "    {}: {{", py_str(&m.model_identifier));
-        for v in &m.variables {
-            let d = &v.decl;
-            let _ = writeln!(out, "        {}: Variable(", py_str(&d.name));
-            for field in [
-                py_str(&d.name),
-                py_str(type_name(d.var_type)),
-                py_str(d.causality.as_str()),
-                py_str(v.variability.as_str()),
-                d.unit.as_deref().map_or_else(|| "None".into(), py_str),
-                py_start(d.var_type, &d.start),
-                py_opt_float(d.min),
-                py_opt_float(d.max),
-                py_str(&d.description),
-            ] {
-                let _ = writeln!(out, "            {field},");
-            }
-            out.push_str("        ),\n");
-        }
-        out.push_str("    },\n");
-    }
-    out.push_str("}\n\n");
+    members.push(std::mem::take(&mut out));
 
     // The controller interface: commands, phases, mission.
     let iface = &interface.variables;
-    let commands: Vec<String> = iface
+    let commands: Vec<&str> = iface
         .iter()
         .filter(|v| v.group.as_deref() == Some("command"))
-        .map(|v| v.name.clone())
+        .map(|v| v.name.as_str())
         .collect();
-    tuple_of(
-        &mut out,
-        "COMMANDS",
-        "The controllers' commands (outputs of the controller interface's `command` group), thrust first.",
-        &commands,
-    );
+    members.push(format!("  \"commands\": {}", strings(&commands)));
     let plant = models
         .iter()
         .find(|m| m.model_identifier == PLANT)
         .ok_or_else(|| DeclError(format!("no model {PLANT}")))?;
-    let _ = writeln!(
-        out,
-        "#: The plant's thrust limits (N): its parameters `{THRUST_MIN}`, `{THRUST_MAX}`.\n\
-         THRUST_LIMITS = ({}, {})\n\
-         #: The plant's deflection limit of every surface, +/- (rad): its parameter `{DEFLECTION_LIMIT}`.\n\
-         DEFLECTION_LIMIT = {}\n",
-        py_float(start_of(plant, THRUST_MIN)?),
-        py_float(start_of(plant, THRUST_MAX)?),
-        py_float(start_of(plant, DEFLECTION_LIMIT)?),
+    members.push(format!(
+        "  \"thrust_limits\": [{}, {}]",
+        jf(start_of(plant, THRUST_MIN)?),
+        jf(start_of(plant, THRUST_MAX)?)
+    ));
+    members.push(format!(
+        "  \"deflection_limit\": {}",
+        jf(start_of(plant, DEFLECTION_LIMIT)?)
+    ));
+    object(
+        &mut out,
+        "phase_names",
+        "  ",
+        interface.phases.iter().map(|p| (p.code.to_string(), js(&p.name))),
     );
+    members.push(std::mem::take(&mut out));
 
-    out.push_str("#: Names of the codes of the controllers' `phase` output.\nPHASE_NAMES: dict[int, str] = {\n");
-    for p in &interface.phases {
-        let _ = writeln!(out, "    {}: {},", p.code, py_str(&p.name));
-    }
-    out.push_str("}\n\n");
     let mission_phases: Vec<_> = interface.phases.iter().filter(|p| p.duration.is_some()).collect();
     for (i, p) in mission_phases.iter().enumerate() {
         if p.code != i as i64 {
@@ -251,79 +215,54 @@ pub fn render(models: &[Model], interface: &DeclFile) -> Result<String, DeclErro
         .filter(|v| v.group.as_deref() == Some("mission") && v.causality == Causality::Parameter)
         .collect();
     let is_mission = |name: &str| mission.iter().any(|v| v.name == name);
-    tuple_of(
-        &mut out,
-        "PHASES",
-        "The phases of the mission (codes 0, 1, ...), in order.",
-        &mission_phases.iter().map(|p| p.name.clone()).collect::<Vec<_>>(),
-    );
-    let durations: Vec<String> = mission_phases.iter().filter_map(|p| p.duration.clone()).collect();
+    let phases: Vec<&str> = mission_phases.iter().map(|p| p.name.as_str()).collect();
+    members.push(format!("  \"phases\": {}", strings(&phases)));
+    let durations: Vec<&str> = mission_phases.iter().filter_map(|p| p.duration.as_deref()).collect();
     if let Some(d) = durations.iter().find(|d| !is_mission(d)) {
         return Err(DeclError(format!("phase duration '{d}' is not a mission parameter")));
     }
-    tuple_of(
+    members.push(format!("  \"phase_durations\": {}", strings(&durations)));
+    let names: Vec<&str> = mission.iter().map(|v| v.name.as_str()).collect();
+    members.push(format!("  \"mission\": {}", strings(&names)));
+    object(
         &mut out,
-        "PHASE_DURATIONS",
-        "The mission parameters of the phases' durations (s), in phase order.",
-        &durations,
+        "mission_defaults",
+        "  ",
+        mission
+            .iter()
+            .map(|v| (v.name.clone(), j_start(VarType::Real, &v.start))),
     );
-    tuple_of(
+    members.push(std::mem::take(&mut out));
+    object(
         &mut out,
-        "MISSION",
-        "The mission parameters every controller declares (the controller interface's `mission` group).",
-        &mission.iter().map(|v| v.name.clone()).collect::<Vec<_>>(),
+        "mission_ranges",
+        "  ",
+        mission
+            .iter()
+            .map(|v| (v.name.clone(), format!("[{}, {}]", jf_opt(v.min), jf_opt(v.max)))),
     );
-    out.push_str("#: Their declared defaults.\nMISSION_DEFAULTS: dict[str, float] = {\n");
-    for v in &mission {
-        let _ = writeln!(out, "    {}: {},", py_str(&v.name), py_start(VarType::Real, &v.start));
-    }
-    out.push_str(
-        "}\n\n#: Their declared ranges (min, max).\nMISSION_RANGES: dict[str, tuple[float | None, float | None]] = {\n",
-    );
-    for v in &mission {
-        let _ = writeln!(
-            out,
-            "    {}: ({}, {}),",
-            py_str(&v.name),
-            py_opt_float(v.min),
-            py_opt_float(v.max)
-        );
-    }
-    out.push_str("}\n\n");
+    members.push(std::mem::take(&mut out));
 
-    out.push_str("#: Named missions: values over `MISSION_DEFAULTS`.\nPRESETS: dict[str, dict[str, float]] = {\n");
+    let mut presets = Vec::new();
     for (name, preset) in &interface.presets {
         if let Some(k) = preset.values.keys().find(|k| !is_mission(k)) {
             return Err(DeclError(format!("preset '{name}': '{k}' is not a mission parameter")));
         }
-        if preset.values.is_empty() {
-            let _ = writeln!(out, "    {}: {{}},", py_str(name));
-            continue;
-        }
-        let _ = writeln!(out, "    {}: {{", py_str(name));
         // In the mission group's order.
-        for v in &mission {
-            if let Some(x) = preset.values.get(&v.name) {
-                let _ = writeln!(out, "        {}: {},", py_str(&v.name), py_float(*x));
-            }
-        }
-        out.push_str("    },\n");
+        let values: Vec<String> = mission
+            .iter()
+            .filter_map(|v| Some(format!("{}: {}", js(&v.name), jf(*preset.values.get(&v.name)?))))
+            .collect();
+        presets.push((name.clone(), format!("{{{}}}", values.join(", "))));
     }
-    out.push_str("}\n\n#: What each preset is.\nPRESET_DESCRIPTIONS: dict[str, str] = {\n");
-    for (name, preset) in &interface.presets {
-        let _ = writeln!(out, "    {}: {},", py_str(name), py_str(&preset.description));
-    }
-    out.push_str(
-        "}\n\n\n\
-         def mission(preset: str = \"default\", **values: float) -> dict[str, float]:\n    \
-         \"\"\"Every mission parameter: the declared defaults, the preset's values, then `values`.\"\"\"\n    \
-         unknown = [k for k in values if k not in MISSION_DEFAULTS]\n    \
-         if unknown:\n        \
-         raise KeyError(f\"not mission parameters: {unknown}\")\n    \
-         return {**MISSION_DEFAULTS, **PRESETS[preset], **values}\n\n\n\
-         def stop_time(params: dict[str, float]) -> float:\n    \
-         \"\"\"The end of the mission: the sum of its phases' durations (s).\"\"\"\n    \
-         return float(sum(float(params[k]) for k in PHASE_DURATIONS))\n",
+    object(&mut out, "presets", "  ", presets);
+    members.push(std::mem::take(&mut out));
+    object(
+        &mut out,
+        "preset_descriptions",
+        "  ",
+        interface.presets.iter().map(|(n, p)| (n.clone(), js(&p.description))),
     );
-    Ok(out)
+    members.push(out);
+    Ok(format!("{{\n{}\n}}\n", members.join(",\n")))
 }

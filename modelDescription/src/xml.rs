@@ -78,36 +78,44 @@ fn write_all(w: &mut W, model: &Model) -> Result<()> {
 /// as the Reference FMUs do. No event indicators, no time events: the model is smooth
 /// between input changes, which the importer handles at its communication points.
 fn model_exchange(w: &mut W, model: &Model) -> Result<()> {
-    w.create_element("ModelExchange")
-        .with_attributes([
-            ("modelIdentifier", model.model_identifier.as_str()),
-            ("needsExecutionTool", "false"),
-            ("completedIntegratorStepNotNeeded", "true"),
-            ("canBeInstantiatedOnlyOncePerProcess", "false"),
-            ("canNotUseMemoryManagementFunctions", "true"),
-            ("canGetAndSetFMUstate", "true"),
-            ("canSerializeFMUstate", "true"),
-            ("providesDirectionalDerivative", "false"),
-        ])
-        .write_empty()?;
-    Ok(())
+    interface(
+        w,
+        "ModelExchange",
+        model,
+        &[("completedIntegratorStepNotNeeded", "true")],
+    )
 }
 
 fn co_simulation(w: &mut W, model: &Model) -> Result<()> {
-    w.create_element("CoSimulation")
-        .with_attributes([
-            ("modelIdentifier", model.model_identifier.as_str()),
-            ("needsExecutionTool", "false"),
+    interface(
+        w,
+        "CoSimulation",
+        model,
+        &[
             ("canHandleVariableCommunicationStepSize", "true"),
             ("canInterpolateInputs", "false"),
             ("maxOutputDerivativeOrder", "0"),
             ("canRunAsynchronuously", "false"),
-            ("canBeInstantiatedOnlyOncePerProcess", "false"),
-            ("canNotUseMemoryManagementFunctions", "true"),
-            ("canGetAndSetFMUstate", "true"),
-            ("canSerializeFMUstate", "true"),
-            ("providesDirectionalDerivative", "false"),
-        ])
+        ],
+    )
+}
+
+/// One interface element: the model identifier, `specific` capabilities, then those both
+/// interfaces share (many instances, the FMU's own memory management, FMU states).
+fn interface(w: &mut W, element: &str, model: &Model, specific: &[(&str, &str)]) -> Result<()> {
+    let head = [
+        ("modelIdentifier", model.model_identifier.as_str()),
+        ("needsExecutionTool", "false"),
+    ];
+    let shared = [
+        ("canBeInstantiatedOnlyOncePerProcess", "false"),
+        ("canNotUseMemoryManagementFunctions", "true"),
+        ("canGetAndSetFMUstate", "true"),
+        ("canSerializeFMUstate", "true"),
+        ("providesDirectionalDerivative", "false"),
+    ];
+    w.create_element(element)
+        .with_attributes(head.into_iter().chain(specific.iter().copied()).chain(shared))
         .write_empty()?;
     Ok(())
 }
@@ -244,47 +252,39 @@ fn model_structure(w: &mut W, model: &Model) -> Result<()> {
         .collect();
     let derivatives: Vec<&Variable> = model.continuous_states().into_iter().map(|(_, d)| d).collect();
     w.create_element("ModelStructure").write_inner_content(|w| {
-        if !outputs.is_empty() {
-            w.create_element("Outputs").write_inner_content(|w| {
-                for v in &outputs {
-                    let deps: Vec<String> = v
-                        .decl
-                        .depends_on
-                        .iter()
-                        .map(|n| index_of(model, n).to_string())
-                        .collect();
-                    let index = index_of(model, v.name()).to_string();
-                    let deps = deps.join(" ");
-                    w.create_element("Unknown")
-                        .with_attributes([("index", index.as_str()), ("dependencies", deps.as_str())])
-                        .write_empty()?;
-                }
-                Ok(())
-            })?;
-        }
-        if !derivatives.is_empty() {
-            // No `dependencies` attribute: a derivative may depend on every state and input.
-            w.create_element("Derivatives").write_inner_content(|w| {
-                for v in &derivatives {
-                    let index = index_of(model, v.name()).to_string();
-                    w.create_element("Unknown")
-                        .with_attribute(("index", index.as_str()))
-                        .write_empty()?;
-                }
-                Ok(())
-            })?;
-        }
-        if !initial.is_empty() {
-            // No `dependencies` attribute: an initial unknown may depend on every known.
-            w.create_element("InitialUnknowns").write_inner_content(|w| {
-                for v in &initial {
-                    let index = index_of(model, v.name()).to_string();
-                    w.create_element("Unknown")
-                        .with_attribute(("index", index.as_str()))
-                        .write_empty()?;
-                }
-                Ok(())
-            })?;
+        unknowns(w, model, "Outputs", &outputs, true)?;
+        // No `dependencies` attribute: a derivative may depend on every state and input.
+        unknowns(w, model, "Derivatives", &derivatives, false)?;
+        // No `dependencies` attribute: an initial unknown may depend on every known.
+        unknowns(w, model, "InitialUnknowns", &initial, false)?;
+        Ok(())
+    })?;
+    Ok(())
+}
+
+/// The `element` list of `vars` as `Unknown`s (by index), each with its declared
+/// `dependencies` if `with_dependencies`; nothing if `vars` is empty.
+fn unknowns(w: &mut W, model: &Model, element: &str, vars: &[&Variable], with_dependencies: bool) -> Result<()> {
+    if vars.is_empty() {
+        return Ok(());
+    }
+    w.create_element(element).write_inner_content(|w| {
+        for v in vars {
+            let index = index_of(model, v.name()).to_string();
+            let unknown = w.create_element("Unknown").with_attribute(("index", index.as_str()));
+            if with_dependencies {
+                let deps: Vec<String> = v
+                    .decl
+                    .depends_on
+                    .iter()
+                    .map(|n| index_of(model, n).to_string())
+                    .collect();
+                unknown
+                    .with_attribute(("dependencies", deps.join(" ").as_str()))
+                    .write_empty()?;
+            } else {
+                unknown.write_empty()?;
+            }
         }
         Ok(())
     })?;

@@ -300,8 +300,9 @@ fn nested_fields_need_a_group_built_on_default() {
     assert!(rust.contains("value.x.y[2] = self.a;"), "{rust}");
 }
 
+/// The data that `python/tailsim/declarations.py` loads is the generator's.
 #[test]
-fn python_declarations_module_matches_generated() {
+fn python_declarations_data_matches_generated() {
     let generated = model_description::python::declarations_module(&dir(), env!("CARGO_PKG_VERSION")).unwrap();
     let path = dir().join("..").join(model_description::python::MODULE_PATH);
     let committed =

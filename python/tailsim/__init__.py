@@ -6,7 +6,7 @@ name, docs/DESIGN.md "Ports and timing") and its configurations: `ClosedLoop`
 every controller output goes to the plant input of the same name) and
 `AvionicsLoop` (plant, sensors, estimator, controller). `tailsim.campaign` is the
 Monte-Carlo campaign, `tailsim.reports` the reports, `tailsim.metrics` the
-measures of a run, `tailsim.declarations` the FMUs' declared interfaces (generated).
+measures of a run, `tailsim.declarations` the FMUs' declared interfaces (generated data).
 """
 
 from .masters import ClosedLoop, Fmu, RunResult, one_minus_cosine_gust, step

@@ -8,7 +8,7 @@
 //! - `regen`: rewrite the reviewed copies `modelDescription/generated/<id>.xml`, the
 //!   variable references `modelDescription/generated/<id>.md`, the generated Rust
 //!   parameter defaults `modelDescription/generated/*_generated.rs` and the Python
-//!   declarations module `python/tailsim/declarations.py`.
+//!   declarations `python/tailsim/declarations.json`.
 
 mod ssp;
 

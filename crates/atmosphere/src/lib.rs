@@ -19,7 +19,6 @@ pub mod dryden;
 
 use dryden::{Coefficients, Dryden};
 use sensor_model::rng::NoiseRng;
-use std::fmt;
 
 /// One international knot (m/s): 1852 m per hour.
 pub const KNOT: f64 = 1852.0 / 3600.0;
@@ -89,27 +88,9 @@ pub enum Profile {
     Log { z0: f64 },
 }
 
-/// A parameter out of range: its name and why.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ParamError(pub String);
-
-impl fmt::Display for ParamError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-impl std::error::Error for ParamError {}
-
-/// An input or a step the model cannot take (non-finite value, too many samples).
-#[derive(Debug, Clone, PartialEq)]
-pub struct InputError(pub String);
-
-impl fmt::Display for InputError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-impl std::error::Error for InputError {}
+/// A parameter out of range (its name and why), and an input or a step the model cannot
+/// take (non-finite value, too many samples): the sensor model's error types.
+pub use sensor_model::{InputError, ParamError};
 
 /// What the atmosphere reads (plant outputs of the same names), held over a step.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

@@ -101,6 +101,8 @@ macro_rules! flight_controller_binding {
 pub use flight_mission;
 pub use flight_mission::{SampledUnit, SteppedUnit};
 
+pub mod testing;
+
 /// The FMU model of the unit of binding `B`.
 pub struct UnitFmu<B: Binding> {
     /// The unit as freshly built, with the configuration it was built from

@@ -262,3 +262,59 @@ pub fn restore_forged<M: FmuModel>(name: &str, marker: f64, forged: f64) -> Forg
         }
     }
 }
+
+/// A model `M` whose start values `set` changes fails `initialize` with an error whose
+/// message contains `what`, and a step after the failed initialisation is an error, not a
+/// panic.
+pub fn assert_initialization_fails<M: FmuModel>(set: impl FnOnce(&mut M::Vars), what: &str) {
+    use crate::{Logger, VariableStore};
+    let mut v = M::Vars::with_start_values();
+    set(&mut v);
+    let mut m = M::new(&v);
+    let e = m
+        .initialize(&mut v, 0.0, &mut Logger::null())
+        .err()
+        .unwrap_or_else(|| panic!("{what}: initialisation succeeded"));
+    assert!(e.message.contains(what), "{what}: {e}");
+    assert!(m.do_step(&mut v, 0.0, 0.02, &mut Logger::null()).is_err());
+}
+
+/// The FMU state of `m` (variables `v`) taken now continues bit-identically: steps `k` of
+/// `steps` (at t = k h, `input(v, k)` set first) give the same `outputs` in a fresh model
+/// restored from the written state and the variables saved with it (as
+/// fmi2DeSerializeFMUstate does: variables, then model state); every truncation of the
+/// state is an error, never a panic.
+pub fn assert_state_round_trip<M: FmuModel, O: PartialEq + std::fmt::Debug>(
+    m: &mut M,
+    v: &mut M::Vars,
+    steps: std::ops::Range<usize>,
+    h: f64,
+    input: impl Fn(&mut M::Vars, usize),
+    outputs: impl Fn(&M::Vars) -> O,
+) {
+    use crate::{Logger, StateReader, StateWriter};
+    let mut log = Logger::null();
+    let mut w = StateWriter::new();
+    m.write_state(&mut w);
+    let bytes = w.into_bytes();
+    let mut v2 = v.clone();
+    let mut reference = Vec::new();
+    for k in steps.clone() {
+        input(v, k);
+        m.do_step(v, k as f64 * h, h, &mut log).unwrap();
+        reference.push(outputs(v));
+    }
+    let mut m2 = M::new(&v2);
+    let mut r = StateReader::new(&bytes);
+    m2.read_state(&mut r).unwrap();
+    r.finish().unwrap();
+    for (i, k) in steps.enumerate() {
+        input(&mut v2, k);
+        m2.do_step(&mut v2, k as f64 * h, h, &mut log).unwrap();
+        assert_eq!(outputs(&v2), reference[i], "step {k}");
+    }
+    for n in 0..bytes.len() {
+        let mut m3 = M::new(&v2);
+        assert!(m3.read_state(&mut StateReader::new(&bytes[..n])).is_err(), "{n}");
+    }
+}

@@ -11,7 +11,7 @@
 
 use flight_mission::MissionParams;
 use lqr_control::linalg::{dare_sda, lqr_gain};
-use lqr_control::model::{EulerRep, NA};
+use lqr_control::model::NA;
 use lqr_control::{LqrController, LqrParams};
 use nalgebra::{DMatrix, SMatrix};
 use std::hint::black_box;
@@ -72,12 +72,7 @@ fn main() {
     std::fs::create_dir_all(&out).expect("output folder");
     let m = MissionParams::default();
     let c = LqrController::new(Airframe::default(), m, LqrParams::default()).expect("controller");
-    let p = c.trajectory().at(t);
-    let rep = if p.euler_321.y > LqrParams::default().euler_switch_pitch {
-        EulerRep::E231
-    } else {
-        EulerRep::E321
-    };
+    let (p, rep) = c.reference_and_euler_set(t);
     let x = p.state(rep);
     let sol = c.solve_gain(rep, &x, &p.u, t).expect("gain");
     let w = c.schedule().at(&m, t);

@@ -37,12 +37,7 @@ impl Settling {
     fn compute(t: f64, n: usize) -> Self {
         let m = MissionParams::default();
         let c = LqrController::new(Airframe::default(), m, LqrParams::default()).expect("controller");
-        let p = c.trajectory().at(t);
-        let rep = if p.euler_321.y > LqrParams::default().euler_switch_pitch {
-            EulerRep::E231
-        } else {
-            EulerRep::E321
-        };
+        let (p, rep) = c.reference_and_euler_set(t);
         let sol = c.solve_gain(rep, &p.state(rep), &p.u, t).expect("gain");
         let w = c.schedule().at(&m, t);
         let q = SMatrix::<f64, NA, NA>::from_diagonal(&w.q);

@@ -403,8 +403,7 @@ impl LqrController {
 
     /// Initial gains on the trajectory's start point, so a failure shows at construction.
     fn initial_gains(&mut self) -> Result<(), ControlError> {
-        let p0 = self.trajectory.at(0.0);
-        let rep = euler_set(p0.euler_321.y, &self.params.stages().error_state);
+        let (p0, rep) = self.reference_and_euler_set(0.0);
         let sol = self.solve_gain(rep, &p0.state(rep), &p0.u, 0.0).map_err(|e| {
             ControlError(format!(
                 "gain computation at the start of the trajectory failed: {}",
@@ -420,6 +419,14 @@ impl LqrController {
     /// The reference trajectory.
     pub fn trajectory(&self) -> &Trajectory {
         &self.trajectory
+    }
+
+    /// The trajectory's point at `t` and the Euler set the gain is computed in there
+    /// (2-3-1 above `euler_switch_pitch`, §3.2.3.2).
+    pub fn reference_and_euler_set(&self, t: f64) -> (trajectory::TrajPoint, EulerRep) {
+        let p = self.trajectory.at(t);
+        let rep = euler_set(p.euler_321.y, &self.params.stages().error_state);
+        (p, rep)
     }
 
     /// The current gain matrix and the Euler set it belongs to.

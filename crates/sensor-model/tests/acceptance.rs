@@ -193,66 +193,55 @@ fn unfiltered_noise_matches_table_d1_and_means_are_unbiased() {
     // 2000 s at 20 ms: 100 000 samples per analogue channel, 8000 GPS fixes.
     let (analog, gps) = still_run(p, 0.02, 100_000);
     let (truth_analog, truth_gps) = expected(&p);
-    let u_r = truth_analog[9];
     // Pitot: σ_V = σ_Δp / (ρ₀ u_r) to first order in σ_Δp/Δp (here 1 Pa / 376 Pa).
-    let sigma_analog = [
-        p.accel_std,
-        p.accel_std,
-        p.accel_std,
-        p.gyro_std,
-        p.gyro_std,
-        p.gyro_std,
-        p.mag_std,
-        p.mag_std,
-        p.mag_std,
-        p.pitot_std / (RHO_0 * u_r),
-    ];
+    let sigma_analog = delivered_sigma(&p, truth_analog[9]);
     for c in 0..10 {
-        let s = &analog[c];
-        let n = s.n as f64;
-        println!(
-            "unfiltered channel {c}: σ/σ_param = {:.4}, (mean − truth)·√n/σ = {:+.2}",
-            s.std() / sigma_analog[c],
-            (s.mean() - truth_analog[c]) * n.sqrt() / sigma_analog[c]
-        );
-        assert!(
-            (s.std() / sigma_analog[c] - 1.0).abs() < 0.05,
-            "channel {c}: σ {} vs {}",
-            s.std(),
-            sigma_analog[c]
-        );
-        assert!(
-            (s.mean() - truth_analog[c]).abs() < 3.0 * sigma_analog[c] / n.sqrt(),
-            "channel {c}: mean {} vs truth {}",
-            s.mean(),
-            truth_analog[c]
+        let sigma = sigma_analog[c];
+        assert_noise(
+            &format!("unfiltered channel {c}"),
+            &analog[c],
+            sigma,
+            truth_analog[c],
+            sigma,
         );
     }
-    let sigma_gps = [
+    let sigma_gps = gps_sigma(&p);
+    for c in 0..6 {
+        assert!(gps[c].n >= 7_900, "{} fixes", gps[c].n);
+        assert_noise(&format!("gps {c}"), &gps[c], sigma_gps[c], truth_gps[c], sigma_gps[c]);
+    }
+}
+
+/// The sample `s` of a noisy channel has the standard deviation `sigma` within 5 % and its
+/// mean within 3 `mean_sigma`/√n of `truth` (`mean_sigma`: the σ of the white noise behind
+/// it, whose long-run variance the mean's is).
+fn assert_noise(what: &str, s: &Stats, sigma: f64, truth: f64, mean_sigma: f64) {
+    let n = s.n as f64;
+    println!(
+        "{what}: n = {}, σ = {:.5e}, σ/σ_param = {:.4}, (mean − truth)·√n/σ = {:+.2}",
+        s.n,
+        s.std(),
+        s.std() / sigma,
+        (s.mean() - truth) * n.sqrt() / mean_sigma
+    );
+    assert!((s.std() / sigma - 1.0).abs() < 0.05, "{what}: σ {} vs {sigma}", s.std());
+    assert!(
+        (s.mean() - truth).abs() < 3.0 * mean_sigma / n.sqrt(),
+        "{what}: mean {} vs truth {truth}",
+        s.mean()
+    );
+}
+
+/// Table D.1 σ of the GPS's latitude, longitude, height and NED velocity.
+fn gps_sigma(p: &Params) -> [f64; 6] {
+    [
         p.gps_latlon_std,
         p.gps_latlon_std,
         p.gps_height_std,
         p.gps_vel_std,
         p.gps_vel_std,
         p.gps_vel_std,
-    ];
-    for c in 0..6 {
-        let s = &gps[c];
-        assert!(s.n >= 7_900, "{} fixes", s.n);
-        let n = s.n as f64;
-        println!(
-            "gps {c}: σ/σ_param = {:.4}, (mean − truth)·√n/σ = {:+.2}",
-            s.std() / sigma_gps[c],
-            (s.mean() - truth_gps[c]) * n.sqrt() / sigma_gps[c]
-        );
-        assert!((s.std() / sigma_gps[c] - 1.0).abs() < 0.05, "gps {c}: σ {}", s.std());
-        assert!(
-            (s.mean() - truth_gps[c]).abs() < 3.0 * sigma_gps[c] / n.sqrt(),
-            "gps {c}: mean {} vs {}",
-            s.mean(),
-            truth_gps[c]
-        );
-    }
+    ]
 }
 
 /// Table D.1 σ per delivered analogue channel (accel x/y/z, gyro p/q/r, mag x/y/z) and the
@@ -305,44 +294,25 @@ fn delivered_noise_is_table_d1_after_the_filter() {
     let sigma = delivered_sigma(&p, truth_analog[9]);
     let gain = [g_acc, g_acc, g_acc, g_gyro, g_gyro, g_gyro, g_50, g_50, g_50, g_50];
     for c in 0..10 {
-        let s = &analog[c];
-        println!(
-            "delivered channel {c}: n = {}, σ = {:.5e}, σ/σ_Table D.1 = {:.4}",
-            s.n,
-            s.std(),
-            s.std() / sigma[c]
-        );
-        assert!(
-            (s.std() / sigma[c] - 1.0).abs() < 0.05,
-            "channel {c}: σ {} vs {}",
-            s.std(),
-            sigma[c]
-        );
         let white = sigma[c] / gain[c];
-        assert!(
-            (s.mean() - truth_analog[c]).abs() < 3.0 * white / (s.n as f64).sqrt(),
-            "channel {c}: mean {} vs {}",
-            s.mean(),
-            truth_analog[c]
+        assert_noise(
+            &format!("delivered channel {c}"),
+            &analog[c],
+            sigma[c],
+            truth_analog[c],
+            white,
         );
     }
     // GPS (digital, unfiltered): Table D.1 on each fix.
-    let sigma_gps = [
-        p.gps_latlon_std,
-        p.gps_latlon_std,
-        p.gps_height_std,
-        p.gps_vel_std,
-        p.gps_vel_std,
-        p.gps_vel_std,
-    ];
+    let sigma_gps = gps_sigma(&p);
     for c in 0..6 {
-        println!(
-            "delivered gps {c}: n = {}, σ/σ_Table D.1 = {:.4}",
-            gps[c].n,
-            gps[c].std() / sigma_gps[c]
+        assert_noise(
+            &format!("delivered gps {c}"),
+            &gps[c],
+            sigma_gps[c],
+            truth_gps[c],
+            sigma_gps[c],
         );
-        assert!((gps[c].std() / sigma_gps[c] - 1.0).abs() < 0.05, "gps {c}");
-        assert!((gps[c].mean() - truth_gps[c]).abs() < 3.0 * sigma_gps[c] / (gps[c].n as f64).sqrt());
     }
 }
 
@@ -421,18 +391,7 @@ fn delivered_noise_is_table_d1_on_a_steady_trajectory() {
         );
         assert!((ratio - 1.0).abs() < 0.05, "channel {c}: {ratio}");
     }
-    let p = &noisy;
-    for (c, sg) in [
-        p.gps_latlon_std,
-        p.gps_latlon_std,
-        p.gps_height_std,
-        p.gps_vel_std,
-        p.gps_vel_std,
-        p.gps_vel_std,
-    ]
-    .iter()
-    .enumerate()
-    {
+    for (c, sg) in gps_sigma(&noisy).iter().enumerate() {
         let ratio = gps[c].std() / sg;
         println!("steady turn, gps {c}: n = {}, σ/σ_Table D.1 = {ratio:.4}", gps[c].n);
         assert!((ratio - 1.0).abs() < 0.05, "gps {c}: {ratio}");

@@ -103,10 +103,18 @@ pub struct ForcesMoments {
     pub slipstream_speed: f64,
 }
 
+impl ForcesMoments {
+    /// Force then moment, body axes: (X, Y, Z, L, M, N).
+    pub fn wrench(&self) -> [f64; 6] {
+        let (f, m) = (&self.force_body, &self.moment_body);
+        [f.x, f.y, f.z, m.x, m.y, m.z]
+    }
+}
+
 /// Columns of `DCM^BW` (A.2.7): the wind axes x_w, y_w, z_w in body components, of the
 /// velocity `v` (body components). Returns (x_w, y_w, z_w, sin α, cos α).
 #[inline]
-fn wind_axes(v: &Vector3<f64>, speed: f64) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>, f64, f64) {
+pub(crate) fn wind_axes(v: &Vector3<f64>, speed: f64) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>, f64, f64) {
     if speed < AIRSPEED_EPS {
         return (Vector3::x(), Vector3::y(), Vector3::z(), 0.0, 1.0);
     }

@@ -372,14 +372,7 @@ mod tests {
             z[6],
             &Surfaces::from_array([z[7], z[8], z[9], z[10], z[11], z[12]]),
         );
-        SVector::<f64, 6>::new(
-            fm.force_body.x,
-            fm.force_body.y,
-            fm.force_body.z,
-            fm.moment_body.x,
-            fm.moment_body.y,
-            fm.moment_body.z,
-        )
+        SVector::<f64, 6>::from(fm.wrench())
     }
 
     /// Against central differences at flight conditions across the envelope (level flight,

@@ -190,6 +190,17 @@ pub struct InvalidParameter {
     pub requirement: &'static str,
 }
 
+impl InvalidParameter {
+    /// `Err` of the parameter `name` whose `value` is not `requirement`.
+    pub fn err<T>(name: &'static str, value: f64, requirement: &'static str) -> Result<T, Self> {
+        Err(Self {
+            name,
+            value,
+            requirement,
+        })
+    }
+}
+
 impl fmt::Display for InvalidParameter {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "{} = {} must be {}", self.name, self.value, self.requirement)
@@ -310,36 +321,37 @@ impl Airframe {
     /// disc area, time constants, servo rate and the interpolation angle positive; gravity,
     /// deflection limit and interpolation limit non-negative; `thrust_min <= thrust_max`.
     pub fn validate(&self) -> Result<(), InvalidParameter> {
-        let bad = |name, value, requirement| {
-            Err(InvalidParameter {
-                name,
-                value,
-                requirement,
-            })
-        };
+        let bad = InvalidParameter::err;
         for (name, value) in self.named_values() {
             if !value.is_finite() {
                 return bad(name, value, "finite");
             }
         }
-        let positive: [(&'static str, f64); 15] = [
-            ("mass", self.mass),
-            ("i_xx", self.i_xx),
-            ("i_yy", self.i_yy),
-            ("i_zz", self.i_zz),
-            ("wing_area", self.wing_area),
-            ("mean_chord", self.mean_chord),
-            ("wing_span", self.wing_span),
-            ("aspect_ratio", self.aspect_ratio),
-            ("oswald_efficiency", self.oswald_efficiency),
-            ("prop_disc_area", self.prop_disc_area),
-            ("tau_thrust", self.tau_thrust),
-            ("servo_tau", self.servo_tau),
-            ("servo_rate_limit", self.servo_rate_limit),
-            ("alpha_1", self.alpha_1),
-            ("alpha_interp_limit", self.alpha_interp_limit),
+        // Looked up by name in `named_values` (the generated list of every field).
+        let values = self.named_values();
+        let value_of = |name: &str| {
+            let found = values.iter().find(|(n, _)| *n == name);
+            found.unwrap_or_else(|| panic!("{name} is not an Airframe parameter")).1
+        };
+        const POSITIVE: [&str; 15] = [
+            "mass",
+            "i_xx",
+            "i_yy",
+            "i_zz",
+            "wing_area",
+            "mean_chord",
+            "wing_span",
+            "aspect_ratio",
+            "oswald_efficiency",
+            "prop_disc_area",
+            "tau_thrust",
+            "servo_tau",
+            "servo_rate_limit",
+            "alpha_1",
+            "alpha_interp_limit",
         ];
-        for (name, value) in positive {
+        for name in POSITIVE {
+            let value = value_of(name);
             if value <= 0.0 {
                 return bad(name, value, "positive");
             }

@@ -118,7 +118,7 @@
 
 use nalgebra::Vector3;
 
-use crate::aero::{ForcesMoments, Surfaces, AIRSPEED_EPS};
+use crate::aero::{wind_axes, ForcesMoments, Surfaces, AIRSPEED_EPS};
 use crate::airframe::{Airframe, Coefficients, InvalidParameter};
 
 /// Which aerodynamic model the plant uses (FMU parameter `aero_model`).
@@ -262,19 +262,7 @@ impl Flow {
     #[inline]
     fn axes_of(v: Vector3<f64>) -> Self {
         let speed = v.norm();
-        if speed < AIRSPEED_EPS {
-            return Self::of(v);
-        }
-        let xw = v * (1.0 / speed);
-        let h = (v.x * v.x + v.z * v.z).sqrt();
-        let (sa, ca) = if h > 0.0 {
-            let h_inv = 1.0 / h;
-            (v.z * h_inv, v.x * h_inv)
-        } else {
-            (0.0, 1.0)
-        };
-        let zw = Vector3::new(-sa, 0.0, ca);
-        let yw = zw.cross(&xw);
+        let (xw, yw, zw, sa, ca) = wind_axes(&v, speed);
         Self {
             v,
             speed,
@@ -290,40 +278,14 @@ impl Flow {
 
     #[inline]
     fn of(v: Vector3<f64>) -> Self {
-        let speed = v.norm();
-        if speed < AIRSPEED_EPS {
-            return Self {
-                v,
-                speed,
-                alpha: 0.0,
-                beta: 0.0,
-                xw: Vector3::x(),
-                yw: Vector3::y(),
-                zw: Vector3::z(),
-                sa: 0.0,
-                ca: 1.0,
-            };
+        let flow = Self::axes_of(v);
+        if flow.speed < AIRSPEED_EPS {
+            return flow;
         }
-        let xw = v * (1.0 / speed);
-        let h = (v.x * v.x + v.z * v.z).sqrt();
-        let (sa, ca) = if h > 0.0 {
-            let h_inv = 1.0 / h;
-            (v.z * h_inv, v.x * h_inv)
-        } else {
-            (0.0, 1.0)
-        };
-        let zw = Vector3::new(-sa, 0.0, ca);
-        let yw = zw.cross(&xw);
         Self {
-            v,
-            speed,
             alpha: libm::atan2(v.z, v.x),
-            beta: xw.y.clamp(-1.0, 1.0).asin(),
-            xw,
-            yw,
-            zw,
-            sa,
-            ca,
+            beta: flow.xw.y.clamp(-1.0, 1.0).asin(),
+            ..flow
         }
     }
 }
@@ -335,13 +297,7 @@ impl GlobalAero {
     /// Every parameter finite; 0 ≤ α_a < α_s ≤ 90°, 0 ≤ β_a < β_s ≤ 90°, C_D90 > 0,
     /// 0 ≤ δ_a < δ_s < 90° (reversed flow).
     pub fn validate(&self) -> Result<(), InvalidParameter> {
-        let bad = |name, value, requirement| {
-            Err(InvalidParameter {
-                name,
-                value,
-                requirement,
-            })
-        };
+        let bad = InvalidParameter::err;
         let half_pi = core::f64::consts::FRAC_PI_2;
         for (name, value) in [
             ("alpha_attached", self.alpha_attached),

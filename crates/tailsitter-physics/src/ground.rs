@@ -103,13 +103,7 @@ impl Ground {
 
     /// Finite, non-negative geometry and gains, positive stiffness (height may be +∞).
     pub fn validate(&self) -> Result<(), InvalidParameter> {
-        let bad = |name, value, requirement| {
-            Err(InvalidParameter {
-                name,
-                value,
-                requirement,
-            })
-        };
+        let bad = InvalidParameter::err;
         if self.height.is_nan() || self.height == f64::NEG_INFINITY {
             return bad("ground_height", self.height, "a number (or +inf for no ground)");
         }

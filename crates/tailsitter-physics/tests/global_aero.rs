@@ -622,17 +622,7 @@ fn reversed_flow_seams_are_c1() {
     let h = 1e-7;
     let zero = Vector3::zeros();
     let s0 = Surfaces::default();
-    let eval = |al: f64, be: f64| {
-        let fm = g.forces_moments(&a, &v_air(20.0, al, be), &zero, 0.0, &s0).0;
-        [
-            fm.force_body.x,
-            fm.force_body.y,
-            fm.force_body.z,
-            fm.moment_body.x,
-            fm.moment_body.y,
-            fm.moment_body.z,
-        ]
-    };
+    let eval = |al: f64, be: f64| g.forces_moments(&a, &v_air(20.0, al, be), &zero, 0.0, &s0).0.wrench();
     let check = |al: f64, be: f64, d_al: f64, d_be: f64| {
         let f0 = eval(al, be);
         let fp = eval(al + d_al * h, be + d_be * h);

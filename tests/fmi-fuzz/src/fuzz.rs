@@ -89,6 +89,25 @@ impl Report {
         (self.coverage.len(), outcomes)
     }
 
+    /// The checks every short test run makes: no invariant violated, every sequence's
+    /// reset checked, and more than half of them a state restore.
+    pub fn assert_sound(&self) {
+        assert_eq!(self.violations, 0, "invariant violations (see output)");
+        assert_eq!(self.reset_checks, self.sequences);
+        assert!(
+            self.restore_checks > self.sequences / 2,
+            "restore checks {}",
+            self.restore_checks
+        );
+    }
+
+    /// Every "fmi2Function @ state" of `must` was called at least once.
+    pub fn assert_covers(&self, must: &[&str]) {
+        for must in must {
+            assert!(self.coverage.contains_key(*must), "{must} never exercised");
+        }
+    }
+
     pub fn print(&self) {
         let (pairs, outcomes) = self.coverage_summary();
         println!(
@@ -1906,70 +1925,57 @@ impl<'a> Fuzzer<'a> {
             let op = self.rng.below(16);
             let nx = *self.rng.pick(&[n, n, n, n.saturating_sub(1), n + 1, 0]);
             let in_ = |states: &[Me]| states.contains(&st);
+            // Each call: its name, whether it is legal here, its status, and the state a
+            // legal call that returns OK leads to (`None`: it stays).
             // SAFETY (every call below): live component, buffers of n + 1 ≥ nx elements.
             let (name, expect, s, next) = unsafe {
                 match op {
-                    0 => {
-                        let ok = in_(&[Me::Instantiated]);
-                        (
-                            "fmi2SetupExperiment",
-                            ok,
-                            ffi!(api, setup_experiment(c, 0, 0.0, 0.0, 0, 0.0)),
-                            st,
-                        )
-                    }
-                    1 => {
-                        let ok = in_(&[Me::Instantiated]);
-                        let s = ffi!(api, enter_initialization_mode(c));
-                        (
-                            "fmi2EnterInitializationMode",
-                            ok,
-                            s,
-                            if ok { Me::InitializationMode } else { st },
-                        )
-                    }
-                    2 => {
-                        let ok = in_(&[Me::InitializationMode]);
-                        let s = ffi!(api, exit_initialization_mode(c));
-                        ("fmi2ExitInitializationMode", ok, s, if ok { Me::EventMode } else { st })
-                    }
-                    3 => {
-                        let ok = in_(&[Me::EventMode, Me::ContinuousTimeMode]);
-                        (
-                            "fmi2EnterEventMode",
-                            ok,
-                            ffi!(api, enter_event_mode(c)),
-                            if ok { Me::EventMode } else { st },
-                        )
-                    }
-                    4 => {
-                        let ok = in_(&[Me::EventMode]);
-                        (
-                            "fmi2NewDiscreteStates",
-                            ok,
-                            ffi!(api, new_discrete_states(c, &mut info)),
-                            st,
-                        )
-                    }
-                    5 => {
-                        let ok = in_(&[Me::EventMode]);
-                        let s = ffi!(api, enter_continuous_time_mode(c));
-                        (
-                            "fmi2EnterContinuousTimeMode",
-                            ok,
-                            s,
-                            if ok { Me::ContinuousTimeMode } else { st },
-                        )
-                    }
-                    6 => {
-                        let ok = in_(&[Me::ContinuousTimeMode]);
-                        let s = ffi!(api, completed_integrator_step(c, 1, &mut flag, &mut flag2));
-                        ("fmi2CompletedIntegratorStep", ok, s, st)
-                    }
+                    0 => (
+                        "fmi2SetupExperiment",
+                        in_(&[Me::Instantiated]),
+                        ffi!(api, setup_experiment(c, 0, 0.0, 0.0, 0, 0.0)),
+                        None,
+                    ),
+                    1 => (
+                        "fmi2EnterInitializationMode",
+                        in_(&[Me::Instantiated]),
+                        ffi!(api, enter_initialization_mode(c)),
+                        Some(Me::InitializationMode),
+                    ),
+                    2 => (
+                        "fmi2ExitInitializationMode",
+                        in_(&[Me::InitializationMode]),
+                        ffi!(api, exit_initialization_mode(c)),
+                        Some(Me::EventMode),
+                    ),
+                    3 => (
+                        "fmi2EnterEventMode",
+                        in_(&[Me::EventMode, Me::ContinuousTimeMode]),
+                        ffi!(api, enter_event_mode(c)),
+                        Some(Me::EventMode),
+                    ),
+                    4 => (
+                        "fmi2NewDiscreteStates",
+                        in_(&[Me::EventMode]),
+                        ffi!(api, new_discrete_states(c, &mut info)),
+                        None,
+                    ),
+                    5 => (
+                        "fmi2EnterContinuousTimeMode",
+                        in_(&[Me::EventMode]),
+                        ffi!(api, enter_continuous_time_mode(c)),
+                        Some(Me::ContinuousTimeMode),
+                    ),
+                    6 => (
+                        "fmi2CompletedIntegratorStep",
+                        in_(&[Me::ContinuousTimeMode]),
+                        ffi!(api, completed_integrator_step(c, 1, &mut flag, &mut flag2)),
+                        None,
+                    ),
                     7 => {
                         let t = *self.rng.pick(&[0.01, 0.5, f64::NAN, f64::INFINITY]);
                         let ok = in_(&[Me::EventMode, Me::ContinuousTimeMode]) && t.is_finite();
-                        ("fmi2SetTime", ok, ffi!(api, set_time(c, t)), st)
+                        ("fmi2SetTime", ok, ffi!(api, set_time(c, t)), None)
                     }
                     8 => {
                         // Perturb the last states read back, sometimes with a NaN.
@@ -1985,17 +1991,14 @@ impl<'a> Fuzzer<'a> {
                         v.push(0.0);
                         let ok = in_(&[Me::ContinuousTimeMode]) && nx == n && !nan;
                         let s = ffi!(api, set_continuous_states(c, v.as_ptr(), nx));
-                        ("fmi2SetContinuousStates", ok, s, st)
+                        ("fmi2SetContinuousStates", ok, s, None)
                     }
-                    9 => {
-                        let ok = in_(&[Me::EventMode, Me::ContinuousTimeMode, Me::Terminated]) && nx == n;
-                        (
-                            "fmi2GetDerivatives",
-                            ok,
-                            ffi!(api, get_derivatives(c, x.as_mut_ptr(), nx)),
-                            st,
-                        )
-                    }
+                    9 => (
+                        "fmi2GetDerivatives",
+                        in_(&[Me::EventMode, Me::ContinuousTimeMode, Me::Terminated]) && nx == n,
+                        ffi!(api, get_derivatives(c, x.as_mut_ptr(), nx)),
+                        None,
+                    ),
                     10 => {
                         let ok = in_(&[
                             Me::InitializationMode,
@@ -2007,7 +2010,7 @@ impl<'a> Fuzzer<'a> {
                         if s == OK {
                             good_x = Some(x[..n].to_vec());
                         }
-                        ("fmi2GetContinuousStates", ok, s, st)
+                        ("fmi2GetContinuousStates", ok, s, None)
                     }
                     11 => {
                         let ok =
@@ -2016,7 +2019,7 @@ impl<'a> Fuzzer<'a> {
                         if s == OK && x[..n].iter().any(|v| !(v.is_finite() && *v > 0.0)) {
                             self.violation(fmu, format!("fmi2GetNominalsOfContinuousStates gave {:?}", &x[..n]));
                         }
-                        ("fmi2GetNominalsOfContinuousStates", ok, s, st)
+                        ("fmi2GetNominalsOfContinuousStates", ok, s, None)
                     }
                     12 => {
                         let ni = *self.rng.pick(&[0, 0, 1, 3]);
@@ -2026,26 +2029,19 @@ impl<'a> Fuzzer<'a> {
                             Me::ContinuousTimeMode,
                             Me::Terminated,
                         ]) && ni == 0;
-                        (
-                            "fmi2GetEventIndicators",
-                            ok,
-                            ffi!(api, get_event_indicators(c, x.as_mut_ptr(), ni)),
-                            st,
-                        )
+                        let s = ffi!(api, get_event_indicators(c, x.as_mut_ptr(), ni));
+                        ("fmi2GetEventIndicators", ok, s, None)
                     }
-                    13 => ("fmi2DoStep", false, ffi!(api, do_step(c, 0.0, 0.01, 1)), st),
-                    14 => {
-                        let ok = in_(&[Me::EventMode, Me::ContinuousTimeMode]);
-                        (
-                            "fmi2Terminate",
-                            ok,
-                            ffi!(api, terminate(c)),
-                            if ok { Me::Terminated } else { st },
-                        )
-                    }
+                    13 => ("fmi2DoStep", false, ffi!(api, do_step(c, 0.0, 0.01, 1)), None),
+                    14 => (
+                        "fmi2Terminate",
+                        in_(&[Me::EventMode, Me::ContinuousTimeMode]),
+                        ffi!(api, terminate(c)),
+                        Some(Me::Terminated),
+                    ),
                     _ => {
                         good_x = None;
-                        ("fmi2Reset", true, ffi!(api, reset(c)), Me::Instantiated)
+                        ("fmi2Reset", true, ffi!(api, reset(c)), Some(Me::Instantiated))
                     }
                 }
             };
@@ -2068,8 +2064,9 @@ impl<'a> Fuzzer<'a> {
             if host.records()[from..].iter().any(|r| r.message.contains("panic")) {
                 self.violation(fmu, format!("{name} in ME state {st:?} panicked"));
             }
-            if s == OK || op == 15 {
-                st = next;
+            // fmi2Reset leads to Instantiated whatever it returns.
+            if (s == OK && expect) || op == 15 {
+                st = next.unwrap_or(st);
             }
         }
     }

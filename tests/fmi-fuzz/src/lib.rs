@@ -291,24 +291,7 @@ impl Fmu {
     /// (typically a GUID mismatch: the library is older than `modelDescription/`).
     pub fn instance(&self, name: &str, logging_on: bool) -> Instance<'_> {
         self.instantiate(name, logging_on).unwrap_or_else(|| {
-            let host = Host::new();
-            let cname = CString::new(name).expect("no NUL");
-            let guid = CString::new(self.guid.as_str()).expect("no NUL");
-            // SAFETY: valid arguments; a non-NULL result is freed at once.
-            let c = unsafe {
-                ffi!(
-                    self.api,
-                    instantiate(
-                        cname.as_ptr(),
-                        fmi2Type_fmi2CoSimulation,
-                        guid.as_ptr(),
-                        c"".as_ptr(),
-                        &*host.callbacks,
-                        0,
-                        1
-                    )
-                )
-            };
+            let (host, c) = self.instantiate_raw(name, c"", true);
             if !c.is_null() {
                 // SAFETY: live component.
                 unsafe { ffi!(self.api, free_instance(c)) };
@@ -323,10 +306,17 @@ impl Fmu {
 
     /// Instantiate with this model's GUID and a fresh recording host.
     pub fn instantiate(&self, name: &str, logging_on: bool) -> Option<Instance<'_>> {
+        let (host, c) = self.instantiate_raw(name, c"file:///nonexistent", logging_on);
+        (!c.is_null()).then_some(Instance { fmu: self, c, host })
+    }
+
+    /// fmi2Instantiate (Co-Simulation, this model's GUID) logging into a fresh host; the
+    /// component may be NULL. The host owns the callbacks: keep it while the component lives.
+    fn instantiate_raw(&self, name: &str, resources: &std::ffi::CStr, logging_on: bool) -> (Host, fmi2Component) {
         let host = Host::new();
         let cname = CString::new(name).expect("no NUL");
         let guid = CString::new(self.guid.as_str()).expect("no NUL");
-        // SAFETY: valid arguments; the callbacks outlive the instance (owned by it).
+        // SAFETY: valid arguments; the callbacks are boxed in `host`, returned with the component.
         let c = unsafe {
             ffi!(
                 self.api,
@@ -334,14 +324,14 @@ impl Fmu {
                     cname.as_ptr(),
                     fmi2Type_fmi2CoSimulation,
                     guid.as_ptr(),
-                    c"file:///nonexistent".as_ptr(),
+                    resources.as_ptr(),
                     &*host.callbacks,
                     0,
                     i32::from(logging_on)
                 )
             )
         };
-        (!c.is_null()).then_some(Instance { fmu: self, c, host })
+        (host, c)
     }
 }
 
@@ -472,38 +462,26 @@ impl Instance<'_> {
             )
         }
     }
-    pub fn get_reals(&mut self, vrs: &[u32]) -> (fmi2Status, Vec<f64>) {
-        let mut out = vec![0.0; vrs.len()];
+    /// One fmi2Get{Real,Integer,Boolean} call over `vrs`.
+    fn get_values<T: Copy + Default>(
+        &mut self,
+        vrs: &[u32],
+        get: Option<unsafe extern "C" fn(fmi2Component, *const fmi2ValueReference, usize, *mut T) -> fmi2Status>,
+    ) -> (fmi2Status, Vec<T>) {
+        let mut out = vec![T::default(); vrs.len()];
+        let get = get.expect("fmi2Get* resolved at load time");
         // SAFETY: live instance, arrays of equal length.
-        let s = unsafe {
-            ffi!(
-                self.fmu.api,
-                get_real(self.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr())
-            )
-        };
+        let s = unsafe { get(self.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr()) };
         (s, out)
+    }
+    pub fn get_reals(&mut self, vrs: &[u32]) -> (fmi2Status, Vec<f64>) {
+        self.get_values(vrs, self.fmu.api.get_real)
     }
     pub fn get_integers(&mut self, vrs: &[u32]) -> (fmi2Status, Vec<i32>) {
-        let mut out = vec![0; vrs.len()];
-        // SAFETY: live instance, arrays of equal length.
-        let s = unsafe {
-            ffi!(
-                self.fmu.api,
-                get_integer(self.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr())
-            )
-        };
-        (s, out)
+        self.get_values(vrs, self.fmu.api.get_integer)
     }
     pub fn get_booleans(&mut self, vrs: &[u32]) -> (fmi2Status, Vec<i32>) {
-        let mut out = vec![0; vrs.len()];
-        // SAFETY: live instance, arrays of equal length.
-        let s = unsafe {
-            ffi!(
-                self.fmu.api,
-                get_boolean(self.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr())
-            )
-        };
-        (s, out)
+        self.get_values(vrs, self.fmu.api.get_boolean)
     }
     pub fn get_strings(&mut self, vrs: &[u32]) -> (fmi2Status, Vec<String>) {
         let mut out = vec![std::ptr::null(); vrs.len()];
@@ -603,16 +581,22 @@ pub fn cycle(fmu: &Fmu, steps: usize) -> bool {
     for k in 0..steps {
         ok &= inst.step(k as f64 * h, h) == OK;
     }
+    ok &= state_round_trip(&mut inst, |inst| inst.snapshot_bits().0.iter().all(|s| *s == OK));
+    ok &= inst.terminate() == OK;
+    ok
+}
+
+/// Get the FMU state, serialize it, deserialize and set the copy, run `then` (its result
+/// counts), free both states: true if every status was OK.
+fn state_round_trip(inst: &mut Instance<'_>, then: impl FnOnce(&mut Instance<'_>) -> bool) -> bool {
     let (s, mut state) = inst.get_state();
-    ok &= s == OK;
+    let mut ok = s == OK;
     let (s, bytes) = inst.serialize(state);
     ok &= s == OK;
     let (s, mut restored) = inst.deserialize(&bytes);
     ok &= s == OK && inst.set_state(restored) == OK;
-    let (s, _) = inst.snapshot_bits();
-    ok &= s.iter().all(|s| *s == OK);
+    ok &= then(inst);
     ok &= inst.free_state(&mut restored) == OK && inst.free_state(&mut state) == OK;
-    ok &= inst.terminate() == OK;
     ok
 }
 
@@ -624,13 +608,7 @@ pub fn light_cycle(fmu: &Fmu) -> bool {
         return false;
     };
     let mut ok = inst.setup(0.0, None) == OK;
-    let (s, mut state) = inst.get_state();
-    ok &= s == OK;
-    let (s, bytes) = inst.serialize(state);
-    ok &= s == OK;
-    let (s, mut restored) = inst.deserialize(&bytes);
-    ok &= s == OK && inst.set_state(restored) == OK;
-    ok &= inst.free_state(&mut restored) == OK && inst.free_state(&mut state) == OK;
+    ok &= state_round_trip(&mut inst, |_| true);
     ok
 }
 

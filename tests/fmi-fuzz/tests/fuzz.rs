@@ -30,22 +30,14 @@ fn random_call_sequences_keep_every_invariant() {
     println!("{:.1} s", t0.elapsed().as_secs_f64());
     report.print();
     let (pairs, _) = report.coverage_summary();
-    assert_eq!(report.violations, 0, "invariant violations (see output)");
-    assert_eq!(report.reset_checks, report.sequences);
-    assert!(
-        report.restore_checks > report.sequences / 2,
-        "restore checks {}",
-        report.restore_checks
-    );
+    report.assert_sound();
     assert!(pairs > 150, "only {pairs} (function, state) pairs covered");
     let mut must = vec!["fmi2DoStep @ StepComplete", "fmi2DeSerializeFMUstate @ Terminated"];
     // StepFailed only where a model under test can fail a step (per model, not forced).
     if required_models().iter().any(|m| STEP_CAN_FAIL.contains(&m.as_str())) {
         must.push("fmi2SetFMUstate @ StepFailed");
     }
-    for must in must {
-        assert!(report.coverage.contains_key(must), "{must} never exercised");
-    }
+    report.assert_covers(&must);
     // Model Exchange instances of the plant (the only ME model): the ME calls ran legally
     // (some OK) in the ME states, and illegally elsewhere.
     if !required_models().iter().any(|m| m == "tailsitter_plant") {
@@ -57,9 +49,6 @@ fn random_call_sequences_keep_every_invariant() {
     let me_cfg = Config {
         seed,
         sequences: env("FMI_FUZZ_ME_SEQUENCES", 3000),
-        deadline: None,
-        max_calls: 40,
-        per_fmu_cap: Default::default(),
         ..Default::default()
     };
     let report = Fuzzer::new(&plant, seed).run(&me_cfg);

@@ -82,8 +82,9 @@ fn sixty_four_concurrent_instances_match_sequential_runs() {
     }
 }
 
-/// RSS before and after `n` cycles (after a warm-up); panics if a cycle fails.
-fn rss_over(fmu: &Fmu, n: usize, cycle: impl Fn(&Fmu) -> bool) -> (u64, u64, u64) {
+/// Run `n` cycles of `what` on `fmu` (after up to 200 warm-up cycles): the resident set
+/// must not grow by 4 MiB (10 000 cycles leaking even 400 bytes each would add ~4 MiB).
+fn assert_rss_flat(fmu: &Fmu, what: &str, n: usize, cycle: impl Fn(&Fmu) -> bool) {
     for _ in 0..n.min(200) {
         assert!(cycle(fmu));
     }
@@ -95,7 +96,17 @@ fn rss_over(fmu: &Fmu, n: usize, cycle: impl Fn(&Fmu) -> bool) -> (u64, u64, u64
             mid = rss_kib();
         }
     }
-    (before, mid, rss_kib())
+    let after = rss_kib();
+    println!(
+        "{}: {what}: RSS {before} KiB → {mid} KiB → {after} KiB over {n} cycles ({:+} KiB)",
+        fmu.id,
+        after as i64 - before as i64
+    );
+    assert!(
+        after < before + 4096,
+        "{}: RSS grew from {before} KiB to {after} KiB",
+        fmu.id
+    );
 }
 
 #[test]
@@ -103,19 +114,7 @@ fn ten_thousand_instantiate_free_cycles_do_not_grow_the_resident_set() {
     let _serial = serial();
     const CYCLES: usize = 10_000;
     for fmu in &load_required() {
-        let (before, mid, after) = rss_over(fmu, CYCLES, light_cycle);
-        println!(
-            "{}: instantiate/setup/state/serialize/free: RSS {before} KiB → {mid} KiB → {after} KiB \
-             over {CYCLES} cycles ({:+} KiB)",
-            fmu.id,
-            after as i64 - before as i64
-        );
-        // 10 000 cycles leaking even 400 bytes each would add ~4 MiB.
-        assert!(
-            after < before + 4096,
-            "{}: RSS grew from {before} KiB to {after} KiB",
-            fmu.id
-        );
+        assert_rss_flat(fmu, "instantiate/setup/state/serialize/free", CYCLES, light_cycle);
     }
 }
 
@@ -125,16 +124,6 @@ fn full_life_cycles_do_not_grow_the_resident_set() {
     // With initialisation and a step; fewer for the LQR FMU (~40 ms per initialisation).
     for fmu in &load_required() {
         let n = if fmu.id == "tailsitter_lqr" { 300 } else { 5_000 };
-        let (before, mid, after) = rss_over(fmu, n, |f| cycle(f, 1));
-        println!(
-            "{}: full life cycle: RSS {before} KiB → {mid} KiB → {after} KiB over {n} cycles ({:+} KiB)",
-            fmu.id,
-            after as i64 - before as i64
-        );
-        assert!(
-            after < before + 4096,
-            "{}: RSS grew from {before} KiB to {after} KiB",
-            fmu.id
-        );
+        assert_rss_flat(fmu, "full life cycle", n, |f| cycle(f, 1));
     }
 }

@@ -6,11 +6,14 @@
 
 use closed_loop::{fly, Scenario};
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use flight_mission::{ControllerInput, MissionParams, SampledUnit};
+use flight_mission::{MissionParams, SampledUnit};
 use lqr_control::model::EulerRep;
 use lqr_control::{LqrController, LqrParams};
-use nalgebra::Vector3;
 use tailsitter_physics::{Airframe, Plant};
+
+#[path = "../tests/support/replay.rs"]
+mod replay;
+use replay::recorded_inputs;
 
 fn controller(params: LqrParams) -> LqrController {
     LqrController::new(Airframe::default(), MissionParams::default(), params).unwrap()
@@ -34,16 +37,9 @@ fn samples(c: &mut Criterion) {
     let m = MissionParams::default();
     let plant = Plant::new(Airframe::default());
     let x0 = plant.trim_vertical_climb(m.v_vertical).unwrap().state;
-    let trace = fly(&plant, x0, &mut controller(LqrParams::default()), &Scenario::mission(m));
-    let inputs: Vec<ControllerInput> = trace
-        .samples
-        .iter()
-        .map(|s| ControllerInput {
-            t: s.t,
-            measurement: s.measurement,
-            ref_offset_ned: Vector3::zeros(),
-        })
-        .collect();
+    let scenario = Scenario::mission(m);
+    let trace = fly(&plant, x0, &mut controller(LqrParams::default()), &scenario);
+    let inputs = recorded_inputs(&trace, &scenario);
     for (name, period) in [
         ("mission_samples_relinearised", 0.2),
         ("mission_samples_fixed_gain", 1e6),

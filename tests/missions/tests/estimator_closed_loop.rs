@@ -263,39 +263,36 @@ fn held_or_fresh(
     );
 }
 
-#[test]
-fn lqr_flies_the_mission_on_the_estimates() {
-    let m = MissionParams::default();
-    let mut c = LqrController::new(Airframe::default(), m, LqrParams::default()).unwrap();
-    let f = fly_on_estimates(&mut c, 1, false);
+/// `name` flies the default mission on the estimates of the avionics chain (the
+/// controller flies the estimate: the true distance from the reference is its own tracking
+/// error, 0.39 m for the LQR on the true state, plus the estimation error of the
+/// displacement since the start; positions relative to the start, so the first GPS fix's
+/// error, σ 4 m per axis, cancels): the estimate stays inside its reported 3σ (√trace),
+/// the true tracking error within the bar of 5 m.
+fn assert_flies_the_mission_on_the_estimates<C: FlightController>(name: &str, c: &mut C, seed: u64) {
+    let f = fly_on_estimates(c, seed, false);
     eprintln!(
-        "LQR on estimates: max |true position − reference| {:.2} m ({:.2} m after 5 s), max position estimation error {:.2} m (≤ {:.2} × 3σ), max attitude error {:.2}°, rejected {}",
+        "{name} on estimates: max |true position − reference| {:.2} m ({:.2} m after 5 s), max position estimation error {:.2} m (≤ {:.2} × 3σ), max attitude error {:.2}°, rejected {}",
         f.max_true_error, f.max_true_error_after_5s, f.max_est_error, f.max_error_ratio, f.max_att_error.to_degrees(), f.rejected
     );
     assert_eq!(f.final_phase, Phase::Vertical2);
     assert!(f.lost.is_none(), "{:?}", f.lost);
-    // The estimate stays inside its reported 3σ (√trace) while the controller flies on it.
-    // The controller flies the estimate: the true distance from the reference is its own
-    // tracking error (0.39 m on the true state) plus the estimation error of the
-    // displacement since the start (positions relative to the start: the first GPS fix's
-    // error, σ 4 m per axis, cancels); the bar is 5 m.
     assert!(f.max_error_ratio < 1.0, "estimation error {} × 3σ", f.max_error_ratio);
     assert!(f.max_true_error < 5.0, "true tracking error {}", f.max_true_error);
+}
+
+#[test]
+fn lqr_flies_the_mission_on_the_estimates() {
+    let m = MissionParams::default();
+    let mut c = LqrController::new(Airframe::default(), m, LqrParams::default()).unwrap();
+    assert_flies_the_mission_on_the_estimates("LQR", &mut c, 1);
 }
 
 #[test]
 fn tsd_flies_the_mission_on_the_estimates() {
     let m = MissionParams::default();
     let mut c = TsdController::new(Airframe::default(), m, TsdParams::default()).unwrap();
-    let f = fly_on_estimates(&mut c, 2, false);
-    eprintln!(
-        "TSD on estimates: max |true position − reference| {:.2} m ({:.2} m after 5 s), max position estimation error {:.2} m (≤ {:.2} × 3σ), max attitude error {:.2}°, rejected {}",
-        f.max_true_error, f.max_true_error_after_5s, f.max_est_error, f.max_error_ratio, f.max_att_error.to_degrees(), f.rejected
-    );
-    assert_eq!(f.final_phase, Phase::Vertical2);
-    assert!(f.lost.is_none(), "{:?}", f.lost);
-    assert!(f.max_error_ratio < 1.0, "estimation error {} × 3σ", f.max_error_ratio);
-    assert!(f.max_true_error < 5.0, "true tracking error {}", f.max_true_error);
+    assert_flies_the_mission_on_the_estimates("TSD", &mut c, 2);
 }
 
 /// With the avionics' 8 Hz second-order Butterworth on the analogue channels (App. D.3:

@@ -2,21 +2,15 @@
 //! (`tailsitter_physics::Plant`, its trimmed 3 m/s vertical climb as initial state),
 //! through the pure-Rust master of `closed-loop`. Run with `--nocapture` for the numbers.
 
-use closed_loop::{fly, MissionCheck, Ordering, Scenario, Trace};
+use closed_loop::{MissionCheck, Ordering, Scenario, Trace};
 use flight_mission::MissionParams;
 use lqr_control::{LqrController, LqrParams};
 use nalgebra::Vector3;
-use tailsitter_physics::{Airframe, Plant};
+use tailsitter_physics::Airframe;
 
-fn run(plant_af: Airframe, params: LqrParams, scenario: &Scenario) -> (Trace, MissionCheck, LqrController) {
-    let plant = Plant::new(plant_af);
-    let x0 = plant.trim_vertical_climb(scenario.mission.v_vertical).unwrap().state;
-    let mut c = LqrController::new(Airframe::default(), scenario.mission, params).unwrap();
-    let trace = fly(&plant, x0, &mut c, scenario);
-    let theta_trim = plant.trim_level(scenario.mission.v_level).unwrap().theta;
-    let check = MissionCheck::of(&trace, &scenario.mission, theta_trim);
-    (trace, check, c)
-}
+#[path = "support/lqr.rs"]
+mod lqr;
+use lqr::run;
 
 fn report(name: &str, trace: &Trace, check: &MissionCheck, c: &LqrController) {
     println!(

@@ -1,20 +1,14 @@
 //! Steady wind in vertical flight and crosswind over the mission (position integral action).
 
-use closed_loop::{fly, MissionCheck, Scenario, Trace, Wind};
+use closed_loop::{Scenario, Wind};
 use flight_mission::MissionParams;
-use lqr_control::{LqrController, LqrParams};
+use lqr_control::LqrParams;
 use nalgebra::Vector3;
-use tailsitter_physics::{Airframe, Plant};
+use tailsitter_physics::Airframe;
 
-fn run(params: LqrParams, scenario: &Scenario) -> (Trace, MissionCheck, LqrController) {
-    let plant = Plant::new(Airframe::default());
-    let x0 = plant.trim_vertical_climb(scenario.mission.v_vertical).unwrap().state;
-    let mut c = LqrController::new(Airframe::default(), scenario.mission, params).unwrap();
-    let trace = fly(&plant, x0, &mut c, scenario);
-    let theta_trim = plant.trim_level(scenario.mission.v_level).unwrap().theta;
-    let check = MissionCheck::of(&trace, &scenario.mission, theta_trim);
-    (trace, check, c)
-}
+#[path = "support/lqr.rs"]
+mod lqr;
+use lqr::run;
 
 /// Vertical flight (40 s) in a constant wind `w` (NED air velocity, m/s): (max error, error
 /// after 15 s max, final error, completed).
@@ -26,7 +20,7 @@ fn vertical_in_wind(params: LqrParams, w: Vector3<f64>, t_end: f64) -> (f64, f64
     let mut s = Scenario::mission(m);
     s.stop_time = t_end;
     s.wind = Wind::Constant(w);
-    let (trace, _, c) = run(params, &s);
+    let (trace, _, c) = run(Airframe::default(), params, &s);
     let max = trace.max_pos_error();
     let late = trace
         .samples
@@ -132,7 +126,7 @@ fn steady_broadside_wind_vertical_flight() {
 fn default_mission_in_3_m_s_crosswind() {
     let mut s = Scenario::mission(MissionParams::default());
     s.wind = Wind::Constant(Vector3::new(0.0, 3.0, 0.0));
-    let (trace, check, c) = run(LqrParams::default(), &s);
+    let (trace, check, c) = run(Airframe::default(), LqrParams::default(), &s);
     print!("{check}");
     println!(
         "3 m/s crosswind mission: max position error {:.3} m, fallbacks {}",
