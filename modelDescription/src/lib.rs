@@ -262,12 +262,21 @@ pub struct DeclFile {
     /// [`python`]).
     #[serde(default)]
     pub presets: BTreeMap<String, Preset>,
-    /// Whether every initial unknown depends on every input: a sampled unit whose outputs
-    /// after fmi2ExitInitializationMode hold the value computed from the inputs set in
-    /// Initialization Mode. Otherwise an initial unknown depends on the inputs among its
-    /// [`VariableDecl::depends_on`] only. See [`Model::initial_dependencies`].
+    /// The inputs every initial unknown depends on: `true` for all of them, or their
+    /// names: a sampled unit whose outputs after fmi2ExitInitializationMode hold the
+    /// value computed from the inputs set in Initialization Mode. Besides these an
+    /// initial unknown depends on the inputs among its [`VariableDecl::depends_on`].
+    /// See [`Model::initial_dependencies`].
     #[serde(default)]
-    pub initial_depends_on_inputs: Option<bool>,
+    pub initial_depends_on_inputs: Option<InitialInputs>,
+}
+
+/// [`DeclFile::initial_depends_on_inputs`]: every input (`true`), none (`false`) or those named.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(untagged)]
+pub enum InitialInputs {
+    All(bool),
+    Named(Vec<String>),
 }
 
 /// One code of the `phase` output.
@@ -351,8 +360,8 @@ pub struct Model {
     /// Name-based UUID (v5) over the interface: changes whenever any variable,
     /// the identifier or the version changes.
     pub guid: String,
-    /// [`DeclFile::initial_depends_on_inputs`] of the model's file.
-    pub initial_depends_on_inputs: bool,
+    /// The inputs every initial unknown depends on ([`DeclFile::initial_depends_on_inputs`]).
+    pub initial_inputs: Vec<String>,
 }
 
 impl Model {
@@ -427,8 +436,8 @@ impl Model {
     /// every parameter (all have a start value and no `initial`, so exact). An initial
     /// unknown depends on every parameter (conservative: the initial state is set, and
     /// the calculated parameters trimmed, from them) and on every input when the model
-    /// declares `initialDependsOnInputs`, else on the inputs among its [`Self::dependencies`]
-    /// (the states themselves are not knowns at initialisation).
+    /// names in `initialDependsOnInputs` ([`Self::initial_inputs`]) and on the inputs among
+    /// its [`Self::dependencies`] (the states themselves are not knowns at initialisation).
     pub fn initial_dependencies(&self, v: &Variable) -> Vec<usize> {
         let direct: BTreeSet<usize> = self.dependencies(v).into_iter().collect();
         self.variables
@@ -436,7 +445,7 @@ impl Model {
             .enumerate()
             .filter(|(i, k)| match k.decl.causality {
                 Causality::Parameter => true,
-                Causality::Input => self.initial_depends_on_inputs || direct.contains(&(i + 1)),
+                Causality::Input => self.initial_inputs.contains(&k.decl.name) || direct.contains(&(i + 1)),
                 _ => false,
             })
             .map(|(i, _)| i + 1)
@@ -446,7 +455,7 @@ impl Model {
     /// [`Self::outputs`] and [`Self::initial_unknowns`] with their dependencies as value
     /// references: (unknown, knowns) pairs, for probes that check the declared structure
     /// against the real feedthrough of an FMU.
-    pub fn structure_refs(&self) -> (Vec<(u32, Vec<u32>)>, Vec<(u32, Vec<u32>)>) {
+    pub fn structure_refs(&self) -> (Vec<UnknownRefs>, Vec<UnknownRefs>) {
         let vr = |i: usize| self.variables[i - 1].value_reference;
         let refs = |list: Vec<&Variable>, deps: &dyn Fn(&Variable) -> Vec<usize>| {
             list.into_iter()
@@ -459,6 +468,9 @@ impl Model {
         )
     }
 }
+
+/// An unknown of ModelStructure and the knowns it depends on, by value reference.
+pub type UnknownRefs = (u32, Vec<u32>);
 
 /// In a `dependsOn` list: every continuous state.
 pub const ALL_STATES: &str = "@states";
@@ -527,7 +539,17 @@ pub fn load(dir: &Path, model_identifier: &str, version: &str) -> Result<Model, 
         variables,
         sources,
         guid: String::new(),
-        initial_depends_on_inputs: root.initial_depends_on_inputs.unwrap_or(false),
+        initial_inputs: Vec::new(),
+    };
+    model.initial_inputs = match root.initial_depends_on_inputs.clone() {
+        None | Some(InitialInputs::All(false)) => Vec::new(),
+        Some(InitialInputs::All(true)) => model
+            .variables
+            .iter()
+            .filter(|v| v.decl.causality == Causality::Input)
+            .map(|v| v.name().to_string())
+            .collect(),
+        Some(InitialInputs::Named(names)) => names,
     };
     check(&model)?;
     model.guid = guid_of(&model);
@@ -709,6 +731,11 @@ fn check(model: &Model) -> Result<(), DeclError> {
         .filter(|v| v.decl.causality == Causality::Input)
         .map(|v| v.name())
         .collect();
+    for i in &model.initial_inputs {
+        if !inputs.contains(i.as_str()) {
+            return err(format!("initialDependsOnInputs: '{i}' is not an input"));
+        }
+    }
     for v in &model.variables {
         let d = &v.decl;
         let n = &d.name;
