@@ -114,3 +114,33 @@ def test_wrong_guid_is_refused_at_instantiate(model, tmp_path):
     good.doStep(0.0, float(md.defaultExperiment.stepSize))
     good.terminate()
     good.freeInstance()
+
+
+def test_model_structure_states_its_dependencies(model):
+    """Every Unknown of ModelStructure carries `dependencies` (none = "depends on every
+    known", which makes an importer solve an algebraic loop over all the connections
+    at initialisation), naming only knowns of its list: inputs and continuous states
+    for Outputs and Derivatives (FMI 2.0 §2.2.8), inputs and variables with
+    initial="exact" for InitialUnknowns. Nothing reads a command input directly except
+    the plant's actuator derivatives; a sampled unit's initial outputs read its inputs."""
+    md = read_model_description(str(fmu_path(model)), validate=True)
+    inputs = {v for v in md.modelVariables if v.causality == "input"}
+    states = {d.variable.derivative for d in md.derivatives}
+    exact = {v for v in md.modelVariables if v.initial == "exact" or (v.causality == "parameter" and v.initial is None)}
+    lists = [("Outputs", md.outputs, inputs | states), ("Derivatives", md.derivatives, inputs | states)]
+    lists.append(("InitialUnknowns", md.initialUnknowns, inputs | exact))
+    for name, unknowns, knowns in lists:
+        for u in unknowns:
+            assert u.dependencies is not None, f"{name}/{u.variable.name}: no dependencies"
+            stray = [v.name for v in u.dependencies if v not in knowns]
+            assert not stray, f"{name}/{u.variable.name} depends on {stray}, not knowns of the list"
+    commands = {v for v in inputs if v.name.endswith("_cmd")}
+    for u in md.outputs:
+        assert not (set(u.dependencies) & commands), f"output {u.variable.name} reads a command directly"
+    if model == "tailsitter_plant":
+        for u in md.initialUnknowns:
+            read = {v.name for v in set(u.dependencies) & commands}
+            assert read <= {u.variable.name.removeprefix("der_") + "_cmd"}, (u.variable.name, read)
+    else:
+        assert not any(set(u.dependencies) & inputs for u in md.outputs)
+        assert all(set(u.dependencies) & inputs for u in md.initialUnknowns)

@@ -158,8 +158,11 @@ pub struct VariableDecl {
     #[serde(default)]
     pub display_unit: Option<String>,
     pub description: String,
-    /// Outputs only: names of the inputs this output depends on directly
-    /// (direct feedthrough). Empty = depends on states only.
+    /// Outputs and state derivatives: the knowns this value depends on at a
+    /// communication point or in Continuous-Time Mode (ModelStructure `dependencies`):
+    /// names of inputs (direct feedthrough) and of continuous states, or [`ALL_STATES`]
+    /// for every continuous state. An output that is itself a state depends on that
+    /// state without naming it. Empty = depends on no input (nor state).
     #[serde(default)]
     pub depends_on: Vec<String>,
     /// Name of a group (see [`DeclFile::groups`]) this variable is a field of:
@@ -259,6 +262,21 @@ pub struct DeclFile {
     /// [`python`]).
     #[serde(default)]
     pub presets: BTreeMap<String, Preset>,
+    /// The inputs every initial unknown depends on: `true` for all of them, or their
+    /// names: a sampled unit whose outputs after fmi2ExitInitializationMode hold the
+    /// value computed from the inputs set in Initialization Mode. Besides these an
+    /// initial unknown depends on the inputs among its [`VariableDecl::depends_on`].
+    /// See [`Model::initial_dependencies`].
+    #[serde(default)]
+    pub initial_depends_on_inputs: Option<InitialInputs>,
+}
+
+/// [`DeclFile::initial_depends_on_inputs`]: every input (`true`), none (`false`) or those named.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(untagged)]
+pub enum InitialInputs {
+    All(bool),
+    Named(Vec<String>),
 }
 
 /// One code of the `phase` output.
@@ -342,6 +360,8 @@ pub struct Model {
     /// Name-based UUID (v5) over the interface: changes whenever any variable,
     /// the identifier or the version changes.
     pub guid: String,
+    /// The inputs every initial unknown depends on ([`DeclFile::initial_depends_on_inputs`]).
+    pub initial_inputs: Vec<String>,
 }
 
 impl Model {
@@ -362,7 +382,98 @@ impl Model {
     pub fn model_exchange(&self) -> bool {
         self.variables.iter().any(|v| v.decl.derivative_of.is_some())
     }
+
+    /// 1-based index of the variable `name` in ModelVariables.
+    pub fn index_of(&self, name: &str) -> Option<usize> {
+        self.variables.iter().position(|v| v.name() == name).map(|i| i + 1)
+    }
+
+    /// ModelStructure/Outputs and /Derivatives: the unknowns, in ModelVariables order
+    /// (Outputs) and in continuous-state order (Derivatives).
+    pub fn outputs(&self) -> Vec<&Variable> {
+        self.variables
+            .iter()
+            .filter(|v| v.decl.causality == Causality::Output)
+            .collect()
+    }
+
+    /// ModelStructure/InitialUnknowns (FMI 2.0 §2.2.8): outputs and calculated parameters
+    /// (none declares `initial`, so they are `calculated`) and the continuous states and
+    /// their derivatives (the states here are outputs or locals without start value).
+    pub fn initial_unknowns(&self) -> Vec<&Variable> {
+        let states: BTreeSet<&str> = self.continuous_states().iter().map(|(s, _)| s.name()).collect();
+        self.variables
+            .iter()
+            .filter(|v| {
+                matches!(v.decl.causality, Causality::Output | Causality::CalculatedParameter)
+                    || v.decl.derivative_of.is_some()
+                    || states.contains(v.name())
+            })
+            .collect()
+    }
+
+    /// The `dependencies` of an output or a state derivative (indices into
+    /// ModelVariables, ascending): the inputs and continuous states of its `dependsOn`
+    /// ([`ALL_STATES`] expanded), and the output itself when it is a continuous state.
+    pub fn dependencies(&self, v: &Variable) -> Vec<usize> {
+        let states = self.continuous_states();
+        let mut deps = BTreeSet::new();
+        for name in &v.decl.depends_on {
+            if name == ALL_STATES {
+                deps.extend(states.iter().filter_map(|(s, _)| self.index_of(s.name())));
+            } else {
+                deps.extend(self.index_of(name));
+            }
+        }
+        if states.iter().any(|(s, _)| s.name() == v.name()) {
+            deps.extend(self.index_of(v.name()));
+        }
+        deps.into_iter().collect()
+    }
+
+    /// The `dependencies` of an initial unknown (indices, ascending). The knowns of
+    /// Initialization Mode are the inputs and the variables with initial = "exact": here
+    /// every parameter (all have a start value and no `initial`, so exact). An initial
+    /// unknown depends on every parameter (conservative: the initial state is set, and
+    /// the calculated parameters trimmed, from them) and on every input when the model
+    /// names in `initialDependsOnInputs` ([`Self::initial_inputs`]) and on the inputs among
+    /// its [`Self::dependencies`] (the states themselves are not knowns at initialisation).
+    pub fn initial_dependencies(&self, v: &Variable) -> Vec<usize> {
+        let direct: BTreeSet<usize> = self.dependencies(v).into_iter().collect();
+        self.variables
+            .iter()
+            .enumerate()
+            .filter(|(i, k)| match k.decl.causality {
+                Causality::Parameter => true,
+                Causality::Input => self.initial_inputs.contains(&k.decl.name) || direct.contains(&(i + 1)),
+                _ => false,
+            })
+            .map(|(i, _)| i + 1)
+            .collect()
+    }
+
+    /// [`Self::outputs`] and [`Self::initial_unknowns`] with their dependencies as value
+    /// references: (unknown, knowns) pairs, for probes that check the declared structure
+    /// against the real feedthrough of an FMU.
+    pub fn structure_refs(&self) -> (Vec<UnknownRefs>, Vec<UnknownRefs>) {
+        let vr = |i: usize| self.variables[i - 1].value_reference;
+        let refs = |list: Vec<&Variable>, deps: &dyn Fn(&Variable) -> Vec<usize>| {
+            list.into_iter()
+                .map(|v| (v.value_reference, deps(v).into_iter().map(vr).collect()))
+                .collect()
+        };
+        (
+            refs(self.outputs(), &|v| self.dependencies(v)),
+            refs(self.initial_unknowns(), &|v| self.initial_dependencies(v)),
+        )
+    }
 }
+
+/// An unknown of ModelStructure and the knowns it depends on, by value reference.
+pub type UnknownRefs = (u32, Vec<u32>);
+
+/// In a `dependsOn` list: every continuous state.
+pub const ALL_STATES: &str = "@states";
 
 /// Suffix of a group's type path in [`DeclFile::groups`]: the value starts from the
 /// type's `Default` and only the declared fields are assigned.
@@ -428,6 +539,17 @@ pub fn load(dir: &Path, model_identifier: &str, version: &str) -> Result<Model, 
         variables,
         sources,
         guid: String::new(),
+        initial_inputs: Vec::new(),
+    };
+    model.initial_inputs = match root.initial_depends_on_inputs.clone() {
+        None | Some(InitialInputs::All(false)) => Vec::new(),
+        Some(InitialInputs::All(true)) => model
+            .variables
+            .iter()
+            .filter(|v| v.decl.causality == Causality::Input)
+            .map(|v| v.name().to_string())
+            .collect(),
+        Some(InitialInputs::Named(names)) => names,
     };
     check(&model)?;
     model.guid = guid_of(&model);
@@ -599,7 +721,8 @@ fn is_rust_identifier(s: &str) -> bool {
 }
 
 /// Check the rules of FMI 2.0 (start/initial per causality, min ≤ start ≤ max, units known)
-/// and our own (names are Rust identifiers, unique; dependencies name inputs; groups declared).
+/// and our own (names are Rust identifiers, unique; dependencies name inputs or states;
+/// groups declared).
 fn check(model: &Model) -> Result<(), DeclError> {
     let mut names = BTreeSet::new();
     let inputs: BTreeSet<&str> = model
@@ -608,6 +731,11 @@ fn check(model: &Model) -> Result<(), DeclError> {
         .filter(|v| v.decl.causality == Causality::Input)
         .map(|v| v.name())
         .collect();
+    for i in &model.initial_inputs {
+        if !inputs.contains(i.as_str()) {
+            return err(format!("initialDependsOnInputs: '{i}' is not an input"));
+        }
+    }
     for v in &model.variables {
         let d = &v.decl;
         let n = &d.name;
@@ -676,12 +804,21 @@ fn check(model: &Model) -> Result<(), DeclError> {
         } else if v.display_unit.is_some() {
             return err(format!("variable '{n}': displayUnit without unit"));
         }
-        if !d.depends_on.is_empty() && d.causality != Causality::Output {
-            return err(format!("variable '{n}': dependsOn only for outputs"));
+        if !d.depends_on.is_empty() && d.causality != Causality::Output && d.derivative_of.is_none() {
+            return err(format!(
+                "variable '{n}': dependsOn only for outputs and state derivatives"
+            ));
         }
         for dep in &d.depends_on {
-            if !inputs.contains(dep.as_str()) {
-                return err(format!("variable '{n}': dependsOn '{dep}' is not an input"));
+            let state = dep == ALL_STATES
+                || model
+                    .variables
+                    .iter()
+                    .any(|o| o.decl.derivative_of.as_deref() == Some(dep.as_str()));
+            if !inputs.contains(dep.as_str()) && !state {
+                return err(format!(
+                    "variable '{n}': dependsOn '{dep}' is neither an input nor a continuous state"
+                ));
             }
         }
         if let Some(x) = d.nominal {

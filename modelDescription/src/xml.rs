@@ -5,7 +5,7 @@
 //! ModelStructure. No timestamp is written, so the output is reproducible and
 //! can be compared byte for byte with the reviewed copy in the repository.
 
-use crate::{fmt_f64, units, Causality, Model, Start, VarType, Variable, AUTHOR, GENERATION_TOOL, LOG_CATEGORIES};
+use crate::{fmt_f64, units, Model, Start, VarType, Variable, AUTHOR, GENERATION_TOOL, LOG_CATEGORIES};
 use quick_xml::events::{BytesDecl, Event};
 use quick_xml::Writer;
 use std::collections::BTreeSet;
@@ -237,54 +237,36 @@ fn index_of(model: &Model, name: &str) -> usize {
 }
 
 fn model_structure(w: &mut W, model: &Model) -> Result<()> {
-    let outputs: Vec<&Variable> = model
-        .variables
-        .iter()
-        .filter(|v| v.decl.causality == Causality::Output)
-        .collect();
-    let initial: Vec<&Variable> = model
-        .variables
-        .iter()
-        .filter(|v| {
-            matches!(v.decl.causality, Causality::Output | Causality::CalculatedParameter)
-                || v.decl.derivative_of.is_some()
-        })
-        .collect();
     let derivatives: Vec<&Variable> = model.continuous_states().into_iter().map(|(_, d)| d).collect();
     w.create_element("ModelStructure").write_inner_content(|w| {
-        unknowns(w, model, "Outputs", &outputs, true)?;
-        // No `dependencies` attribute: a derivative may depend on every state and input.
-        unknowns(w, model, "Derivatives", &derivatives, false)?;
-        // No `dependencies` attribute: an initial unknown may depend on every known.
-        unknowns(w, model, "InitialUnknowns", &initial, false)?;
-        Ok(())
+        write_unknowns(w, model, "Outputs", &model.outputs(), |v| model.dependencies(v))?;
+        write_unknowns(w, model, "Derivatives", &derivatives, |v| model.dependencies(v))?;
+        write_unknowns(w, model, "InitialUnknowns", &model.initial_unknowns(), |v| {
+            model.initial_dependencies(v)
+        })
     })?;
     Ok(())
 }
 
-/// The `element` list of `vars` as `Unknown`s (by index), each with its declared
-/// `dependencies` if `with_dependencies`; nothing if `vars` is empty.
-fn unknowns(w: &mut W, model: &Model, element: &str, vars: &[&Variable], with_dependencies: bool) -> Result<()> {
-    if vars.is_empty() {
+/// One list of ModelStructure (nothing when `list` is empty): an `Unknown` per variable
+/// with its `dependencies` (indices of the knowns, ascending; an empty list = none).
+fn write_unknowns(
+    w: &mut W,
+    model: &Model,
+    name: &str,
+    list: &[&Variable],
+    deps: impl Fn(&Variable) -> Vec<usize>,
+) -> Result<()> {
+    if list.is_empty() {
         return Ok(());
     }
-    w.create_element(element).write_inner_content(|w| {
-        for v in vars {
+    w.create_element(name).write_inner_content(|w| {
+        for v in list {
             let index = index_of(model, v.name()).to_string();
-            let unknown = w.create_element("Unknown").with_attribute(("index", index.as_str()));
-            if with_dependencies {
-                let deps: Vec<String> = v
-                    .decl
-                    .depends_on
-                    .iter()
-                    .map(|n| index_of(model, n).to_string())
-                    .collect();
-                unknown
-                    .with_attribute(("dependencies", deps.join(" ").as_str()))
-                    .write_empty()?;
-            } else {
-                unknown.write_empty()?;
-            }
+            let deps: Vec<String> = deps(v).iter().map(usize::to_string).collect();
+            w.create_element("Unknown")
+                .with_attributes([("index", index.as_str()), ("dependencies", deps.join(" ").as_str())])
+                .write_empty()?;
         }
         Ok(())
     })?;

@@ -193,7 +193,11 @@ fn malformed_declarations_are_rejected() {
         ),
         (
             r#"{"name":"a","causality":"output","dependsOn":["x"],"description":"d"}"#.to_string(),
-            "not an input",
+            "neither an input nor a continuous state",
+        ),
+        (
+            r#"{"name":"a","causality":"parameter","start":1,"dependsOn":["@states"],"description":"d"}"#.to_string(),
+            "only for outputs and state derivatives",
         ),
         (
             r#"{"name":"a","causality":"parameter","type":"Integer","start":1.5,"description":"d"}"#.to_string(),

@@ -13,6 +13,7 @@ pub mod instance;
 pub mod logger;
 pub mod model;
 pub mod state;
+pub mod structure_probe;
 pub mod test_host;
 pub mod testing;
 pub mod variables;
