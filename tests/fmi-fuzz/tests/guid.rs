@@ -36,12 +36,13 @@ fn the_guid_follows_the_interface() {
         assert_eq!(guid(&tmp, id), fmu.guid, "{id}: same declaration, same GUID");
         let path = tmp.join(format!("{id}.json"));
         let original = std::fs::read_to_string(&path).expect("read");
-        // A variable declared in this file (not in an included fragment).
+        // A variable declared in this file (not in an included fragment) that no other
+        // declaration names (a `dependsOn` would dangle after the rename).
         let first = fmu
             .vars
             .iter()
             .map(|v| v.name.clone())
-            .find(|n| original.contains(&format!("\"{n}\"")))
+            .find(|n| original.matches(&format!("\"{n}\"")).count() == 1)
             .expect("a variable declared in the model's own file");
         let edits: Vec<(&str, String)> = vec![
             ("rename a variable", original.replacen(&format!("\"{first}\""), &format!("\"{first}_renamed\""), 1)),
