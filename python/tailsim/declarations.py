@@ -10,7 +10,7 @@ mission presets. This module only loads it into the names below.
 from __future__ import annotations
 
 import json
-from pathlib import Path
+from importlib import resources
 from typing import NamedTuple
 
 
@@ -34,7 +34,9 @@ class DefaultExperiment(NamedTuple):
     step_size: float
 
 
-_DATA = json.loads((Path(__file__).with_name("declarations.json")).read_text(encoding="utf-8"))
+# importlib.resources reads it from a folder or from a zip (the campaign ships the package
+# to workers that lack it as a zip archive).
+_DATA = json.loads(resources.files(__package__).joinpath("declarations.json").read_text(encoding="utf-8"))
 
 
 def _floats(values: dict) -> dict[str, float]:

@@ -184,7 +184,7 @@ def _package_zip() -> bytes:
     pkg = pathlib.Path(__file__).resolve().parents[1]
     buf = io.BytesIO()
     with zipfile.ZipFile(buf, "w") as z:
-        for f in sorted(pkg.rglob("*.py")):
+        for f in sorted([*pkg.rglob("*.py"), *pkg.rglob("*.json")]):
             info = zipfile.ZipInfo(f"tailsim/{f.relative_to(pkg).as_posix()}", date_time=(2020, 1, 1, 0, 0, 0))
             z.writestr(info, f.read_bytes())
     return buf.getvalue()
