@@ -22,6 +22,7 @@ import json
 import math
 import pathlib
 
+from . import load_json_into
 from .markdown import fmt_or_dash, shortest
 
 FILE = "aero_models.json"
@@ -51,10 +52,7 @@ MODEL_NOTES = (
 
 def load_into(d: dict, folder: str | pathlib.Path) -> dict:
     """Add `aero_models.json` of `folder` (if the campaign wrote it) to the report data `d`."""
-    path = pathlib.Path(folder) / FILE
-    if path.exists():
-        d["aero_models"] = json.loads(path.read_text())
-    return d
+    return load_json_into(d, folder, FILE, "aero_models")
 
 
 def _num(x) -> float:
