@@ -23,7 +23,7 @@ import math
 import pathlib
 
 from . import load_json_into
-from .markdown import fmt_or_dash, shortest
+from .markdown import fmt_or_dash, shortest, table_head
 
 FILE = "aero_models.json"
 
@@ -208,11 +208,7 @@ def gust_table(a: dict, controllers: list[str]) -> list[str]:
         "the ground. Cells: thesis / global.",
         "",
     ]
-    header, rule = "| phase | axis |", "|---|---|"
-    for k in controllers:
-        header += f" {k} (m/s) |"
-        rule += "---|"
-    out += [header + " changed |", rule + "---|"]
+    out += table_head(["phase", "axis", *(f"{k} (m/s)" for k in controllers), "changed"])
     by = {(r["phase"], r["axis"], r["controller"], r["aero_model"]): r for r in g["rows"]}
     cases: list[tuple[str, str]] = []
     for r in g["rows"]:
