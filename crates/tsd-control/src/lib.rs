@@ -271,47 +271,6 @@ impl TsdController {
         self.saturated = 0;
     }
 
-    /// Write the complete dynamic state ([`STATE_LEN`] values) for FMU-state serialisation.
-    pub fn save(&self, out: &mut impl FnMut(f64)) {
-        out(if self.initialized { 1.0 } else { 0.0 });
-        out(self.integrators.thrust);
-        out(self.integrators.normal);
-        out(self.integrators.roll);
-        out(self.integrators.directional);
-        out(self.saturated as f64);
-        self.weathervane.save(out);
-        self.ground.save(out);
-    }
-
-    /// Restore what [`Self::save`] wrote; a truncated state is an error and leaves `self` unchanged.
-    pub fn restore(&mut self, next: &mut impl FnMut() -> Option<f64>) -> Result<(), ControlError> {
-        let mut v = [0.0; STATE_LEN];
-        for slot in v.iter_mut() {
-            *slot = next().ok_or_else(|| ControlError("truncated TSD controller state".into()))?;
-        }
-        let mut weathervane = self.weathervane;
-        let mut rest = v[6..].iter().copied();
-        weathervane.restore(&mut || rest.next()).map_err(ControlError)?;
-        self.weathervane = weathervane;
-        self.initialized = v[0] != 0.0;
-        self.integrators = Integrators {
-            thrust: v[1],
-            normal: v[2],
-            roll: v[3],
-            directional: v[4],
-        };
-        self.saturated = if v[5].is_finite() && v[5] >= 0.0 {
-            v[5] as u32
-        } else {
-            0
-        };
-        let mut rest = v[6 + guidance::weathervane::WEATHERVANE_STATE_LEN..].iter().copied();
-        self.ground
-            .restore(&mut || rest.next())
-            .ok_or_else(|| ControlError("truncated TSD controller state".into()))?;
-        Ok(())
-    }
-
     fn err(msg: impl Into<String>) -> ControlError {
         ControlError(msg.into())
     }
@@ -350,12 +309,45 @@ impl SampledUnit for TsdController {
         c.mission.sample_time
     }
 
+    /// Write the complete dynamic state ([`STATE_LEN`] values) for FMU-state serialisation.
     fn save(&self, out: &mut impl FnMut(f64)) {
-        Self::save(self, out)
+        out(if self.initialized { 1.0 } else { 0.0 });
+        out(self.integrators.thrust);
+        out(self.integrators.normal);
+        out(self.integrators.roll);
+        out(self.integrators.directional);
+        out(self.saturated as f64);
+        self.weathervane.save(out);
+        self.ground.save(out);
     }
 
+    /// Restore what [`Self::save`] wrote; a truncated state is an error and leaves `self` unchanged.
     fn restore(&mut self, next: &mut impl FnMut() -> Option<f64>) -> Result<(), ControlError> {
-        Self::restore(self, next)
+        let mut v = [0.0; STATE_LEN];
+        for slot in v.iter_mut() {
+            *slot = next().ok_or_else(|| ControlError("truncated TSD controller state".into()))?;
+        }
+        let mut weathervane = self.weathervane;
+        let mut rest = v[6..].iter().copied();
+        weathervane.restore(&mut || rest.next()).map_err(ControlError)?;
+        self.weathervane = weathervane;
+        self.initialized = v[0] != 0.0;
+        self.integrators = Integrators {
+            thrust: v[1],
+            normal: v[2],
+            roll: v[3],
+            directional: v[4],
+        };
+        self.saturated = if v[5].is_finite() && v[5] >= 0.0 {
+            v[5] as u32
+        } else {
+            0
+        };
+        let mut rest = v[6 + guidance::weathervane::WEATHERVANE_STATE_LEN..].iter().copied();
+        self.ground
+            .restore(&mut || rest.next())
+            .ok_or_else(|| ControlError("truncated TSD controller state".into()))?;
+        Ok(())
     }
 
     /// One sample of the TSD controller: the stages of Figs. 4.1–4.2 in signal order
