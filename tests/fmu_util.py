@@ -72,10 +72,20 @@ class Unpacked:
         )
         s.instantiate(callbacks=(log.callbacks if log else None))
         if init:
-            s.setupExperiment(startTime=0.0)
-            s.enterInitializationMode()
+            self.enter_initialization(s)
             s.exitInitializationMode()
         return s
+
+    @staticmethod
+    def enter_initialization(s: FMU2Slave) -> FMU2Slave:
+        """Set up the experiment from t = 0 and enter initialization mode (parameters settable)."""
+        s.setupExperiment(startTime=0.0)
+        s.enterInitializationMode()
+        return s
+
+    def initializing_slave(self, name: str = "instance", log: LogRecorder | None = None) -> FMU2Slave:
+        """A slave in initialization mode: `slave` without leaving it."""
+        return self.enter_initialization(self.slave(name, log, init=False))
 
     def get(self, slave: FMU2Slave, *names: str) -> list[float]:
         return slave.getReal([self.vr[n] for n in names])
