@@ -574,8 +574,9 @@ fn check_switches(params: &LqrParams) -> Result<TrajectoryMode, ControlError> {
     }
 }
 
-/// Everything an [`LqrController`] is built from: the FMU's parameters.
-#[derive(Debug, Clone, PartialEq)]
+/// Everything an [`LqrController`] is built from: the FMU's parameters. The default: the
+/// nominal airframe, the default mission, tuning and the built-in weights.
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct LqrConfig {
     /// The controller's own model of the airframe (may differ from the plant's).
     pub airframe: Airframe,
@@ -589,10 +590,8 @@ impl LqrConfig {
     /// The nominal airframe, the given mission, default tuning and weights.
     pub fn with_mission(mission: MissionParams) -> Self {
         Self {
-            airframe: Airframe::default(),
             mission,
-            params: LqrParams::default(),
-            weights_file: String::new(),
+            ..Self::default()
         }
     }
 }

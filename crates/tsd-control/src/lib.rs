@@ -276,8 +276,9 @@ impl TsdController {
     }
 }
 
-/// Everything a [`TsdController`] is built from: the FMU's parameters.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// Everything a [`TsdController`] is built from: the FMU's parameters. The default: the
+/// nominal airframe, the default mission and tuning.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct TsdConfig {
     /// The controller's own model of the airframe (may differ from the plant's).
     pub airframe: Airframe,
@@ -289,9 +290,8 @@ impl TsdConfig {
     /// The nominal airframe, the given mission and the default tuning (Table 4.3 poles).
     pub fn with_mission(mission: MissionParams) -> Self {
         Self {
-            airframe: Airframe::default(),
             mission,
-            params: TsdParams::default(),
+            ..Self::default()
         }
     }
 }
