@@ -179,6 +179,8 @@ pub fn variables_module(model: &Model, xml_file: &str) -> String {
 
     // VariableStore.
     let _ = writeln!(w, "impl VariableStore for Variables {{");
+    let _ = writeln!(w, "    const MODEL_IDENTIFIER: &'static str = MODEL_IDENTIFIER;");
+    let _ = writeln!(w, "    const GUID: &'static str = GUID;");
     let _ = writeln!(w, "    const VARIABLES: &'static [VariableSpec] = &[");
     for v in &model.variables {
         let d = &v.decl;
