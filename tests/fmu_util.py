@@ -72,10 +72,20 @@ class Unpacked:
         )
         s.instantiate(callbacks=(log.callbacks if log else None))
         if init:
-            s.setupExperiment(startTime=0.0)
-            s.enterInitializationMode()
+            self.enter_initialization(s)
             s.exitInitializationMode()
         return s
+
+    @staticmethod
+    def enter_initialization(s: FMU2Slave) -> FMU2Slave:
+        """Set up the experiment from t = 0 and enter initialization mode (parameters settable)."""
+        s.setupExperiment(startTime=0.0)
+        s.enterInitializationMode()
+        return s
+
+    def initializing_slave(self, name: str = "instance", log: LogRecorder | None = None) -> FMU2Slave:
+        """A slave in initialization mode: `slave` without leaving it."""
+        return self.enter_initialization(self.slave(name, log, init=False))
 
     def get(self, slave: FMU2Slave, *names: str) -> list[float]:
         return slave.getReal([self.vr[n] for n in names])
@@ -118,3 +128,42 @@ def assert_refused(log: LogRecorder, call: Callable[..., object], what: str, *ar
     else:
         raise AssertionError(f"{what}: the call succeeded")
     assert any(what in m for m in log.errors()), (what, log.messages)
+
+
+@dataclass
+class CosimRun:
+    """An SSP flown under libcosim: the `plant` and `controller` slaves, their variables'
+    references by name, the last values and the plant's airspeed series observed."""
+
+    execution: object
+    plant: int
+    ctrl: int
+    pv: dict[str, int]
+    cv: dict[str, int]
+    last: object
+    series: object
+
+
+def libcosim_fly_ssp(path: pathlib.Path, n_slaves: int, stop_ns: int = 35 * 10**9) -> CosimRun:
+    """Load `path` with libcosim's `from_ssp_file` (step size from its annotation), check it
+    holds `n_slaves` components and run it to `stop_ns`, observing the plant's airspeed."""
+    from libcosimpy.CosimEnums import CosimVariableType
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+    from libcosimpy.CosimObserver import CosimObserver
+
+    log_output_level(CosimLogLevel.ERROR)
+    execution = CosimExecution.from_ssp_file(str(path))
+    assert execution.num_slaves() == n_slaves
+    plant = execution.slave_index_from_instance_name("plant")
+    ctrl = execution.slave_index_from_instance_name("controller")
+    assert plant is not None and ctrl is not None
+    pv = {v.name.decode(): v.reference for v in execution.slave_variables(plant)}
+    cv = {v.name.decode(): v.reference for v in execution.slave_variables(ctrl)}
+    last = CosimObserver.create_last_value()
+    series = CosimObserver.create_time_series()
+    assert execution.add_observer(last) and execution.add_observer(series)
+    assert series.start_time_series(plant, pv["airspeed"], CosimVariableType.REAL)
+    assert execution.simulate_until(stop_ns)
+    assert execution.status().current_time == stop_ns
+    return CosimRun(execution, plant, ctrl, pv, cv, last, series)

@@ -28,9 +28,7 @@ def atmosphere(tmp_path_factory) -> Unpacked:
 
 # ----------------------------------------------------------------- its own behaviour
 def started(f: Unpacked, name: str, log: LogRecorder | None = None, ints: dict | None = None, **reals):
-    s = f.slave(name, log, init=False)
-    s.setupExperiment(startTime=0.0)
-    s.enterInitializationMode()
+    s = f.initializing_slave(name, log)
     if reals:
         f.set(s, **reals)
     for n, x in (ints or {}).items():
@@ -130,9 +128,7 @@ def test_fmu_state_and_serialisation_continue_bit_identically(atmosphere):
 
 def test_nan_and_out_of_range_parameters_are_errors_not_crashes(atmosphere):
     log = LogRecorder()
-    s = atmosphere.slave("params", log, init=False)
-    s.setupExperiment(startTime=0.0)
-    s.enterInitializationMode()
+    s = atmosphere.initializing_slave("params", log)
     for name, value in (("wind_speed", math.nan), ("wind_speed", -1.0), ("turbulence_sample_time", 0.0)):
         log.clear()
         assert_refused(log, atmosphere.set, name, s, **{name: value})

@@ -69,9 +69,7 @@ def manoeuvre(plant, slave):
 def finals_for(plant, steps, **params):
     finals = {}
     for h in steps:
-        s = plant.slave(f"h{h}", init=False)
-        s.setupExperiment(startTime=0.0)
-        s.enterInitializationMode()
+        s = plant.initializing_slave(f"h{h}")
         plant.set(s, **params)
         s.exitInitializationMode()
         manoeuvre(plant, s)
@@ -168,8 +166,7 @@ def test_illegal_call_order_is_an_error(plant):
     log = LogRecorder()
     s = plant.slave("order", log, init=False)
     assert_refused(log, lambda: s.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.02), "fmi2DoStep")
-    s.setupExperiment(startTime=0.0)
-    s.enterInitializationMode()
+    plant.enter_initialization(s)
     s.exitInitializationMode()
     with pytest.raises(Exception):  # wrong communication point
         s.doStep(currentCommunicationPoint=1.0, communicationStepSize=0.02)
@@ -190,9 +187,7 @@ def test_out_of_range_parameter_is_rejected_at_set(plant):
 def test_divergence_is_reported_as_an_error(plant):
     """Absurd commands/parameters must end in fmi2Error naming the state, not NaN outputs."""
     log = LogRecorder()
-    s = plant.slave("diverge", log, init=False)
-    s.setupExperiment(startTime=0.0)
-    s.enterInitializationMode()
+    s = plant.initializing_slave("diverge", log)
     plant.set(s, i_xx=1e-4, i_yy=1e-4, i_zz=1e-4)  # featherweight inertia
     s.exitInitializationMode()
     plant.set(s, aileron_cmd=0.4, elevator_cmd=0.4, rudder_cmd=0.4)

@@ -40,9 +40,7 @@ def test_plant_to_sensors_by_name(plant, sensors):
     output of the same name, and each measurement is its truth within 5 delivered σ (Table D.1)."""
     p = plant.slave("plant")
     log = LogRecorder()
-    s = sensors.slave("sensors", log, init=False)
-    s.setupExperiment(startTime=0.0)
-    s.enterInitializationMode()
+    s = sensors.initializing_slave("sensors", log)
     sensors.set(s, **dict(zip(TRUTH, plant.get(p, *TRUTH), strict=False)))
     s.exitInitializationMode()
     accel_std, gps_h_std = sensors.get(s, "accel_std", "gps_height_std")
@@ -148,9 +146,7 @@ def test_all_zero_inputs_before_the_first_plant_sample_are_held_with_a_warning(s
 
 def test_out_of_range_parameters_are_refused(sensors):
     log = LogRecorder()
-    s = sensors.slave("params", log, init=False)
-    s.setupExperiment(startTime=0.0)
-    s.enterInitializationMode()
+    s = sensors.initializing_slave("params", log)
     # Outside the declared range: refused by the setter.
     with pytest.raises(Exception):
         s.setInteger([sensors.vr["fault_channel"]], [11])

@@ -31,6 +31,7 @@ import numpy as np
 import pytest
 from lxml import etree
 
+from fmu_util import libcosim_fly_ssp
 from tailsim.metrics import CRITERIA, declared_mission, level_window, phase_starts
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -264,26 +265,8 @@ def test_fmpy_simulate_ssp_flies_the_default_mission(controller):
 @pytest.mark.parametrize("controller", CONTROLLERS)
 def test_libcosim_from_ssp_file_flies_the_default_mission(controller):
     """Straight libcosimpy: from_ssp_file takes step size and mission from the SSP."""
-    from libcosimpy.CosimEnums import CosimVariableType
-    from libcosimpy.CosimExecution import CosimExecution
-    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
-    from libcosimpy.CosimObserver import CosimObserver
-
-    log_output_level(CosimLogLevel.ERROR)
-    execution = CosimExecution.from_ssp_file(str(ssp_path(controller)))
-    assert execution.num_slaves() == len(COMPONENTS)
-    plant = execution.slave_index_from_instance_name("plant")
-    ctrl = execution.slave_index_from_instance_name("controller")
-    assert plant is not None and ctrl is not None
-    pv = {v.name.decode(): v.reference for v in execution.slave_variables(plant)}
-    cv = {v.name.decode(): v.reference for v in execution.slave_variables(ctrl)}
-    last = CosimObserver.create_last_value()
-    series = CosimObserver.create_time_series()
-    assert execution.add_observer(last) and execution.add_observer(series)
-    assert series.start_time_series(plant, pv["airspeed"], CosimVariableType.REAL)
-    assert execution.simulate_until(35 * 10**9)
-    status = execution.status()
-    assert status.current_time == 35 * 10**9  # 1750 steps of the annotated 0.02 s
+    run = libcosim_fly_ssp(ssp_path(controller), len(COMPONENTS))  # 1750 steps of the annotated 0.02 s
+    plant, ctrl, pv, cv, last, series = run.plant, run.ctrl, run.pv, run.cv, run.last, run.series
     # The parameter bindings reached the controller.
     assert last.last_real_values(ctrl, [cv[n] for n in MISSION]) == pytest.approx(list(MISSION.values()))
     theta, airspeed = last.last_real_values(plant, [pv["theta"], pv["airspeed"]])

@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 from lxml import etree
 
+from fmu_util import libcosim_fly_ssp
 from tailsim.metrics import CRITERIA, declared_mission, level_window
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -143,24 +144,8 @@ def test_libcosim_flies_the_avionics_system(controller):
     72–104° off): the estimator predicted with the thesis's linear aerodynamics while the
     LQR's back transition runs the plant's wing to α ≈ 50°; its `aero_model` now defaults to
     the plant's (global)."""
-    from libcosimpy.CosimEnums import CosimVariableType
-    from libcosimpy.CosimExecution import CosimExecution
-    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
-    from libcosimpy.CosimObserver import CosimObserver
-
-    log_output_level(CosimLogLevel.ERROR)
-    execution = CosimExecution.from_ssp_file(str(ssp_path(controller)))
-    assert execution.num_slaves() == len(ELEMENTS) + 1
-    plant = execution.slave_index_from_instance_name("plant")
-    ctrl = execution.slave_index_from_instance_name("controller")
-    pv = {v.name.decode(): v.reference for v in execution.slave_variables(plant)}
-    cv = {v.name.decode(): v.reference for v in execution.slave_variables(ctrl)}
-    last = CosimObserver.create_last_value()
-    series = CosimObserver.create_time_series()
-    assert execution.add_observer(last) and execution.add_observer(series)
-    assert series.start_time_series(plant, pv["airspeed"], CosimVariableType.REAL)
-    assert execution.simulate_until(35 * 10**9)
-    assert execution.status().current_time == 35 * 10**9
+    run = libcosim_fly_ssp(ssp_path(controller), len(ELEMENTS) + 1)
+    plant, ctrl, pv, cv, last, series = run.plant, run.ctrl, run.pv, run.cv, run.last, run.series
     theta, airspeed = last.last_real_values(plant, [pv["theta"], pv["airspeed"]])
     final_pitch = abs(math.degrees(theta) - 90.0)
     times, _, speeds = series.time_series_real_samples(plant, pv["airspeed"], from_step=1, sample_count=1750)

@@ -4,7 +4,7 @@
 //!   `MissionParams::named_values` (group `mission`, table
 //!   `model_description::defaults::CRATES`);
 //! - `OUT_DIR/presets_generated.rs`: `PRESETS`, the named missions (`presets`);
-//! - `OUT_DIR/measurement_generated.rs`: `Measurement::first_non_finite`, naming
+//! - `OUT_DIR/measurement_generated.rs`: `Measurement::named_values` and `first_non_finite`, naming
 //!   the port of a non-finite value (group `measurement`).
 
 use std::path::PathBuf;

@@ -79,8 +79,6 @@ pub struct AtmosphereBinding;
 impl Binding for AtmosphereBinding {
     type Unit = AtmosphereUnit;
     type Vars = Variables;
-    const MODEL_IDENTIFIER: &'static str = MODEL_IDENTIFIER;
-    const GUID: &'static str = GUID;
     const NAME: &'static str = "atmosphere";
 
     fn config(v: &Variables) -> Result<Params, ParamError> {

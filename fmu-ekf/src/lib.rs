@@ -109,8 +109,6 @@ pub struct EkfBinding;
 impl Binding for EkfBinding {
     type Unit = Estimator;
     type Vars = Variables;
-    const MODEL_IDENTIFIER: &'static str = MODEL_IDENTIFIER;
-    const GUID: &'static str = GUID;
     const NAME: &'static str = "estimator";
 
     fn config(v: &Variables) -> Result<EstimatorParams, ParamError> {

@@ -83,8 +83,6 @@ pub struct SensorsBinding;
 impl Binding for SensorsBinding {
     type Unit = Sensors;
     type Vars = Variables;
-    const MODEL_IDENTIFIER: &'static str = MODEL_IDENTIFIER;
-    const GUID: &'static str = GUID;
     const NAME: &'static str = "sensor model";
 
     fn config(v: &Variables) -> Result<Params, ParamError> {

@@ -56,16 +56,21 @@ const fn plain(type_name: &'static str, group: &'static str, prefix: &'static st
     }
 }
 
+/// [`plain`] with the `named_values` table as well.
+const fn named(type_name: &'static str, group: &'static str) -> StructDefaults {
+    StructDefaults {
+        named_values: true,
+        ..plain(type_name, group, "")
+    }
+}
+
 /// Every generated `impl Default`.
 pub const CRATES: &[CrateDefaults] = &[
     CrateDefaults {
         krate: "tailsitter-physics",
         file: "tailsitter_plant.json",
         out: "airframe_generated.rs",
-        structs: &[StructDefaults {
-            named_values: true,
-            ..plain("Airframe", "airframe", "")
-        }],
+        structs: &[named("Airframe", "airframe")],
     },
     CrateDefaults {
         krate: "tailsitter-physics",
@@ -92,10 +97,7 @@ pub const CRATES: &[CrateDefaults] = &[
         krate: "flight-mission",
         file: "fragments/controller_interface.json",
         out: "mission_generated.rs",
-        structs: &[StructDefaults {
-            named_values: true,
-            ..plain("MissionParams", "mission", "")
-        }],
+        structs: &[named("MissionParams", "mission")],
     },
     CrateDefaults {
         krate: "lqr-control",

@@ -37,42 +37,59 @@ use std::sync::LazyLock;
 
 /// The plant every system holds.
 pub const PLANT: &str = "tailsitter_plant";
-/// Controllers a system is written for (each when its FMU exists).
-pub const CONTROLLERS: &[&str] = &["tailsitter_lqr", "tailsitter_tsd"];
-/// Mission parameters (docs/DESIGN.md §3) with their declared defaults, bound on the
-/// controller: the `mission` group of `modelDescription/fragments/controller_interface.json`.
-pub static MISSION: LazyLock<Vec<(&'static str, f64)>> = LazyLock::new(|| {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../modelDescription");
-    let (decls, _) = model_description::load_declarations(&dir, "fragments/controller_interface.json")
-        .unwrap_or_else(|e| panic!("controller interface declaration: {e}"));
-    decls
-        .into_iter()
-        .filter(|d| d.group.as_deref() == Some("mission"))
-        .map(|d| match d.start {
-            Some(model_description::Start::Number(x)) => (&*d.name.leak(), x),
-            other => panic!("mission parameter {} has start {other:?}", d.name),
+/// The declarations' folder.
+fn declarations_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../modelDescription")
+}
+
+/// Controllers a system is written for (each when its FMU exists): the models declared in
+/// `modelDescription/` that include the controller interface (the plant only connects to it),
+/// in the order of their identifiers.
+pub static CONTROLLERS: LazyLock<Vec<&'static str>> = LazyLock::new(|| {
+    let dir = declarations_dir();
+    let interface = dir.join("fragments/controller_interface.json");
+    let mut ids: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .filter_map(|e| e.ok()?.file_name().to_str()?.strip_suffix(".json").map(str::to_string))
+        .filter(|id| id != PLANT)
+        .collect();
+    ids.sort();
+    ids.into_iter()
+        .filter(|id| {
+            let model = model_description::load(&dir, id, "0").unwrap_or_else(|e| panic!("declaration {id}: {e}"));
+            model.sources.contains(&interface)
         })
+        .map(|id| &*id.leak())
         .collect()
 });
+
+/// The parameters of group `group` in declaration `file` (below `modelDescription/`) with
+/// their declared (numeric) defaults; `what` names them in a panic.
+fn declared_parameters(file: &str, group: &str, what: &str) -> Vec<(&'static str, f64)> {
+    let (decls, _) = model_description::load_declarations(&declarations_dir(), file)
+        .unwrap_or_else(|e| panic!("{what} declaration: {e}"));
+    decls
+        .into_iter()
+        .filter(|d| d.group.as_deref() == Some(group) && d.causality == model_description::Causality::Parameter)
+        .map(|d| match d.start {
+            Some(model_description::Start::Number(x)) => (&*d.name.leak(), x),
+            other => panic!("{what} parameter {} has start {other:?}", d.name),
+        })
+        .collect()
+}
+
+/// Mission parameters (docs/DESIGN.md §3) with their declared defaults, bound on the
+/// controller: the `mission` group of `modelDescription/fragments/controller_interface.json`.
+pub static MISSION: LazyLock<Vec<(&'static str, f64)>> =
+    LazyLock::new(|| declared_parameters("fragments/controller_interface.json", "mission", "mission"));
 
 /// The atmosphere of the systems (a component when its FMU is in the folder).
 pub const ATMOSPHERE: &str = "tailsitter_atmosphere";
 
 /// The atmosphere's parameters (group `params` of `modelDescription/tailsitter_atmosphere.json`)
 /// with their declared defaults: calm air.
-pub static ATMOSPHERE_PARAMS: LazyLock<Vec<(&'static str, f64)>> = LazyLock::new(|| {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../modelDescription");
-    let (decls, _) = model_description::load_declarations(&dir, &format!("{ATMOSPHERE}.json"))
-        .unwrap_or_else(|e| panic!("atmosphere declaration: {e}"));
-    decls
-        .into_iter()
-        .filter(|d| d.group.as_deref() == Some("params") && d.causality == model_description::Causality::Parameter)
-        .map(|d| match d.start {
-            Some(model_description::Start::Number(x)) => (&*d.name.leak(), x),
-            other => panic!("atmosphere parameter {} has start {other:?}", d.name),
-        })
-        .collect()
-});
+pub static ATMOSPHERE_PARAMS: LazyLock<Vec<(&'static str, f64)>> =
+    LazyLock::new(|| declared_parameters(&format!("{ATMOSPHERE}.json"), "params", "atmosphere"));
 
 /// A mission parameter's declared default.
 fn mission_default(name: &str) -> f64 {
@@ -94,19 +111,8 @@ fn mission_default(name: &str) -> f64 {
 /// it flies. Giving it the true plant (perfect model knowledge, the comparison issue 15 found
 /// flattering to the LQR) takes a deliberate second change: the same values in `design_model`.
 /// One source: the values come from the plant's declaration, as the controllers' defaults do.
-pub static DESIGN_AIRFRAME: LazyLock<Vec<(&'static str, f64)>> = LazyLock::new(|| {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../modelDescription");
-    let (decls, _) = model_description::load_declarations(&dir, &format!("{PLANT}.json"))
-        .unwrap_or_else(|e| panic!("plant declaration: {e}"));
-    decls
-        .into_iter()
-        .filter(|d| d.group.as_deref() == Some("airframe") && d.causality == model_description::Causality::Parameter)
-        .map(|d| match d.start {
-            Some(model_description::Start::Number(x)) => (&*d.name.leak(), x),
-            other => panic!("airframe parameter {} has start {other:?}", d.name),
-        })
-        .collect()
-});
+pub static DESIGN_AIRFRAME: LazyLock<Vec<(&'static str, f64)>> =
+    LazyLock::new(|| declared_parameters(&format!("{PLANT}.json"), "airframe", "airframe"));
 
 /// Default experiment: the default mission (docs/DESIGN.md §3), from t = 0 to the end
 /// of its last phase.
@@ -172,7 +178,7 @@ pub fn write_all(dir: &Path) -> Result<Vec<PathBuf>, String> {
     let atmosphere_fmu = dir.join(format!("{ATMOSPHERE}.fmu"));
     let atmosphere_fmu = atmosphere_fmu.exists().then_some(atmosphere_fmu);
     let mut written = Vec::new();
-    for id in CONTROLLERS {
+    for id in CONTROLLERS.iter() {
         let controller_fmu = dir.join(format!("{id}.fmu"));
         if !controller_fmu.exists() {
             println!("skipping {id}.ssp: {} missing", controller_fmu.display());
@@ -809,6 +815,11 @@ mod tests {
             ports,
             units: vec![],
         }
+    }
+
+    #[test]
+    fn controllers_are_the_models_including_the_controller_interface() {
+        assert_eq!(*CONTROLLERS, ["tailsitter_lqr", "tailsitter_tsd"]);
     }
 
     #[test]

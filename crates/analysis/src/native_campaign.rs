@@ -21,9 +21,7 @@ use lqr_control::{LqrController, LqrParams};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use tailsitter_physics::{
-    idx, pitch_321, quat_from_euler_321, AeroModel, Airframe, GlobalAero, Ground, Plant, StateVector,
-};
+use tailsitter_physics::{AeroModel, Airframe, GlobalAero, Ground, Plant, StateVector};
 use tsd_control::{TsdController, TsdParams};
 
 /// The plant FMU's default `initial_speed` (m/s): the vertical-climb trim it starts from.
@@ -112,15 +110,7 @@ pub fn plant_of(job: &Job) -> Result<(Plant, StateVector), String> {
     let trim = plant
         .trim_vertical_climb(INITIAL_SPEED)
         .map_err(|e| format!("initial trim at initial_speed = {INITIAL_SPEED} m/s failed: {e}"))?;
-    let mut x = trim.state;
-    // As fmu-plant: the trim re-oriented with heading 0 from its 3-2-1 pitch (from the DCM).
-    let theta = pitch_321(&x.fixed_rows::<4>(idx::Q1).into_owned());
-    x.fixed_rows_mut::<4>(idx::Q1)
-        .copy_from(&quat_from_euler_321(0.0, theta, 0.0));
-    x[idx::POS_N] = 0.0;
-    x[idx::POS_E] = 0.0;
-    x[idx::POS_D] = 0.0;
-    Ok((plant, x))
+    Ok((plant, crate::wind_envelope::at_origin_heading_0(trim.state)))
 }
 
 /// The mission of a job (the declared defaults, then the job's values by name).

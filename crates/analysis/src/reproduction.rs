@@ -203,43 +203,8 @@ fn table_4_4(configuration: i32, mission: &MissionParams, cond: Condition) -> Va
     }
     .effective()
     .unwrap_or_default();
-    let c = C64::new;
-    let (lv, placed) = match cond {
-        Condition::Level => (
-            true,
-            vec![
-                ("Axial", c(p.axial_pole_1_level, 0.0)),
-                ("Axial", c(p.axial_pole_2_level, 0.0)),
-                ("Roll rate", c(p.roll_pole_re_level, p.roll_pole_im_level)),
-                ("Normal", c(p.normal_pole_real_level, 0.0)),
-                ("Normal", c(p.normal_pole_re_level, p.normal_pole_im_level)),
-                ("Directional", c(p.directional_pole_real_level, 0.0)),
-                (
-                    "Directional",
-                    c(p.directional_pole_re_level, p.directional_pole_im_level),
-                ),
-                ("Normal vector", c(p.nvd_pole_level, 0.0)),
-                ("Guidance", c(p.guidance_pole_re_level, p.guidance_pole_im_level)),
-            ],
-        ),
-        Condition::Vertical => (
-            false,
-            vec![
-                ("Axial", c(p.axial_pole_1_vertical, 0.0)),
-                ("Axial", c(p.axial_pole_2_vertical, 0.0)),
-                ("Roll rate", c(p.roll_pole_re_vertical, p.roll_pole_im_vertical)),
-                ("Normal", c(p.normal_pole_real_vertical, 0.0)),
-                ("Normal", c(p.normal_pole_re_vertical, p.normal_pole_im_vertical)),
-                ("Directional", c(p.directional_pole_real_vertical, 0.0)),
-                (
-                    "Directional",
-                    c(p.directional_pole_re_vertical, p.directional_pole_im_vertical),
-                ),
-                ("Normal vector", c(p.nvd_pole_vertical, 0.0)),
-                ("Guidance", c(p.guidance_pole_re_vertical, p.guidance_pole_im_vertical)),
-            ],
-        ),
-    };
+    let lv = cond == Condition::Level;
+    let placed = crate::sweep::tsd_placed_of(&p, cond);
     let all = poles(&Airframe::default(), Kind::Tsd, configuration, mission, cond);
     let Some(all) = all else {
         return json!({"condition": cond.name(), "error": "operating point not reached", "rows": []});

@@ -78,6 +78,19 @@ macro_rules! aero {
     };
 }
 
+/// A physical parameter of Table 5.1: one airframe field scaled.
+macro_rules! physical {
+    ($name:expr, $id:expr, $field:ident, $lqr:expr, $tsd:expr) => {
+        Param {
+            name: $name,
+            id: $id,
+            class: ParamClass::Physical,
+            thesis: ($lqr, $tsd),
+            scale: |a: &mut Airframe, f: f64| a.$field *= f,
+        }
+    };
+}
+
 /// The 25 parameters of Table 5.1 with the thesis's values.
 pub fn params() -> Vec<Param> {
     vec![
@@ -102,34 +115,10 @@ pub fn params() -> Vec<Param> {
         aero!("C_nr", "Cnr", c_n_r_a0, c_n_r_a1, 5.9, 24.7),
         aero!("C_nδa", "Cnda", c_n_da_a0, c_n_da_a1, 0.6, 1.4),
         aero!("C_nδr", "Cndr", c_n_dr_a0, c_n_dr_a1, 5.5, 124.4),
-        Param {
-            name: "m",
-            id: "m",
-            class: ParamClass::Physical,
-            thesis: (7.4, 14.0),
-            scale: |a, f| a.mass *= f,
-        },
-        Param {
-            name: "I_x",
-            id: "Ix",
-            class: ParamClass::Physical,
-            thesis: (5.5, 10.0),
-            scale: |a, f| a.i_xx *= f,
-        },
-        Param {
-            name: "I_y",
-            id: "Iy",
-            class: ParamClass::Physical,
-            thesis: (5.1, 12.0),
-            scale: |a, f| a.i_yy *= f,
-        },
-        Param {
-            name: "I_z",
-            id: "Iz",
-            class: ParamClass::Physical,
-            thesis: (3.4, 9.4),
-            scale: |a, f| a.i_zz *= f,
-        },
+        physical!("m", "m", mass, 7.4, 14.0),
+        physical!("I_x", "Ix", i_xx, 5.5, 10.0),
+        physical!("I_y", "Iy", i_yy, 5.1, 12.0),
+        physical!("I_z", "Iz", i_zz, 3.4, 9.4),
     ]
 }
 

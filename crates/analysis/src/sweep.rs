@@ -512,38 +512,55 @@ const THESIS_TABLE_4_4: [(&str, &str, &str); 5] = [
 
 /// Placed TSD poles (Table 4.3, from the controller's parameters): (loop, poles, upper half).
 fn tsd_placed(cond: Condition) -> Vec<(&'static str, C64)> {
-    let p = tsd_control::TsdParams::default();
+    tsd_placed_of(&tsd_control::TsdParams::default(), cond)
+}
+
+/// The poles `p` places at `cond` (Table 4.3 form): (loop, pole, upper half).
+pub(crate) fn tsd_placed_of(p: &tsd_control::TsdParams, cond: Condition) -> Vec<(&'static str, C64)> {
+    // (level, vertical) of one parameter, chosen by the condition.
+    let at = |level: f64, vertical: f64| if cond == Condition::Level { level } else { vertical };
     let c = |re: f64, im: f64| C64::new(re, im);
-    match cond {
-        Condition::Level => vec![
-            ("Axial", c(p.axial_pole_1_level, 0.0)),
-            ("Axial", c(p.axial_pole_2_level, 0.0)),
-            ("Roll rate", c(p.roll_pole_re_level, p.roll_pole_im_level)),
-            ("Normal", c(p.normal_pole_real_level, 0.0)),
-            ("Normal", c(p.normal_pole_re_level, p.normal_pole_im_level)),
-            ("Directional", c(p.directional_pole_real_level, 0.0)),
-            (
-                "Directional",
-                c(p.directional_pole_re_level, p.directional_pole_im_level),
+    vec![
+        ("Axial", c(at(p.axial_pole_1_level, p.axial_pole_1_vertical), 0.0)),
+        ("Axial", c(at(p.axial_pole_2_level, p.axial_pole_2_vertical), 0.0)),
+        (
+            "Roll rate",
+            c(
+                at(p.roll_pole_re_level, p.roll_pole_re_vertical),
+                at(p.roll_pole_im_level, p.roll_pole_im_vertical),
             ),
-            ("Normal vector", c(p.nvd_pole_level, 0.0)),
-            ("Guidance", c(p.guidance_pole_re_level, p.guidance_pole_im_level)),
-        ],
-        Condition::Vertical => vec![
-            ("Axial", c(p.axial_pole_1_vertical, 0.0)),
-            ("Axial", c(p.axial_pole_2_vertical, 0.0)),
-            ("Roll rate", c(p.roll_pole_re_vertical, p.roll_pole_im_vertical)),
-            ("Normal", c(p.normal_pole_real_vertical, 0.0)),
-            ("Normal", c(p.normal_pole_re_vertical, p.normal_pole_im_vertical)),
-            ("Directional", c(p.directional_pole_real_vertical, 0.0)),
-            (
-                "Directional",
-                c(p.directional_pole_re_vertical, p.directional_pole_im_vertical),
+        ),
+        (
+            "Normal",
+            c(at(p.normal_pole_real_level, p.normal_pole_real_vertical), 0.0),
+        ),
+        (
+            "Normal",
+            c(
+                at(p.normal_pole_re_level, p.normal_pole_re_vertical),
+                at(p.normal_pole_im_level, p.normal_pole_im_vertical),
             ),
-            ("Normal vector", c(p.nvd_pole_vertical, 0.0)),
-            ("Guidance", c(p.guidance_pole_re_vertical, p.guidance_pole_im_vertical)),
-        ],
-    }
+        ),
+        (
+            "Directional",
+            c(at(p.directional_pole_real_level, p.directional_pole_real_vertical), 0.0),
+        ),
+        (
+            "Directional",
+            c(
+                at(p.directional_pole_re_level, p.directional_pole_re_vertical),
+                at(p.directional_pole_im_level, p.directional_pole_im_vertical),
+            ),
+        ),
+        ("Normal vector", c(at(p.nvd_pole_level, p.nvd_pole_vertical), 0.0)),
+        (
+            "Guidance",
+            c(
+                at(p.guidance_pole_re_level, p.guidance_pole_re_vertical),
+                at(p.guidance_pole_im_level, p.guidance_pole_im_vertical),
+            ),
+        ),
+    ]
 }
 
 fn write(out: &Path, name: &str, text: &str) -> std::io::Result<()> {

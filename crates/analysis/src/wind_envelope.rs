@@ -104,14 +104,19 @@ pub fn trimmed_climb(plant: &Plant, speed: f64) -> Result<StateVector, String> {
     let trim = plant
         .trim_vertical_climb(speed)
         .map_err(|e| format!("vertical-climb trim at {speed} m/s: {e}"))?;
-    let mut x = trim.state;
+    Ok(at_origin_heading_0(trim.state))
+}
+
+/// As fmu-plant starts from a trim: `x` re-oriented with heading 0 from its 3-2-1 pitch
+/// (from the DCM), at the origin.
+pub fn at_origin_heading_0(mut x: StateVector) -> StateVector {
     let theta = pitch_321(&x.fixed_rows::<4>(idx::Q1).into_owned());
     x.fixed_rows_mut::<4>(idx::Q1)
         .copy_from(&quat_from_euler_321(0.0, theta, 0.0));
     x[idx::POS_N] = 0.0;
     x[idx::POS_E] = 0.0;
     x[idx::POS_D] = 0.0;
-    Ok(x)
+    x
 }
 
 /// The atmosphere of a turbulent case: uniform steady wind `speed` from `bearing_deg`,

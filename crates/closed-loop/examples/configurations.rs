@@ -67,11 +67,8 @@ fn main() {
                         let phases: Vec<String> = check.phase_errors.iter().map(|p| format!("{:.2}", p.max)).collect();
                         println!(
                             "| {ctl} | {conf_name} | {plant_name} | {} | {} | {:.2} | {} | {:.1} | {:.2} |",
-                            match &trace.failure {
-                                None => "yes".to_string(),
-                                Some(f) => format!("no: {f}"),
-                            },
-                            if check.passed() { "pass" } else { "fail" },
+                            trace.completed_cell(),
+                            check.verdict(),
                             trace.max_pos_error(),
                             phases.join(" / "),
                             trace.max_alpha(t0, t1).to_degrees(),

@@ -339,6 +339,14 @@ impl Trace {
         out
     }
 
+    /// The run's completion as a table cell: `yes`, or `no: ` and the failure.
+    pub fn completed_cell(&self) -> String {
+        match &self.failure {
+            None => "yes".to_string(),
+            Some(f) => format!("no: {f}"),
+        }
+    }
+
     /// Maximum position error over the whole run (m).
     pub fn max_pos_error(&self) -> f64 {
         self.samples.iter().map(Sample::pos_error).fold(0.0, f64::max)
@@ -448,6 +456,15 @@ impl MissionCheck {
             final_pitch_error,
             all_finite: samples.iter().all(|x| x.finite),
             phase_errors,
+        }
+    }
+
+    /// [`Self::passed`] as a table cell: `pass` or `fail`.
+    pub fn verdict(&self) -> &'static str {
+        if self.passed() {
+            "pass"
+        } else {
+            "fail"
         }
     }
 

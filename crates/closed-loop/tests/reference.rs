@@ -26,53 +26,28 @@ const DECIMATION: usize = 5;
 /// Tolerance, relative to max(1, |reference|).
 const TOLERANCE: f64 = 1e-9;
 
-/// Column names (the FMU port names) and how to read them from a sample.
-#[allow(clippy::type_complexity)]
-const COLUMNS: &[(&str, fn(&Sample) -> f64)] = &[
-    ("time", |s| s.t),
-    ("pos_n", |s| s.measurement.pos_ned.x),
-    ("pos_e", |s| s.measurement.pos_ned.y),
-    ("pos_d", |s| s.measurement.pos_ned.z),
-    ("vel_n", |s| s.measurement.vel_ned.x),
-    ("vel_e", |s| s.measurement.vel_ned.y),
-    ("vel_d", |s| s.measurement.vel_ned.z),
-    ("u", |s| s.measurement.vel_body.x),
-    ("v", |s| s.measurement.vel_body.y),
-    ("w", |s| s.measurement.vel_body.z),
-    ("p", |s| s.measurement.rates.x),
-    ("q", |s| s.measurement.rates.y),
-    ("r", |s| s.measurement.rates.z),
-    ("quat_1", |s| s.measurement.quat[0]),
-    ("quat_2", |s| s.measurement.quat[1]),
-    ("quat_3", |s| s.measurement.quat[2]),
-    ("quat_4", |s| s.measurement.quat[3]),
-    ("airspeed", |s| s.measurement.airspeed),
-    ("alpha", |s| s.measurement.alpha),
-    ("beta", |s| s.measurement.beta),
-    ("thrust", |s| s.measurement.thrust),
-    ("elevator", |s| s.measurement.surfaces[0]),
-    ("aileron", |s| s.measurement.surfaces[1]),
-    ("rudder", |s| s.measurement.surfaces[2]),
-    ("flap_collective", |s| s.measurement.surfaces[3]),
-    ("flap_differential", |s| s.measurement.surfaces[4]),
-    ("vertical_flap", |s| s.measurement.surfaces[5]),
-    ("accel_x", |s| s.measurement.specific_force_body.x),
-    ("accel_y", |s| s.measurement.specific_force_body.y),
-    ("accel_z", |s| s.measurement.specific_force_body.z),
-    ("induced_velocity", |s| s.measurement.induced_velocity),
-    ("thrust_cmd", |s| s.command.thrust),
-    ("elevator_cmd", |s| s.command.elevator),
-    ("aileron_cmd", |s| s.command.aileron),
-    ("rudder_cmd", |s| s.command.rudder),
-    ("flap_collective_cmd", |s| s.command.flap_collective),
-    ("flap_differential_cmd", |s| s.command.flap_differential),
-    ("vertical_flap_cmd", |s| s.command.vertical_flap),
-    ("ref_pos_n", |s| s.diagnostics.ref_pos_ned.x),
-    ("ref_pos_e", |s| s.diagnostics.ref_pos_ned.y),
-    ("ref_pos_d", |s| s.diagnostics.ref_pos_ned.z),
-    ("ref_airspeed", |s| s.diagnostics.ref_airspeed),
-    ("phase", |s| s.diagnostics.phase.code() as f64),
-];
+/// The columns of a sample: (FMU port name, value).
+fn columns(s: &Sample) -> Vec<(&'static str, f64)> {
+    let c = &s.command;
+    let g = &s.diagnostics;
+    let mut row = vec![("time", s.t)];
+    row.extend(s.measurement.named_values());
+    row.extend([
+        ("thrust_cmd", c.thrust),
+        ("elevator_cmd", c.elevator),
+        ("aileron_cmd", c.aileron),
+        ("rudder_cmd", c.rudder),
+        ("flap_collective_cmd", c.flap_collective),
+        ("flap_differential_cmd", c.flap_differential),
+        ("vertical_flap_cmd", c.vertical_flap),
+        ("ref_pos_n", g.ref_pos_ned.x),
+        ("ref_pos_e", g.ref_pos_ned.y),
+        ("ref_pos_d", g.ref_pos_ned.z),
+        ("ref_airspeed", g.ref_airspeed),
+        ("phase", g.phase.code() as f64),
+    ]);
+    row
+}
 
 fn reference_path(controller: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -82,22 +57,25 @@ fn reference_path(controller: &str) -> PathBuf {
 
 /// The default mission from the plant's trimmed vertical climb (what the plant
 /// FMU starts in with its default parameters), sampled every `DECIMATION` points.
-fn fly_default(controller: &mut impl FlightController) -> Vec<Vec<f64>> {
+/// The column names and the decimated rows of the default mission.
+fn fly_default(controller: &mut impl FlightController) -> (Vec<&'static str>, Vec<Vec<f64>>) {
     let mission = MissionParams::default();
     let plant = Plant::new(Airframe::default());
     let x0 = plant.trim_vertical_climb(mission.v_vertical).unwrap().state;
     let trace = fly(&plant, x0, controller, &Scenario::mission(mission));
     assert!(trace.completed(), "{:?}", trace.failure);
-    trace
+    let names = columns(&trace.samples[0]).iter().map(|c| c.0).collect();
+    let rows = trace
         .samples
         .iter()
         .step_by(DECIMATION)
-        .map(|s| COLUMNS.iter().map(|(_, f)| f(s)).collect())
-        .collect()
+        .map(|s| columns(s).iter().map(|c| c.1).collect())
+        .collect();
+    (names, rows)
 }
 
-fn write_csv(path: &PathBuf, rows: &[Vec<f64>]) {
-    let mut text = COLUMNS.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(",");
+fn write_csv(path: &PathBuf, names: &[&str], rows: &[Vec<f64>]) {
+    let mut text = names.join(",");
     text.push('\n');
     for row in rows {
         // `{:?}` of f64: shortest text that reads back to the same double.
@@ -107,16 +85,15 @@ fn write_csv(path: &PathBuf, rows: &[Vec<f64>]) {
     std::fs::write(path, text).unwrap();
 }
 
-fn check(controller: &str, rows: &[Vec<f64>]) {
+fn check(controller: &str, (names, rows): (Vec<&str>, Vec<Vec<f64>>)) {
     let path = reference_path(controller);
     if std::env::var_os("TAILSIM_REGEN_REFERENCE").is_some() {
-        write_csv(&path, rows);
+        write_csv(&path, &names, &rows);
         eprintln!("wrote {}", path.display());
     }
     let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let names: Vec<&str> = COLUMNS.iter().map(|(n, _)| *n).collect();
     assert_eq!(header, names, "columns of {}", path.display());
     let stored: Vec<Vec<f64>> = lines
         .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
@@ -149,11 +126,11 @@ fn check(controller: &str, rows: &[Vec<f64>]) {
 fn lqr_default_mission_matches_reference() {
     let mission = MissionParams::default();
     let mut c = LqrController::new(Airframe::default(), mission, LqrParams::default()).unwrap();
-    check("lqr", &fly_default(&mut c));
+    check("lqr", fly_default(&mut c));
 }
 
 #[test]
 fn tsd_default_mission_matches_reference() {
     let mut c = TsdController::with_mission(MissionParams::default()).unwrap();
-    check("tsd", &fly_default(&mut c));
+    check("tsd", fly_default(&mut c));
 }

@@ -39,10 +39,10 @@ pub trait Binding: 'static {
     type Unit: SteppedUnit;
     /// The generated variable store of the FMU.
     type Vars: VariableStore;
-    /// `modelIdentifier` of the FMU.
-    const MODEL_IDENTIFIER: &'static str;
-    /// GUID of the FMU.
-    const GUID: &'static str;
+    /// `modelIdentifier` of the FMU: its generated variables'.
+    const MODEL_IDENTIFIER: &'static str = <Self::Vars as VariableStore>::MODEL_IDENTIFIER;
+    /// GUID of the FMU: its generated variables'.
+    const GUID: &'static str = <Self::Vars as VariableStore>::GUID;
     /// Name of the unit in messages, e.g. "LQR".
     const NAME: &'static str;
     /// The unit's configuration from the parameters; a parameter that has no
@@ -70,8 +70,6 @@ macro_rules! flight_controller_binding {
         impl $crate::Binding for $binding {
             type Unit = $crate::flight_mission::Sampled<$unit>;
             type Vars = Variables;
-            const MODEL_IDENTIFIER: &'static str = MODEL_IDENTIFIER;
-            const GUID: &'static str = GUID;
             const NAME: &'static str = $name;
 
             fn config(

@@ -65,6 +65,10 @@ pub struct ContinuousState {
 pub trait VariableStore: Clone + Send + 'static {
     /// Every declared variable, in declaration order.
     const VARIABLES: &'static [VariableSpec];
+    /// `modelIdentifier` of the FMU the variables are generated for.
+    const MODEL_IDENTIFIER: &'static str;
+    /// GUID of that FMU's interface.
+    const GUID: &'static str;
 
     /// A store holding every variable's start value.
     fn with_start_values() -> Self;

@@ -486,50 +486,6 @@ impl LqrController {
         &self.schedule
     }
 
-    /// Append the controller's state (everything `sample` depends on besides its
-    /// construction parameters) as f64s.
-    pub fn save(&self, out: &mut impl FnMut(f64)) {
-        let origin = self
-            .origin
-            .unwrap_or_else(|| Vector3::new(f64::NAN, f64::NAN, f64::NAN));
-        out(if self.origin.is_some() { 1.0 } else { 0.0 });
-        for v in origin.iter() {
-            out(*v);
-        }
-        out(self.integrator);
-        out(if self.have_gain { 1.0 } else { 0.0 });
-        out(self.rep as i32 as f64);
-        out(self.next_relinearisation);
-        out(self.stats.solves as f64);
-        out(self.stats.fallbacks as f64);
-        out(self.stats.last_spectral_radius);
-        for v in self.gain.iter() {
-            out(*v);
-        }
-        for v in self.pos_integrator.iter() {
-            out(*v);
-        }
-        for v in self.wind.iter() {
-            out(*v);
-        }
-        out(f64::from(self.anchored_phase));
-        self.weathervane.save(out);
-        for v in self.wind_shift.iter() {
-            out(*v);
-        }
-        self.ground.save(out);
-        out(f64::from(u8::from(self.ground_active)));
-        out(self.stats.warm_solves as f64);
-        out(f64::from(u8::from(self.warm_p.is_some())));
-        for v in self.warm_p.unwrap_or_else(SMatrix::zeros).iter() {
-            out(*v);
-        }
-        out(self.warm_len as f64);
-        for v in self.warm_hist.iter().flat_map(|m| m.iter()) {
-            out(*v);
-        }
-    }
-
     /// Positions in the [`Self::save`] layout of the controller's continuous states, with
     /// names: index 4 = the airspeed integrator; after the gains ∫ΔN, ∫ΔE, ∫Δh (with
     /// `position_integral = 1`) and the wind estimate (with `wind_compensation = 1`).
@@ -543,60 +499,6 @@ impl LqrController {
             v.extend([(n + 3, "ŵ_N"), (n + 4, "ŵ_E"), (n + 5, "ŵ_D")]);
         }
         v
-    }
-
-    /// Restore what [`Self::save`] wrote; `None` from `next` = truncated state.
-    pub fn restore(&mut self, next: &mut impl FnMut() -> Option<f64>) -> Result<(), ControlError> {
-        let mut take = || next().ok_or_else(|| ControlError("truncated LQR controller state".into()));
-        let has_origin = take()? != 0.0;
-        let o = Vector3::new(take()?, take()?, take()?);
-        self.origin = if has_origin { Some(o) } else { None };
-        self.integrator = take()?;
-        self.have_gain = take()? != 0.0;
-        self.rep = if take()? == 0.0 { EulerRep::E321 } else { EulerRep::E231 };
-        self.next_relinearisation = take()?;
-        self.stats.solves = take()? as u64;
-        self.stats.fallbacks = take()? as u64;
-        self.stats.last_spectral_radius = take()?;
-        for v in self.gain.iter_mut() {
-            *v = take()?;
-        }
-        for v in self.pos_integrator.iter_mut() {
-            *v = take()?;
-        }
-        for v in self.wind.iter_mut() {
-            *v = take()?;
-        }
-        let phase = take()?;
-        if !(0.0..=4.0).contains(&phase) || phase.fract() != 0.0 {
-            return Err(ControlError(format!("LQR controller state: anchored phase {phase}")));
-        }
-        self.anchored_phase = phase as i32;
-        self.weathervane.restore(&mut || next()).map_err(ControlError)?;
-        let mut take = || next().ok_or_else(|| ControlError("truncated LQR controller state".into()));
-        self.wind_shift = Vector3::new(take()?, take()?, take()?);
-        self.ground
-            .restore(&mut || take().ok())
-            .ok_or_else(|| ControlError("truncated LQR controller state".into()))?;
-        self.ground_active = take()? != 0.0;
-        self.stats.warm_solves = take()? as u64;
-        let has_warm = take()? != 0.0;
-        let mut p = SMatrix::<f64, NR, NR>::zeros();
-        for v in p.iter_mut() {
-            *v = take()?;
-        }
-        self.warm_p = has_warm.then_some(p);
-        let len = take()?;
-        if !(0.0..=2.0).contains(&len) || len.fract() != 0.0 {
-            return Err(ControlError(format!("LQR controller state: warm-start history {len}")));
-        }
-        self.warm_len = len as usize;
-        for m in self.warm_hist.iter_mut() {
-            for v in m.iter_mut() {
-                *v = take()?;
-            }
-        }
-        Ok(())
     }
 }
 
@@ -672,8 +574,9 @@ fn check_switches(params: &LqrParams) -> Result<TrajectoryMode, ControlError> {
     }
 }
 
-/// Everything an [`LqrController`] is built from: the FMU's parameters.
-#[derive(Debug, Clone, PartialEq)]
+/// Everything an [`LqrController`] is built from: the FMU's parameters. The default: the
+/// nominal airframe, the default mission, tuning and the built-in weights.
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct LqrConfig {
     /// The controller's own model of the airframe (may differ from the plant's).
     pub airframe: Airframe,
@@ -687,10 +590,8 @@ impl LqrConfig {
     /// The nominal airframe, the given mission, default tuning and weights.
     pub fn with_mission(mission: MissionParams) -> Self {
         Self {
-            airframe: Airframe::default(),
             mission,
-            params: LqrParams::default(),
-            weights_file: String::new(),
+            ..Self::default()
         }
     }
 }
@@ -715,12 +616,102 @@ impl SampledUnit for LqrController {
         c.mission.sample_time
     }
 
+    /// Append the controller's state (everything `sample` depends on besides its
+    /// construction parameters) as f64s.
     fn save(&self, out: &mut impl FnMut(f64)) {
-        Self::save(self, out)
+        let origin = self
+            .origin
+            .unwrap_or_else(|| Vector3::new(f64::NAN, f64::NAN, f64::NAN));
+        out(if self.origin.is_some() { 1.0 } else { 0.0 });
+        for v in origin.iter() {
+            out(*v);
+        }
+        out(self.integrator);
+        out(if self.have_gain { 1.0 } else { 0.0 });
+        out(self.rep as i32 as f64);
+        out(self.next_relinearisation);
+        out(self.stats.solves as f64);
+        out(self.stats.fallbacks as f64);
+        out(self.stats.last_spectral_radius);
+        for v in self.gain.iter() {
+            out(*v);
+        }
+        for v in self.pos_integrator.iter() {
+            out(*v);
+        }
+        for v in self.wind.iter() {
+            out(*v);
+        }
+        out(f64::from(self.anchored_phase));
+        self.weathervane.save(out);
+        for v in self.wind_shift.iter() {
+            out(*v);
+        }
+        self.ground.save(out);
+        out(f64::from(u8::from(self.ground_active)));
+        out(self.stats.warm_solves as f64);
+        out(f64::from(u8::from(self.warm_p.is_some())));
+        for v in self.warm_p.unwrap_or_else(SMatrix::zeros).iter() {
+            out(*v);
+        }
+        out(self.warm_len as f64);
+        for v in self.warm_hist.iter().flat_map(|m| m.iter()) {
+            out(*v);
+        }
     }
 
+    /// Restore what [`Self::save`] wrote; `None` from `next` = truncated state.
     fn restore(&mut self, next: &mut impl FnMut() -> Option<f64>) -> Result<(), ControlError> {
-        Self::restore(self, next)
+        let mut take = || next().ok_or_else(|| ControlError("truncated LQR controller state".into()));
+        let has_origin = take()? != 0.0;
+        let o = Vector3::new(take()?, take()?, take()?);
+        self.origin = if has_origin { Some(o) } else { None };
+        self.integrator = take()?;
+        self.have_gain = take()? != 0.0;
+        self.rep = if take()? == 0.0 { EulerRep::E321 } else { EulerRep::E231 };
+        self.next_relinearisation = take()?;
+        self.stats.solves = take()? as u64;
+        self.stats.fallbacks = take()? as u64;
+        self.stats.last_spectral_radius = take()?;
+        for v in self.gain.iter_mut() {
+            *v = take()?;
+        }
+        for v in self.pos_integrator.iter_mut() {
+            *v = take()?;
+        }
+        for v in self.wind.iter_mut() {
+            *v = take()?;
+        }
+        let phase = take()?;
+        if !(0.0..=4.0).contains(&phase) || phase.fract() != 0.0 {
+            return Err(ControlError(format!("LQR controller state: anchored phase {phase}")));
+        }
+        self.anchored_phase = phase as i32;
+        self.weathervane.restore(&mut || next()).map_err(ControlError)?;
+        let mut take = || next().ok_or_else(|| ControlError("truncated LQR controller state".into()));
+        self.wind_shift = Vector3::new(take()?, take()?, take()?);
+        self.ground
+            .restore(&mut || take().ok())
+            .ok_or_else(|| ControlError("truncated LQR controller state".into()))?;
+        self.ground_active = take()? != 0.0;
+        self.stats.warm_solves = take()? as u64;
+        let has_warm = take()? != 0.0;
+        let mut p = SMatrix::<f64, NR, NR>::zeros();
+        for v in p.iter_mut() {
+            *v = take()?;
+        }
+        self.warm_p = has_warm.then_some(p);
+        let len = take()?;
+        if !(0.0..=2.0).contains(&len) || len.fract() != 0.0 {
+            return Err(ControlError(format!("LQR controller state: warm-start history {len}")));
+        }
+        self.warm_len = len as usize;
+        for m in self.warm_hist.iter_mut() {
+            for v in m.iter_mut() {
+                *v = take()?;
+            }
+        }
+        Ok(())
     }
 
     /// One sample of Fig. 3.2, stage by stage (README, "Where the blocks of Fig. 3.2 live"):

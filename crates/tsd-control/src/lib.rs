@@ -271,8 +271,46 @@ impl TsdController {
         self.saturated = 0;
     }
 
+    fn err(msg: impl Into<String>) -> ControlError {
+        ControlError(msg.into())
+    }
+}
+
+/// Everything a [`TsdController`] is built from: the FMU's parameters. The default: the
+/// nominal airframe, the default mission and tuning.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct TsdConfig {
+    /// The controller's own model of the airframe (may differ from the plant's).
+    pub airframe: Airframe,
+    pub mission: MissionParams,
+    pub params: TsdParams,
+}
+
+impl TsdConfig {
+    /// The nominal airframe, the given mission and the default tuning (Table 4.3 poles).
+    pub fn with_mission(mission: MissionParams) -> Self {
+        Self {
+            mission,
+            ..Self::default()
+        }
+    }
+}
+
+impl SampledUnit for TsdController {
+    type Config = TsdConfig;
+    type Input = ControllerInput;
+    type Output = ControllerOutput;
+
+    fn build(c: &TsdConfig) -> Result<Self, ParamError> {
+        Self::new(c.airframe, c.mission, c.params)
+    }
+
+    fn sample_time(c: &TsdConfig) -> f64 {
+        c.mission.sample_time
+    }
+
     /// Write the complete dynamic state ([`STATE_LEN`] values) for FMU-state serialisation.
-    pub fn save(&self, out: &mut impl FnMut(f64)) {
+    fn save(&self, out: &mut impl FnMut(f64)) {
         out(if self.initialized { 1.0 } else { 0.0 });
         out(self.integrators.thrust);
         out(self.integrators.normal);
@@ -284,7 +322,7 @@ impl TsdController {
     }
 
     /// Restore what [`Self::save`] wrote; a truncated state is an error and leaves `self` unchanged.
-    pub fn restore(&mut self, next: &mut impl FnMut() -> Option<f64>) -> Result<(), ControlError> {
+    fn restore(&mut self, next: &mut impl FnMut() -> Option<f64>) -> Result<(), ControlError> {
         let mut v = [0.0; STATE_LEN];
         for slot in v.iter_mut() {
             *slot = next().ok_or_else(|| ControlError("truncated TSD controller state".into()))?;
@@ -310,52 +348,6 @@ impl TsdController {
             .restore(&mut || rest.next())
             .ok_or_else(|| ControlError("truncated TSD controller state".into()))?;
         Ok(())
-    }
-
-    fn err(msg: impl Into<String>) -> ControlError {
-        ControlError(msg.into())
-    }
-}
-
-/// Everything a [`TsdController`] is built from: the FMU's parameters.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TsdConfig {
-    /// The controller's own model of the airframe (may differ from the plant's).
-    pub airframe: Airframe,
-    pub mission: MissionParams,
-    pub params: TsdParams,
-}
-
-impl TsdConfig {
-    /// The nominal airframe, the given mission and the default tuning (Table 4.3 poles).
-    pub fn with_mission(mission: MissionParams) -> Self {
-        Self {
-            airframe: Airframe::default(),
-            mission,
-            params: TsdParams::default(),
-        }
-    }
-}
-
-impl SampledUnit for TsdController {
-    type Config = TsdConfig;
-    type Input = ControllerInput;
-    type Output = ControllerOutput;
-
-    fn build(c: &TsdConfig) -> Result<Self, ParamError> {
-        Self::new(c.airframe, c.mission, c.params)
-    }
-
-    fn sample_time(c: &TsdConfig) -> f64 {
-        c.mission.sample_time
-    }
-
-    fn save(&self, out: &mut impl FnMut(f64)) {
-        Self::save(self, out)
-    }
-
-    fn restore(&mut self, next: &mut impl FnMut() -> Option<f64>) -> Result<(), ControlError> {
-        Self::restore(self, next)
     }
 
     /// One sample of the TSD controller: the stages of Figs. 4.1–4.2 in signal order

@@ -238,18 +238,23 @@ def run_campaign(
     t_compute = t_last = t0  # first submission (after any cluster start-up), last result
     n_workers_used = 1
     cluster = own_client = None
+
+    def record(row, client) -> float:
+        """Store a finished run and report it; returns when it arrived."""
+        t = time.perf_counter()
+        writer.add(row)
+        if bar:
+            bar.update()
+        if on_row:
+            on_row(row, client)
+        return t
+
     try:
         if serial:
             install_fmus(blobs)
             t_compute = time.perf_counter()
             for j in todo:
-                row = run_job(j, spec_json, digests)
-                t_last = time.perf_counter()
-                writer.add(row)
-                if bar:
-                    bar.update()
-                if on_row:
-                    on_row(row, None)
+                t_last = record(run_job(j, spec_json, digests), None)
         elif todo:
             from distributed import Client, as_completed
 
@@ -302,12 +307,7 @@ def run_campaign(
                         continue
                     row = fut.result()
                     fut.release()
-                    t_last = time.perf_counter()
-                    writer.add(row)
-                    if bar:
-                        bar.update()
-                    if on_row:
-                        on_row(row, client)
+                    t_last = record(row, client)
             except BaseException:
                 client.cancel(futures)
                 raise

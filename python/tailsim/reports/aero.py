@@ -22,7 +22,8 @@ import json
 import math
 import pathlib
 
-from .markdown import fmt_or_dash, shortest
+from . import load_json_into
+from .markdown import fmt_or_dash, shortest, table_head
 
 FILE = "aero_models.json"
 
@@ -51,10 +52,7 @@ MODEL_NOTES = (
 
 def load_into(d: dict, folder: str | pathlib.Path) -> dict:
     """Add `aero_models.json` of `folder` (if the campaign wrote it) to the report data `d`."""
-    path = pathlib.Path(folder) / FILE
-    if path.exists():
-        d["aero_models"] = json.loads(path.read_text())
-    return d
+    return load_json_into(d, folder, FILE, "aero_models")
 
 
 def _num(x) -> float:
@@ -210,11 +208,7 @@ def gust_table(a: dict, controllers: list[str]) -> list[str]:
         "the ground. Cells: thesis / global.",
         "",
     ]
-    header, rule = "| phase | axis |", "|---|---|"
-    for k in controllers:
-        header += f" {k} (m/s) |"
-        rule += "---|"
-    out += [header + " changed |", rule + "---|"]
+    out += table_head(["phase", "axis", *(f"{k} (m/s)" for k in controllers), "changed"])
     by = {(r["phase"], r["axis"], r["controller"], r["aero_model"]): r for r in g["rows"]}
     cases: list[tuple[str, str]] = []
     for r in g["rows"]:

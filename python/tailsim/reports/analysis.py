@@ -23,7 +23,7 @@ from . import hover as report_hover
 from . import reproduction as report_reproduction
 from . import takeoff as report_takeoff
 from . import wind_envelope as report_wind
-from .markdown import fmt_or_dash, fmt_pole, markdown_to_html, shortest
+from .markdown import fmt_or_dash, fmt_pole, markdown_to_html, shortest, table_head
 
 OPEN_LOOP_NOTES = (
     "Differences from the thesis: the thesis's modes were computed from its AVL-based model with numbers it "
@@ -159,14 +159,8 @@ def table_5_1(d: dict) -> list[str]:
         "thesis's column is level flight.",
         "",
     ]
-    header, rule = "| parameter |", "|---|"
-    for k in d["controllers"]:
-        header += f" {k} thesis |"
-        rule += "---|"
-        for c in d["conditions"]:
-            header += f" {k} ours ({c}) |"
-            rule += "---|"
-    out += [header, rule]
+    cells = [[f"{k} thesis", *(f"{k} ours ({c})" for c in d["conditions"])] for k in d["controllers"]]
+    out += table_head(["parameter", *(c for per_controller in cells for c in per_controller)])
     rows = {(r["param"], r["controller"], r["condition"]): r for r in s["rows"]}
     for p in d["params"]:
         line = f"| {p['name']} |"
@@ -201,11 +195,9 @@ def _robustness_table(d: dict, rows: list[dict]) -> list[str]:
     `thesis / global`."""
     models = sorted({r.get("aero_model", 0) for r in rows})
     both = models == [0, 1]
-    header, rule = "| parameter |", "|---|"
-    for k in d["controllers"]:
-        header += f" {k} range | {k} passes | {k} worst pos. err (m) |"
-        rule += "---|---|---|"
-    out = [header, rule]
+    out = table_head(
+        ["parameter", *(c for k in d["controllers"] for c in (f"{k} range", f"{k} passes", f"{k} worst pos. err (m)"))]
+    )
     by = {(r["param"], r["controller"], r.get("aero_model", 0)): r for r in rows}
     for p in d["params"]:
         line = f"| {p['name']} |"
@@ -286,12 +278,9 @@ def gusts(d: dict) -> list[str]:
         "on thesis against global aerodynamics.",
         "",
     ]
-    header, rule = "| phase | axis |", "|---|---|"
     bound = shortest(g["pos_bound_m"])
-    for k in d["controllers"]:
-        header += f" {k} largest survived (m/s) | {k} max pos. err at it (m) | {k} largest with pos. err ≤ {bound} m |"
-        rule += "---|---|---|"
-    out += [header, rule]
+    per_controller = ("largest survived (m/s)", "max pos. err at it (m)", f"largest with pos. err ≤ {bound} m")
+    out += table_head(["phase", "axis", *(f"{k} {c}" for k in d["controllers"] for c in per_controller)])
     cases: list[tuple[str, str]] = []
     for r in g["rows"]:
         if (r["phase"], r["axis"]) not in cases:

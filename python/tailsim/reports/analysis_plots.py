@@ -30,6 +30,18 @@ def rows(path):
         return list(csv.DictReader(f))
 
 
+def unique(items):
+    """The distinct items, in the order they first occur."""
+    return list(dict.fromkeys(items))
+
+
+def save(fig, path, dpi):
+    """Lay out, write and close a figure."""
+    fig.tight_layout()
+    fig.savefig(path, dpi=dpi)
+    plt.close(fig)
+
+
 def splane(ax, title):
     ax.axvline(0, color="k", lw=0.5)
     ax.axhline(0, color="k", lw=0.5)
@@ -57,9 +69,7 @@ def main(out):
         ax.plot([t[0] for t in thesis], [t[1] for t in thesis], "o", mfc="none", label="thesis (level)")
         splane(ax, "Open-loop modes")
         ax.legend(fontsize=7)
-        fig.tight_layout()
-        fig.savefig(out / "open_loop_modes.png", dpi=120)
-        plt.close(fig)
+        save(fig, out / "open_loop_modes.png", 120)
 
     if (out / "closed_loop_poles.csv").exists():
         cl = rows(out / "closed_loop_poles.csv")
@@ -72,9 +82,7 @@ def main(out):
                 ax.plot([p[0] for p in pts], [p[1] for p in pts], mk, label=ctl)
             splane(ax, f"Closed-loop poles, {cond} flight")
             ax.legend(fontsize=7)
-            fig.tight_layout()
-            fig.savefig(out / f"closed_loop_poles_{cond}.png", dpi=120)
-            plt.close(fig)
+            save(fig, out / f"closed_loop_poles_{cond}.png", 120)
 
     if (out / "loci.csv").exists():
         loci = defaultdict(lambda: defaultdict(list))
@@ -83,10 +91,7 @@ def main(out):
                 (int(r["k"]), float(r["re"]), float(r["im"]))
             )
         combos = sorted({(c, d) for (c, d, _) in loci})
-        params = []
-        for _, _, p in loci:
-            if p not in params:
-                params.append(p)
+        params = unique(p for _, _, p in loci)
 
         def draw(ax, key, title):
             for pts in loci[key].values():
@@ -102,9 +107,7 @@ def main(out):
                 axs = axs if len(pitch) > 1 else [axs]
                 for ax, p in zip(axs, pitch, strict=False):
                     draw(ax, (ctl, cond, p), f"{ctl} {cond}: {p} (dot = smallest factor)")
-                fig.tight_layout()
-                fig.savefig(out / f"loci_{ctl}_{cond}_pitch.png", dpi=110)
-                plt.close(fig)
+                save(fig, out / f"loci_{ctl}_{cond}_pitch.png", 110)
             ps = [p for p in params if (ctl, cond, p) in loci]
             ncol = 5
             nrow = (len(ps) + ncol - 1) // ncol
@@ -114,17 +117,12 @@ def main(out):
                     draw(axs[i // ncol][i % ncol], (ctl, cond, p), f"{ctl} {cond}: {p}")
                 for j in range(len(ps), nrow * ncol):
                     axs[j // ncol][j % ncol].axis("off")
-                fig.tight_layout()
-                fig.savefig(out / f"loci_{ctl}_{cond}_all.png", dpi=80)
-                plt.close(fig)
+                save(fig, out / f"loci_{ctl}_{cond}_all.png", 80)
 
     if (out / "table_5_1.csv").exists():
         t = rows(out / "table_5_1.csv")
         level = [r for r in t if r["condition"] == "level"]
-        params = []
-        for r in level:
-            if r["param"] not in params:
-                params.append(r["param"])
+        params = unique(r["param"] for r in level)
         fig, ax = plt.subplots(figsize=(12, 4.5))
         w = 0.2
         for i, (ctl, col) in enumerate((("LQR", "C0"), ("TSD", "C1"))):
@@ -147,16 +145,11 @@ def main(out):
         ax.set_ylabel("RMS pole movement (% of ω_n)")
         ax.set_title("Table 5.1, level flight: thesis against regenerated")
         ax.legend(fontsize=8)
-        fig.tight_layout()
-        fig.savefig(out / "table_5_1.png", dpi=110)
-        plt.close(fig)
+        save(fig, out / "table_5_1.png", 110)
 
     if (out / "robustness.csv").exists():
         r = rows(out / "robustness.csv")
-        params = []
-        for x in r:
-            if x["param"] not in params:
-                params.append(x["param"])
+        params = unique(x["param"] for x in r)
         # One row of panels per aerodynamic model (issue 13: thesis 0, global 1).
         models = sorted({x.get("aero_model", "0") for x in r})
         name = {"0": "thesis aero", "1": "global aero"}
@@ -176,17 +169,11 @@ def main(out):
                 ax.set_xlabel("scale factor (plant only)")
                 ax.set_title(f"{ctl}, {name.get(model, model)}: mission passed (green) / failed (red)", fontsize=9)
                 ax.axvline(1, color="k", lw=0.5)
-        fig.tight_layout()
-        fig.savefig(out / "robustness.png", dpi=110)
-        plt.close(fig)
+        save(fig, out / "robustness.png", 110)
 
     if (out / "gusts.csv").exists():
         g = rows(out / "gusts.csv")
-        cases = []
-        for x in g:
-            c = (x["phase"], x["axis"])
-            if c not in cases:
-                cases.append(c)
+        cases = unique((x["phase"], x["axis"]) for x in g)
         fig, ax = plt.subplots(figsize=(9, 4))
         for i, ctl in enumerate(("LQR", "TSD")):
             best = []
@@ -207,8 +194,6 @@ def main(out):
         ax.set_xticklabels([f"{p}\n{a}" for p, a in cases], fontsize=8)
         ax.set_ylabel("largest survived 1−cos gust (m/s)")
         ax.legend()
-        fig.tight_layout()
-        fig.savefig(out / "gusts.png", dpi=110)
-        plt.close(fig)
+        save(fig, out / "gusts.png", 110)
 
     report_envelope.plot(out, json.loads((out / "report.json").read_text())) if (out / "report.json").exists() else None

@@ -10,7 +10,7 @@ and Jacobi, global aerodynamics.
 from __future__ import annotations
 
 from .. import declarations
-from .markdown import shortest
+from .markdown import shortest, table_head
 
 PHASES = list(declarations.PHASES)
 ORDERINGS = ["Gauss-Seidel", "Jacobi"]
@@ -67,11 +67,9 @@ def section(d: dict) -> list[str]:
         "### Steady wind from the east (the issue's table)",
         "",
     ]
-    header, rule = "| wind step |", "|---|"
-    for k in controllers:
-        header += f" {k} tuned, GS | {k} tuned, Jacobi | {k} thesis, GS |"
-        rule += "---|---|---|"
-    out += [header, rule]
+    out += table_head(
+        ["wind step", *(c for k in controllers for c in (f"{k} tuned, GS", f"{k} tuned, Jacobi", f"{k} thesis, GS"))]
+    )
     for v in st["speeds"]:
         line = f"| {shortest(v)} m/s from the east |"
         for k in controllers:

@@ -47,9 +47,14 @@ def fmt_pole(re: float, im: float) -> str:
     return f"{re:.3f} ± {abs(im):.3f}i"
 
 
+def table_head(header: list[str]) -> list[str]:
+    """The header and rule lines of a Markdown table."""
+    return ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+
+
 def table(header: list[str], rows: Iterable[list[str]]) -> list[str]:
     """A Markdown table."""
-    out = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    out = table_head(header)
     out += ["| " + " | ".join(r) + " |" for r in rows]
     return out
 

@@ -6,9 +6,9 @@ air, nominal plant). Every number comes from the result file."""
 
 from __future__ import annotations
 
-import json
 import pathlib
 
+from . import load_json_into
 from .markdown import fmt_or_dash, fmt_pole, table
 
 FILE = "reproduction.json"
@@ -37,10 +37,7 @@ TABLE_4_4_NOTES = (
 
 def load_into(d: dict, folder: str | pathlib.Path) -> dict:
     """Add `reproduction.json` of `folder` (if written) to the report data `d`."""
-    path = pathlib.Path(folder) / FILE
-    if path.exists():
-        d["reproduction"] = json.loads(path.read_text())
-    return d
+    return load_json_into(d, folder, FILE, "reproduction")
 
 
 def _pole(p) -> str:

@@ -12,9 +12,10 @@ Markdown lines (hooked into `tailsim.reports.analysis.SECTIONS`); `plot(folder)`
 
 from __future__ import annotations
 
-import json
 import math
 import pathlib
+
+from . import load_json_into
 
 FILE = "wind_envelope.json"
 MISSIONS = {"default": "default mission", "takeoff_landing": "take-off to landing"}
@@ -26,10 +27,7 @@ WINDS = {
 
 def load_into(d: dict, folder: str | pathlib.Path) -> dict:
     """Add `wind_envelope.json` of `folder` (if the analysis wrote it) to the report data `d`."""
-    path = pathlib.Path(folder) / FILE
-    if path.exists():
-        d["wind_envelope"] = json.loads(path.read_text())
-    return d
+    return load_json_into(d, folder, FILE, "wind_envelope")
 
 
 def _err(x) -> str:

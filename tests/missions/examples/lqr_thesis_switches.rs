@@ -199,11 +199,8 @@ fn main() {
         println!(
             "| {} | {aero} | {} | {} | {:.2} | {} | {:.1} at {:.2} | {:.2} | {:.1} | {x_i} | {} | {} | {same} |",
             case.name,
-            match &trace.failure {
-                None => "yes".to_string(),
-                Some(f) => format!("no: {f}"),
-            },
-            if check.passed() { "pass" } else { "fail" },
+            trace.completed_cell(),
+            check.verdict(),
             trace.max_pos_error(),
             phases.join(" / "),
             alpha_max.to_degrees(),

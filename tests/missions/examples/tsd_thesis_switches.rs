@@ -13,100 +13,28 @@
 //! `cargo run --release -p tsd-control --example thesis_switches [-- <v_vertical> ...]`
 //! (default 3 m/s; the rows "V_V = …" fly the printed design at other climb speeds).
 
+use analysis::closed::{chart_of_plant, plant_from_chart, PLANT_COORDS};
 use closed_loop::{fly, measure, plant_inputs, MissionCheck, Scenario};
 use flight_mission::{ControllerInput, MissionParams, SampledUnit};
-use nalgebra::{DMatrix, Vector3, Vector4};
-use tailsitter_physics::{idx, Airframe, InputVector, Plant, StateVector};
+use nalgebra::{DMatrix, Vector3};
+use tailsitter_physics::{Airframe, InputVector, Plant, StateVector};
 use tsd_control::{TsdController, TsdParams};
 
-fn quat_mul(a: &Vector4<f64>, b: &Vector4<f64>) -> Vector4<f64> {
-    let (av, aw) = (Vector3::new(a[0], a[1], a[2]), a[3]);
-    let (bv, bw) = (Vector3::new(b[0], b[1], b[2]), b[3]);
-    let v = bv * aw + av * bw + av.cross(&bv);
-    Vector4::new(v.x, v.y, v.z, aw * bw - av.dot(&bv))
+/// Name of the map's coordinate `i`: the plant's 19 minimal coordinates, then the four integrators.
+fn coord(i: usize) -> &'static str {
+    const INTEGRATORS: [&str; 4] = ["I_axial", "I_normal", "I_roll", "I_directional"];
+    PLANT_COORDS
+        .get(i)
+        .copied()
+        .unwrap_or_else(|| INTEGRATORS[i - PLANT_COORDS.len()])
 }
-
-/// Plant state from `base` and 19 minimal deviations (attitude as a rotation vector).
-fn from_chart(base: &StateVector, d: &[f64]) -> StateVector {
-    let mut x = *base;
-    for k in 0..6 {
-        x[idx::POS_N + k] += d[k];
-    }
-    let th = Vector3::new(d[6], d[7], d[8]);
-    let a = th.norm();
-    let e = if a > 0.0 {
-        let s = (0.5 * a).sin() / a;
-        Vector4::new(th.x * s, th.y * s, th.z * s, (0.5 * a).cos())
-    } else {
-        Vector4::new(0.0, 0.0, 0.0, 1.0)
-    };
-    let q = quat_mul(&base.fixed_rows::<4>(idx::Q1).into_owned(), &e);
-    x.fixed_rows_mut::<4>(idx::Q1).copy_from(&(q / q.norm()));
-    for k in 0..10 {
-        x[idx::P + k] += d[9 + k];
-    }
-    x
-}
-
-/// The 19 minimal deviations of `x` from `base`.
-fn to_chart(base: &StateVector, x: &StateVector) -> [f64; 19] {
-    let mut d = [0.0; 19];
-    for k in 0..6 {
-        d[k] = x[idx::POS_N + k] - base[idx::POS_N + k];
-    }
-    let q0 = base.fixed_rows::<4>(idx::Q1).into_owned();
-    let q0c = Vector4::new(-q0[0], -q0[1], -q0[2], q0[3]);
-    let mut e = quat_mul(&q0c, &x.fixed_rows::<4>(idx::Q1).into_owned());
-    if e[3] < 0.0 {
-        e = -e;
-    }
-    let v = Vector3::new(e[0], e[1], e[2]);
-    let s = v.norm();
-    let th = if s > 0.0 {
-        v * (2.0 * s.atan2(e[3]) / s)
-    } else {
-        Vector3::zeros()
-    };
-    d[6..9].copy_from_slice(th.as_slice());
-    for k in 0..10 {
-        d[9 + k] = x[idx::P + k] - base[idx::P + k];
-    }
-    d
-}
-
-/// Rightmost closed-loop pole (s-plane) of the vertical climb of `mission`: the sampled map
-/// (plant's 19 minimal coordinates, the four integrators) linearised by central differences
-/// one second before the end of vertical flight 1.
-/// Names of the map's coordinates.
-const COORDS: [&str; 23] = [
-    "pos_n",
-    "pos_e",
-    "pos_d",
-    "u",
-    "v",
-    "w",
-    "δθx",
-    "δθy",
-    "δθz",
-    "p",
-    "q",
-    "r",
-    "thrust",
-    "δe",
-    "δa",
-    "δr",
-    "δfc",
-    "δfd",
-    "δv",
-    "I_axial",
-    "I_normal",
-    "I_roll",
-    "I_directional",
-];
 
 /// A pole and the two map coordinates with the largest share of its eigenvector.
 type Pole = (nalgebra::Complex<f64>, [&'static str; 2]);
 
+/// Rightmost closed-loop pole (s-plane) of the vertical climb of `mission`: the sampled map
+/// (plant's 19 minimal coordinates, the four integrators) linearised by central differences
+/// one second before the end of vertical flight 1.
 fn vertical_poles(plant: &Plant, p: TsdParams, mission: MissionParams) -> Option<Vec<Pole>> {
     let ts = mission.sample_time;
     let x0 = plant.trim_vertical_climb(mission.v_vertical).ok()?.state;
@@ -129,7 +57,7 @@ fn vertical_poles(plant: &Plant, p: TsdParams, mission: MissionParams) -> Option
     let base_c = save(&ctl);
     let dyn_idx = [1usize, 2, 3, 4];
     let step = |z: &[f64]| -> (StateVector, Vec<f64>) {
-        let xs = from_chart(&x, &z[..19]);
+        let xs = plant_from_chart(&x, &z[..19]);
         let mut c = ctl.clone();
         let mut s = base_c.clone();
         for (k, i) in dyn_idx.iter().enumerate() {
@@ -160,7 +88,7 @@ fn vertical_poles(plant: &Plant, p: TsdParams, mission: MissionParams) -> Option
     }
     let eval = |z: &[f64]| -> Vec<f64> {
         let (xn, sn) = step(z);
-        let mut out = to_chart(&bx, &xn).to_vec();
+        let mut out = chart_of_plant(&bx, &xn).to_vec();
         out.extend(dyn_idx.iter().map(|i| sn[*i] - bs[*i]));
         out
     };
@@ -200,7 +128,7 @@ fn vertical_poles(plant: &Plant, p: TsdParams, mission: MissionParams) -> Option
             order.sort_by(|a, b| v[*b].norm().total_cmp(&v[*a].norm()));
             (
                 C::new(z.norm().ln() / ts, z.im.atan2(z.re) / ts),
-                [COORDS[order[0]], COORDS[order[1]]],
+                [coord(order[0]), coord(order[1])],
             )
         })
         .collect();

@@ -61,6 +61,8 @@ const fn spec(
 const INF: f64 = f64::INFINITY;
 
 impl VariableStore for ToyVars {
+    const MODEL_IDENTIFIER: &'static str = "toy";
+    const GUID: &'static str = TOY_GUID;
     const VARIABLES: &'static [VariableSpec] = &[
         spec(
             "u",
