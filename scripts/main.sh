@@ -56,6 +56,10 @@ cargo xtask dist
 if [ "$analysis" = 1 ]; then
     echo "== analysis campaign (out/analysis)"
     cargo run --release --locked -p analysis -- all --out out/analysis
+    echo "== the thesis reproduction (Table 5.1 by §5.1 with the thesis configurations, Table 4.4, modes, missions)"
+    cargo run --release --locked -p analysis -- reproduction --out out/analysis
+    echo "== wind envelope of the default mission (both controllers, 0-10 m/s, 8 bearings, steady and turbulent)"
+    cargo run --release --locked -p analysis -- wind-envelope --default-only --out out/analysis
     .venv/bin/python -m tailsim.reports.analysis out/analysis
 fi
 # Before the missions: the comparison report's first section is the paired Monte-Carlo result.
