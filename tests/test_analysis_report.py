@@ -5,7 +5,7 @@ report.json + CSV + aero_models.json, copied without summary.json and the cache,
 "out" set back to "out/analysis" and each take-off/landing trajectory trimmed to 11 points;
 crates/analysis/README.md); the Rust test `tiny_campaign_tables_come_from_runs_and_are_cached`
 checks that a campaign still writes report.json with the same structure. The robustness
-sweep is flown on both aerodynamic models (issue 13): its table shows thesis / global side
+sweep is flown on both aerodynamic models: its table shows thesis / global side
 by side with a generated what-changed-and-why."""
 
 from __future__ import annotations
@@ -46,8 +46,8 @@ def test_every_section_and_file_is_written(rendered):
         "## Nonlinear robustness (beyond the thesis)",
         "### Wider sweep: τ^3 (0.30 … 1.00 aerodynamic, 0.751 … 1.000 m and I)",
         "## Gust sweep (beyond the thesis)",
-        "## Thesis (linear) against global aerodynamics (beyond the thesis, issue 13)",
-        "## Transitions inside the linear α range (issue 16)",
+        "## Thesis (linear) against global aerodynamics (beyond the thesis)",
+        "## Transitions inside the linear α range",
     ]:
         assert heading in text.splitlines(), heading
     for name in analysis_report.SECTIONS:
@@ -77,7 +77,7 @@ def test_tables_hold_the_data(rendered):
     assert cl.count("| loop | placed | achieved (ours) | thesis Table 4.4 |") == 2
     assert "| Roll rate |" in cl and "−10.6 ± 4.5i" in cl  # thesis Table 4.4, roll rate, level
     # Robustness: range, passes and worst error of each controller, thesis / global model
-    # side by side (issue 13).
+    # side by side.
     rb = next(line for line in lines_of(folder, "robustness.md") if line.startswith("| C_mδe |"))
     cells = [c.strip() for c in rb.strip("|").split("|")]
     by = {(r["controller"], r["aero_model"]): r for r in d["robustness"]["rows"]}
@@ -100,7 +100,7 @@ def test_tables_hold_the_data(rendered):
     # Gusts: 3 phases × 3 axes.
     gu = [line for line in lines_of(folder, "gusts.md") if line.startswith("| ") and not line.startswith("| phase")]
     assert len(gu) == 9
-    # Transitions (issue 16): one row per tuned run, the thesis configuration on the issue's timings.
+    # Transitions: one row per tuned run, the thesis configuration on the issue's timings.
     env = d["envelope_transitions"]
     tr = [
         line

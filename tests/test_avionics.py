@@ -1,4 +1,4 @@
-"""Avionics in the loop (issue 14): plant → tailsitter_sensors → tailsitter_ekf →
+"""Avionics in the loop: plant → tailsitter_sensors → tailsitter_ekf →
 controller → plant under fmpy (tailsim.masters.avionics). Both controllers fly the
 default mission on the estimator's outputs; the true position error per phase
 and the estimation errors per phase are printed (pytest -s).

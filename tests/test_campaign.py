@@ -1,4 +1,4 @@
-"""The Monte-Carlo campaign (issue 15, parts 3–5): sampling, the runner against
+"""The Monte-Carlo campaign : sampling, the runner against
 ClosedLoop, and the Dask campaign on a 2-worker LocalCluster on 127.0.0.1
 (distributed = serial, resume, a killed worker, a failing sample)."""
 

@@ -141,7 +141,7 @@ def test_fast_mission_tsd(fmus):
     """TSD flies T1 = 3 s, T2 = 4 s with α below 20° (thesis §4.4.4)."""
     params = {"t_transition_1": 3.0, "t_transition_2": 4.0}
     # The thesis's result, on the thesis's (linear) aerodynamics: with the global model
-    # (aero_model = 1, issue 13) this transition stalls the wing (alpha up to about 80 deg).
+    # (aero_model = 1) this transition stalls the wing (alpha up to about 80 deg).
     result = fly(
         fmus, "tailsitter_tsd", controller_params=params, plant_params={"aero_model": 0}, stop_time=5 + 3 + 10 + 4 + 5
     )

@@ -1,4 +1,4 @@
-"""FMI 2.0 conformance of every packaged FMU (issue 7): two independent static
+"""FMI 2.0 conformance of every packaged FMU: two independent static
 checkers (fmpy's validator and fmu-manipulation-toolbox's `fmutool -check`),
 packaging (binary, documentation/index.html), model metadata, and the GUID
 check at instantiation (a wrong GUID gives NULL plus a logged reason, never a

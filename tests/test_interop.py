@@ -1,4 +1,4 @@
-"""Interoperability matrix (issue 7): every packaged FMU under two independent
+"""Interoperability matrix: every packaged FMU under two independent
 runtimes, fmpy (its own FMI 2.0 bindings) and libcosim (libcosimpy, DNV/OSP on
 the FMI Library): instantiate, initialise, step through the default
 experiment, read every Real; get/set/serialize the FMU state where the master

@@ -59,7 +59,7 @@ def runs(fmus):
             assert ssp.exists(), f"{ssp} missing: run `cargo xtask dist` first"
             # The masters are compared on the thesis's aerodynamics (aero_model = 0): with the
             # plant's default global model LQR's first transition stalls the wing, which
-            # amplifies the one-sample delay of libcosim (2.8 m, issue 13). The SSP (default
+            # amplifies the one-sample delay of libcosim (2.8 m). The SSP (default
             # bindings) is compared with a plain run at the defaults.
             thesis = {"aero_model": 0}
             cache[controller] = {

@@ -71,7 +71,7 @@ def test_constant_wind_is_flown_through(fmus):
     wind = (0.0, 2.0, 0.0)
     hover_long = {"t_vertical_1": 30.0}
     # On the thesis's aerodynamics (the controller's design model): with the global model
-    # (default, issue 13) β = 34° here is past the sideslip stall band and TSD drifts 0.13 m/s.
+    # (default) β = 34° here is past the sideslip stall band and TSD drifts 0.13 m/s.
     r = ClosedLoop(
         fmus["tailsitter_plant"], fmus["tailsitter_tsd"], plant_params={"aero_model": 0}, controller_params=hover_long
     ).run(stop_time=10.0, wind=lambda t: wind)

@@ -30,7 +30,7 @@ COMPARED = PLANT_STATES_BUT_FLAPS
 # ~ (2 ms)^5 f^(5) and CVode's tolerance-controlled error are both far below 1e-6 per
 # sample; the closed loop (marginally stable in hover) may grow them over 35 s, but not
 # past 0.1 mm (measured: 1e-5 N thrust, 5e-6 m position, on the thesis's transitions). The
-# α-limited profile (issue 16) ends the LQR's back transition in a coasting climb with the
+# α-limited profile ends the LQR's back transition in a coasting climb with the
 # thrust at its 0 N floor, where the induced velocity has a kink that both integrators step
 # across differently: 1.0e-4 measured there. 3e-4 in SI units (m, m/s, rad/s, N, rad).
 ME_TOL = 3e-4

@@ -1,4 +1,4 @@
-"""The sensor FMU `tailsitter_sensors` (issue 14, part 1) through fmpy (the conformance
+"""The sensor FMU `tailsitter_sensors`  through fmpy (the conformance
 checks and the every-variable test run over it with every FMU: test_conformance.py,
 test_variables.py): its own behaviour through the real C ABI: plant → sensors wired by name,
 reset mid-run, FMU state (get/set and serialised) continuing bit-identically,

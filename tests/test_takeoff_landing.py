@@ -112,7 +112,7 @@ def test_report_section_and_plot_from_the_campaign_data(tmp_path):
         shutil.copy(f, tmp_path / f.name)
     d = json.loads((data / "report.json").read_text())
     lines = report_takeoff.section(d)
-    assert "## Take-off and landing (issue 16)" in lines
+    assert "## Take-off and landing" in lines
     rows = [x for x in lines if x.startswith("| LQR |") or x.startswith("| TSD |")]
     # One row per flight in each of the two tables.
     assert len(rows) == 2 * len(d["takeoff_landing"]["flights"]) == 8
@@ -123,4 +123,4 @@ def test_report_section_and_plot_from_the_campaign_data(tmp_path):
     analysis_report.write(tmp_path)
     assert (tmp_path / "takeoff_landing.png").stat().st_size > 10_000
     text = (tmp_path / "report.md").read_text()
-    assert "## Take-off and landing (issue 16)" in text and "takeoff_landing.png" in text
+    assert "## Take-off and landing" in text and "takeoff_landing.png" in text

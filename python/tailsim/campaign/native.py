@@ -1,5 +1,5 @@
-"""The campaign's runs flown by the native Rust loop on identical jobs (issue 15,
-performance): the same samples, parameters, wind and limits as the fmpy runs, through
+"""The campaign's runs flown by the native Rust loop on identical jobs
+(performance): the same samples, parameters, wind and limits as the fmpy runs, through
 `analysis campaign-jobs` (crates/analysis/src/native_campaign.rs), compared row by row
 with the fmpy campaign's rows and timed side by side.
 

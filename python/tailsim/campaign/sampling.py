@@ -1,4 +1,4 @@
-"""The sample space of the Monte-Carlo campaign (issue 15, part 3).
+"""The sample space of the Monte-Carlo campaign.
 
 A *sample* is one draw of everything random: the 25 uncertain parameters of the
 thesis's Table 5.1 (each scaled by an independent log-uniform factor within

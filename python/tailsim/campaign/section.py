@@ -1,4 +1,4 @@
-"""The comparison section of the report: the paired Monte-Carlo result (issue 15).
+"""The comparison section of the report: the paired Monte-Carlo result.
 
 The controllers are compared on the same random plants, winds and gusts (paired
 samples, `tailsim.campaign`), not on one nominal mission: completion probability of
@@ -211,7 +211,7 @@ def report_section(out: str | pathlib.Path) -> list[str]:
     and, when present, the main job's campaign in `<out>/campaign`."""
     md = [
         "",
-        "## Comparison: paired Monte-Carlo (issue 15)",
+        "## Comparison: paired Monte-Carlo",
         "",
         "The controllers are compared on uncertain plants, not on the nominal one (where each controller's design "
         "model is the plant exactly): every sample is flown by every arm, so differences are paired. The nominal "

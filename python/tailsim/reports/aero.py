@@ -42,7 +42,7 @@ MODEL_NOTES = (
     "lifts again as a section flown backwards (C_L {clrev:.2f} at {atrev:.0f}°) and stalls early "
     "({ra}°–{rs}° from 180°). Where a run leaves attached flow the thesis's model gives the aircraft lift, "
     "restoring moments and control authority a real wing does not have, so the two models differ there — the "
-    "verdict column says in which direction. The controllers are not retuned (issue 13): where one now fails, "
+    "verdict column says in which direction. The controllers are not retuned: where one now fails, "
     "the table says so. What the global model leaves out: it is quasi-steady (no dynamic stall, stall hysteresis "
     "or stall delay in fast pitch-ups, which add transient lift and pitching moment in the quickest transitions), has "
     "no jet-height correction of the slip-stream strip (it overestimates slip-stream lift in a crosswind), and "
@@ -135,7 +135,7 @@ def section(d: dict) -> list[str]:
     cl90 = c["thesis"]["c_L"][i90]
     out = [
         "",
-        "## Thesis (linear) against global aerodynamics (beyond the thesis, issue 13)",
+        "## Thesis (linear) against global aerodynamics (beyond the thesis)",
         "",
         MODEL_NOTES.format(
             aa=shortest(round(c["alpha_attached_deg"], 6)),

@@ -191,7 +191,7 @@ def _range(r: dict | None) -> str:
 
 
 def _robustness_table(d: dict, rows: list[dict]) -> list[str]:
-    """One row per parameter; with rows on both aerodynamic models (issue 13) every cell is
+    """One row per parameter; with rows on both aerodynamic models every cell is
     `thesis / global`."""
     models = sorted({r.get("aero_model", 0) for r in rows})
     both = models == [0, 1]
@@ -232,7 +232,7 @@ def robustness(d: dict) -> list[str]:
     if both:
         out += [
             "",
-            "Every flight is flown twice (issue 13): on the thesis's linear aerodynamics (`aero_model` 0, the "
+            "Every flight is flown twice: on the thesis's linear aerodynamics (`aero_model` 0, the "
             "controllers' design model) and on the global model (`aero_model` 1, the plant FMU's default); same "
             "plant otherwise (no ground), same untuned controllers. Cells: thesis / global.",
         ]

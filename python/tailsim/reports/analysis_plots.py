@@ -150,7 +150,7 @@ def main(out):
     if (out / "robustness.csv").exists():
         r = rows(out / "robustness.csv")
         params = unique(x["param"] for x in r)
-        # One row of panels per aerodynamic model (issue 13: thesis 0, global 1).
+        # One row of panels per aerodynamic model (thesis 0, global 1).
         models = sorted({x.get("aero_model", "0") for x in r})
         name = {"0": "thesis aero", "1": "global aero"}
         fig, axs = plt.subplots(len(models), 2, figsize=(12, 5 * len(models)), sharey=True, squeeze=False)

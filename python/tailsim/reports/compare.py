@@ -295,7 +295,7 @@ def run(args) -> int:
         f"Level-trim pitch of the plant at {defaults['v_level']:g} m/s: {math.degrees(theta_trim):.2f}°. Wall time "
         f"{time.time() - t_start:.0f} s."
     )
-    md += campaign_section.report_section(out)  # the comparison: paired Monte-Carlo (issue 15)
+    md += campaign_section.report_section(out)  # the comparison: paired Monte-Carlo
     md += ["", "## Missions (thesis ch. 6 comparison)", ""]
     md.append("| " + " | ".join(header) + " |")
     md.append("|" + "---|" * len(header))

@@ -22,7 +22,7 @@ def section(d: dict) -> list[str]:
     bound = shortest(round(e["alpha_bound_deg"], 6))
     out = [
         "",
-        "## Transitions inside the linear α range (issue 16)",
+        "## Transitions inside the linear α range",
         "",
         f"Global aerodynamics (aero_model = {e['aero_model']}), flown natively (`closed_loop::fly`). The tuned "
         "controllers (configuration 0) fly the α- and thrust-limited point-mass profile "

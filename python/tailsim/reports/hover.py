@@ -1,4 +1,4 @@
-"""Hover in wind (issue 16): the `envelope_hover` key of the analysis campaign's
+"""Hover in wind: the `envelope_hover` key of the analysis campaign's
 `report.json` (`crates/analysis/src/envelope_hover.rs`) rendered as Markdown.
 
 Steady wind steps of 5, 7 and 8 m/s from eight bearings and 1 − cos gusts along each
@@ -54,7 +54,7 @@ def section(d: dict) -> list[str]:
     thesis = {(r["controller"], r["speed"]): r for r in st["rows"] if r["configuration"] == "thesis"}
     out = [
         "",
-        "## Hover in wind (issue 16)",
+        "## Hover in wind",
         "",
         f"Global aerodynamics, the plant's ground 10 m below the start. Hover is the vertical phase at "
         f"{shortest(st['v_vertical'])} m/s climb (the LQR's model needs airspeed); the wind is a step at "

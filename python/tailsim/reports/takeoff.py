@@ -1,4 +1,4 @@
-"""Take-off-to-landing section of the analysis report (issue 16), rendered from the
+"""Take-off-to-landing section of the analysis report, rendered from the
 `takeoff_landing` key the Rust campaign writes into `report.json`
 (`crates/analysis/src/takeoff_landing.rs`): both controllers start at rest on the gear,
 take off, fly the thesis's mission and land on a target point, on the global
@@ -32,7 +32,7 @@ def section(d: dict) -> list[str]:
     c = tl["criteria"]
     m = dict(tl["mission"])
     out = [
-        "## Take-off and landing (issue 16)",
+        "## Take-off and landing",
         "",
         "Both controllers start at rest on the gear (plant `initial_condition = 2`, global aerodynamics, ground "
         f"contact), spin the motors up for {_f(m['takeoff_spinup_time'], 1)} s to "
