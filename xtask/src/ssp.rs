@@ -43,21 +43,31 @@ fn declarations_dir() -> PathBuf {
 }
 
 /// Controllers a system is written for (each when its FMU exists): the models declared in
-/// `modelDescription/` that include the controller interface (the plant only connects to it),
-/// in the order of their identifiers.
+/// `modelDescription/` whose outputs include every command of the controller interface (the
+/// rule of `tailsim.controllers`), in the order of their identifiers.
 pub static CONTROLLERS: LazyLock<Vec<&'static str>> = LazyLock::new(|| {
     let dir = declarations_dir();
-    let interface = dir.join("fragments/controller_interface.json");
+    let (interface, _) = model_description::load_declarations(&dir, "fragments/controller_interface.json")
+        .unwrap_or_else(|e| panic!("controller interface declaration: {e}"));
+    let commands: Vec<String> = interface
+        .into_iter()
+        .filter(|d| d.group.as_deref() == Some("command"))
+        .map(|d| d.name)
+        .collect();
     let mut ids: Vec<String> = std::fs::read_dir(&dir)
         .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
         .filter_map(|e| e.ok()?.file_name().to_str()?.strip_suffix(".json").map(str::to_string))
-        .filter(|id| id != PLANT)
         .collect();
     ids.sort();
     ids.into_iter()
         .filter(|id| {
             let model = model_description::load(&dir, id, "0").unwrap_or_else(|e| panic!("declaration {id}: {e}"));
-            model.sources.contains(&interface)
+            commands.iter().all(|c| {
+                model
+                    .variables
+                    .iter()
+                    .any(|v| v.name() == c && v.decl.causality == model_description::Causality::Output)
+            })
         })
         .map(|id| &*id.leak())
         .collect()
