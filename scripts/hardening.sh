@@ -9,7 +9,7 @@
 #                                              FMI functions and states exercised; exit 1 on
 #                                              any violation → target/hardening/calls.txt
 #
-# Environment: TAILSITTER_FMUS=a,b narrows the FMUs (default: all five, fmi-fuzz ALL_MODELS);
+# Environment: TAILSITTER_FMUS=a,b narrows the FMUs (default: every declared model, fmi-fuzz all_models);
 # HARDENING_SKIP_DIST=1 skips `cargo xtask dist`; FUZZ_SEED sets the fuzz seed;
 # VALGRIND_CYCLES (default 5) cycles per FMU under valgrind; RSS_CYCLES (default 100000)
 # light and RSS_FULL_CYCLES (default 5000; ~40 ms each for the LQR FMU) full cycles.

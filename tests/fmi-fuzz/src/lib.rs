@@ -31,15 +31,17 @@ pub mod model_description_types {
     pub use model_description::{Causality, VarType, Variability};
 }
 
-/// Every FMU of the workspace.
-pub const ALL_MODELS: [&str; 6] = [
-    "tailsitter_plant",
-    "tailsitter_lqr",
-    "tailsitter_tsd",
-    "tailsitter_sensors",
-    "tailsitter_ekf",
-    "tailsitter_atmosphere",
-];
+/// Every FMU of the workspace: each model declared in `modelDescription/<id>.json`, plant
+/// first, then by identifier (a new unit is fuzzed by its declaration alone).
+pub fn all_models() -> Vec<String> {
+    let dir = workspace_root().join("modelDescription");
+    let mut ids: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .filter_map(|e| e.ok()?.file_name().to_str()?.strip_suffix(".json").map(str::to_string))
+        .collect();
+    ids.sort_by_key(|id| (id != "tailsitter_plant", id.clone()));
+    ids
+}
 
 /// The models whose `fmi2DoStep` random inputs make fail (the plant leaves its flight
 /// envelope): a fuzz run over at least one of them must reach `StepFailed`. The estimator
@@ -72,11 +74,11 @@ pub fn workspace_root() -> PathBuf {
         .expect("workspace root")
 }
 
-/// The models under test: `TAILSITTER_FMUS` (comma-separated) or all of [`ALL_MODELS`].
+/// The models under test: `TAILSITTER_FMUS` (comma-separated) or [`all_models`].
 pub fn required_models() -> Vec<String> {
     match std::env::var("TAILSITTER_FMUS") {
         Ok(list) if !list.trim().is_empty() => list.split(',').map(|s| s.trim().to_string()).collect(),
-        _ => ALL_MODELS.iter().map(|s| s.to_string()).collect(),
+        _ => all_models(),
     }
 }
 
