@@ -1,8 +1,10 @@
 //! Project tasks, run as `cargo xtask <task>`:
-//! - `dist`: build the FMU libraries in release mode for linux64 (x86_64-unknown-linux-gnu) and
-//!   win64 (x86_64-pc-windows-gnu, cross-linked with MinGW-w64) and write
-//!   `dist/<modelIdentifier>.fmu` (modelDescription.xml, binaries/linux64/<id>.so,
-//!   binaries/win64/<id>.dll, documentation/index.html);
+//! - `dist`: build the FMU libraries in release mode for linux64 (x86_64-unknown-linux-gnu
+//!   linked against glibc 2.17 by cargo-zigbuild) and win64 (x86_64-pc-windows-gnu,
+//!   cross-linked with MinGW-w64) and write `dist/<modelIdentifier>.fmu`
+//!   (modelDescription.xml, binaries/linux64/<id>.so, binaries/win64/<id>.dll,
+//!   documentation/index.html); with the platform aarch64-linux also the separate ARM
+//!   archives `dist/aarch64-linux/<modelIdentifier>.fmu` (see [`Platform::Aarch64Linux`]);
 //! - `ssp`: write the SSP 1.0 closed-loop systems `dist/<controller>.ssp` from the packaged FMUs
 //!   (`dist` writes them too);
 //! - `regen`: rewrite the reviewed copies `modelDescription/generated/<id>.xml`, the
@@ -94,8 +96,8 @@ enum Task {
         /// Output folder.
         #[arg(long, default_value = "dist")]
         out: PathBuf,
-        /// Platforms to build and pack (FMI 2.0 folder names).
-        #[arg(long, value_delimiter = ',', default_value = "linux64,win64")]
+        /// Platforms to build and pack (FMI 2.0 folder names, and aarch64-linux).
+        #[arg(long, value_delimiter = ',', default_value = "linux64,win64,aarch64-linux")]
         platforms: Vec<Platform>,
     },
     /// Write dist/<controller>.ssp (plant + controller closed loop, SSP 1.0) from the packaged FMUs.
@@ -111,31 +113,60 @@ enum Task {
 /// A binary platform of an FMI 2.0 archive.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 enum Platform {
-    /// `binaries/linux64/<id>.so`, built for the host (x86_64-unknown-linux-gnu).
+    /// `binaries/linux64/<id>.so` of `dist/<id>.fmu`: x86_64-unknown-linux-gnu, linked
+    /// against glibc 2.17 (the manylinux2014 baseline) by cargo-zigbuild.
     Linux64,
-    /// `binaries/win64/<id>.dll`, cross-built for x86_64-pc-windows-gnu.
+    /// `binaries/win64/<id>.dll` of `dist/<id>.fmu`: cross-built for x86_64-pc-windows-gnu.
     Win64,
+    /// aarch64-unknown-linux-gnu, glibc 2.17, by cargo-zigbuild. FMI 2.0 names no ARM
+    /// platform folder and an importer on ARM Linux looks in `linux64` (fmpy does), so
+    /// these go into separate archives `<out>/aarch64-linux/<id>.fmu` whose
+    /// `binaries/linux64/<id>.so` is the aarch64 library; `dist/<id>.fmu` never holds it.
+    #[value(name = "aarch64-linux")]
+    Aarch64Linux,
 }
 
 /// The Rust target of the win64 binaries (GNU ABI: links with Debian's MinGW-w64, no MSVC).
 const WIN64_TARGET: &str = "x86_64-pc-windows-gnu";
 /// The MinGW-w64 C compiler rustc links win64 binaries with (Debian `gcc-mingw-w64-x86-64`).
 const MINGW_GCC: &str = "x86_64-w64-mingw32-gcc";
+/// The oldest glibc the Linux binaries load on: they are linked against its symbol
+/// versions (cargo-zigbuild's `<target>.<glibc>` suffix), so no `GLIBC_x.y` they need is
+/// newer (tests/test_glibc.py checks every packaged library).
+pub const GLIBC: &str = "2.17";
 
 impl Platform {
     /// Folder under `binaries/` and file name of the library of model `id`.
     fn archive_path(self, id: &str) -> String {
         match self {
-            Platform::Linux64 => format!("binaries/linux64/{id}.so"),
+            Platform::Linux64 | Platform::Aarch64Linux => format!("binaries/linux64/{id}.so"),
             Platform::Win64 => format!("binaries/win64/{id}.dll"),
+        }
+    }
+
+    /// The Rust target triple.
+    fn target(self) -> &'static str {
+        match self {
+            Platform::Linux64 => "x86_64-unknown-linux-gnu",
+            Platform::Win64 => WIN64_TARGET,
+            Platform::Aarch64Linux => "aarch64-unknown-linux-gnu",
         }
     }
 
     /// Where cargo writes the release library of model `id`.
     fn built_path(self, root: &Path, id: &str) -> PathBuf {
+        let dir = root.join("target").join(self.target()).join("release");
         match self {
-            Platform::Linux64 => root.join(format!("target/release/lib{id}.so")),
-            Platform::Win64 => root.join(format!("target/{WIN64_TARGET}/release/{id}.dll")),
+            Platform::Linux64 | Platform::Aarch64Linux => dir.join(format!("lib{id}.so")),
+            Platform::Win64 => dir.join(format!("{id}.dll")),
+        }
+    }
+
+    /// The archive this platform's binaries go into, under the output folder.
+    fn archive_folder(self, out: &Path) -> PathBuf {
+        match self {
+            Platform::Linux64 | Platform::Win64 => out.to_path_buf(),
+            Platform::Aarch64Linux => out.join("aarch64-linux"),
         }
     }
 }
@@ -231,45 +262,78 @@ fn dist(only: &[String], out: &Path, platforms: &[Platform]) -> Result<(), Strin
         build(&root, &selected, *platform)?;
     }
     let out = absolute(out);
-    std::fs::create_dir_all(&out).map_err(|e| e.to_string())?;
+    // The archives to write: `out` (linux64, win64) and `out/aarch64-linux`, each with
+    // the platforms whose binaries it holds.
+    let mut archives: Vec<(PathBuf, Vec<Platform>)> = Vec::new();
+    for &platform in platforms {
+        let folder = platform.archive_folder(&out);
+        match archives.iter_mut().find(|(f, _)| *f == folder) {
+            Some((_, list)) => list.push(platform),
+            None => archives.push((folder, vec![platform])),
+        }
+    }
     for FmuCrate { id, docs, .. } in selected {
         let model = load(id)?;
-        let mut binaries = Vec::new();
-        for platform in platforms {
-            let lib = platform.built_path(&root, id);
-            let bytes = std::fs::read(&lib).map_err(|e| format!("{}: {e}", lib.display()))?;
-            binaries.push((platform.archive_path(id), bytes));
-        }
         let mut readme = String::new();
         for path in docs {
             let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
             readme.push_str(&text);
             readme.push_str("\n\n");
         }
-        let path = out.join(format!("{id}.fmu"));
-        write_fmu(&path, &model, &binaries, &documentation(&model, &readme, platforms))?;
-        println!(
-            "wrote {} ({} variables, guid {})",
-            path.display(),
-            model.variables.len(),
-            model.guid
-        );
+        for (folder, archive_platforms) in &archives {
+            let mut binaries = Vec::new();
+            for platform in archive_platforms {
+                let lib = platform.built_path(&root, id);
+                let bytes = std::fs::read(&lib).map_err(|e| format!("{}: {e}", lib.display()))?;
+                binaries.push((platform.archive_path(id), bytes));
+            }
+            std::fs::create_dir_all(folder).map_err(|e| format!("{}: {e}", folder.display()))?;
+            let path = folder.join(format!("{id}.fmu"));
+            let html = documentation(&model, &readme, archive_platforms);
+            write_fmu(&path, &model, &binaries, &html)?;
+            println!(
+                "wrote {} ({} variables, guid {})",
+                path.display(),
+                model.variables.len(),
+                model.guid
+            );
+        }
     }
-    // The closed-loop systems of whatever FMUs the folder now holds.
+    // The closed-loop systems of whatever FMUs the folder now holds, when its archives
+    // were rewritten.
     let has = |id: &str| out.join(format!("{id}.fmu")).exists();
-    if has(ssp::PLANT) && ssp::CONTROLLERS.iter().any(|c| has(c)) {
+    let rewritten = archives.iter().any(|(f, _)| *f == out);
+    if rewritten && has(ssp::PLANT) && ssp::CONTROLLERS.iter().any(|c| has(c)) {
         ssp::write_all(&out)?;
     }
     Ok(())
 }
 
-/// `cargo build --release` of the selected FMU crates for one platform.
+/// `cargo build --release` of the selected FMU crates for one platform (the Linux
+/// platforms: `cargo zigbuild`, linked against glibc [`GLIBC`]).
 fn build(root: &Path, selected: &[&FmuCrate], platform: Platform) -> Result<(), String> {
-    let mut cargo = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
-    cargo.current_dir(root).args(["build", "--release", "--locked"]);
-    if platform == Platform::Win64 {
-        win64_environment(&mut cargo)?;
-        cargo.args(["--target", WIN64_TARGET]);
+    let mut cargo = match platform {
+        Platform::Win64 => {
+            let mut cargo = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
+            win64_environment(&mut cargo)?;
+            cargo.args(["build", "--target", WIN64_TARGET]);
+            cargo
+        }
+        Platform::Linux64 | Platform::Aarch64Linux => {
+            let mut cargo = zigbuild(root)?;
+            cargo.args(["zigbuild", "--target", &format!("{}.{GLIBC}", platform.target())]);
+            cargo
+        }
+    };
+    cargo.current_dir(root).args(["--release", "--locked"]);
+    if platform != Platform::Win64 {
+        // Zig reports its include folder relative to the working directory when it lies
+        // below it (`.venv/...`), and cargo-zigbuild hands that to bindgen, which runs in
+        // fmi-sys' folder and then finds no <stddef.h>. From target/ the path is absolute;
+        // cargo still finds .cargo/config.toml in the parent folders.
+        let dir = root.join("target");
+        std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        cargo.current_dir(dir).arg("--manifest-path").arg(root.join("Cargo.toml"));
     }
     for f in selected {
         cargo.args(["-p", &f.krate]);
@@ -279,6 +343,27 @@ fn build(root: &Path, selected: &[&FmuCrate], platform: Platform) -> Result<(), 
         return Err(format!("cargo build --release for {platform:?} failed"));
     }
     Ok(())
+}
+
+/// cargo-zigbuild, with Zig: the PyPI wheels `cargo-zigbuild` and `ziglang` pinned in
+/// tests/requirements.txt, which scripts/setup.sh installs into `.venv`. The venv's
+/// `bin` goes first on the PATH, so cargo-zigbuild finds Zig as `python3 -m ziglang`.
+/// Zig links against stubs of the requested glibc's symbol versions; the Rust code
+/// and its floating point are rustc's, as in a plain `cargo build`.
+fn zigbuild(root: &Path) -> Result<Command, String> {
+    let bin = root.join(".venv/bin");
+    let exe = bin.join("cargo-zigbuild");
+    if !exe.exists() {
+        return Err(format!(
+            "{} missing: run scripts/setup.sh (installs cargo-zigbuild and Zig from tests/requirements.txt)",
+            exe.display()
+        ));
+    }
+    let mut path = vec![bin];
+    path.extend(std::env::split_paths(&std::env::var_os("PATH").unwrap_or_default()));
+    let mut cargo = Command::new(exe);
+    cargo.env("PATH", std::env::join_paths(path).map_err(|e| e.to_string())?);
+    Ok(cargo)
 }
 
 /// Check the win64 cross tool chain and point bindgen at MinGW's compiler headers.
@@ -378,7 +463,13 @@ fn platforms_section(model: &model_description::Model, platforms: &[Platform]) -
             Platform::Linux64 => (
                 platform.archive_path(&model.model_identifier),
                 "x86_64-unknown-linux-gnu",
-                "glibc, libgcc_s (every x86-64 Linux)",
+                "glibc 2.17 or later (every x86-64 Linux since RHEL/CentOS 7, the manylinux2014 baseline)",
+            ),
+            Platform::Aarch64Linux => (
+                platform.archive_path(&model.model_identifier),
+                "<strong>aarch64</strong>-unknown-linux-gnu (64-bit ARM: this archive is for ARM Linux \
+                 only; FMI 2.0 has no ARM folder name and importers on ARM Linux read <code>linux64</code>)",
+                "glibc 2.17 or later (every aarch64 Linux distribution)",
             ),
             Platform::Win64 => (
                 platform.archive_path(&model.model_identifier),
@@ -390,9 +481,14 @@ fn platforms_section(model: &model_description::Model, platforms: &[Platform]) -
             "<tr><td><code>{folder}</code></td><td>{built}</td><td>{runtime}</td></tr>\n"
         ));
     }
+    let aarch64 = if platforms.contains(&Platform::Aarch64Linux) {
+        "The x86-64 and Windows binaries are in the archive of the same name one folder up."
+    } else {
+        "aarch64 Linux ships as separate archives (<code>aarch64-linux/&lt;modelIdentifier&gt;.fmu</code>: FMI 2.0 \
+         has no ARM folder name distinct from x86-64's <code>linux64</code>)."
+    };
     format!(
         "<h2>Platforms and interfaces</h2>\n<p>{interfaces}.</p>\n<table>\n<tr><th>binary</th><th>built for</th>\
-<th>needs at run time</th></tr>\n{rows}</table>\n<p>Not shipped: aarch64 Linux (FMI 2.0 has no folder name \
-distinct from x86-64's <code>linux64</code>), macOS (needs Apple's SDK), FMI 3.0.</p>\n"
+<th>needs at run time</th></tr>\n{rows}</table>\n<p>{aarch64} Not shipped: macOS (needs Apple's SDK), FMI 3.0.</p>\n"
     )
 }
