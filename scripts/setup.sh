@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Set up a fresh machine: system packages (libclang for fmi-sys' bindgen; MinGW-w64
-# and Wine for the win64 binaries), the Rust target x86_64-pc-windows-gnu, the Rust
-# crates (fetched by cargo on first build), the pinned Python venv and the tailsim package
+# and Wine for the win64 binaries; Debian's aarch64 cross gcc, glibc and qemu-user for
+# the aarch64 tests), the Rust targets x86_64-pc-windows-gnu and aarch64-unknown-linux-gnu,
+# the Rust crates (fetched by cargo on first build), the pinned Python venv (with Zig and
+# cargo-zigbuild, which link the Linux binaries against glibc 2.17) and the tailsim package
 # (pyproject.toml; installed editable into the venv, so no PYTHONPATH is needed).
 # Idempotent and non-interactive: re-running only checks.
 set -euo pipefail
@@ -29,9 +31,21 @@ if ! command -v x86_64-w64-mingw32-gcc >/dev/null || ! command -v x86_64-w64-min
     echo "== installing gcc-mingw-w64-x86-64 (links the win64 DLLs)"
     apt_install gcc-mingw-w64-x86-64
 fi
-if ! grep -qx x86_64-pc-windows-gnu <<<"$(rustup target list --installed)"; then
-    echo "== adding the Rust target x86_64-pc-windows-gnu"
-    rustup target add x86_64-pc-windows-gnu
+# aarch64-linux binaries: `cargo xtask dist` links the FMU libraries with cargo-zigbuild
+# (Zig, glibc 2.17; both from the venv below). The tests link with Debian's cross gcc and
+# run under qemu-user with Debian's aarch64 glibc in /usr/aarch64-linux-gnu
+# (.cargo/config.toml; tests/test_aarch64.py).
+installed_targets=$(rustup target list --installed)
+for target in x86_64-pc-windows-gnu aarch64-unknown-linux-gnu; do
+    if ! grep -qx "$target" <<<"$installed_targets"; then
+        echo "== adding the Rust target $target"
+        rustup target add "$target"
+    fi
+done
+if ! command -v aarch64-linux-gnu-gcc >/dev/null || [ ! -e /usr/aarch64-linux-gnu/lib/libc.so.6 ] \
+    || ! command -v qemu-aarch64 >/dev/null; then
+    echo "== installing gcc-aarch64-linux-gnu, libc6-dev-arm64-cross, qemu-user (aarch64 tests)"
+    apt_install gcc-aarch64-linux-gnu libc6-dev-arm64-cross qemu-user
 fi
 if [ ! -x /usr/lib/wine/wine64 ] && ! command -v wine64 >/dev/null; then
     echo "== installing wine64 (runs the win64 DLLs in the tests, through fmpy's remoting)"

@@ -333,7 +333,10 @@ fn build(root: &Path, selected: &[&FmuCrate], platform: Platform) -> Result<(), 
         // cargo still finds .cargo/config.toml in the parent folders.
         let dir = root.join("target");
         std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-        cargo.current_dir(dir).arg("--manifest-path").arg(root.join("Cargo.toml"));
+        cargo
+            .current_dir(dir)
+            .arg("--manifest-path")
+            .arg(root.join("Cargo.toml"));
     }
     for f in selected {
         cargo.args(["-p", &f.krate]);

@@ -1,6 +1,7 @@
-//! Drive the built FMU libraries (`target/release/lib<id>.so`) through their
-//! real C ABI, the way a foreign host does: `dlopen` with `libloading`, a
-//! recording host logger, and thin wrappers that return the raw `fmi2Status`.
+//! Drive the built FMU libraries (`target/x86_64-unknown-linux-gnu/release/lib<id>.so`,
+//! the linux64 libraries `cargo xtask dist` builds and packs) through their real C ABI,
+//! the way a foreign host does: `dlopen` with `libloading`, a recording host logger, and
+//! thin wrappers that return the raw `fmi2Status`.
 //!
 //! - [`fuzz`]: random FMI call sequences against a mirror of the state machine
 //!   (the short deterministic run is `tests/fuzz.rs`; the long run is the
@@ -82,11 +83,12 @@ pub fn required_models() -> Vec<String> {
     }
 }
 
-/// `target/release/lib<id>.so` (or `$FMI_FUZZ_LIB_DIR/lib<id>.so`).
+/// `target/x86_64-unknown-linux-gnu/release/lib<id>.so`, built by `cargo xtask dist` (or
+/// `$FMI_FUZZ_LIB_DIR/lib<id>.so`).
 pub fn library_path(id: &str) -> PathBuf {
     let dir = std::env::var_os("FMI_FUZZ_LIB_DIR")
         .map(PathBuf::from)
-        .unwrap_or_else(|| workspace_root().join("target/release"));
+        .unwrap_or_else(|| workspace_root().join("target/x86_64-unknown-linux-gnu/release"));
     dir.join(format!("lib{id}.so"))
 }
 
@@ -228,7 +230,7 @@ unsafe impl Sync for Fmu {}
 unsafe impl Send for Fmu {}
 
 impl Fmu {
-    /// Load `target/release/lib<id>.so` and the declaration `modelDescription/<id>.json`.
+    /// Load [`library_path`] and the declaration `modelDescription/<id>.json`.
     pub fn load(id: &str) -> Result<Self, String> {
         let path = library_path(id);
         if !path.exists() {

@@ -1,5 +1,5 @@
 //! The short deterministic fuzz run of the test suite: a fixed seed and a fixed
-//! number of random FMI call sequences over every FMU library (target/release,
+//! number of random FMI call sequences over every FMU library (target/x86_64-unknown-linux-gnu/release,
 //! built by `cargo xtask dist`). `FMI_FUZZ_SEQUENCES` / `FMI_FUZZ_LQR_SEQUENCES` /
 //! `FMI_FUZZ_SEED` override;
 //! the long run is `cargo run --release -p fmi-fuzz -- fuzz --seconds N`.

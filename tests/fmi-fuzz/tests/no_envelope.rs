@@ -1,6 +1,6 @@
 //! The short deterministic fuzz runs over the FMUs with no envelope to leave, the
 //! atmosphere (`tailsitter_atmosphere`) and the sensors (`tailsitter_sensors`),
-//! target/release, built by `cargo xtask dist --only <id>`: random FMI call sequences
+//! target/x86_64-unknown-linux-gnu/release, built by `cargo xtask dist --only <id>`: random FMI call sequences
 //! keep every invariant of the other FMUs' run.
 
 use fmi_fuzz::fuzz::{Config, Fuzzer};

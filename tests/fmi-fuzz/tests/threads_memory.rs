@@ -1,4 +1,4 @@
-//! Threads and memory through the real C ABI (target/release libraries):
+//! Threads and memory through the real C ABI (target/x86_64-unknown-linux-gnu/release libraries):
 //! 64 instances stepped concurrently give bit-identical results to sequential
 //! runs, and 10 000 instantiate/state/free cycles (plus full life cycles with
 //! initialisation and a step) do not grow the resident set (numbers printed; run with --nocapture).
