@@ -39,7 +39,7 @@ OUT=target/hardening
 mkdir -p "$OUT"
 
 if [ "${HARDENING_SKIP_DIST:-0}" != 1 ]; then
-    if [ -n "${TAILSITTER_FMUS:-}" ]; then cargo xtask dist --only "$TAILSITTER_FMUS"; else cargo xtask dist; fi
+    if [ -n "${TAILSITTER_FMUS:-}" ]; then cargo xtask dist --platforms linux64,win64 --only "$TAILSITTER_FMUS"; else cargo xtask dist --platforms linux64,win64; fi
 fi
 cargo build --release -p fmi-fuzz --bin fmi-fuzz
 BIN=target/release/fmi-fuzz
