@@ -133,7 +133,7 @@ const MINGW_GCC: &str = "x86_64-w64-mingw32-gcc";
 /// The oldest glibc the Linux binaries load on: they are linked against its symbol
 /// versions (cargo-zigbuild's `<target>.<glibc>` suffix), so no `GLIBC_x.y` they need is
 /// newer (tests/test_glibc.py checks every packaged library).
-pub const GLIBC: &str = "2.17";
+const GLIBC: &str = "2.17";
 
 impl Platform {
     /// Folder under `binaries/` and file name of the library of model `id`.
@@ -316,28 +316,27 @@ fn build(root: &Path, selected: &[&FmuCrate], platform: Platform) -> Result<(), 
         Platform::Win64 => {
             let mut cargo = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
             win64_environment(&mut cargo)?;
-            cargo.args(["build", "--target", WIN64_TARGET]);
+            cargo.current_dir(root).args(["build", "--target", WIN64_TARGET]);
             cargo
         }
         Platform::Linux64 | Platform::Aarch64Linux => {
             let mut cargo = zigbuild(root)?;
-            cargo.args(["zigbuild", "--target", &format!("{}.{GLIBC}", platform.target())]);
+            // Zig reports its include folder relative to the working directory when it
+            // lies below it (`.venv/...`), and cargo-zigbuild hands that to bindgen, which
+            // runs in fmi-sys' folder and then finds no <stddef.h>. From target/ the path
+            // is absolute; cargo still finds .cargo/config.toml in the parent folders.
+            let dir = root.join("target");
+            std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+            cargo
+                .current_dir(dir)
+                .arg("zigbuild")
+                .arg("--manifest-path")
+                .arg(root.join("Cargo.toml"));
+            cargo.args(["--target", &format!("{}.{GLIBC}", platform.target())]);
             cargo
         }
     };
-    cargo.current_dir(root).args(["--release", "--locked"]);
-    if platform != Platform::Win64 {
-        // Zig reports its include folder relative to the working directory when it lies
-        // below it (`.venv/...`), and cargo-zigbuild hands that to bindgen, which runs in
-        // fmi-sys' folder and then finds no <stddef.h>. From target/ the path is absolute;
-        // cargo still finds .cargo/config.toml in the parent folders.
-        let dir = root.join("target");
-        std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-        cargo
-            .current_dir(dir)
-            .arg("--manifest-path")
-            .arg(root.join("Cargo.toml"));
-    }
+    cargo.args(["--release", "--locked"]);
     for f in selected {
         cargo.args(["-p", &f.krate]);
     }
