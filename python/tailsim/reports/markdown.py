@@ -78,7 +78,7 @@ def slug(heading: str, separator: str = "-") -> str:
 def toc(lines: list[str], level: int = 2) -> list[str]:
     """A linked table of contents (Markdown bullets) of the headings of `level` in `lines`."""
     mark = "#" * level + " "
-    return [f"- [{h[len(mark):]}](#{slug(h[len(mark):])})" for h in lines if h.startswith(mark)]
+    return [f"- [{h[len(mark) :]}](#{slug(h[len(mark) :])})" for h in lines if h.startswith(mark)]
 
 
 def markdown_to_html(lines: list[str], base: pathlib.Path, title: str) -> str:
@@ -107,6 +107,6 @@ def markdown_to_html(lines: list[str], base: pathlib.Path, title: str) -> str:
     body = re.sub(r'src="([^"]+)"', embed, body)
     return (
         "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
-        "<meta name='viewport' content='width=device-width, initial-scale=1'>"
+        "<meta name='viewport' content='width=device-width, initial-scale=1'><link rel='icon' href='data:,'>"
         f"<title>{html.escape(title)}</title><style>{STYLE}</style></head><body>{body}</body></html>\n"
     )

@@ -121,7 +121,7 @@ def campaign_findings(folder: str | pathlib.Path) -> list[Finding]:
         ranked = sorted(members, key=lambda a: (-stats[a][1] / max(stats[a][0], 1), _nan_last(stats[a][3])))
         best = ranked[0]
         per = "; ".join(
-            f"{label(a[0])} {stats[a][1]}/{stats[a][0]} ({_f(stats[a][1] / max(stats[a][0], 1))} "
+            f"{label(a[0])} {stats[a][1]}/{stats[a][0]} (P = {_f(stats[a][1] / max(stats[a][0], 1))} "
             f"{_interval(stats[a][2])}, median RMS error {_f(stats[a][3])} m)"
             for a in ranked
         )
@@ -149,17 +149,17 @@ def campaign_findings(folder: str | pathlib.Path) -> list[Finding]:
                 better = other[0]  # completion not separated, the other has the smaller error
                 continue
             separated = False
+        n = len(set(cols["sample_id"][_arm_mask(cols, best)].tolist()))
         found.append(
             Finding(
-                condition=f"uncertain plants in wind and gusts, {config} configuration, {state} state",
+                condition=f"uncertain plants in wind and gusts ({n} samples), {config} configuration, {state} state",
                 better=better if separated else None,
-                by="; ".join(diffs),
+                by=f"completed: {per}; paired: " + "; ".join(diffs),
                 source=source,
-                detail=[per],
             )
         )
     if found:
-        found[0].detail.append(f"{len(set(cols['sample_id'].tolist()))} samples: " + _conditions_text(spec))
+        found[-1].detail.append("Uncertain plants: " + _conditions_text(spec) + ".")
     return found
 
 
@@ -234,25 +234,13 @@ def wind_findings(path: str | pathlib.Path) -> list[Finding]:
         held = {k: [c for c in mine if c["controller"] == k] for k in ctrls}
         count = {k: sum(bool(c["held"]) for c in held[k]) for k in ctrls}
 
-        def all_bearings(k: str) -> float:
-            ok = [s for s in sorted({c["speed"] for c in held[k]}) if all(c["held"] for c in held[k] if c["speed"] <= s)]
-            return max(ok) if ok else math.nan
-
         ranked = sorted(ctrls, key=lambda k: -count[k])
         best = ranked[0]
         found.append(
             Finding(
                 condition=f"nominal plant in steady wind of every speed and bearing, {mission} mission, {wind} wind",
                 better=best if all(count[best] > count[k] for k in ranked[1:]) else None,
-                by="; ".join(
-                    f"{label(k)} holds {count[k]}/{len(held[k])} cells"
-                    + (
-                        f", every bearing up to {all_bearings(k):g} m/s"
-                        if math.isfinite(all_bearings(k))
-                        else ", not every bearing at any speed"
-                    )
-                    for k in ranked
-                )
+                by="; ".join(f"{label(k)} holds {count[k]}/{len(held[k])} cells, {_reach(held[k])}" for k in ranked)
                 + " (a grid, no interval)",
                 source=str(path),
             )
@@ -260,14 +248,25 @@ def wind_findings(path: str | pathlib.Path) -> list[Finding]:
     return found
 
 
+def _reach(cells: list[dict]) -> str:
+    """Up to which wind speed every cell (every bearing, every lower speed) is held."""
+    ok = [s for s in sorted({c["speed"] for c in cells}) if all(c["held"] for c in cells if c["speed"] <= s)]
+    if not ok:
+        return "not held at every bearing at any speed"
+    return "held at every bearing only without wind" if max(ok) == 0 else f"held at every bearing up to {max(ok):g} m/s"
+
+
 def collect(out: str | pathlib.Path) -> list[Finding]:
     """Every finding of the run in `out`: the campaign, the wind envelope, the nominal missions."""
     out = pathlib.Path(out)
-    return (
+    found = (
         campaign_findings(out / "campaign")
         + wind_findings(out / "analysis" / "wind_envelope.json")
         + nominal_findings(out / "metrics.json")
     )
+    for f in found:
+        f.source = str(pathlib.Path(f.source).relative_to(out))
+    return found
 
 
 def overall(findings: list[Finding]) -> str:
@@ -300,9 +299,10 @@ def markdown(findings: list[Finding], heading: str = "## Verdict") -> list[str]:
     for f in findings:
         md.append(f"| {f.condition} | {label(f.better) if f.better else 'not separated'} | {f.by} |")
     for f in findings:
-        md += ["", *f.detail] if f.detail else []
+        for d in f.detail:
+            md += ["", d]
     sources = sorted({f.source for f in findings})
-    md += ["", "Read from " + ", ".join(f"`{s}`" for s in sources) + "."]
+    md += ["", "Read from this run's " + ", ".join(f"`{s}`" for s in sources) + "."]
     return md
 
 
@@ -338,9 +338,7 @@ def headline_table(summary: Mapping[str, Any]) -> list[str]:
         for k in ctrls:
             r = arms_.get((k, *g))
             cells.append(
-                f"{_f(r['p'], 3)} {_interval(r['wilson95'], 3)}, {_f(r['median_completed']['rms_err'])} m"
-                if r
-                else "–"
+                f"{_f(r['p'], 3)} {_interval(r['wilson95'], 3)}, {_f(r['median_completed']['rms_err'])} m" if r else "–"
             )
         top = max(present, key=lambda k: arms_[(k, *g)]["p"])
         sep = all(arms_[(top, *g)]["wilson95"][0] > arms_[(k, *g)]["wilson95"][1] for k in present if k != top)
