@@ -118,13 +118,13 @@ def plot_mission(runs: dict[str, RunResult], title: str, path: pathlib.Path, sta
         ax[2, 0].plot(t, r["thrust"], color=c, label=f"{key.upper()} T")
         for s, ls in zip(surfaces, styles, strict=False):
             ax[2, 1].plot(t, np.degrees(r[s]), color=c, ls=ls, lw=1, label=f"{key.upper()} {s}")
-    ax[0, 0].set(xlabel="north [m]", ylabel="height [m]", title="track (Figs. 3.20 / 4.19)")
+    ax[0, 0].set(xlabel="north (m)", ylabel="height (m)", title="track (Figs. 3.20 / 4.19)")
     ax[0, 0].axis("equal")
-    ax[0, 1].set(xlabel="t [s]", ylabel="airspeed [m/s]", title="airspeed")
-    ax[1, 0].set(xlabel="t [s]", ylabel="angle [deg]", title="angle of attack α and pitch θ")
-    ax[1, 1].set(xlabel="t [s]", ylabel="distance [m]", title="position error")
-    ax[2, 0].set(xlabel="t [s]", ylabel="thrust [N]", title="thrust")
-    ax[2, 1].set(xlabel="t [s]", ylabel="deflection [deg]", title="surface deflections (the surfaces that move)")
+    ax[0, 1].set(xlabel="t (s)", ylabel="airspeed (m/s)", title="airspeed")
+    ax[1, 0].set(xlabel="t (s)", ylabel="angle (deg)", title="angle of attack α and pitch θ")
+    ax[1, 1].set(xlabel="t (s)", ylabel="distance (m)", title="position error")
+    ax[2, 0].set(xlabel="t (s)", ylabel="thrust (N)", title="thrust")
+    ax[2, 1].set(xlabel="t (s)", ylabel="deflection (deg)", title="surface deflections (the surfaces that move)")
     for k, a in enumerate(ax.flat):
         if starts and k:
             shade_phases(a, starts, label=k == 1)
@@ -152,7 +152,7 @@ def plot_steps(step_runs: dict[str, dict[str, tuple[RunResult, float]]], path: p
                 a.plot(r.time[m] - t_step, pos_error(r)[m], color=COLORS[key], label=key.upper())
         a.axhline(CRITERIA["settling_band"], color="k", lw=0.8, ls=":")
         flight, axis = case.split()
-        a.set(title=f"5 m {axis} step in {flight} flight", xlabel="time after step [s]", ylabel="position error [m]")
+        a.set(title=f"5 m {axis} step in {flight} flight", xlabel="time after step (s)", ylabel="position error (m)")
         a.grid(True, alpha=0.3)
         a.legend()
     fig.suptitle(f"Position steps of 5 m; {what}" if what else "Position steps of 5 m")
@@ -314,27 +314,27 @@ def run(args) -> int:
     row("mission completed", lambda x: "yes" if x.completed else f"no ({x.reason})")
     rows.append(
         (
-            "transitions requested T1 / T2 [s]",
+            "transitions requested T1 / T2 (s)",
             [f"{missions[m][0]:g} / {missions[m][1]:g}" for m in missions for k in keys],
         )
     )
     row(
-        "transitions flown [s] (γ within 5° of level / vertical for good)",
+        "transitions flown (s) (γ within 5° of level / vertical for good)",
         lambda x: " / ".join(fmt(v, 1) for v in x.flown_transition),
     )
     for i, ph in enumerate(PHASES):
-        row(f"max / RMS position error, {ph} [m]", lambda x, i=i: f"{fmt(x.max_error[i])} / {fmt(x.rms_error[i])}")
+        row(f"max / RMS position error, {ph} (m)", lambda x, i=i: f"{fmt(x.max_error[i])} / {fmt(x.rms_error[i])}")
     row(
-        "max altitude deviation, transition 1 / 2 [m]",
+        "max altitude deviation, transition 1 / 2 (m)",
         lambda x: " / ".join(fmt(v) for v in x.altitude_deviation_transition),
     )
-    row("max α [deg]", lambda x: fmt(x.max_alpha_deg, 1))
-    row("time in actuator saturation [s]", lambda x: fmt(x.saturation_time))
+    row("max α (deg)", lambda x: fmt(x.max_alpha_deg, 1))
+    row("time in actuator saturation (s)", lambda x: fmt(x.saturation_time))
     row(
-        "level flight: max airspeed error [m/s] / pitch error [deg]",
+        "level flight: max airspeed error (m/s) / pitch error (deg)",
         lambda x: f"{fmt(x.level_airspeed_error)} / {fmt(x.level_pitch_error_deg)}",
     )
-    row("controller compute per step (fmpy call incl.) [µs]", lambda x: fmt(x.controller_us_per_step, 0))
+    row("controller compute per step (fmpy call incl.) (µs)", lambda x: fmt(x.controller_us_per_step, 0))
     fastest = {}
     alpha_max = CRITERIA["linear_alpha_max"]
     for k in keys:
@@ -359,7 +359,7 @@ def run(args) -> int:
                 vals.append(fmt(step_settling(r, t_step)))
             else:
                 vals.append("failed")
-        step_rows.append((f"settling time to < {CRITERIA['settling_band']:g} m, 5 m step, {name} [s]", vals))
+        step_rows.append((f"settling time to < {CRITERIA['settling_band']:g} m, 5 m step, {name} (s)", vals))
 
     body = campaign_part(out)
     body += ["", "## Missions (thesis ch. 6 comparison)", ""]
