@@ -66,7 +66,7 @@ fi
 # Before the missions: the report's verdict reads the paired Monte-Carlo result (every controller, both
 # configurations, perfect state and the avionics chain, on the same uncertain plants in wind).
 echo "== Monte-Carlo campaign (out/campaign; the full run: docs/CAMPAIGN.md)"
-.venv/bin/python -m tailsim.campaign --samples 16 --seed 1 --out out/campaign --replace --no-progress \
+.venv/bin/python -m tailsim.campaign --samples 32 --seed 1 --out out/campaign --replace --no-progress \
     --configurations tuned,thesis --state-sources perfect,avionics
 echo "== flying the missions"
 .venv/bin/python -m tailsim.reports.compare --out out "${runner_args[@]+"${runner_args[@]}"}"

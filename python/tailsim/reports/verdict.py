@@ -136,10 +136,15 @@ def campaign_findings(folder: str | pathlib.Path) -> list[Finding]:
             de = (eb - eo)[both]
             de = de[np.isfinite(de)]
             er = (float(de.mean()) if de.size else math.nan, bootstrap_mean_ci(de), int(de.size))
+            error = (
+                f"RMS position error {_signed(er[0])} m {_interval(er[1], signed=True)} ({er[2]} samples both "
+                "completed)"
+                if er[2]
+                else "no sample completed by both"
+            )
             diffs.append(
                 f"{label(best[0])} − {label(other[0])} on the same {d.size} samples: completion "
-                f"{_signed(dc[0])} {_interval(dc[1], signed=True)}, RMS position error {_signed(er[0])} m "
-                f"{_interval(er[1], signed=True)} ({er[2]} samples both completed)"
+                f"{_signed(dc[0])} {_interval(dc[1], signed=True)}, {error}"
             )
             if dc[1][0] > 0:
                 continue  # completes more often, the interval excludes 0
