@@ -26,23 +26,31 @@ def test_readme_is_short():
     assert len(README.read_text().splitlines()) <= 150
 
 
-def test_headline_table_is_generated_from_the_committed_full_run():
-    text = README.read_text()
+def test_generated_tables_match_the_committed_full_run():
+    """The README's headline table and docs/CAMPAIGN.md's full-run tables are the ones
+    generated from docs/campaign_full_run.json."""
+    stale = verdict.regenerate(ROOT, write=False)
+    assert stale == [], f"{stale}: run `python -m tailsim.reports.verdict --docs`"
+    assert verdict.main(["--docs", "--check"]) == 0
     summary = json.loads(verdict.FULL_RUN.read_text())
-    assert verdict.readme_with_headline(text, summary) == text, (
-        "README's headline table differs from docs/campaign_full_run.json: "
-        "run `python -m tailsim.reports.verdict --readme README.md`"
-    )
-    # and the check command agrees
-    assert verdict.main(["--readme", str(README), "--check"]) == 0
+    for file, (name, make) in verdict.DOCS.items():
+        begin, end = verdict.markers(name)
+        text = (ROOT / file).read_text()
+        assert text[text.index(begin) + len(begin) : text.index(end)].strip() == "\n".join(make(summary)).strip()
 
 
-def test_headline_check_fails_on_a_changed_figure(tmp_path):
-    copy = tmp_path / "README.md"
-    text = README.read_text()
-    row = next(line for line in text.splitlines() if line.startswith("| tuned, perfect |"))
-    copy.write_text(text.replace(row, row.replace("0.", "0.9", 1)))
-    assert verdict.main(["--readme", str(copy), "--check"]) == 1
+def test_a_changed_figure_is_found(tmp_path):
+    """A figure edited by hand in a generated block, or a result file that changed, is found."""
+    for file in verdict.DOCS:
+        (tmp_path / file).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / file).write_text((ROOT / file).read_text())
+    summary = json.loads(verdict.FULL_RUN.read_text())
+    assert verdict.regenerate(tmp_path, summary, write=False) == []
+    arm = next(iter(summary["arms"].values()))
+    arm["p"] += 0.001
+    assert verdict.regenerate(tmp_path, summary, write=False) == list(verdict.DOCS)
+    assert verdict.regenerate(tmp_path, summary) == list(verdict.DOCS)
+    assert verdict.regenerate(tmp_path, summary, write=False) == []
 
 
 def test_readme_documents_every_initial_condition_and_the_angle_unit():
