@@ -11,11 +11,13 @@ from __future__ import annotations
 import functools
 import http.server
 import pathlib
+import shutil
 import threading
 
 import pytest
 
 from tailsim.campaign.driver import main as campaign_main
+from tailsim.reports import analysis as analysis_report
 from tailsim.reports.compare import main as compare_main
 
 CHROMIUM = pathlib.Path("/usr/bin/chromium")
@@ -37,6 +39,9 @@ VIEWPORTS = [(390, 844), (1366, 768)]
 def served(tmp_path_factory):
     """A small run's report folder, served on localhost; yields its base address."""
     out = tmp_path_factory.mktemp("browser") / "out"
+    # The analysis report of the tests' small analysis data (a fixture of the Rust campaign).
+    shutil.copytree(pathlib.Path(__file__).parent / "data" / "analysis", out / "analysis")
+    analysis_report.write(out / "analysis")
     assert (
         campaign_main(["--samples", "3", "--seed", "1", "--out", str(out / "campaign"), "--serial", "--no-progress"])
         == 0
@@ -125,9 +130,10 @@ def test_report_in_chromium(served, browser, width, height):
     page.close()
 
 
+@pytest.mark.parametrize("page_path", ["campaign/report.html", "analysis/report.html"])
 @pytest.mark.parametrize(("width", "height"), VIEWPORTS)
-def test_campaign_report_in_chromium(served, browser, width, height):
+def test_other_reports_in_chromium(served, browser, width, height, page_path):
     base, _ = served
-    page, errors = open_page(browser, f"{base}/campaign/report.html", width, height)
+    page, errors = open_page(browser, f"{base}/{page_path}", width, height)
     check_page(page, errors, width)
     page.close()
