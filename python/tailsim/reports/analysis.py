@@ -225,7 +225,7 @@ def robustness(d: dict) -> list[str]:
         "",
         "The whole default mission flown in the nonlinear closed loop with the parameter scaled over the same sweep as "
         "Table 5.1 (τ = 1.5 / 1.1); range = contiguous range of factors around 1 over which the mission passes the "
-        "controller issues' criteria (`MissionCheck::passed`); worst = largest position error over that range; passes "
+        "mission criteria (`MissionCheck::passed`); worst = largest position error over that range; passes "
         "= passing points of N. The mission is symmetric and flown in calm air, so the lateral derivatives are hardly "
         "excited (identical position errors): their robustness shows in the gust sweep.",
     ]
