@@ -72,12 +72,17 @@ CONFIGURATIONS = {0: "tuned", 1: "thesis"}
 
 
 def setting(plant: Fmu, ctrls: dict[str, Fmu]) -> str:
-    """What flies, for the plots' titles: the plant's aerodynamic model and each controller's configuration."""
+    """What flies, for the plots' titles: the plant's aerodynamic model and each controller's
+    configuration (a controller without the `configuration` switch flies its declared defaults)."""
     aero = AERO_MODELS.get(int(plant.start("aero_model")), f"aero_model {plant.start('aero_model'):g}")
-    conf = ", ".join(
-        f"{k.upper()} {CONFIGURATIONS.get(int(c.start('configuration')), c.start('configuration'))}"
-        for k, c in ctrls.items()
-    )
+
+    def configuration(c: Fmu) -> str:
+        if "configuration" not in c.variables:
+            return "default"
+        v = c.start("configuration")
+        return CONFIGURATIONS.get(int(v), f"configuration {v:g}")
+
+    conf = ", ".join(f"{k.upper()} {configuration(c)}" for k, c in ctrls.items())
     return f"plant: {aero}; {conf} configuration"
 
 

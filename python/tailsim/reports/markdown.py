@@ -22,7 +22,7 @@ STYLE = (
     ".table-wrap{overflow-x:auto;max-width:100%;margin:0.6em 0}"
     "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:3px 8px;vertical-align:top}th{background:#eee}"
     "img{max-width:100%;height:auto}pre{overflow-x:auto}"
-    "p,li,td,code{overflow-wrap:anywhere}"
+    "p,li,code{overflow-wrap:anywhere}td{overflow-wrap:break-word}"
     ".headerlink{text-decoration:none;color:#bbb;margin-left:0.3em}"
     ".toc ul{margin:0.2em 0}"
 )

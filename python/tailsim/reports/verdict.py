@@ -121,7 +121,7 @@ def campaign_findings(folder: str | pathlib.Path) -> list[Finding]:
         best = ranked[0]
         per = "; ".join(
             f"{label(a[0])} {stats[a][1]}/{stats[a][0]} (P = {_f(stats[a][1] / max(stats[a][0], 1))} "
-            f"{_interval(stats[a][2])}, median RMS error {_f(stats[a][3])} m)"
+            f"{_interval(stats[a][2])}" + (f", median RMS error {_f(stats[a][3])} m)" if stats[a][1] else ")")
             for a in ranked
         )
         separated, diffs = True, []
