@@ -455,7 +455,7 @@ def campaign_part(out: pathlib.Path) -> list[str]:
         "",
     ]
     try:
-        md += campaign_section.markdown(campaign_section.summarize([folder]), f"Campaign in `{folder}`")
+        md += campaign_section.markdown(campaign_section.summarize([folder]), "Campaign in `campaign/`")
     except Exception as e:  # noqa: BLE001 - a broken campaign folder must not lose the report
         md += [f"(campaign in {folder} not summarised: {e})"]
     for p in sorted(folder.glob("*.png")):
