@@ -159,3 +159,19 @@ def test_flown_transitions_measure_the_flight_path():
     r.signals["vel_d"] = -speed * np.ones_like(t)
     r.signals["vel_n"] = 0 * t
     assert math.isnan(flown_transitions(r, mission)[0])
+
+
+def test_cli_prints_the_verdict_of_a_run_folder(tmp_path, capsys):
+    """What `scripts/main.sh` prints at its end: one sentence, one line per condition."""
+    write_campaign(
+        tmp_path / "campaign",
+        {("one", "tuned", "perfect"): [True] * 30, ("two", "tuned", "perfect"): [i % 3 == 0 for i in range(30)]},
+        {"one": 0.5, "two": 2.0},
+    )
+    assert verdict.main([str(tmp_path)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0] == "Verdict: ONE is better in 1 of the 1 conditions measured."
+    assert lines[1].startswith(
+        "- uncertain plants in wind and gusts (30 samples), tuned configuration, perfect state: ONE."
+    )
+    assert "`" not in "\n".join(lines) and "**" not in "\n".join(lines)
