@@ -170,7 +170,10 @@ def test_cli_prints_the_verdict_of_a_run_folder(tmp_path, capsys):
     )
     assert verdict.main([str(tmp_path)]) == 0
     lines = capsys.readouterr().out.splitlines()
-    assert lines[0] == "Verdict: ONE is better in 1 of the 1 conditions measured."
+    assert (
+        lines[0]
+        == "Verdict: ONE is better in 1 of the 1 conditions (tuned configuration, uncertain plants, perfect state)."
+    )
     assert lines[1].startswith(
         "- uncertain plants in wind and gusts (30 samples), tuned configuration, perfect state: ONE."
     )

@@ -51,6 +51,8 @@ class Finding:
     """By how much, with the intervals (Markdown)."""
     source: str
     """The result file it is read from."""
+    short: str = ""
+    """The condition in a few words, for the one-sentence summary."""
     detail: list[str] = field(default_factory=list)
 
 
@@ -160,6 +162,7 @@ def campaign_findings(folder: str | pathlib.Path) -> list[Finding]:
                 better=better if separated else None,
                 by=f"completed: {per}; paired: " + "; ".join(diffs),
                 source=source,
+                short=f"{config} configuration, uncertain plants, {state} state",
             )
         )
     if found:
@@ -214,6 +217,7 @@ def nominal_findings(path: str | pathlib.Path) -> list[Finding]:
                 better=best if ok else None,
                 by="; ".join(cells) + " (one run each, no interval)",
                 source=str(path),
+                short=f"nominal {mission} mission",
             )
         )
     return found
@@ -247,6 +251,7 @@ def wind_findings(path: str | pathlib.Path) -> list[Finding]:
                 by="; ".join(f"{label(k)} holds {count[k]}/{len(held[k])} cells, {_reach(held[k])}" for k in ranked)
                 + " (a grid, no interval)",
                 source=str(path),
+                short=f"wind envelope, {mission} mission, {wind} wind",
             )
         )
     return found
@@ -274,21 +279,23 @@ def collect(out: str | pathlib.Path) -> list[Finding]:
 
 
 def overall(findings: list[Finding]) -> str:
-    """One sentence: which controller the measured conditions favour."""
+    """One sentence: which controller is better under which of the measured conditions."""
     if not findings:
         return "No result files: nothing was measured in this run."
-    wins: dict[str, int] = {}
+    wins: dict[str, list[str]] = {}
     for f in findings:
         if f.better:
-            wins[label(f.better)] = wins.get(label(f.better), 0) + 1
-    open_ = sum(f.better is None for f in findings)
+            wins.setdefault(label(f.better), []).append(f.short or f.condition)
+    open_ = [f.short or f.condition for f in findings if f.better is None]
     if not wins:
         return f"No controller is separated from the others in any of the {len(findings)} conditions measured."
-    ranked = sorted(wins, key=lambda k: -wins[k])
-    parts = [f"{k} is better in {wins[k]} of the {len(findings)} conditions measured" for k in ranked]
+    ranked = sorted(wins, key=lambda k: -len(wins[k]))
+    parts = [
+        f"{k} is better in {len(wins[k])} of the {len(findings)} conditions ({'; '.join(wins[k])})" for k in ranked
+    ]
     if open_:
-        parts.append(f"{open_} not separated")
-    return "; ".join(parts) + "."
+        parts.append(f"not separated in {len(open_)} ({'; '.join(open_)})")
+    return ", ".join(parts) + "."
 
 
 def markdown(findings: list[Finding], heading: str = "## Verdict") -> list[str]:
