@@ -30,6 +30,7 @@
 
 // Rust's shortest round-trip representation, as in modelDescription.xml; a valid xs:double.
 use model_description::fmt_f64 as real;
+use model_description::xml::{element, empty};
 use quick_xml::events::{BytesStart, Event};
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
@@ -372,46 +373,36 @@ type XmlResult = std::io::Result<()>;
 /// The connectors of one component: every output (recorded by tools that record connectors), and
 /// the inputs a connection drives.
 fn component(w: &mut Xml, name: &str, fmu: &FmuInfo, inputs: &[&str], parameter_sets: &[ParamSet]) -> XmlResult {
-    w.create_element("ssd:Component")
-        .with_attributes([
-            ("name", name),
-            ("type", "application/x-fmu-sharedlibrary"),
-            ("source", resource(&fmu.model_identifier).as_str()),
-        ])
-        .write_inner_content(|w| {
-            w.create_element("ssd:Connectors").write_inner_content(|w| {
-                let ports = fmu.ports.iter().filter(|p| {
-                    p.causality == "output" || (p.causality == "input" && inputs.contains(&p.name.as_str()))
-                });
-                for p in ports {
-                    w.create_element("ssd:Connector")
-                        .with_attributes([("name", p.name.as_str()), ("kind", p.causality.as_str())])
-                        .write_inner_content(|w| {
-                            let mut ty = w.create_element(format!("ssc:{}", p.kind));
-                            if let Some(unit) = p.unit.as_deref().filter(|_| p.kind == "Real") {
-                                ty = ty.with_attribute(("unit", unit));
-                            }
-                            ty.write_empty()?;
-                            Ok(())
-                        })?;
-                }
-                Ok(())
-            })?;
-            if parameter_sets.iter().any(|(_, p)| !p.is_empty()) {
-                w.create_element("ssd:ParameterBindings").write_inner_content(|w| {
-                    for (set, parameters) in parameter_sets.iter().filter(|(_, p)| !p.is_empty()) {
-                        w.create_element("ssd:ParameterBinding").write_inner_content(|w| {
-                            w.create_element("ssd:ParameterValues")
-                                .write_inner_content(|w| parameter_set(w, set, parameters))?;
-                            Ok(())
-                        })?;
-                    }
-                    Ok(())
-                })?;
-            }
-            Ok(())
+    let source = resource(&fmu.model_identifier);
+    let attributes = [
+        ("name", name),
+        ("type", "application/x-fmu-sharedlibrary"),
+        ("source", source.as_str()),
+    ];
+    element(w, "ssd:Component", attributes, |w| {
+        let connected =
+            |p: &&Port| p.causality == "output" || (p.causality == "input" && inputs.contains(&p.name.as_str()));
+        element(w, "ssd:Connectors", [], |w| {
+            fmu.ports.iter().filter(connected).try_for_each(|p| {
+                let unit = p.unit.as_deref().filter(|_| p.kind == "Real");
+                let connector = [("name", p.name.as_str()), ("kind", p.causality.as_str())];
+                element(w, "ssd:Connector", connector, |w| {
+                    empty(w, &format!("ssc:{}", p.kind), unit.map(|u| ("unit", u)))
+                })
+            })
         })?;
-    Ok(())
+        let sets: Vec<_> = parameter_sets.iter().filter(|(_, p)| !p.is_empty()).collect();
+        if sets.is_empty() {
+            return Ok(());
+        }
+        element(w, "ssd:ParameterBindings", [], |w| {
+            sets.into_iter().try_for_each(|(set, parameters)| {
+                element(w, "ssd:ParameterBinding", [], |w| {
+                    element(w, "ssd:ParameterValues", [], |w| parameter_set(w, set, parameters))
+                })
+            })
+        })
+    })
 }
 
 /// Named parameter sets of a component: (set name, [(name, type element, value)]).
@@ -419,25 +410,15 @@ type ParamSet = (&'static str, Vec<(&'static str, String, String)>);
 
 /// An inline SSV parameter set named `set`: (name, type element, value).
 fn parameter_set(w: &mut Xml, set: &str, parameters: &[(&str, String, String)]) -> XmlResult {
-    w.create_element("ssv:ParameterSet")
-        .with_attributes([("version", "1.0"), ("name", set)])
-        .write_inner_content(|w| {
-            w.create_element("ssv:Parameters").write_inner_content(|w| {
-                for (name, kind, value) in parameters {
-                    w.create_element("ssv:Parameter")
-                        .with_attribute(("name", *name))
-                        .write_inner_content(|w| {
-                            w.create_element(format!("ssv:{kind}"))
-                                .with_attribute(("value", value.as_str()))
-                                .write_empty()?;
-                            Ok(())
-                        })?;
-                }
-                Ok(())
-            })?;
-            Ok(())
-        })?;
-    Ok(())
+    element(w, "ssv:ParameterSet", [("version", "1.0"), ("name", set)], |w| {
+        element(w, "ssv:Parameters", [], |w| {
+            parameters.iter().try_for_each(|(name, kind, value)| {
+                element(w, "ssv:Parameter", [("name", *name)], |w| {
+                    empty(w, &format!("ssv:{kind}"), [("value", value.as_str())])
+                })
+            })
+        })
+    })
 }
 
 /// Parameter values for `fmu`, checking each is a parameter of the declared type.
@@ -697,85 +678,59 @@ fn write_ssd(name: &str, description: &str, elements: &[Element], links: &[Conne
             units.push(u);
         }
     }
+    let (stop, base_step) = (real(stop_time()), real(mission_default("sample_time")));
+    let root = [
+        ("xmlns:ssd", NS_SSD),
+        ("xmlns:ssc", NS_SSC),
+        ("xmlns:ssv", NS_SSV),
+        ("xmlns:osp", NS_OSP),
+        ("version", "1.0"),
+        ("name", name),
+        (
+            "generationTool",
+            concat!("tailsitter xtask ", env!("CARGO_PKG_VERSION")),
+        ),
+    ];
     model_description::xml::document(|w| {
-        w.create_element("ssd:SystemStructureDescription")
-            .with_attributes([
-                ("xmlns:ssd", NS_SSD),
-                ("xmlns:ssc", NS_SSC),
-                ("xmlns:ssv", NS_SSV),
-                ("xmlns:osp", NS_OSP),
-                ("version", "1.0"),
-                ("name", name),
-                (
-                    "generationTool",
-                    concat!("tailsitter xtask ", env!("CARGO_PKG_VERSION")),
-                ),
-            ])
-            .write_inner_content(|w| {
-                w.create_element("ssd:System")
-                    .with_attributes([("name", name), ("description", description)])
-                    .write_inner_content(|w| {
-                        w.create_element("ssd:Elements").write_inner_content(|w| {
-                            for (name, fmu, inputs, parameters) in elements {
-                                component(w, name, fmu, inputs, parameters)?;
-                            }
-                            Ok(())
-                        })?;
-                        w.create_element("ssd:Connections").write_inner_content(|w| {
-                            for c in links {
-                                w.create_element("ssd:Connection")
-                                    .with_attributes([
-                                        ("startElement", c.start),
-                                        ("startConnector", c.name.as_str()),
-                                        ("endElement", c.end),
-                                        ("endConnector", c.name.as_str()),
-                                    ])
-                                    .write_empty()?;
-                            }
-                            Ok(())
-                        })?;
-                        Ok(())
-                    })?;
-                if !units.is_empty() {
-                    w.create_element("ssd:Units").write_inner_content(|w| {
-                        for u in &units {
-                            w.create_element("ssc:Unit")
-                                .with_attribute(("name", u.name.as_str()))
-                                .write_inner_content(|w| {
-                                    w.create_element("ssc:BaseUnit")
-                                        .with_attributes(u.base.iter().map(|(k, v)| (k.as_str(), v.as_str())))
-                                        .write_empty()?;
-                                    Ok(())
-                                })?;
-                        }
-                        Ok(())
-                    })?;
-                }
-                w.create_element("ssd:DefaultExperiment")
-                    .with_attributes([("startTime", "0.0"), ("stopTime", real(stop_time()).as_str())])
-                    .write_inner_content(|w| {
-                        w.create_element("ssd:Annotations").write_inner_content(|w| {
-                            w.create_element("ssc:Annotation")
-                                .with_attribute(("type", "com.opensimulationplatform"))
-                                .write_inner_content(|w| {
-                                    w.create_element("osp:Algorithm").write_inner_content(|w| {
-                                        w.create_element("osp:FixedStepAlgorithm")
-                                            .with_attribute((
-                                                "baseStepSize",
-                                                real(mission_default("sample_time")).as_str(),
-                                            ))
-                                            .write_empty()?;
-                                        Ok(())
-                                    })?;
-                                    Ok(())
-                                })?;
-                            Ok(())
-                        })?;
-                        Ok(())
-                    })?;
-                Ok(())
+        element(w, "ssd:SystemStructureDescription", root, |w| {
+            element(w, "ssd:System", [("name", name), ("description", description)], |w| {
+                element(w, "ssd:Elements", [], |w| {
+                    elements
+                        .iter()
+                        .try_for_each(|(name, fmu, inputs, parameters)| component(w, name, fmu, inputs, parameters))
+                })?;
+                element(w, "ssd:Connections", [], |w| {
+                    links.iter().try_for_each(|c| {
+                        let ends = [
+                            ("startElement", c.start),
+                            ("startConnector", c.name.as_str()),
+                            ("endElement", c.end),
+                            ("endConnector", c.name.as_str()),
+                        ];
+                        empty(w, "ssd:Connection", ends)
+                    })
+                })
             })?;
-        Ok(())
+            if !units.is_empty() {
+                element(w, "ssd:Units", [], |w| {
+                    units.iter().try_for_each(|u| {
+                        element(w, "ssc:Unit", [("name", u.name.as_str())], |w| {
+                            empty(w, "ssc:BaseUnit", u.base.iter().map(|(k, v)| (k.as_str(), v.as_str())))
+                        })
+                    })
+                })?;
+            }
+            let experiment = [("startTime", "0.0"), ("stopTime", stop.as_str())];
+            element(w, "ssd:DefaultExperiment", experiment, |w| {
+                element(w, "ssd:Annotations", [], |w| {
+                    element(w, "ssc:Annotation", [("type", "com.opensimulationplatform")], |w| {
+                        element(w, "osp:Algorithm", [], |w| {
+                            empty(w, "osp:FixedStepAlgorithm", [("baseStepSize", base_step.as_str())])
+                        })
+                    })
+                })
+            })
+        })
     })
     .map_err(|e| e.to_string())
 }
