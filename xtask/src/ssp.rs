@@ -353,18 +353,37 @@ pub struct Connection {
 pub fn connections(plant: &FmuInfo, controller: &FmuInfo) -> Result<Vec<Connection>, String> {
     let mut out = links_between(plant, "plant", controller, "controller")?;
     out.extend(links_between(controller, "controller", plant, "plant")?);
-    let undriven: Vec<_> = plant
+    require_driven(&out, plant, "plant", is_command, controller)?;
+    Ok(out)
+}
+
+/// A command input (`*_cmd`): what a controller drives.
+fn is_command(p: &Port) -> bool {
+    p.name.ends_with("_cmd")
+}
+
+/// Errors unless every input of `fmu` (component `id`) that `which` selects is the end of one of
+/// `links`; `driver` is the FMU that should drive them.
+fn require_driven(
+    links: &[Connection],
+    fmu: &FmuInfo,
+    id: &str,
+    which: impl Fn(&Port) -> bool,
+    driver: &FmuInfo,
+) -> Result<(), String> {
+    let undriven: Vec<_> = fmu
         .with("input")
-        .filter(|p| p.name.ends_with("_cmd") && !out.iter().any(|c| c.end == "plant" && c.name == p.name))
+        .filter(|p| which(p) && !links.iter().any(|c| c.end == id && c.name == p.name))
         .map(|p| p.name.as_str())
         .collect();
-    if !undriven.is_empty() {
-        return Err(format!(
-            "{} does not drive plant inputs {undriven:?}",
-            controller.model_identifier
-        ));
+    if undriven.is_empty() {
+        Ok(())
+    } else {
+        Err(format!(
+            "{} does not drive {id} inputs {undriven:?}",
+            driver.model_identifier
+        ))
     }
-    Ok(out)
 }
 
 type Xml = model_description::xml::XmlWriter;
@@ -450,23 +469,30 @@ fn controller_sets(controller: &FmuInfo) -> Result<Vec<ParamSet>, String> {
     ])
 }
 
-/// The atmosphere's links by name (plant → atmosphere, atmosphere → plant) and its parameter
-/// set `atmosphere` (the declared defaults, [`ATMOSPHERE_PARAMS`]: calm). Every atmosphere
-/// input must be a plant output.
-fn atmosphere_element(plant: &FmuInfo, atmosphere: &FmuInfo) -> Result<(Vec<Connection>, Vec<ParamSet>), String> {
-    let mut links = links_between(plant, "plant", atmosphere, "atmosphere")?;
+/// The plant's parameter set `plant`: it starts in the trimmed vertical climb at the mission's
+/// climb speed (docs/DESIGN.md §3).
+fn plant_sets(plant: &FmuInfo) -> Result<Vec<ParamSet>, String> {
+    let start = [
+        ("initial_condition", "Integer", "0".to_string()),
+        ("initial_speed", "Real", real(mission_default("v_vertical"))),
+    ];
+    Ok(vec![("plant", bindings(plant, &start)?)])
+}
+
+/// The atmosphere component, if given: its links by name (plant → atmosphere, atmosphere →
+/// plant) join `links`, and its parameter set `atmosphere` (the declared defaults,
+/// [`ATMOSPHERE_PARAMS`]: calm) is returned. Every atmosphere input must be a plant output.
+fn add_atmosphere<'a>(
+    plant: &FmuInfo,
+    atmosphere: Option<&'a FmuInfo>,
+    links: &mut Vec<Connection>,
+) -> Result<Option<(&'a FmuInfo, Vec<ParamSet>)>, String> {
+    let Some(atmosphere) = atmosphere else {
+        return Ok(None);
+    };
+    links.extend(links_between(plant, "plant", atmosphere, "atmosphere")?);
     links.extend(links_between(atmosphere, "atmosphere", plant, "plant")?);
-    let undriven: Vec<_> = atmosphere
-        .with("input")
-        .filter(|p| !links.iter().any(|c| c.end == "atmosphere" && c.name == p.name))
-        .map(|p| p.name.as_str())
-        .collect();
-    if !undriven.is_empty() {
-        return Err(format!(
-            "{} does not drive atmosphere inputs {undriven:?}",
-            plant.model_identifier
-        ));
-    }
+    require_driven(links, atmosphere, "atmosphere", |_| true, plant)?;
     let values: Vec<_> = ATMOSPHERE_PARAMS
         .iter()
         .map(|(n, v)| match atmosphere.port(n).map(|p| p.kind.as_str()) {
@@ -474,7 +500,7 @@ fn atmosphere_element(plant: &FmuInfo, atmosphere: &FmuInfo) -> Result<(Vec<Conn
             _ => (*n, "Real", real(*v)),
         })
         .collect();
-    Ok((links, vec![("atmosphere", bindings(atmosphere, &values)?)]))
+    Ok(Some((atmosphere, vec![("atmosphere", bindings(atmosphere, &values)?)])))
 }
 
 /// SystemStructure.ssd of the closed loop, with the atmosphere component if given.
@@ -484,38 +510,19 @@ pub fn system_description(
     atmosphere: Option<&FmuInfo>,
 ) -> Result<String, String> {
     let mut links = connections(plant, controller)?;
-    let atmosphere = atmosphere
-        .map(|a| atmosphere_element(plant, a))
-        .transpose()?
-        .zip(atmosphere);
-    if let Some(((l, _), _)) = &atmosphere {
-        links.extend(l.iter().cloned());
-    }
-    let inputs_of =
-        |end: &str| -> Vec<&str> { links.iter().filter(|c| c.end == end).map(|c| c.name.as_str()).collect() };
-    let (plant_inputs, controller_inputs) = (inputs_of("plant"), inputs_of("controller"));
+    let atmosphere = add_atmosphere(plant, atmosphere, &mut links)?;
     let controller_parameters = controller_sets(controller)?;
-    let v_vertical = mission_default("v_vertical");
-    // The plant starts in the trimmed vertical climb at the mission's climb speed (docs/DESIGN.md §3).
-    let plant_parameters = bindings(
-        plant,
-        &[
-            ("initial_condition", "Integer", "0".to_string()),
-            ("initial_speed", "Real", real(v_vertical)),
-        ],
-    )?;
+    let plant_parameters = plant_sets(plant)?;
     let name = format!("{}_closed_loop", controller.model_identifier);
     let description = format!(
         "Tail-sitter closed loop: {} flying {} (docs/DESIGN.md section 2 port wiring by name, section 3 mission).",
         controller.model_identifier, plant.model_identifier
     );
     let mut elements = vec![
-        ("controller", controller, controller_inputs, controller_parameters),
-        ("plant", plant, plant_inputs, vec![("plant", plant_parameters)]),
+        ("controller", controller, controller_parameters),
+        ("plant", plant, plant_parameters),
     ];
-    if let Some(((_, sets), fmu)) = atmosphere {
-        elements.push(("atmosphere", fmu, inputs_of("atmosphere"), sets));
-    }
+    elements.extend(atmosphere.map(|(fmu, sets)| ("atmosphere", fmu, sets)));
     write_ssd(&name, &description, &elements, &links)
 }
 
@@ -565,47 +572,12 @@ pub fn avionics_system_description(
     links.extend(links_between(ekf, "estimator", controller, "controller")?);
     links.extend(links_between(controller, "controller", plant, "plant")?);
     links.extend(links_between(controller, "controller", ekf, "estimator")?);
-    let atmosphere = atmosphere
-        .map(|a| atmosphere_element(plant, a))
-        .transpose()?
-        .zip(atmosphere);
-    if let Some(((l, _), _)) = &atmosphere {
-        links.extend(l.iter().cloned());
-    }
-    for (fmu, id) in [(plant, "plant"), (ekf, "estimator")] {
-        let undriven: Vec<_> = fmu
-            .with("input")
-            .filter(|p| p.name.ends_with("_cmd") && !links.iter().any(|c| c.end == id && c.name == p.name))
-            .map(|p| p.name.as_str())
-            .collect();
-        if !undriven.is_empty() {
-            return Err(format!(
-                "{} does not drive {id} inputs {undriven:?}",
-                controller.model_identifier
-            ));
-        }
-    }
-    let undriven: Vec<_> = ekf
-        .with("input")
-        .filter(|p| !p.name.ends_with("_cmd") && !links.iter().any(|c| c.end == "estimator" && c.name == p.name))
-        .map(|p| p.name.as_str())
-        .collect();
-    if !undriven.is_empty() {
-        return Err(format!(
-            "{} does not drive estimator inputs {undriven:?}",
-            sensors.model_identifier
-        ));
-    }
-    let inputs_of =
-        |end: &str| -> Vec<&str> { links.iter().filter(|c| c.end == end).map(|c| c.name.as_str()).collect() };
+    let atmosphere = add_atmosphere(plant, atmosphere, &mut links)?;
+    require_driven(&links, plant, "plant", is_command, controller)?;
+    require_driven(&links, ekf, "estimator", is_command, controller)?;
+    require_driven(&links, ekf, "estimator", |p| !is_command(p), sensors)?;
     let controller_parameters = controller_sets(controller)?;
-    let plant_parameters = bindings(
-        plant,
-        &[
-            ("initial_condition", "Integer", "0".to_string()),
-            ("initial_speed", "Real", real(mission_default("v_vertical"))),
-        ],
-    )?;
+    let plant_parameters = plant_sets(plant)?;
     // SSP importers (fmpy, libcosim) are Jacobi masters: the estimator fuses the sensors'
     // outputs of the previous step, one `sample_time` old (its `measurement_latency`), and
     // the plant gets the controller's output one step later (its `prediction_lead`).
@@ -621,19 +593,12 @@ pub fn avionics_system_description(
         controller.model_identifier, plant.model_identifier, ekf.model_identifier, sensors.model_identifier
     );
     let mut elements = vec![
-        ("controller", controller, inputs_of("controller"), controller_parameters),
-        (
-            "estimator",
-            ekf,
-            inputs_of("estimator"),
-            vec![("estimator", estimator_parameters)],
-        ),
-        ("sensors", sensors, inputs_of("sensors"), Vec::new()),
-        ("plant", plant, inputs_of("plant"), vec![("plant", plant_parameters)]),
+        ("controller", controller, controller_parameters),
+        ("estimator", ekf, vec![("estimator", estimator_parameters)]),
+        ("sensors", sensors, Vec::new()),
+        ("plant", plant, plant_parameters),
     ];
-    if let Some(((_, sets), fmu)) = atmosphere {
-        elements.push(("atmosphere", fmu, inputs_of("atmosphere"), sets));
-    }
+    elements.extend(atmosphere.map(|(fmu, sets)| ("atmosphere", fmu, sets)));
     write_ssd(&name, &description, &elements, &links)
 }
 
@@ -667,8 +632,8 @@ pub fn write_avionics_ssp(dir: &Path, controller_id: &str) -> Result<PathBuf, St
     Ok(path)
 }
 
-/// One element of a system: its name, FMU, connected inputs and parameter bindings.
-type Element<'a> = (&'a str, &'a FmuInfo, Vec<&'a str>, Vec<ParamSet>);
+/// One element of a system: its name, FMU and parameter bindings.
+type Element<'a> = (&'a str, &'a FmuInfo, Vec<ParamSet>);
 
 /// SystemStructure.ssd of `elements` wired by `links`, with the default mission experiment.
 fn write_ssd(name: &str, description: &str, elements: &[Element], links: &[Connection]) -> Result<String, String> {
@@ -695,9 +660,14 @@ fn write_ssd(name: &str, description: &str, elements: &[Element], links: &[Conne
         element(w, "ssd:SystemStructureDescription", root, |w| {
             element(w, "ssd:System", [("name", name), ("description", description)], |w| {
                 element(w, "ssd:Elements", [], |w| {
-                    elements
-                        .iter()
-                        .try_for_each(|(name, fmu, inputs, parameters)| component(w, name, fmu, inputs, parameters))
+                    elements.iter().try_for_each(|(name, fmu, parameters)| {
+                        let inputs: Vec<&str> = links
+                            .iter()
+                            .filter(|c| c.end == *name)
+                            .map(|c| c.name.as_str())
+                            .collect();
+                        component(w, name, fmu, &inputs, parameters)
+                    })
                 })?;
                 element(w, "ssd:Connections", [], |w| {
                     links.iter().try_for_each(|c| {
