@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
-# The main job, from a fresh clone: set up, build and package the three FMUs
+# The main job, from a fresh clone: set up, build and package the FMUs
 # (and the SSP systems) into dist/, run the analysis campaign (modes,
 # closed-loop poles, Table 5.1 sensitivity, nonlinear robustness and gust
 # sweeps; cached in out/analysis/cache, so a re-run only computes what
 # changed), fly the default and fast missions and the position-step tests
-# with the LQR and the TSD controller, and write CSVs, plots and the
-# comparison report (out/report.md, out/report.html).
+# with each declared controller, and write CSVs, plots and the
+# comparison report (out/report.md, out/report.html); it ends with the verdict.
 #
 #   scripts/main.sh [--help] [--no-analysis] [runner options: --controller lqr|tsd|both, --jacobi, --no-steps, ...]
 set -euo pipefail
@@ -18,7 +18,8 @@ usage: scripts/main.sh [--no-analysis] [runner options]
 The main job: set up the machine (scripts/setup.sh), build and package the FMUs and
 the SSP systems into dist/ (cargo xtask dist), run the analysis campaign (out/analysis),
 a small Monte-Carlo campaign (out/campaign), fly the missions and the position steps
-with each controller and write the comparison report (out/report.md, out/report.html).
+with each controller, write the comparison report (out/report.md, out/report.html) and
+print its verdict.
 
   -h, --help       this help (nothing is set up or built)
   --no-analysis    skip the analysis campaign
@@ -62,8 +63,13 @@ if [ "$analysis" = 1 ]; then
     cargo run --release --locked -p analysis -- wind-envelope --default-only --out out/analysis
     .venv/bin/python -m tailsim.reports.analysis out/analysis
 fi
-# Before the missions: the comparison report's first section is the paired Monte-Carlo result.
+# Before the missions: the report's verdict reads the paired Monte-Carlo result (every controller, both
+# configurations, perfect state and the avionics chain, on the same uncertain plants in wind).
 echo "== Monte-Carlo campaign (out/campaign; the full run: docs/CAMPAIGN.md)"
-.venv/bin/python -m tailsim.campaign --samples 16 --seed 1 --out out/campaign --replace --no-progress
+.venv/bin/python -m tailsim.campaign --samples 32 --seed 1 --out out/campaign --replace --no-progress \
+    --configurations tuned,thesis --state-sources perfect,avionics
 echo "== flying the missions"
 .venv/bin/python -m tailsim.reports.compare --out out "${runner_args[@]+"${runner_args[@]}"}"
+echo
+.venv/bin/python -m tailsim.reports.verdict out
+echo "(the report: out/report.html)"

@@ -56,6 +56,12 @@ if ! command -v wine64 >/dev/null; then
     $SUDO ln -sf /usr/lib/wine/wine64 /usr/local/bin/wine64
 fi
 
+# The browser test of the reports drives Debian's Chromium (never a browser download).
+if [ ! -x /usr/bin/chromium ]; then
+    echo "== installing chromium (the reports' browser test)"
+    apt_install chromium
+fi
+
 if [ ! -x .venv/bin/python ] || ! cmp -s tests/requirements.txt .venv/requirements.installed; then
     echo "== creating Python venv .venv (pinned: tests/requirements.txt)"
     python3 -m venv .venv

@@ -1,7 +1,8 @@
 //! Generates from the plant's declaration (`modelDescription/tailsitter_plant.json`,
 //! the single source of every parameter, default and port name) into `OUT_DIR`:
 //! - `airframe_generated.rs`: `impl Default for Airframe` (the declared start values)
-//!   and `Airframe::named_values` (group `airframe`, table `model_description::defaults::CRATES`);
+//!   and `Airframe::named_values` (group `airframe`, table `model_description::defaults::CRATES`),
+//!   likewise `Ground`, `GlobalAero` and `Site` (from `fragments/site.json`);
 //! - `input_names.rs`: `INPUT_NAMES`, the plant's command inputs (group `command`).
 
 use std::path::PathBuf;

@@ -113,6 +113,7 @@ impl Binding for EkfBinding {
 
     fn config(v: &Variables) -> Result<EstimatorParams, ParamError> {
         let mut p = v.estimator();
+        p.earth.site = v.site();
         p.tuning.gps_reset_after = v.gps_reset_after.max(1) as u32;
         if v.app_d_configuration {
             p = p.app_d();

@@ -136,7 +136,7 @@ impl Sim {
             plant,
             x: trim.state,
             u: trim.inputs,
-            frame: LocalFrame::new(e.ref_latitude, e.ref_longitude, e.ref_height),
+            frame: LocalFrame::new(e.site.ref_latitude, e.site.ref_longitude, e.site.ref_height),
             noise: Noise(7),
             k: 0,
         }

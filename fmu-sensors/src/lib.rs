@@ -101,6 +101,7 @@ impl Binding for SensorsBinding {
         Ok(Params {
             seed,
             fault_mode,
+            site: v.site(),
             ..v.params()
         })
     }

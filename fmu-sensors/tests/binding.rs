@@ -131,19 +131,23 @@ fn declared_start_values_are_the_model_defaults() {
         .unwrap();
     let d = sensor_model::Params::default();
     // Angles are declared in rad from the same degrees: equal to the last bits or nearly.
+    let (ps, ds) = (p.site, d.site);
     for (a, b) in [
-        (p.ref_latitude, d.ref_latitude),
-        (p.ref_longitude, d.ref_longitude),
-        (p.mag_declination, d.mag_declination),
-        (p.mag_inclination, d.mag_inclination),
+        (ps.ref_latitude, ds.ref_latitude),
+        (ps.ref_longitude, ds.ref_longitude),
+        (ps.mag_declination, ds.mag_declination),
+        (ps.mag_inclination, ds.mag_inclination),
     ] {
         assert!((a - b).abs() < 1e-12, "{a} vs {b}");
     }
     let same_angles = sensor_model::Params {
-        ref_latitude: d.ref_latitude,
-        ref_longitude: d.ref_longitude,
-        mag_declination: d.mag_declination,
-        mag_inclination: d.mag_inclination,
+        site: sensor_model::Site {
+            ref_latitude: ds.ref_latitude,
+            ref_longitude: ds.ref_longitude,
+            mag_declination: ds.mag_declination,
+            mag_inclination: ds.mag_inclination,
+            ..ps
+        },
         ..p
     };
     assert_eq!(same_angles, d);

@@ -38,13 +38,8 @@ impl Default for Earth {
     /// The start values declared in modelDescription/tailsitter_ekf.json.
     fn default() -> Self {
         Self {
-            ref_latitude: -0.592190215201676,
-            ref_longitude: 0.32916909692613056,
-            ref_height: 0.0,
-            mag_field_total: 0.2513,
-            mag_declination: -0.46443211395569106,
-            mag_inclination: -1.1297516248159296,
             gravity: 9.81,
+            site: Default::default(),
         }
     }
 }

@@ -17,6 +17,8 @@ pub enum Extra {
         name: &'static str,
         variants: &'static [&'static str],
     },
+    /// The field type's own (generated) `Default`: a struct of another group.
+    Default,
 }
 
 /// One struct whose `impl Default` is generated.
@@ -94,6 +96,12 @@ pub const CRATES: &[CrateDefaults] = &[
         }],
     },
     CrateDefaults {
+        krate: "tailsitter-physics",
+        file: "fragments/site.json",
+        out: "site_generated.rs",
+        structs: &[plain("Site", "site", "")],
+    },
+    CrateDefaults {
         krate: "flight-mission",
         file: "fragments/controller_interface.json",
         out: "mission_generated.rs",
@@ -117,6 +125,7 @@ pub const CRATES: &[CrateDefaults] = &[
         out: "sensor_params_generated.rs",
         structs: &[StructDefaults {
             extra: &[
+                ("site", Extra::Default),
                 ("seed", Extra::Start("seed")),
                 (
                     "fault_mode",
@@ -136,7 +145,10 @@ pub const CRATES: &[CrateDefaults] = &[
         structs: &[
             plain("SensorNoise", "estimator", "noise"),
             plain("ProcessNoise", "estimator", "process"),
-            plain("Earth", "estimator", "earth"),
+            StructDefaults {
+                extra: &[("site", Extra::Default)],
+                ..plain("Earth", "estimator", "earth")
+            },
             StructDefaults {
                 extra: &[("gps_reset_after", Extra::Start("gps_reset_after"))],
                 ..plain("Tuning", "estimator", "tuning")
@@ -159,6 +171,7 @@ pub fn generate(dir: &Path, c: &CrateDefaults) -> Result<(String, Vec<PathBuf>),
             .map(|(field, e)| {
                 let value = match e {
                     Extra::Start(name) => rust::start_of(&decls, name),
+                    Extra::Default => "Default::default()".to_string(),
                     Extra::Variant { name, variants } => {
                         let start = rust::start_of(&decls, name);
                         let index: usize = start.parse().map_err(|_| DeclError(format!("{name}: start {start}")))?;

@@ -27,6 +27,30 @@ pub fn document(body: impl FnOnce(&mut XmlWriter) -> Result<()>) -> Result<Strin
     Ok(text)
 }
 
+/// `<name attributes>`, the children `body` writes, `</name>` (`<name ...></name>` when it
+/// writes none).
+pub fn element<'a>(
+    w: &mut XmlWriter,
+    name: &str,
+    attributes: impl IntoIterator<Item = (&'a str, &'a str)>,
+    body: impl FnOnce(&mut XmlWriter) -> Result<()>,
+) -> Result<()> {
+    w.create_element(name)
+        .with_attributes(attributes)
+        .write_inner_content(body)?;
+    Ok(())
+}
+
+/// `<name attributes/>`.
+pub fn empty<'a>(
+    w: &mut XmlWriter,
+    name: &str,
+    attributes: impl IntoIterator<Item = (&'a str, &'a str)>,
+) -> Result<()> {
+    w.create_element(name).with_attributes(attributes).write_empty()?;
+    Ok(())
+}
+
 /// The complete modelDescription.xml of `model`.
 pub fn model_description(model: &Model) -> String {
     document(|w| write_all(w, model)).expect("writing XML into memory cannot fail")
@@ -36,42 +60,40 @@ type W = XmlWriter;
 
 fn write_all(w: &mut W, model: &Model) -> Result<()> {
     let n_events = "0";
-    w.create_element("fmiModelDescription")
-        .with_attributes([
-            ("fmiVersion", "2.0"),
-            ("modelName", model.model_name.as_str()),
-            ("guid", model.guid.as_str()),
-            ("description", model.description.as_str()),
-            ("author", AUTHOR),
-            ("version", model.version.as_str()),
-            ("generationTool", GENERATION_TOOL),
-            ("variableNamingConvention", "flat"),
-            ("numberOfEventIndicators", n_events),
-        ])
-        .write_inner_content(|w| {
-            if model.model_exchange() {
-                model_exchange(w, model)?;
-            }
-            co_simulation(w, model)?;
-            unit_definitions(w, model)?;
-            log_categories(w)?;
-            let e = &model.default_experiment;
-            w.create_element("DefaultExperiment")
-                .with_attributes([
-                    ("startTime", fmt_f64(e.start_time).as_str()),
-                    ("stopTime", fmt_f64(e.stop_time).as_str()),
-                    ("stepSize", fmt_f64(e.step_size).as_str()),
-                ])
-                .write_empty()?;
-            w.create_element("ModelVariables").write_inner_content(|w| {
-                for v in &model.variables {
-                    scalar_variable(w, model, v)?;
-                }
-                Ok(())
-            })?;
-            model_structure(w, model)
+    let attributes = [
+        ("fmiVersion", "2.0"),
+        ("modelName", model.model_name.as_str()),
+        ("guid", model.guid.as_str()),
+        ("description", model.description.as_str()),
+        ("author", AUTHOR),
+        ("version", model.version.as_str()),
+        ("generationTool", GENERATION_TOOL),
+        ("variableNamingConvention", "flat"),
+        ("numberOfEventIndicators", n_events),
+    ];
+    element(w, "fmiModelDescription", attributes, |w| {
+        if model.model_exchange() {
+            model_exchange(w, model)?;
+        }
+        co_simulation(w, model)?;
+        unit_definitions(w, model)?;
+        log_categories(w)?;
+        let e = &model.default_experiment;
+        let (start, stop, step) = (fmt_f64(e.start_time), fmt_f64(e.stop_time), fmt_f64(e.step_size));
+        empty(
+            w,
+            "DefaultExperiment",
+            [
+                ("startTime", start.as_str()),
+                ("stopTime", stop.as_str()),
+                ("stepSize", step.as_str()),
+            ],
+        )?;
+        element(w, "ModelVariables", [], |w| {
+            model.variables.iter().try_for_each(|v| scalar_variable(w, model, v))
         })?;
-    Ok(())
+        model_structure(w, model)
+    })
 }
 
 /// `<ModelExchange>`: the same binary (same modelIdentifier) serves both interfaces,
@@ -114,10 +136,11 @@ fn interface(w: &mut W, element: &str, model: &Model, specific: &[(&str, &str)])
         ("canSerializeFMUstate", "true"),
         ("providesDirectionalDerivative", "false"),
     ];
-    w.create_element(element)
-        .with_attributes(head.into_iter().chain(specific.iter().copied()).chain(shared))
-        .write_empty()?;
-    Ok(())
+    empty(
+        w,
+        element,
+        head.into_iter().chain(specific.iter().copied()).chain(shared),
+    )
 }
 
 /// The units actually used, in the order of [`units::UNITS`].
@@ -131,99 +154,86 @@ fn unit_definitions(w: &mut W, model: &Model) -> Result<()> {
     if used.is_empty() {
         return Ok(());
     }
-    w.create_element("UnitDefinitions").write_inner_content(|w| {
-        for u in used {
-            w.create_element("Unit")
-                .with_attribute(("name", u.name))
-                .write_inner_content(|w| {
-                    let mut base = w.create_element("BaseUnit");
-                    for (name, exp) in [("kg", u.kg), ("m", u.m), ("s", u.s), ("A", u.a), ("rad", u.rad)] {
-                        if exp != 0 {
-                            base = base.with_attribute((name, exp.to_string().as_str()));
-                        }
-                    }
-                    if u.factor != 1.0 {
-                        base = base.with_attribute(("factor", fmt_f64(u.factor).as_str()));
-                    }
-                    base.write_empty()?;
-                    for d in u.display_units {
-                        w.create_element("DisplayUnit")
-                            .with_attributes([("name", d.name), ("factor", fmt_f64(d.factor).as_str())])
-                            .write_empty()?;
-                    }
-                    Ok(())
-                })?;
-        }
-        Ok(())
-    })?;
-    Ok(())
+    element(w, "UnitDefinitions", [], |w| {
+        used.into_iter().try_for_each(|u| {
+            element(w, "Unit", [("name", u.name)], |w| {
+                let mut base: Vec<(&str, String)> = [("kg", u.kg), ("m", u.m), ("s", u.s), ("A", u.a), ("rad", u.rad)]
+                    .into_iter()
+                    .filter(|(_, exp)| *exp != 0)
+                    .map(|(name, exp)| (name, exp.to_string()))
+                    .collect();
+                if u.factor != 1.0 {
+                    base.push(("factor", fmt_f64(u.factor)));
+                }
+                empty(w, "BaseUnit", base.iter().map(|(k, v)| (*k, v.as_str())))?;
+                u.display_units.iter().try_for_each(|d| {
+                    empty(
+                        w,
+                        "DisplayUnit",
+                        [("name", d.name), ("factor", fmt_f64(d.factor).as_str())],
+                    )
+                })
+            })
+        })
+    })
 }
 
 fn log_categories(w: &mut W) -> Result<()> {
-    w.create_element("LogCategories").write_inner_content(|w| {
-        for (name, description) in LOG_CATEGORIES {
-            w.create_element("Category")
-                .with_attributes([("name", *name), ("description", *description)])
-                .write_empty()?;
-        }
-        Ok(())
-    })?;
-    Ok(())
+    element(w, "LogCategories", [], |w| {
+        LOG_CATEGORIES
+            .iter()
+            .try_for_each(|(name, description)| empty(w, "Category", [("name", *name), ("description", *description)]))
+    })
 }
 
 fn scalar_variable(w: &mut W, model: &Model, v: &Variable) -> Result<()> {
     let d = &v.decl;
     let vr = v.value_reference.to_string();
-    w.create_element("ScalarVariable")
-        .with_attributes([
-            ("name", d.name.as_str()),
-            ("valueReference", vr.as_str()),
-            ("description", d.description.as_str()),
-            ("causality", d.causality.as_str()),
-            ("variability", v.variability.as_str()),
-        ])
-        .write_inner_content(|w| {
-            let tag = match d.var_type {
-                VarType::Real => "Real",
-                VarType::Integer => "Integer",
-                VarType::Boolean => "Boolean",
-                VarType::String => "String",
-            };
-            let mut attrs: Vec<(&str, String)> = Vec::new();
-            if let Some(u) = &d.unit {
-                attrs.push(("unit", u.clone()));
-            }
-            if let Some(du) = &v.display_unit {
-                attrs.push(("displayUnit", du.clone()));
-            }
-            let number = |x: f64| match d.var_type {
-                VarType::Integer => format!("{}", x as i64),
-                _ => fmt_f64(x),
-            };
-            if let Some(lo) = d.min {
-                attrs.push(("min", number(lo)));
-            }
-            if let Some(hi) = d.max {
-                attrs.push(("max", number(hi)));
-            }
-            if let Some(x) = d.nominal {
-                attrs.push(("nominal", fmt_f64(x)));
-            }
-            match &d.start {
-                Some(Start::Number(x)) => attrs.push(("start", number(*x))),
-                Some(Start::Bool(b)) => attrs.push(("start", b.to_string())),
-                Some(Start::Text(s)) => attrs.push(("start", s.clone())),
-                None => {}
-            }
-            if let Some(state) = &d.derivative_of {
-                attrs.push(("derivative", index_of(model, state).to_string()));
-            }
-            w.create_element(tag)
-                .with_attributes(attrs.iter().map(|(k, v)| (*k, v.as_str())))
-                .write_empty()?;
-            Ok(())
-        })?;
-    Ok(())
+    let attributes = [
+        ("name", d.name.as_str()),
+        ("valueReference", vr.as_str()),
+        ("description", d.description.as_str()),
+        ("causality", d.causality.as_str()),
+        ("variability", v.variability.as_str()),
+    ];
+    element(w, "ScalarVariable", attributes, |w| {
+        let tag = match d.var_type {
+            VarType::Real => "Real",
+            VarType::Integer => "Integer",
+            VarType::Boolean => "Boolean",
+            VarType::String => "String",
+        };
+        let mut attrs: Vec<(&str, String)> = Vec::new();
+        if let Some(u) = &d.unit {
+            attrs.push(("unit", u.clone()));
+        }
+        if let Some(du) = &v.display_unit {
+            attrs.push(("displayUnit", du.clone()));
+        }
+        let number = |x: f64| match d.var_type {
+            VarType::Integer => format!("{}", x as i64),
+            _ => fmt_f64(x),
+        };
+        if let Some(lo) = d.min {
+            attrs.push(("min", number(lo)));
+        }
+        if let Some(hi) = d.max {
+            attrs.push(("max", number(hi)));
+        }
+        if let Some(x) = d.nominal {
+            attrs.push(("nominal", fmt_f64(x)));
+        }
+        match &d.start {
+            Some(Start::Number(x)) => attrs.push(("start", number(*x))),
+            Some(Start::Bool(b)) => attrs.push(("start", b.to_string())),
+            Some(Start::Text(s)) => attrs.push(("start", s.clone())),
+            None => {}
+        }
+        if let Some(state) = &d.derivative_of {
+            attrs.push(("derivative", index_of(model, state).to_string()));
+        }
+        empty(w, tag, attrs.iter().map(|(k, v)| (*k, v.as_str())))
+    })
 }
 
 /// 1-based index of a variable in ModelVariables.
@@ -238,14 +248,13 @@ fn index_of(model: &Model, name: &str) -> usize {
 
 fn model_structure(w: &mut W, model: &Model) -> Result<()> {
     let derivatives: Vec<&Variable> = model.continuous_states().into_iter().map(|(_, d)| d).collect();
-    w.create_element("ModelStructure").write_inner_content(|w| {
+    element(w, "ModelStructure", [], |w| {
         write_unknowns(w, model, "Outputs", &model.outputs(), |v| model.dependencies(v))?;
         write_unknowns(w, model, "Derivatives", &derivatives, |v| model.dependencies(v))?;
         write_unknowns(w, model, "InitialUnknowns", &model.initial_unknowns(), |v| {
             model.initial_dependencies(v)
         })
-    })?;
-    Ok(())
+    })
 }
 
 /// One list of ModelStructure (nothing when `list` is empty): an `Unknown` per variable
@@ -260,15 +269,15 @@ fn write_unknowns(
     if list.is_empty() {
         return Ok(());
     }
-    w.create_element(name).write_inner_content(|w| {
-        for v in list {
+    element(w, name, [], |w| {
+        list.iter().try_for_each(|v| {
             let index = index_of(model, v.name()).to_string();
             let deps: Vec<String> = deps(v).iter().map(usize::to_string).collect();
-            w.create_element("Unknown")
-                .with_attributes([("index", index.as_str()), ("dependencies", deps.join(" ").as_str())])
-                .write_empty()?;
-        }
-        Ok(())
-    })?;
-    Ok(())
+            empty(
+                w,
+                "Unknown",
+                [("index", index.as_str()), ("dependencies", deps.join(" ").as_str())],
+            )
+        })
+    })
 }

@@ -141,6 +141,8 @@ class MissionMetrics:
     level_pitch_error_deg: float
     final_pitch_error_deg: float
     controller_us_per_step: float
+    flown_transition: tuple[float, float]
+    """Flown durations of the two transitions (s, `flown_transitions`): what was flown, not what was asked."""
 
 
 def mission_metrics(
@@ -180,7 +182,41 @@ def mission_metrics(
         level_pitch_error_deg=math.degrees(check.level_pitch_error),
         final_pitch_error_deg=math.degrees(check.final_pitch_error),
         controller_us_per_step=1e6 * r.wall_time_controller / max(r.steps, 1),
+        flown_transition=flown_transitions(r, mission),
     )
+
+
+#: Tolerance of the flown flight-path angle around its target (rad): 5°, the rotation tolerance of the
+#: analysis's transition envelope (`crates/analysis/src/envelope_transitions.rs`, `ROTATION_TOLERANCE`).
+ROTATION_TOLERANCE = math.radians(5.0)
+
+
+def flight_path_angle(r: RunResult) -> np.ndarray:
+    """Flown flight-path angle γ = atan2(−v_d, |v_ne|) (rad): 0 in level flight, π/2 climbing vertically."""
+    return np.arctan2(-r["vel_d"], np.hypot(r["vel_n"], r["vel_e"]))
+
+
+def held_from(t: np.ndarray, ok: np.ndarray, t0: float, t1: float) -> float:
+    """Time (s, from `t0`) after which `ok` holds on every sample of [t0, t1); NaN if it
+    does not hold at the last sample (or there are none)."""
+    w = window(t, t0, t1)
+    tw, okw = t[w], ok[w]
+    if not okw.size or not okw[-1]:
+        return float("nan")
+    bad = np.nonzero(~okw)[0]
+    return float(tw[bad[-1] + 1] - t0) if bad.size else float(tw[0] - t0)
+
+
+def flown_transitions(r: RunResult, mission: Mapping[str, float]) -> tuple[float, float]:
+    """The transitions as flown (s): from the start of each transition until the flown
+    flight-path angle γ is within `ROTATION_TOLERANCE` of its target (0 after the first,
+    90° after the second) and stays there to the end of the following phase (level flight,
+    the last vertical climb). NaN where it never settles. The requested T1, T2 shape the
+    reference; the airframe and the reference generator's limits decide what is flown."""
+    s, t, gamma = phase_starts(mission), r.time, flight_path_angle(r)
+    first = held_from(t, np.abs(gamma) <= ROTATION_TOLERANCE, s[1], s[3])
+    second = held_from(t, np.abs(gamma - math.pi / 2) <= ROTATION_TOLERANCE, s[3], s[5])
+    return (first, second)
 
 
 def step_settling(r: RunResult, t_step: float, band: float | None = None) -> float:

@@ -30,6 +30,7 @@
 
 // Rust's shortest round-trip representation, as in modelDescription.xml; a valid xs:double.
 use model_description::fmt_f64 as real;
+use model_description::xml::{element, empty};
 use quick_xml::events::{BytesStart, Event};
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
@@ -352,18 +353,37 @@ pub struct Connection {
 pub fn connections(plant: &FmuInfo, controller: &FmuInfo) -> Result<Vec<Connection>, String> {
     let mut out = links_between(plant, "plant", controller, "controller")?;
     out.extend(links_between(controller, "controller", plant, "plant")?);
-    let undriven: Vec<_> = plant
+    require_driven(&out, plant, "plant", is_command, controller)?;
+    Ok(out)
+}
+
+/// A command input (`*_cmd`): what a controller drives.
+fn is_command(p: &Port) -> bool {
+    p.name.ends_with("_cmd")
+}
+
+/// Errors unless every input of `fmu` (component `id`) that `which` selects is the end of one of
+/// `links`; `driver` is the FMU that should drive them.
+fn require_driven(
+    links: &[Connection],
+    fmu: &FmuInfo,
+    id: &str,
+    which: impl Fn(&Port) -> bool,
+    driver: &FmuInfo,
+) -> Result<(), String> {
+    let undriven: Vec<_> = fmu
         .with("input")
-        .filter(|p| p.name.ends_with("_cmd") && !out.iter().any(|c| c.end == "plant" && c.name == p.name))
+        .filter(|p| which(p) && !links.iter().any(|c| c.end == id && c.name == p.name))
         .map(|p| p.name.as_str())
         .collect();
-    if !undriven.is_empty() {
-        return Err(format!(
-            "{} does not drive plant inputs {undriven:?}",
-            controller.model_identifier
-        ));
+    if undriven.is_empty() {
+        Ok(())
+    } else {
+        Err(format!(
+            "{} does not drive {id} inputs {undriven:?}",
+            driver.model_identifier
+        ))
     }
-    Ok(out)
 }
 
 type Xml = model_description::xml::XmlWriter;
@@ -372,46 +392,36 @@ type XmlResult = std::io::Result<()>;
 /// The connectors of one component: every output (recorded by tools that record connectors), and
 /// the inputs a connection drives.
 fn component(w: &mut Xml, name: &str, fmu: &FmuInfo, inputs: &[&str], parameter_sets: &[ParamSet]) -> XmlResult {
-    w.create_element("ssd:Component")
-        .with_attributes([
-            ("name", name),
-            ("type", "application/x-fmu-sharedlibrary"),
-            ("source", resource(&fmu.model_identifier).as_str()),
-        ])
-        .write_inner_content(|w| {
-            w.create_element("ssd:Connectors").write_inner_content(|w| {
-                let ports = fmu.ports.iter().filter(|p| {
-                    p.causality == "output" || (p.causality == "input" && inputs.contains(&p.name.as_str()))
-                });
-                for p in ports {
-                    w.create_element("ssd:Connector")
-                        .with_attributes([("name", p.name.as_str()), ("kind", p.causality.as_str())])
-                        .write_inner_content(|w| {
-                            let mut ty = w.create_element(format!("ssc:{}", p.kind));
-                            if let Some(unit) = p.unit.as_deref().filter(|_| p.kind == "Real") {
-                                ty = ty.with_attribute(("unit", unit));
-                            }
-                            ty.write_empty()?;
-                            Ok(())
-                        })?;
-                }
-                Ok(())
-            })?;
-            if parameter_sets.iter().any(|(_, p)| !p.is_empty()) {
-                w.create_element("ssd:ParameterBindings").write_inner_content(|w| {
-                    for (set, parameters) in parameter_sets.iter().filter(|(_, p)| !p.is_empty()) {
-                        w.create_element("ssd:ParameterBinding").write_inner_content(|w| {
-                            w.create_element("ssd:ParameterValues")
-                                .write_inner_content(|w| parameter_set(w, set, parameters))?;
-                            Ok(())
-                        })?;
-                    }
-                    Ok(())
-                })?;
-            }
-            Ok(())
+    let source = resource(&fmu.model_identifier);
+    let attributes = [
+        ("name", name),
+        ("type", "application/x-fmu-sharedlibrary"),
+        ("source", source.as_str()),
+    ];
+    element(w, "ssd:Component", attributes, |w| {
+        let connected =
+            |p: &&Port| p.causality == "output" || (p.causality == "input" && inputs.contains(&p.name.as_str()));
+        element(w, "ssd:Connectors", [], |w| {
+            fmu.ports.iter().filter(connected).try_for_each(|p| {
+                let unit = p.unit.as_deref().filter(|_| p.kind == "Real");
+                let connector = [("name", p.name.as_str()), ("kind", p.causality.as_str())];
+                element(w, "ssd:Connector", connector, |w| {
+                    empty(w, &format!("ssc:{}", p.kind), unit.map(|u| ("unit", u)))
+                })
+            })
         })?;
-    Ok(())
+        let sets: Vec<_> = parameter_sets.iter().filter(|(_, p)| !p.is_empty()).collect();
+        if sets.is_empty() {
+            return Ok(());
+        }
+        element(w, "ssd:ParameterBindings", [], |w| {
+            sets.into_iter().try_for_each(|(set, parameters)| {
+                element(w, "ssd:ParameterBinding", [], |w| {
+                    element(w, "ssd:ParameterValues", [], |w| parameter_set(w, set, parameters))
+                })
+            })
+        })
+    })
 }
 
 /// Named parameter sets of a component: (set name, [(name, type element, value)]).
@@ -419,25 +429,15 @@ type ParamSet = (&'static str, Vec<(&'static str, String, String)>);
 
 /// An inline SSV parameter set named `set`: (name, type element, value).
 fn parameter_set(w: &mut Xml, set: &str, parameters: &[(&str, String, String)]) -> XmlResult {
-    w.create_element("ssv:ParameterSet")
-        .with_attributes([("version", "1.0"), ("name", set)])
-        .write_inner_content(|w| {
-            w.create_element("ssv:Parameters").write_inner_content(|w| {
-                for (name, kind, value) in parameters {
-                    w.create_element("ssv:Parameter")
-                        .with_attribute(("name", *name))
-                        .write_inner_content(|w| {
-                            w.create_element(format!("ssv:{kind}"))
-                                .with_attribute(("value", value.as_str()))
-                                .write_empty()?;
-                            Ok(())
-                        })?;
-                }
-                Ok(())
-            })?;
-            Ok(())
-        })?;
-    Ok(())
+    element(w, "ssv:ParameterSet", [("version", "1.0"), ("name", set)], |w| {
+        element(w, "ssv:Parameters", [], |w| {
+            parameters.iter().try_for_each(|(name, kind, value)| {
+                element(w, "ssv:Parameter", [("name", *name)], |w| {
+                    empty(w, &format!("ssv:{kind}"), [("value", value.as_str())])
+                })
+            })
+        })
+    })
 }
 
 /// Parameter values for `fmu`, checking each is a parameter of the declared type.
@@ -469,23 +469,30 @@ fn controller_sets(controller: &FmuInfo) -> Result<Vec<ParamSet>, String> {
     ])
 }
 
-/// The atmosphere's links by name (plant → atmosphere, atmosphere → plant) and its parameter
-/// set `atmosphere` (the declared defaults, [`ATMOSPHERE_PARAMS`]: calm). Every atmosphere
-/// input must be a plant output.
-fn atmosphere_element(plant: &FmuInfo, atmosphere: &FmuInfo) -> Result<(Vec<Connection>, Vec<ParamSet>), String> {
-    let mut links = links_between(plant, "plant", atmosphere, "atmosphere")?;
+/// The plant's parameter set `plant`: it starts in the trimmed vertical climb at the mission's
+/// climb speed (docs/DESIGN.md §3).
+fn plant_sets(plant: &FmuInfo) -> Result<Vec<ParamSet>, String> {
+    let start = [
+        ("initial_condition", "Integer", "0".to_string()),
+        ("initial_speed", "Real", real(mission_default("v_vertical"))),
+    ];
+    Ok(vec![("plant", bindings(plant, &start)?)])
+}
+
+/// The atmosphere component, if given: its links by name (plant → atmosphere, atmosphere →
+/// plant) join `links`, and its parameter set `atmosphere` (the declared defaults,
+/// [`ATMOSPHERE_PARAMS`]: calm) is returned. Every atmosphere input must be a plant output.
+fn add_atmosphere<'a>(
+    plant: &FmuInfo,
+    atmosphere: Option<&'a FmuInfo>,
+    links: &mut Vec<Connection>,
+) -> Result<Option<(&'a FmuInfo, Vec<ParamSet>)>, String> {
+    let Some(atmosphere) = atmosphere else {
+        return Ok(None);
+    };
+    links.extend(links_between(plant, "plant", atmosphere, "atmosphere")?);
     links.extend(links_between(atmosphere, "atmosphere", plant, "plant")?);
-    let undriven: Vec<_> = atmosphere
-        .with("input")
-        .filter(|p| !links.iter().any(|c| c.end == "atmosphere" && c.name == p.name))
-        .map(|p| p.name.as_str())
-        .collect();
-    if !undriven.is_empty() {
-        return Err(format!(
-            "{} does not drive atmosphere inputs {undriven:?}",
-            plant.model_identifier
-        ));
-    }
+    require_driven(links, atmosphere, "atmosphere", |_| true, plant)?;
     let values: Vec<_> = ATMOSPHERE_PARAMS
         .iter()
         .map(|(n, v)| match atmosphere.port(n).map(|p| p.kind.as_str()) {
@@ -493,7 +500,7 @@ fn atmosphere_element(plant: &FmuInfo, atmosphere: &FmuInfo) -> Result<(Vec<Conn
             _ => (*n, "Real", real(*v)),
         })
         .collect();
-    Ok((links, vec![("atmosphere", bindings(atmosphere, &values)?)]))
+    Ok(Some((atmosphere, vec![("atmosphere", bindings(atmosphere, &values)?)])))
 }
 
 /// SystemStructure.ssd of the closed loop, with the atmosphere component if given.
@@ -503,38 +510,19 @@ pub fn system_description(
     atmosphere: Option<&FmuInfo>,
 ) -> Result<String, String> {
     let mut links = connections(plant, controller)?;
-    let atmosphere = atmosphere
-        .map(|a| atmosphere_element(plant, a))
-        .transpose()?
-        .zip(atmosphere);
-    if let Some(((l, _), _)) = &atmosphere {
-        links.extend(l.iter().cloned());
-    }
-    let inputs_of =
-        |end: &str| -> Vec<&str> { links.iter().filter(|c| c.end == end).map(|c| c.name.as_str()).collect() };
-    let (plant_inputs, controller_inputs) = (inputs_of("plant"), inputs_of("controller"));
+    let atmosphere = add_atmosphere(plant, atmosphere, &mut links)?;
     let controller_parameters = controller_sets(controller)?;
-    let v_vertical = mission_default("v_vertical");
-    // The plant starts in the trimmed vertical climb at the mission's climb speed (docs/DESIGN.md §3).
-    let plant_parameters = bindings(
-        plant,
-        &[
-            ("initial_condition", "Integer", "0".to_string()),
-            ("initial_speed", "Real", real(v_vertical)),
-        ],
-    )?;
+    let plant_parameters = plant_sets(plant)?;
     let name = format!("{}_closed_loop", controller.model_identifier);
     let description = format!(
         "Tail-sitter closed loop: {} flying {} (docs/DESIGN.md section 2 port wiring by name, section 3 mission).",
         controller.model_identifier, plant.model_identifier
     );
     let mut elements = vec![
-        ("controller", controller, controller_inputs, controller_parameters),
-        ("plant", plant, plant_inputs, vec![("plant", plant_parameters)]),
+        ("controller", controller, controller_parameters),
+        ("plant", plant, plant_parameters),
     ];
-    if let Some(((_, sets), fmu)) = atmosphere {
-        elements.push(("atmosphere", fmu, inputs_of("atmosphere"), sets));
-    }
+    elements.extend(atmosphere.map(|(fmu, sets)| ("atmosphere", fmu, sets)));
     write_ssd(&name, &description, &elements, &links)
 }
 
@@ -584,47 +572,12 @@ pub fn avionics_system_description(
     links.extend(links_between(ekf, "estimator", controller, "controller")?);
     links.extend(links_between(controller, "controller", plant, "plant")?);
     links.extend(links_between(controller, "controller", ekf, "estimator")?);
-    let atmosphere = atmosphere
-        .map(|a| atmosphere_element(plant, a))
-        .transpose()?
-        .zip(atmosphere);
-    if let Some(((l, _), _)) = &atmosphere {
-        links.extend(l.iter().cloned());
-    }
-    for (fmu, id) in [(plant, "plant"), (ekf, "estimator")] {
-        let undriven: Vec<_> = fmu
-            .with("input")
-            .filter(|p| p.name.ends_with("_cmd") && !links.iter().any(|c| c.end == id && c.name == p.name))
-            .map(|p| p.name.as_str())
-            .collect();
-        if !undriven.is_empty() {
-            return Err(format!(
-                "{} does not drive {id} inputs {undriven:?}",
-                controller.model_identifier
-            ));
-        }
-    }
-    let undriven: Vec<_> = ekf
-        .with("input")
-        .filter(|p| !p.name.ends_with("_cmd") && !links.iter().any(|c| c.end == "estimator" && c.name == p.name))
-        .map(|p| p.name.as_str())
-        .collect();
-    if !undriven.is_empty() {
-        return Err(format!(
-            "{} does not drive estimator inputs {undriven:?}",
-            sensors.model_identifier
-        ));
-    }
-    let inputs_of =
-        |end: &str| -> Vec<&str> { links.iter().filter(|c| c.end == end).map(|c| c.name.as_str()).collect() };
+    let atmosphere = add_atmosphere(plant, atmosphere, &mut links)?;
+    require_driven(&links, plant, "plant", is_command, controller)?;
+    require_driven(&links, ekf, "estimator", is_command, controller)?;
+    require_driven(&links, ekf, "estimator", |p| !is_command(p), sensors)?;
     let controller_parameters = controller_sets(controller)?;
-    let plant_parameters = bindings(
-        plant,
-        &[
-            ("initial_condition", "Integer", "0".to_string()),
-            ("initial_speed", "Real", real(mission_default("v_vertical"))),
-        ],
-    )?;
+    let plant_parameters = plant_sets(plant)?;
     // SSP importers (fmpy, libcosim) are Jacobi masters: the estimator fuses the sensors'
     // outputs of the previous step, one `sample_time` old (its `measurement_latency`), and
     // the plant gets the controller's output one step later (its `prediction_lead`).
@@ -640,19 +593,12 @@ pub fn avionics_system_description(
         controller.model_identifier, plant.model_identifier, ekf.model_identifier, sensors.model_identifier
     );
     let mut elements = vec![
-        ("controller", controller, inputs_of("controller"), controller_parameters),
-        (
-            "estimator",
-            ekf,
-            inputs_of("estimator"),
-            vec![("estimator", estimator_parameters)],
-        ),
-        ("sensors", sensors, inputs_of("sensors"), Vec::new()),
-        ("plant", plant, inputs_of("plant"), vec![("plant", plant_parameters)]),
+        ("controller", controller, controller_parameters),
+        ("estimator", ekf, vec![("estimator", estimator_parameters)]),
+        ("sensors", sensors, Vec::new()),
+        ("plant", plant, plant_parameters),
     ];
-    if let Some(((_, sets), fmu)) = atmosphere {
-        elements.push(("atmosphere", fmu, inputs_of("atmosphere"), sets));
-    }
+    elements.extend(atmosphere.map(|(fmu, sets)| ("atmosphere", fmu, sets)));
     write_ssd(&name, &description, &elements, &links)
 }
 
@@ -686,8 +632,8 @@ pub fn write_avionics_ssp(dir: &Path, controller_id: &str) -> Result<PathBuf, St
     Ok(path)
 }
 
-/// One element of a system: its name, FMU, connected inputs and parameter bindings.
-type Element<'a> = (&'a str, &'a FmuInfo, Vec<&'a str>, Vec<ParamSet>);
+/// One element of a system: its name, FMU and parameter bindings.
+type Element<'a> = (&'a str, &'a FmuInfo, Vec<ParamSet>);
 
 /// SystemStructure.ssd of `elements` wired by `links`, with the default mission experiment.
 fn write_ssd(name: &str, description: &str, elements: &[Element], links: &[Connection]) -> Result<String, String> {
@@ -697,85 +643,64 @@ fn write_ssd(name: &str, description: &str, elements: &[Element], links: &[Conne
             units.push(u);
         }
     }
+    let (stop, base_step) = (real(stop_time()), real(mission_default("sample_time")));
+    let root = [
+        ("xmlns:ssd", NS_SSD),
+        ("xmlns:ssc", NS_SSC),
+        ("xmlns:ssv", NS_SSV),
+        ("xmlns:osp", NS_OSP),
+        ("version", "1.0"),
+        ("name", name),
+        (
+            "generationTool",
+            concat!("tailsitter xtask ", env!("CARGO_PKG_VERSION")),
+        ),
+    ];
     model_description::xml::document(|w| {
-        w.create_element("ssd:SystemStructureDescription")
-            .with_attributes([
-                ("xmlns:ssd", NS_SSD),
-                ("xmlns:ssc", NS_SSC),
-                ("xmlns:ssv", NS_SSV),
-                ("xmlns:osp", NS_OSP),
-                ("version", "1.0"),
-                ("name", name),
-                (
-                    "generationTool",
-                    concat!("tailsitter xtask ", env!("CARGO_PKG_VERSION")),
-                ),
-            ])
-            .write_inner_content(|w| {
-                w.create_element("ssd:System")
-                    .with_attributes([("name", name), ("description", description)])
-                    .write_inner_content(|w| {
-                        w.create_element("ssd:Elements").write_inner_content(|w| {
-                            for (name, fmu, inputs, parameters) in elements {
-                                component(w, name, fmu, inputs, parameters)?;
-                            }
-                            Ok(())
-                        })?;
-                        w.create_element("ssd:Connections").write_inner_content(|w| {
-                            for c in links {
-                                w.create_element("ssd:Connection")
-                                    .with_attributes([
-                                        ("startElement", c.start),
-                                        ("startConnector", c.name.as_str()),
-                                        ("endElement", c.end),
-                                        ("endConnector", c.name.as_str()),
-                                    ])
-                                    .write_empty()?;
-                            }
-                            Ok(())
-                        })?;
-                        Ok(())
-                    })?;
-                if !units.is_empty() {
-                    w.create_element("ssd:Units").write_inner_content(|w| {
-                        for u in &units {
-                            w.create_element("ssc:Unit")
-                                .with_attribute(("name", u.name.as_str()))
-                                .write_inner_content(|w| {
-                                    w.create_element("ssc:BaseUnit")
-                                        .with_attributes(u.base.iter().map(|(k, v)| (k.as_str(), v.as_str())))
-                                        .write_empty()?;
-                                    Ok(())
-                                })?;
-                        }
-                        Ok(())
-                    })?;
-                }
-                w.create_element("ssd:DefaultExperiment")
-                    .with_attributes([("startTime", "0.0"), ("stopTime", real(stop_time()).as_str())])
-                    .write_inner_content(|w| {
-                        w.create_element("ssd:Annotations").write_inner_content(|w| {
-                            w.create_element("ssc:Annotation")
-                                .with_attribute(("type", "com.opensimulationplatform"))
-                                .write_inner_content(|w| {
-                                    w.create_element("osp:Algorithm").write_inner_content(|w| {
-                                        w.create_element("osp:FixedStepAlgorithm")
-                                            .with_attribute((
-                                                "baseStepSize",
-                                                real(mission_default("sample_time")).as_str(),
-                                            ))
-                                            .write_empty()?;
-                                        Ok(())
-                                    })?;
-                                    Ok(())
-                                })?;
-                            Ok(())
-                        })?;
-                        Ok(())
-                    })?;
-                Ok(())
+        element(w, "ssd:SystemStructureDescription", root, |w| {
+            element(w, "ssd:System", [("name", name), ("description", description)], |w| {
+                element(w, "ssd:Elements", [], |w| {
+                    elements.iter().try_for_each(|(name, fmu, parameters)| {
+                        let inputs: Vec<&str> = links
+                            .iter()
+                            .filter(|c| c.end == *name)
+                            .map(|c| c.name.as_str())
+                            .collect();
+                        component(w, name, fmu, &inputs, parameters)
+                    })
+                })?;
+                element(w, "ssd:Connections", [], |w| {
+                    links.iter().try_for_each(|c| {
+                        let ends = [
+                            ("startElement", c.start),
+                            ("startConnector", c.name.as_str()),
+                            ("endElement", c.end),
+                            ("endConnector", c.name.as_str()),
+                        ];
+                        empty(w, "ssd:Connection", ends)
+                    })
+                })
             })?;
-        Ok(())
+            if !units.is_empty() {
+                element(w, "ssd:Units", [], |w| {
+                    units.iter().try_for_each(|u| {
+                        element(w, "ssc:Unit", [("name", u.name.as_str())], |w| {
+                            empty(w, "ssc:BaseUnit", u.base.iter().map(|(k, v)| (k.as_str(), v.as_str())))
+                        })
+                    })
+                })?;
+            }
+            let experiment = [("startTime", "0.0"), ("stopTime", stop.as_str())];
+            element(w, "ssd:DefaultExperiment", experiment, |w| {
+                element(w, "ssd:Annotations", [], |w| {
+                    element(w, "ssc:Annotation", [("type", "com.opensimulationplatform")], |w| {
+                        element(w, "osp:Algorithm", [], |w| {
+                            empty(w, "osp:FixedStepAlgorithm", [("baseStepSize", base_step.as_str())])
+                        })
+                    })
+                })
+            })
+        })
     })
     .map_err(|e| e.to_string())
 }

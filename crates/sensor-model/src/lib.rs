@@ -18,6 +18,7 @@ use geodesy::LocalTangent;
 use nalgebra::{Vector3, Vector4};
 use rng::{NoiseRng, SplitMix64};
 use std::fmt;
+pub use tailsitter_physics::Site;
 
 /// ISA sea-level air density ρ₀ (kg/m³) of the indicated-airspeed definition.
 pub const RHO_0: f64 = 1.225;
@@ -107,14 +108,9 @@ pub struct Params {
     pub gyro_bias: Vector3<f64>,
     pub mag_bias: Vector3<f64>,
     pub pitot_bias: f64,
-    /// Reference point: latitude, longitude (rad), height above the ellipsoid (m).
-    pub ref_latitude: f64,
-    pub ref_longitude: f64,
-    pub ref_height: f64,
-    /// Earth field: total intensity (Gauss), declination and inclination (rad).
-    pub mag_field_total: f64,
-    pub mag_declination: f64,
-    pub mag_inclination: f64,
+    /// Reference point (latitude, longitude, height above the ellipsoid) and Earth field
+    /// (total intensity, declination, inclination), shared with the state estimator.
+    pub site: Site,
     /// True air density at the pitot (kg/m³).
     pub air_density: f64,
     /// Butterworth on the analogue channels on/off, and its −3 dB frequency (Hz).
@@ -472,24 +468,25 @@ impl Params {
                 return bad(name, b, "a bias must be finite and <= 1e6 in magnitude");
             }
         }
-        if LocalTangent::new(self.ref_latitude, self.ref_longitude, self.ref_height).is_none() {
+        let s = &self.site;
+        if LocalTangent::new(s.ref_latitude, s.ref_longitude, s.ref_height).is_none() {
             return Err(ParamError(format!(
                 "reference point ({}, {}, {}): needs finite values, |ref_latitude| <= 89 deg, |ref_height| <= 100 km",
-                self.ref_latitude, self.ref_longitude, self.ref_height
+                s.ref_latitude, s.ref_longitude, s.ref_height
             )));
         }
-        if !(self.mag_field_total.is_finite() && self.mag_field_total > 0.0 && self.mag_field_total < 1.0) {
+        if !(s.mag_field_total.is_finite() && s.mag_field_total > 0.0 && s.mag_field_total < 1.0) {
             return bad(
                 "mag_field_total",
-                self.mag_field_total,
+                s.mag_field_total,
                 "Earth field must be in (0, 1) Gauss",
             );
         }
-        if !(self.mag_declination.is_finite() && self.mag_declination.abs() <= std::f64::consts::PI) {
-            return bad("mag_declination", self.mag_declination, "must be within +/-pi rad");
+        if !(s.mag_declination.is_finite() && s.mag_declination.abs() <= std::f64::consts::PI) {
+            return bad("mag_declination", s.mag_declination, "must be within +/-pi rad");
         }
-        if !(self.mag_inclination.is_finite() && self.mag_inclination.abs() <= std::f64::consts::FRAC_PI_2) {
-            return bad("mag_inclination", self.mag_inclination, "must be within +/-pi/2 rad");
+        if !(s.mag_inclination.is_finite() && s.mag_inclination.abs() <= std::f64::consts::FRAC_PI_2) {
+            return bad("mag_inclination", s.mag_inclination, "must be within +/-pi/2 rad");
         }
         if !(self.air_density.is_finite() && self.air_density > 0.0 && self.air_density <= 2.0) {
             return bad("air_density", self.air_density, "must be in (0, 2] kg/m3");
@@ -549,7 +546,11 @@ impl Params {
 
     /// Earth field in NED (Gauss): F (cos I cos D, cos I sin D, sin I).
     pub fn field_ned(&self) -> Vector3<f64> {
-        let (f, d, i) = (self.mag_field_total, self.mag_declination, self.mag_inclination);
+        let (f, d, i) = (
+            self.site.mag_field_total,
+            self.site.mag_declination,
+            self.site.mag_inclination,
+        );
         let h = f * libm::cos(i);
         Vector3::new(h * libm::cos(d), h * libm::sin(d), f * libm::sin(i))
     }
@@ -582,16 +583,20 @@ impl SensorModel {
             period,
             filter,
             white_std,
-            tangent: LocalTangent::new(params.ref_latitude, params.ref_longitude, params.ref_height)
-                .expect("validated"),
+            tangent: LocalTangent::new(
+                params.site.ref_latitude,
+                params.site.ref_longitude,
+                params.site.ref_height,
+            )
+            .expect("validated"),
             field_ned: params.field_ned(),
         };
         let mut sm = SplitMix64(params.seed);
         let rng = std::array::from_fn(|_| NoiseRng::from_seed(sm.next_u64()));
         let zero = Measurements {
-            gps_latitude: params.ref_latitude,
-            gps_longitude: params.ref_longitude,
-            gps_height: params.ref_height,
+            gps_latitude: params.site.ref_latitude,
+            gps_longitude: params.site.ref_longitude,
+            gps_height: params.site.ref_height,
             gps_vel: Vector3::zeros(),
             gps_fix_count: 0,
             gps_valid: false,

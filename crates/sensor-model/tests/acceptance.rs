@@ -3,7 +3,7 @@
 //! hold at each rate, faults, reproducibility and bit-exact state restore, bad input.
 
 use nalgebra::{Matrix3, Vector3, Vector4};
-use sensor_model::{FaultMode, Measurements, Params, SensorModel, State, Truth, RHO_0, STATE_WORDS};
+use sensor_model::{FaultMode, Measurements, Params, SensorModel, Site, State, Truth, RHO_0, STATE_WORDS};
 use std::f64::consts::PI;
 
 /// A constant, non-trivial true state: banked, pitched, yawed, rolling, flying at 25 m/s.
@@ -140,7 +140,7 @@ fn expected(p: &Params) -> ([f64; 10], [f64; 6]) {
     // Radii of curvature at the reference latitude (WGS-84).
     let (a, f) = (6_378_137.0, 1.0 / 298.257_223_563);
     let e2 = f * (2.0 - f);
-    let s2 = p.ref_latitude.sin().powi(2);
+    let s2 = p.site.ref_latitude.sin().powi(2);
     let r_m = a * (1.0 - e2) / (1.0 - e2 * s2).powf(1.5);
     let r_n = a / (1.0 - e2 * s2).sqrt();
     (
@@ -157,9 +157,9 @@ fn expected(p: &Params) -> ([f64; 10], [f64; 6]) {
             u_r,
         ],
         [
-            p.ref_latitude + t.pos_ned.x / r_m,
-            p.ref_longitude + t.pos_ned.y / (r_n * p.ref_latitude.cos()),
-            p.ref_height - t.pos_ned.z,
+            p.site.ref_latitude + t.pos_ned.x / r_m,
+            p.site.ref_longitude + t.pos_ned.y / (r_n * p.site.ref_latitude.cos()),
+            p.site.ref_height - t.pos_ned.z,
             t.vel_ned.x,
             t.vel_ned.y,
             t.vel_ned.z,
@@ -744,14 +744,20 @@ fn out_of_range_parameters_are_refused_with_their_name() {
         (
             "reference point",
             Params {
-                ref_latitude: 1.6,
+                site: Site {
+                    ref_latitude: 1.6,
+                    ..Site::default()
+                },
                 ..Params::default()
             },
         ),
         (
             "mag_field_total",
             Params {
-                mag_field_total: 0.0,
+                site: Site {
+                    mag_field_total: 0.0,
+                    ..Site::default()
+                },
                 ..Params::default()
             },
         ),

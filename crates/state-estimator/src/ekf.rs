@@ -565,7 +565,7 @@ impl Ekf {
         params.validate()?;
         let e = &params.earth;
         Ok(Self {
-            frame: LocalFrame::new(e.ref_latitude, e.ref_longitude, e.ref_height),
+            frame: LocalFrame::new(e.site.ref_latitude, e.site.ref_longitude, e.site.ref_height),
             mag_ned: e.mag_ned(),
             model: {
                 let mut m = Plant::new(params.airframe);
@@ -701,7 +701,7 @@ impl Ekf {
                 } else {
                     p.noise.sigma_accel / f
                 };
-                heading_std = (p.noise.sigma_mag / (p.earth.mag_field_total * p.earth.mag_inclination.cos()))
+                heading_std = (p.noise.sigma_mag / (p.earth.site.mag_field_total * p.earth.site.mag_inclination.cos()))
                     .max(if accelerated { tilt_std } else { 0.0 });
             }
             None => {

@@ -2,7 +2,7 @@
 //! reference point and Earth field, initial uncertainties.
 
 use nalgebra::Vector3;
-use tailsitter_physics::Airframe;
+use tailsitter_physics::{Airframe, Site};
 
 /// Measurement noise σ of the sensors (defaults: thesis Table D.1) and the IMU period.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -52,20 +52,8 @@ pub struct ProcessNoise {
 /// Reference point of the local NED frame and the Earth's fields there.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Earth {
-    /// Latitude of the NED origin (rad) (default −33.93°, Stellenbosch).
-    pub ref_latitude: f64,
-    /// Longitude of the NED origin (rad) (default 18.86°).
-    pub ref_longitude: f64,
-    /// Height of the NED origin above the WGS-84 ellipsoid (m) (default 0).
-    pub ref_height: f64,
-    /// Total magnetic field intensity (Gauss): WMM2025 at the reference point, epoch 2025.0,
-    /// 25 132 nT = 0.2513 Gauss (as the sensor model's `mag_field_total`).
-    pub mag_field_total: f64,
-    /// Magnetic declination, east of true north positive (rad): WMM2025 −26.61°.
-    pub mag_declination: f64,
-    /// Magnetic inclination, below the horizontal positive (rad): WMM2025 −64.73° (the field
-    /// points up).
-    pub mag_inclination: f64,
+    /// Reference point and magnetic field: the sensor model's (one declaration).
+    pub site: Site,
     /// Gravitational acceleration (m/s²), as the plant's `gravity` (9.81).
     pub gravity: f64,
 }
@@ -84,9 +72,10 @@ impl SensorNoise {
 impl Earth {
     /// The Earth field in NED components (Gauss): F(cos I cos D, cos I sin D, sin I).
     pub fn mag_ned(&self) -> Vector3<f64> {
-        let (si, ci) = self.mag_inclination.sin_cos();
-        let (sd, cd) = self.mag_declination.sin_cos();
-        self.mag_field_total * Vector3::new(ci * cd, ci * sd, si)
+        let s = &self.site;
+        let (si, ci) = s.mag_inclination.sin_cos();
+        let (sd, cd) = s.mag_declination.sin_cos();
+        s.mag_field_total * Vector3::new(ci * cd, ci * sd, si)
     }
 }
 
@@ -259,7 +248,7 @@ impl EstimatorParams {
             ("sigma_mag", self.noise.sigma_mag),
             ("sigma_pitot", self.noise.sigma_pitot),
             ("sigma_pitot_dp", self.noise.sigma_pitot_dp),
-            ("mag_field_total", self.earth.mag_field_total),
+            ("mag_field_total", self.earth.site.mag_field_total),
             ("gravity", self.earth.gravity),
             ("init_std_wind", self.tuning.init_std_wind),
             ("init_std_gyro_bias", self.tuning.init_std_gyro_bias),
@@ -309,7 +298,7 @@ impl EstimatorParams {
         if tailsitter_physics::AeroModel::from_index(self.prediction.aero_model).is_none() {
             return Err(format!("aero_model = {} must be 0 or 1", self.prediction.aero_model));
         }
-        let e = &self.earth;
+        let e = &self.earth.site;
         if !e.ref_latitude.is_finite() || e.ref_latitude.abs() > 1.5 {
             return Err(format!(
                 "ref_latitude = {} rad must be within ±1.5 rad (the NED frame degenerates at the poles)",

@@ -7,6 +7,8 @@
 //! * [`Plant`]: the 20-state plant: derivatives, fixed-step Runge–Kutta [`Plant::advance`], outputs,
 //!   trims ([`Plant::trim_level`], [`Plant::trim_vertical_climb`]) and [`Plant::linearise`].
 //! * [`attitude`]: quaternion (A.2.8, scalar last), DCMs and Euler angles (3-2-1, 2-3-1).
+//! * [`Site`]: the reference point of the local NED frame and the Earth's magnetic field there
+//!   (shared by the sensor model and the state estimator).
 //!
 //! Frames: earth NED (treated as inertial), body (x forward/nose — up in hover — y right
 //! wing, z down), wind (x along the air-relative velocity, A.2.7). SI units, angles in rad.
@@ -23,6 +25,7 @@ pub mod global_aero;
 pub mod ground;
 pub mod numeric;
 pub mod plant;
+pub mod site;
 
 pub use aero::{ForcesMoments, Surfaces, AIRSPEED_EPS};
 pub use aero_jacobian::{FmJacobian, N_FM_ARGS};
@@ -35,6 +38,7 @@ pub use error::PhysicsError;
 pub use global_aero::{AeroDiagnostics, AeroModel, AeroRegime, GlobalAero};
 pub use ground::{ContactState, Ground};
 pub use plant::{dp5, Envelope, Integrator, Outputs, Plant, Trim, DEFAULT_INTEGRATION_STEP, MAX_SUBSTEPS};
+pub use site::Site;
 
 use nalgebra::SVector;
 

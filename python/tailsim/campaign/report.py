@@ -251,7 +251,7 @@ def write_report(out: str | pathlib.Path, spec: CampaignSpec | None = None, tabl
             b.set(facecolor=color[a], alpha=0.5)
         ax.plot([], [], color=color[a], lw=6, alpha=0.5, label=lab[a])
     ax.set_xticks(range(5), [p.replace(" ", "\n") for p in PHASES])
-    ax.set(ylabel="[m]", title="max position error per phase")
+    ax.set(ylabel="position error (m)", title="max position error per phase")
     ax.set_yscale("log")
     ax.legend()
     for ax, (m, title) in zip(

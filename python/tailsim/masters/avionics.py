@@ -82,7 +82,7 @@ from .. import declarations
 from .closed_loop import commands_driven, int_outputs, real_outputs, ref_offset_external, wind_external
 from .fmu import Fmu, RunResult, pos_error
 from .profiles import TimeFunction
-from .system import Link, System, Unit, check_ordering, default_step, default_stop, wire
+from .system import Link, Loop, System, Unit, check_ordering, wire
 
 #: Parameters of the same meaning in the sensors and the estimator.
 SHARED_PARAMETERS = (
@@ -110,7 +110,7 @@ ERRORS = [
 ]
 
 
-class AvionicsLoop:
+class AvionicsLoop(Loop):
     """Plant + sensors + estimator + controller (see the module documentation).
 
     `*_params`: values set in initialisation mode by name. `plant_step`: the
@@ -186,8 +186,11 @@ class AvionicsLoop:
     def est_name(name: str) -> str:
         return name if name.startswith("est_") else f"est_{name}"
 
-    def system(self, h: float, wind: TimeFunction | None = None, ref_offset: TimeFunction | None = None) -> System:
+    def system_for(self, h: float, wind: TimeFunction | None = None, ref_offset: TimeFunction | None = None) -> System:
         """The chain as a `System`, for the controller step `h` (the Jacobi delays)."""
+        hs = float(self.plant_step or h)
+        if round(h / hs) < 1 or abs(round(h / hs) * hs - h) > 1e-12 * h:
+            raise ValueError(f"plant_step {hs} s must divide the controller step {h} s")
         P, S, E, C = self.plant, self.sensors, self.ekf, self.controller
         links = [
             Link("plant", "sensors", self.plant_to_sensors),
@@ -214,27 +217,11 @@ class AvionicsLoop:
             record_order=["plant", "controller", "ekf", "sensors"],
         )
 
-    def run(
-        self,
-        stop_time: float | None = None,
-        step_size: float | None = None,
-        wind: TimeFunction | None = None,
-        ref_offset: TimeFunction | None = None,
-    ) -> RunResult:
-        h = default_step(self.controller, self.controller_params, step_size)
-        hs = float(self.plant_step or h)
-        if round(h / hs) < 1 or abs(round(h / hs) * hs - h) > 1e-12 * h:
-            raise ValueError(f"plant_step {hs} s must divide the controller step {h} s")
-        system = self.system(h, wind, ref_offset)
-        try:
-            result = system.run(
-                default_stop(self.controller, stop_time), h, minor_step=self.plant_step, callbacks=self.callbacks
-            )
-        except Exception as exc:
-            partial = getattr(exc, "partial_result", None)
-            if partial is not None:
-                exc.partial_result = with_estimation_errors(partial)
-            raise
+    @property
+    def minor_step(self) -> float | None:
+        return self.plant_step
+
+    def finish(self, result: RunResult) -> RunResult:
         return with_estimation_errors(result)
 
 

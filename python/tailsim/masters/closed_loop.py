@@ -20,9 +20,9 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
-from .fmu import Fmu, RunResult
+from .fmu import Fmu
 from .profiles import TimeFunction, zero
-from .system import External, Link, System, Unit, check_ordering, default_step, default_stop, wire
+from .system import External, Link, Loop, System, Unit, check_ordering, wire
 
 #: The plant's wind inputs and the controller's reference-offset inputs (NED).
 WIND = ("wind_n", "wind_e", "wind_d")
@@ -54,7 +54,7 @@ def int_outputs(fmu: Fmu) -> list[str]:
     return [n for n in fmu.names("output") if fmu.variables[n].type == "Integer"]
 
 
-class ClosedLoop:
+class ClosedLoop(Loop):
     """Plant + controller, wired by port name.
 
     plant_params / controller_params: start values set in initialisation mode
@@ -151,22 +151,8 @@ class ClosedLoop:
             record_order=["plant", "controller", "atmosphere"],
         )
 
-    def run(
-        self,
-        stop_time: float | None = None,
-        step_size: float | None = None,
-        wind: TimeFunction | None = None,
-        ref_offset: TimeFunction | None = None,
-        progress: bool = False,
-        description: str = "",
-    ) -> RunResult:
-        return self.system(wind, ref_offset).run(
-            default_stop(self.controller, stop_time),
-            default_step(self.controller, self.controller_params, step_size),
-            callbacks=self.callbacks,
-            progress=progress,
-            description=description or self.controller.identifier,
-        )
+    def system_for(self, h: float, wind: TimeFunction | None, ref_offset: TimeFunction | None) -> System:
+        return self.system(wind, ref_offset)
 
 
 __all__ = ["REF_OFFSET", "WIND", "ClosedLoop", "commands_driven", "ref_offset_external", "wind_external"]

@@ -455,9 +455,60 @@ def default_stop(controller: Fmu, stop_time: float | None) -> float:
     return float(stop_time if stop_time is not None else controller.md.defaultExperiment.stopTime)
 
 
+class Loop:
+    """A configuration of `System` around one controller: what `ClosedLoop` and `AvionicsLoop`
+    share. A subclass sets `controller`, `controller_params` and `callbacks`, builds its
+    system in `system_for` and may post-process the record in `finish`."""
+
+    controller: Fmu
+    controller_params: Mapping[str, float]
+    callbacks: object = None
+    #: Communication step of the minor units (s); None: the controller's step.
+    minor_step: float | None = None
+
+    def system_for(self, h: float, wind: TimeFunction | None, ref_offset: TimeFunction | None) -> System:
+        """The system flown at the controller step `h` with these external functions."""
+        raise NotImplementedError
+
+    def finish(self, result: RunResult) -> RunResult:
+        """The record as returned (also a failed run's `partial_result`)."""
+        return result
+
+    def run(
+        self,
+        stop_time: float | None = None,
+        step_size: float | None = None,
+        wind: TimeFunction | None = None,
+        ref_offset: TimeFunction | None = None,
+        progress: bool = False,
+        description: str = "",
+    ) -> RunResult:
+        """Fly from 0 to `stop_time` (default: the controller's default experiment) at the
+        controller step `step_size` (default: its `sample_time`); `wind` and `ref_offset` are
+        functions of time giving (n, e, d)."""
+        h = default_step(self.controller, self.controller_params, step_size)
+        system = self.system_for(h, wind, ref_offset)
+        try:
+            result = system.run(
+                default_stop(self.controller, stop_time),
+                h,
+                minor_step=self.minor_step,
+                callbacks=self.callbacks,
+                progress=progress,
+                description=description or self.controller.identifier,
+            )
+        except Exception as exc:
+            partial = getattr(exc, "partial_result", None)
+            if partial is not None:
+                exc.partial_result = self.finish(partial)
+            raise
+        return self.finish(result)
+
+
 __all__ = [
     "External",
     "Link",
+    "Loop",
     "NonFinite",
     "ORDERINGS",
     "System",

@@ -23,7 +23,7 @@ from . import hover as report_hover
 from . import reproduction as report_reproduction
 from . import takeoff as report_takeoff
 from . import wind_envelope as report_wind
-from .markdown import fmt_or_dash, fmt_pole, markdown_to_html, shortest, table_head
+from .markdown import fmt_or_dash, fmt_pole, markdown_to_html, shortest, table_head, toc
 
 OPEN_LOOP_NOTES = (
     "Differences from the thesis: the thesis's modes were computed from its AVL-based model with numbers it "
@@ -225,7 +225,7 @@ def robustness(d: dict) -> list[str]:
         "",
         "The whole default mission flown in the nonlinear closed loop with the parameter scaled over the same sweep as "
         "Table 5.1 (τ = 1.5 / 1.1); range = contiguous range of factors around 1 over which the mission passes the "
-        "controller issues' criteria (`MissionCheck::passed`); worst = largest position error over that range; passes "
+        "mission criteria (`MissionCheck::passed`); worst = largest position error over that range; passes "
         "= passing points of N. The mission is symmetric and flown in calm air, so the lateral derivatives are hardly "
         "excited (identical position errors): their robustness shows in the gust sweep.",
     ]
@@ -356,6 +356,7 @@ def write(folder: str | pathlib.Path, with_plots: bool = True) -> pathlib.Path:
         md += ["", "## Plots", ""]
         for p in pngs:
             md += [f"![{p.stem}]({p.name})", ""]
+    md = md[:4] + ["## Contents", "", *toc(md), ""] + md[4:]
     (folder / "report.md").write_text("\n".join(md) + "\n")
     (folder / "report.html").write_text(markdown_to_html(md, folder, "Tail-sitter analysis report"))
     return folder / "report.md"

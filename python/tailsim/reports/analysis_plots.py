@@ -153,9 +153,12 @@ def main(out):
         # One row of panels per aerodynamic model (thesis 0, global 1).
         models = sorted({x.get("aero_model", "0") for x in r})
         name = {"0": "thesis aero", "1": "global aero"}
-        fig, axs = plt.subplots(len(models), 2, figsize=(12, 5 * len(models)), sharey=True, squeeze=False)
+        ctls = unique(x["controller"] for x in r)
+        fig, axs = plt.subplots(
+            len(models), len(ctls), figsize=(6 * len(ctls), 5 * len(models)), sharey=True, squeeze=False
+        )
         for row, model in zip(axs, models, strict=False):
-            for ax, ctl in zip(row, ("LQR", "TSD"), strict=False):
+            for ax, ctl in zip(row, ctls, strict=False):
                 for i, p in enumerate(params):
                     pts = [
                         (float(x["factor"]), x["passed"] == "true")
@@ -164,6 +167,13 @@ def main(out):
                     ]
                     ax.scatter([q[0] for q in pts], [i] * len(pts), c=["g" if q[1] else "r" for q in pts], s=6)
                 ax.set_xscale("log")
+                # Plain decimals on the log axis (matplotlib's default labels read 7×10⁻¹ within a decade).
+                factors = [float(x["factor"]) for x in r]
+                ticks = [
+                    v for v in (0.5, 0.6, 0.7, 0.8, 0.9, 1, 1.1, 1.25, 1.5, 2) if min(factors) <= v <= max(factors)
+                ]
+                ax.minorticks_off()
+                ax.set_xticks(ticks, [f"{v:g}" for v in ticks])
                 ax.set_yticks(range(len(params)))
                 ax.set_yticklabels(params, fontsize=8)
                 ax.set_xlabel("scale factor (plant only)")
@@ -175,7 +185,9 @@ def main(out):
         g = rows(out / "gusts.csv")
         cases = unique((x["phase"], x["axis"]) for x in g)
         fig, ax = plt.subplots(figsize=(9, 4))
-        for i, ctl in enumerate(("LQR", "TSD")):
+        ctls = unique(x["controller"] for x in g)
+        width = 0.8 / len(ctls)
+        for i, ctl in enumerate(ctls):
             best = []
             for ph, axis in cases:
                 pts = sorted(
@@ -189,7 +201,7 @@ def main(out):
                         break
                     b = a
                 best.append(b)
-            ax.bar([j + (i - 0.5) * 0.4 for j in range(len(cases))], best, 0.4, label=ctl)
+            ax.bar([j + (i - (len(ctls) - 1) / 2) * width for j in range(len(cases))], best, width, label=ctl)
         ax.set_xticks(range(len(cases)))
         ax.set_xticklabels([f"{p}\n{a}" for p, a in cases], fontsize=8)
         ax.set_ylabel("largest survived 1−cos gust (m/s)")

@@ -83,7 +83,7 @@ def avionics_section(
             for i, ph in enumerate(PHASES):
                 rows.append(
                     (
-                        f"max position error, {ph} [m]",
+                        f"max position error, {ph} (m)",
                         lambda r, i=i: f"{float(np.max(pos_error(r)[r['phase'] == i], initial=0.0)):.2f}",
                     )
                 )
@@ -101,7 +101,7 @@ def avionics_section(
                     f"Estimation errors, {k.upper()} {m} mission (RMS per phase; α, β weakly observable "
                     "in vertical flight):",
                     "",
-                    "| phase | position [m] | velocity [m/s] | attitude [deg] | airspeed [m/s] | α [deg] | β [deg] |",
+                    "| phase | position (m) | velocity (m/s) | attitude (deg) | airspeed (m/s) | α (deg) | β (deg) |",
                     "|---|---|---|---|---|---|---|",
                 ]
                 for pe in phase_errors(r):

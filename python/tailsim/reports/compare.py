@@ -17,9 +17,10 @@ import numpy as np
 from .. import cli, controllers, declarations
 from ..campaign import section as campaign_section
 from ..masters import ClosedLoop, Fmu, RunResult, pos_error, step
-from ..metrics import CRITERIA, PHASES, mission_metrics, phase_starts, step_settling
+from ..metrics import CRITERIA, PHASES, SURFACES, mission_metrics, phase_starts, step_settling
 from . import analysis as analysis_report
-from .markdown import fmt, markdown_to_html
+from . import verdict
+from .markdown import fmt, markdown_to_html, toc
 
 NAMES = controllers.NAMES
 COLORS = controllers.COLORS
@@ -64,13 +65,52 @@ def mission_params(defaults: dict[str, float], t1: float, t2: float) -> dict[str
     return {**{k: defaults[k] for k in DURATIONS}, "t_transition_1": t1, "t_transition_2": t2}
 
 
-def plot_mission(runs: dict[str, RunResult], title: str, path: pathlib.Path) -> None:
+#: Deflections smaller than this everywhere (rad, 0.05°) leave a surface out of the plots' legends.
+ACTIVE_SURFACE = math.radians(0.05)
+AERO_MODELS = {0: "thesis (linear) aerodynamics", 1: "global (post-stall) aerodynamics"}
+CONFIGURATIONS = {0: "tuned", 1: "thesis"}
+
+
+def setting(plant: Fmu, ctrls: dict[str, Fmu]) -> str:
+    """What flies, for the plots' titles: the plant's aerodynamic model and each controller's
+    configuration (a controller without the `configuration` switch flies its declared defaults)."""
+    aero = AERO_MODELS.get(int(plant.start("aero_model")), f"aero_model {plant.start('aero_model'):g}")
+
+    def configuration(c: Fmu) -> str:
+        if "configuration" not in c.variables:
+            return "default"
+        v = c.start("configuration")
+        return CONFIGURATIONS.get(int(v), f"configuration {v:g}")
+
+    conf = ", ".join(f"{k.upper()} {configuration(c)}" for k, c in ctrls.items())
+    return f"plant: {aero}; {conf} configuration"
+
+
+def shade_phases(ax, starts: list[float], label: bool = False) -> None:
+    """Shade every other phase of the mission (`starts`: phase starts and the end, s) and name them."""
+    for i, (a, b) in enumerate(zip(starts[:-1], starts[1:], strict=False)):
+        if i % 2:
+            ax.axvspan(a, b, color="0.9", zorder=0)
+        if label:
+            ax.text((a + b) / 2, 0.98, PHASES[i], transform=ax.get_xaxis_transform(), ha="center", va="top", fontsize=7)
+
+
+def active_surfaces(runs: dict[str, RunResult]) -> list[str]:
+    """The control surfaces that move in any of `runs` (|δ| > `ACTIVE_SURFACE` somewhere)."""
+    return [s for s in SURFACES if any(np.nanmax(np.abs(r[s]), initial=0.0) > ACTIVE_SURFACE for r in runs.values())]
+
+
+def plot_mission(runs: dict[str, RunResult], title: str, path: pathlib.Path, starts: list[float] | None = None) -> None:
+    """The mission's track, airspeed, α and θ, position error, thrust and the surfaces that move,
+    one colour per controller; the phases shaded (`starts`: phase starts and end, s)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(3, 2, figsize=(13, 11))
+    surfaces = active_surfaces(runs)
+    styles = ["-", "--", ":", "-.", (0, (5, 1)), (0, (1, 1)), (0, (3, 1, 1, 1))]
     for key, r in runs.items():
         c, t = COLORS[key], r.time
         ax[0, 0].plot(r["pos_n"], -r["pos_d"], color=c, label=f"{key.upper()} flown")
@@ -81,16 +121,18 @@ def plot_mission(runs: dict[str, RunResult], title: str, path: pathlib.Path) -> 
         ax[1, 0].plot(t, np.degrees(r["theta"]), color=c, ls=":", label=f"{key.upper()} θ")
         ax[1, 1].plot(t, pos_error(r), color=c, label=key.upper())
         ax[2, 0].plot(t, r["thrust"], color=c, label=f"{key.upper()} T")
-        for s, ls in zip(["elevator", "flap_collective", "aileron", "rudder"], ["-", "--", ":", "-."], strict=False):
+        for s, ls in zip(surfaces, styles, strict=False):
             ax[2, 1].plot(t, np.degrees(r[s]), color=c, ls=ls, lw=1, label=f"{key.upper()} {s}")
-    ax[0, 0].set(xlabel="north [m]", ylabel="height [m]", title="track (Figs. 3.20 / 4.19)")
+    ax[0, 0].set(xlabel="north (m)", ylabel="height (m)", title="track (Figs. 3.20 / 4.19)")
     ax[0, 0].axis("equal")
-    ax[0, 1].set(xlabel="t [s]", ylabel="airspeed [m/s]", title="airspeed")
-    ax[1, 0].set(xlabel="t [s]", ylabel="[deg]", title="angle of attack α and pitch θ")
-    ax[1, 1].set(xlabel="t [s]", ylabel="[m]", title="position error")
-    ax[2, 0].set(xlabel="t [s]", ylabel="[N]", title="thrust")
-    ax[2, 1].set(xlabel="t [s]", ylabel="[deg]", title="surface deflections")
-    for a in ax.flat:
+    ax[0, 1].set(xlabel="t (s)", ylabel="airspeed (m/s)", title="airspeed")
+    ax[1, 0].set(xlabel="t (s)", ylabel="angle (deg)", title="angle of attack α and pitch θ")
+    ax[1, 1].set(xlabel="t (s)", ylabel="distance (m)", title="position error")
+    ax[2, 0].set(xlabel="t (s)", ylabel="thrust (N)", title="thrust")
+    ax[2, 1].set(xlabel="t (s)", ylabel="deflection (deg)", title="surface deflections (the surfaces that move)")
+    for k, a in enumerate(ax.flat):
+        if starts and k:
+            shade_phases(a, starts, label=k == 1)
         a.grid(True, alpha=0.3)
         a.legend(fontsize=7)
     fig.suptitle(title)
@@ -99,7 +141,7 @@ def plot_mission(runs: dict[str, RunResult], title: str, path: pathlib.Path) -> 
     plt.close(fig)
 
 
-def plot_steps(step_runs: dict[str, dict[str, tuple[RunResult, float]]], path: pathlib.Path) -> None:
+def plot_steps(step_runs: dict[str, dict[str, tuple[RunResult, float]]], path: pathlib.Path, what: str = "") -> None:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -115,9 +157,10 @@ def plot_steps(step_runs: dict[str, dict[str, tuple[RunResult, float]]], path: p
                 a.plot(r.time[m] - t_step, pos_error(r)[m], color=COLORS[key], label=key.upper())
         a.axhline(CRITERIA["settling_band"], color="k", lw=0.8, ls=":")
         flight, axis = case.split()
-        a.set(title=f"5 m {axis} step in {flight} flight", xlabel="time after step [s]", ylabel="position error [m]")
+        a.set(title=f"5 m {axis} step in {flight} flight", xlabel="time after step (s)", ylabel="position error (m)")
         a.grid(True, alpha=0.3)
         a.legend()
+    fig.suptitle(f"Position steps of 5 m; {what}" if what else "Position steps of 5 m")
     fig.tight_layout()
     fig.savefig(path, dpi=90)
     plt.close(fig)
@@ -220,27 +263,47 @@ def run(args) -> int:
         except Exception as e:  # noqa: BLE001 - a failed run is a result of the comparison
             failures[(kind, name, key)] = str(e)
 
+    # The numbers of each mission run, written first: the verdict and the report read them from metrics.json.
+    metrics = {}
+    limits = {"deflection_limit": plant.start("deflection_limit"), "thrust_max": plant.start("thrust_max")}
+    flown_params = {
+        m: {**mission_params(defaults, t1, t2), "v_level": defaults["v_level"]} for m, (t1, t2) in missions.items()
+    }
+    for m in missions:
+        for k in keys:
+            if k in mission_runs[m]:
+                metrics[(m, k)] = mission_metrics(mission_runs[m][k], flown_params[m], theta_trim, **limits)
+    summary = {
+        f"{k}_{m}": {"controller": k, "mission": m, "requested": list(missions[m]), **vars(v)}
+        for (m, k), v in metrics.items()
+    }
+    (out / "metrics.json").write_text(json.dumps(summary, indent=1, default=str))
+
+    what = setting(plant, ctrls)
     plots = []
     for m, runs in mission_runs.items():
         if runs:
             t1, t2 = missions[m]
             p = out / f"mission_{m}.png"
-            plot_mission(runs, f"{m} mission: T1 = {t1:g} s, T2 = {t2:g} s", p)
-            plots.append((f"{m.capitalize()} mission (T1 = {t1:g} s, T2 = {t2:g} s)", p))
+            flown = ", ".join(
+                f"{k.upper()} " + " / ".join(fmt(v, 1) for v in metrics[(m, k)].flown_transition) + " s"
+                for k in runs
+                if (m, k) in metrics
+            )
+            plot_mission(
+                runs,
+                f"{m} mission: T1 / T2 requested {t1:g} / {t2:g} s, flown {flown}\n{what}",
+                p,
+                phase_starts(flown_params[m]),
+            )
+            plots.append((f"{m.capitalize()} mission (T1 / T2 requested {t1:g} / {t2:g} s)", p))
     if not args.no_steps and any(step_runs.values()):
         p = out / "steps.png"
-        plot_steps(step_runs, p)
+        plot_steps(step_runs, p, what)
         plots.append(("Position steps of 5 m (§3.4.1, §4.4.2)", p))
 
     # The comparison table.
     rows: list[tuple[str, list[str]]] = []
-    metrics = {}
-    limits = {"deflection_limit": plant.start("deflection_limit"), "thrust_max": plant.start("thrust_max")}
-    for m, (t1, t2) in missions.items():
-        for k in keys:
-            if k in mission_runs[m]:
-                flown = {**mission_params(defaults, t1, t2), "v_level": defaults["v_level"]}
-                metrics[(m, k)] = mission_metrics(mission_runs[m][k], flown, theta_trim, **limits)
     header = ["quantity"] + [f"{k.upper()} {m}" for m in missions for k in keys]
 
     def row(label, f):
@@ -254,27 +317,41 @@ def run(args) -> int:
         rows.append((label, vals))
 
     row("mission completed", lambda x: "yes" if x.completed else f"no ({x.reason})")
-    for i, ph in enumerate(PHASES):
-        row(f"max / RMS position error, {ph} [m]", lambda x, i=i: f"{fmt(x.max_error[i])} / {fmt(x.rms_error[i])}")
+    rows.append(
+        (
+            "transitions requested T1 / T2 (s)",
+            [f"{missions[m][0]:g} / {missions[m][1]:g}" for m in missions for k in keys],
+        )
+    )
     row(
-        "max altitude deviation, transition 1 / 2 [m]",
+        "transitions flown (s) (γ within 5° of level / vertical for good)",
+        lambda x: " / ".join(fmt(v, 1) for v in x.flown_transition),
+    )
+    for i, ph in enumerate(PHASES):
+        row(f"max / RMS position error, {ph} (m)", lambda x, i=i: f"{fmt(x.max_error[i])} / {fmt(x.rms_error[i])}")
+    row(
+        "max altitude deviation, transition 1 / 2 (m)",
         lambda x: " / ".join(fmt(v) for v in x.altitude_deviation_transition),
     )
-    row("max α [deg]", lambda x: fmt(x.max_alpha_deg, 1))
-    row("time in actuator saturation [s]", lambda x: fmt(x.saturation_time))
+    row("max α (deg)", lambda x: fmt(x.max_alpha_deg, 1))
+    row("time in actuator saturation (s)", lambda x: fmt(x.saturation_time))
     row(
-        "level flight: max airspeed error [m/s] / pitch error [deg]",
+        "level flight: max airspeed error (m/s) / pitch error (deg)",
         lambda x: f"{fmt(x.level_airspeed_error)} / {fmt(x.level_pitch_error_deg)}",
     )
-    row("controller compute per step (fmpy call incl.) [µs]", lambda x: fmt(x.controller_us_per_step, 0))
+    row("controller compute per step (fmpy call incl.) (µs)", lambda x: fmt(x.controller_us_per_step, 0))
     fastest = {}
     alpha_max = CRITERIA["linear_alpha_max"]
     for k in keys:
-        # Flown = completed with α in the linear region of the aerodynamic model (thesis §4.4.4).
+        # Flown = completed with α in the linear region of the aerodynamic model (thesis §4.4.4); the
+        # durations are the measured ones, not the requested T1, T2.
         done = [
-            missions[m]
+            metrics[(m, k)].flown_transition
             for m in missions
-            if (m, k) in metrics and metrics[(m, k)].completed and metrics[(m, k)].max_alpha_deg < alpha_max
+            if (m, k) in metrics
+            and metrics[(m, k)].completed
+            and metrics[(m, k)].max_alpha_deg < alpha_max
+            and all(math.isfinite(v) for v in metrics[(m, k)].flown_transition)
         ]
         fastest[k] = min(done, key=lambda tt: tt[0] + tt[1]) if done else None
     step_rows = []
@@ -287,32 +364,29 @@ def run(args) -> int:
                 vals.append(fmt(step_settling(r, t_step)))
             else:
                 vals.append("failed")
-        step_rows.append((f"settling time to < {CRITERIA['settling_band']:g} m, 5 m step, {name} [s]", vals))
+        step_rows.append((f"settling time to < {CRITERIA['settling_band']:g} m, 5 m step, {name} (s)", vals))
 
-    md = ["# Tail-sitter controller comparison", ""]
-    md.append(
-        f"Master: fmpy, {ordering}; plant `tailsitter_plant`; controllers: {', '.join(NAMES[k] for k in keys)}. "
-        f"Level-trim pitch of the plant at {defaults['v_level']:g} m/s: {math.degrees(theta_trim):.2f}°. Wall time "
-        f"{time.time() - t_start:.0f} s."
-    )
-    md += campaign_section.report_section(out)  # the comparison: paired Monte-Carlo
-    md += ["", "## Missions (thesis ch. 6 comparison)", ""]
-    md.append("| " + " | ".join(header) + " |")
-    md.append("|" + "---|" * len(header))
+    body = campaign_part(out)
+    body += ["", "## Missions (thesis ch. 6 comparison)", ""]
+    body.append(f"One run per controller on the nominal plant without wind; {what}.")
+    body.append("")
+    body.append("| " + " | ".join(header) + " |")
+    body.append("|" + "---|" * len(header))
     for label, vals in rows:
-        md.append(f"| {label} | " + " | ".join(vals) + " |")
-    md += [
+        body.append(f"| {label} | " + " | ".join(vals) + " |")
+    body += [
         "",
-        f"Fastest transition flown (completed with α < {alpha_max:g}°): "
+        f"Fastest transitions flown (measured, completed with α < {alpha_max:g}°): "
         + ", ".join(
-            f"{k.upper()} T1 = {fastest[k][0]:g} s, T2 = {fastest[k][1]:g} s"
+            f"{k.upper()} {fastest[k][0]:.1f} s forward, {fastest[k][1]:.1f} s back"
             if fastest[k]
             else f"{k.upper()}: none of the missions flown kept α < {alpha_max:g}°"
             for k in keys
-        ),
+        )
+        + ".",
     ]
     if step_rows:
-        md += [
+        body += [
             "",
             "## Position steps",
             "",
@@ -320,34 +394,42 @@ def run(args) -> int:
             "|" + "---|" * (len(keys) + 1),
         ]
         for label, vals in step_rows:
-            md.append(f"| {label} | " + " | ".join(vals) + " |")
+            body.append(f"| {label} | " + " | ".join(vals) + " |")
     if failures:
-        md += ["", "## Failed runs", ""] + [f"- {k[2].upper()} {k[1]} ({k[0]}): {v}" for k, v in failures.items()]
+        body += ["", "## Failed runs", ""] + [f"- {k[2].upper()} {k[1]} ({k[0]}): {v}" for k, v in failures.items()]
     if not args.no_avionics:
         from .avionics import avionics_section
 
-        md += avionics_section(
+        body += avionics_section(
             dist,
             keys,
-            {
-                m: {**mission_params(defaults, t1, t2), "v_level": defaults["v_level"]}
-                for m, (t1, t2) in missions.items()
-            },
+            flown_params,
             {(m, k): r for m, runs in mission_runs.items() for k, r in runs.items()},
             theta_trim,
             ordering=ordering,
             out=out,
         )
-    md += ["", "## Plots", ""]
+    body += ["", "## Plots", ""]
     for title, p in plots:
-        md += [f"### {title}", "", f"![{title}]({p.name})", ""]
-    md += ["CSV of every run (time + all signals, units in the header): `csv/`."]
-    md += analysis_section(out)
-    (out / "report.md").write_text("\n".join(md) + "\n")
+        body += [f"### {title}", "", f"![{title}]({p.name})", ""]
+    body += ["CSV of every run (time + all signals, units in the header): `csv/`."]
+    body += analysis_section(out)
+    body += documented_runs()
+    body += [
+        "",
+        "## This run",
+        "",
+        f"Master: fmpy, {ordering}; plant `tailsitter_plant`; controllers: {', '.join(NAMES[k] for k in keys)}. "
+        f"Level-trim pitch of the plant at {defaults['v_level']:g} m/s: {math.degrees(theta_trim):.2f}°. Wall time "
+        f"{time.time() - t_start:.0f} s.",
+    ]
 
+    head = ["# Tail-sitter controller comparison", ""]
+    head += verdict.markdown(verdict.collect(out))
+    head += ["", "## Contents", "", *toc(body)]
+    md = head + body
+    (out / "report.md").write_text("\n".join(md) + "\n")
     (out / "report.html").write_text(markdown_to_html(md, out, "Tail-sitter comparison"))
-    summary = {f"{k}_{m}": vars(v) for (m, k), v in metrics.items()}
-    (out / "metrics.json").write_text(json.dumps(summary, indent=1, default=str))
     print(f"report: {out / 'report.md'} and {out / 'report.html'}; plots and csv/ in {out}/")
     for f in failures.values():
         print("failed run:", f, file=sys.stderr)
@@ -355,6 +437,49 @@ def run(args) -> int:
     for c in ctrls.values():
         c.cleanup()
     return 0
+
+
+def campaign_part(out: pathlib.Path) -> list[str]:
+    """This run's paired Monte-Carlo campaign (`<out>/campaign`), with its plots; its own report
+    (`campaign/report.md`) also as HTML."""
+    folder = out / "campaign"
+    if not (folder / "results.parquet").exists():
+        return []
+    md = [
+        "",
+        "## This run's paired Monte-Carlo campaign",
+        "",
+        "The controllers are compared on uncertain plants, not on the nominal one (where each controller's design "
+        "model is the plant exactly): every sample is flown by every arm (controller/configuration/state source), so "
+        "differences are paired. The nominal missions below are single points of this distribution.",
+        "",
+    ]
+    try:
+        md += campaign_section.markdown(campaign_section.summarize([folder]), "Campaign in `campaign/`")
+    except Exception as e:  # noqa: BLE001 - a broken campaign folder must not lose the report
+        md += [f"(campaign in {folder} not summarised: {e})"]
+    for p in sorted(folder.glob("*.png")):
+        md += ["", f"![{p.stem}](campaign/{p.name})"]
+    if (folder / "report.md").exists():
+        page = (folder / "report.md").read_text().splitlines()
+        (folder / "report.html").write_text(markdown_to_html(page, folder, "Tail-sitter Monte-Carlo campaign"))
+        md += ["", "The campaign's own report: [campaign/report.html](campaign/report.html)."]
+    return md
+
+
+def documented_runs() -> list[str]:
+    """The documented full run (`docs/campaign_full_run.json`), labelled as such: not this run's data."""
+    if not campaign_section.FULL_RUN.exists():
+        return []
+    md = [
+        "",
+        "## Documented full runs (not this run)",
+        "",
+        "Recorded earlier with ≥ 1000 samples per arm and summarised into `docs/campaign_full_run.json` "
+        "(how: `docs/CAMPAIGN.md`); shown for reference, not computed by this run.",
+        "",
+    ]
+    return md + campaign_section.markdown(json.loads(campaign_section.FULL_RUN.read_text()), "Full run")
 
 
 if __name__ == "__main__":

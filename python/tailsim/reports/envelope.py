@@ -104,8 +104,8 @@ def plot(out: str | Path, d: dict) -> Path | None:
                 ax.axvline(t, color="0.8", lw=0.5)
     axes[0].axhline(e["alpha_bound_deg"], color="r", ls="--", lw=0.8, label="α bound")
     axes[0].axhline(-e["alpha_bound_deg"], color="r", ls="--", lw=0.8)
-    axes[0].set_ylabel("α (°)")
-    axes[1].set_ylabel("flight-path angle γ (°)")
+    axes[0].set_ylabel("α (deg)")
+    axes[1].set_ylabel("flight-path angle γ (deg)")
     axes[2].set_ylabel("h − h_ref (m)")
     axes[2].set_xlabel("t (s)")
     for ax in axes:

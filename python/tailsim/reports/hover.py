@@ -64,7 +64,7 @@ def section(d: dict) -> list[str]:
         "Tuned configuration (weathervaning heading reference: the belly or back turns into the wind in "
         "vertical flight); the thesis configuration has no weathervane.",
         "",
-        "### Steady wind from the east (the issue's table)",
+        "### Steady wind from the east",
         "",
     ]
     out += table_head(

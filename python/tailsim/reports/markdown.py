@@ -11,11 +11,20 @@ import base64
 import html
 import math
 import pathlib
+import re
 from collections.abc import Iterable
 
+#: The page's style: readable on a phone (390 px) and a desktop; wide tables scroll inside their
+#: own box (`.table-wrap`), never the page; long code words break.
 STYLE = (
-    "body{font-family:sans-serif;max-width:80em;margin:2em auto}table{border-collapse:collapse}"
-    "td,th{border:1px solid #ccc;padding:3px 8px}th{background:#eee}"
+    "body{font-family:system-ui,sans-serif;line-height:1.45;max-width:80em;margin:0 auto;padding:0.5em 1em}"
+    "h1{font-size:1.6em;margin:0.4em 0}h2{margin-top:1.6em}"
+    ".table-wrap{overflow-x:auto;max-width:100%;margin:0.6em 0}"
+    "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:3px 8px;vertical-align:top}th{background:#eee}"
+    "img{max-width:100%;height:auto}pre{overflow-x:auto}"
+    "p,li,code{overflow-wrap:anywhere}td{overflow-wrap:break-word}"
+    ".headerlink{text-decoration:none;color:#bbb;margin-left:0.3em}"
+    ".toc ul{margin:0.2em 0}"
 )
 
 
@@ -59,43 +68,45 @@ def table(header: list[str], rows: Iterable[list[str]]) -> list[str]:
     return out
 
 
+def slug(heading: str, separator: str = "-") -> str:
+    """The anchor of a heading: lower case, letters/digits kept, the rest one `-` (the same in
+    the Markdown's table of contents and the HTML's heading ids)."""
+    words = re.findall(r"\w+", heading.lower())
+    return separator.join(words)
+
+
+def toc(lines: list[str], level: int = 2) -> list[str]:
+    """A linked table of contents (Markdown bullets) of the headings of `level` in `lines`."""
+    mark = "#" * level + " "
+    return [f"- [{h[len(mark) :]}](#{slug(h[len(mark) :])})" for h in lines if h.startswith(mark)]
+
+
 def markdown_to_html(lines: list[str], base: pathlib.Path, title: str) -> str:
-    """The subset of Markdown the reports use (headings, tables, images, bullets,
-    paragraphs) as one self-contained HTML page; images are embedded from `base`."""
-    body = []
-    in_table = False
-    for line in lines:
-        if line.startswith("|"):
-            cells = [c.strip() for c in line.strip().strip("|").split("|")]
-            if set("".join(cells)) <= set("-"):
-                continue
-            if not in_table:
-                body.append("<table>")
-                in_table = True
-                body.append("<tr>" + "".join(f"<th>{html.escape(c)}</th>" for c in cells) + "</tr>")
-            else:
-                body.append("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in cells) + "</tr>")
-            continue
-        if in_table:
-            body.append("</table>")
-            in_table = False
-        if line.startswith("### "):
-            body.append(f"<h3>{html.escape(line[4:])}</h3>")
-        elif line.startswith("## "):
-            body.append(f"<h2>{html.escape(line[3:])}</h2>")
-        elif line.startswith("# "):
-            body.append(f"<h1>{html.escape(line[2:])}</h1>")
-        elif line.startswith("!["):
-            name = line[line.rindex("](") + 2 : -1]
-            data = base64.b64encode((base / name).read_bytes()).decode()
-            body.append(f'<img alt="{html.escape(name)}" src="data:image/png;base64,{data}" style="max-width:100%">')
-        elif line.startswith("- "):
-            body.append(f"<p>• {html.escape(line[2:])}</p>")
-        elif line:
-            body.append(f"<p>{html.escape(line)}</p>")
-    if in_table:
-        body.append("</table>")
+    """The Markdown `lines` as one self-contained HTML page (Python-Markdown with its tables and
+    toc extensions): heading anchors (`slug`), tables wrapped in a scrolling box, a viewport
+    for phones, and every image that is a file of `base` embedded as a data URI."""
+    import markdown
+
+    body = markdown.markdown(
+        "\n".join(lines),
+        extensions=["tables", "toc", "sane_lists"],
+        extension_configs={"toc": {"slugify": lambda value, separator: slug(value, separator), "permalink": "¶"}},
+        output_format="html",
+    )
+    body = body.replace("<table>", '<div class="table-wrap"><table>').replace("</table>", "</table></div>")
+
+    def embed(m: re.Match) -> str:
+        src = html.unescape(m.group(1))
+        path = base / src
+        if "://" in src or src.startswith("data:") or not path.is_file():
+            return m.group(0)
+        kind = "svg+xml" if path.suffix == ".svg" else path.suffix.lstrip(".").replace("jpg", "jpeg")
+        data = base64.b64encode(path.read_bytes()).decode()
+        return f'src="data:image/{kind};base64,{data}"'
+
+    body = re.sub(r'src="([^"]+)"', embed, body)
     return (
-        f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(title)}</title>"
-        f"<style>{STYLE}</style></head><body>{''.join(body)}</body></html>\n"
+        "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
+        "<meta name='viewport' content='width=device-width, initial-scale=1'><link rel='icon' href='data:,'>"
+        f"<title>{html.escape(title)}</title><style>{STYLE}</style></head><body>{body}</body></html>\n"
     )

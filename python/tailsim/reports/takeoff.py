@@ -109,7 +109,7 @@ def plot(folder: str | pathlib.Path) -> pathlib.Path | None:
     axes[1].set_ylabel("height above take-off (m)")
     axes[1].set_title("height", fontsize=9)
     axes[2].set_xlabel("t (s)")
-    axes[2].set_ylabel("tilt from vertical (°)")
+    axes[2].set_ylabel("tilt from vertical (deg)")
     axes[2].set_title("attitude", fontsize=9)
     for ax in axes:
         ax.grid(alpha=0.3)

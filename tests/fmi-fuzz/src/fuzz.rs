@@ -489,17 +489,9 @@ impl<'a> Fuzzer<'a> {
             if self.capped(cfg, f) {
                 continue;
             }
-            progress.mark(index, state, &self.fmus[f].id);
-            let t0 = Instant::now();
-            let id = self.sequence(index, state, f, cfg.max_calls);
-            let entry = self.report.per_fmu.entry(id).or_default();
-            entry.0 += 1;
-            entry.1 += t0.elapsed().as_secs_f64();
-            self.report.sequences += 1;
+            self.timed_sequence(&mut progress, index, state, f, cfg.max_calls);
         }
-        progress.finish();
-        self.free_donors();
-        self.report
+        self.finish(progress)
     }
 
     /// Run the one sequence that starts from RNG state `state` (as logged by a run, or
@@ -515,6 +507,20 @@ impl<'a> Fuzzer<'a> {
             self.fmus[f].id
         );
         let mut progress = crate::progress::Progress::new(None, 0, max_calls);
+        self.timed_sequence(&mut progress, index, state, f, max_calls);
+        self.finish(progress)
+    }
+
+    /// Run sequence `index` (RNG already at `state`) on FMU `f`, marking it in `progress`
+    /// and adding its count and wall time to the report.
+    fn timed_sequence(
+        &mut self,
+        progress: &mut crate::progress::Progress,
+        index: u64,
+        state: u64,
+        f: usize,
+        max_calls: usize,
+    ) {
         progress.mark(index, state, &self.fmus[f].id);
         let t0 = Instant::now();
         let id = self.sequence(index, state, f, max_calls);
@@ -522,6 +528,10 @@ impl<'a> Fuzzer<'a> {
         entry.0 += 1;
         entry.1 += t0.elapsed().as_secs_f64();
         self.report.sequences += 1;
+    }
+
+    /// Close the progress log, free the donor instances and hand back the report.
+    fn finish(mut self, mut progress: crate::progress::Progress) -> Report {
         progress.finish();
         self.free_donors();
         self.report
@@ -1143,10 +1153,10 @@ impl<'a> Fuzzer<'a> {
         }
     }
 
-    fn op_set(&mut self, fmu: &Fmu, live: &mut Live<'_>, from: usize) {
-        let api = &fmu.api;
-        let c = live.inst.c;
-        let st = live.m.st;
+    /// The arguments of a set/get call: a type (Real three times as likely), fewer than
+    /// `max_n` value references of it ([`Self::pick_vr`]), and whether to pass NULL arrays
+    /// instead (5 % of non-empty calls).
+    fn pick_access(&mut self, fmu: &Fmu, max_n: usize, settable_bias: bool) -> (VarType, Vec<u32>, bool) {
         let ty = *self.rng.pick(&[
             VarType::Real,
             VarType::Real,
@@ -1155,9 +1165,18 @@ impl<'a> Fuzzer<'a> {
             VarType::Boolean,
             VarType::String,
         ]);
-        let n = self.rng.below(5);
-        let vrs: Vec<u32> = (0..n).map(|_| self.pick_vr(fmu, ty, true)).collect();
+        let n = self.rng.below(max_n);
+        let vrs: Vec<u32> = (0..n).map(|_| self.pick_vr(fmu, ty, settable_bias)).collect();
         let null_arrays = n > 0 && self.rng.chance(0.05);
+        (ty, vrs, null_arrays)
+    }
+
+    fn op_set(&mut self, fmu: &Fmu, live: &mut Live<'_>, from: usize) {
+        let api = &fmu.api;
+        let c = live.inst.c;
+        let st = live.m.st;
+        let (ty, vrs, null_arrays) = self.pick_access(fmu, 5, true);
+        let n = vrs.len();
         // Expected outcome from the layer's rules.
         let mut ok = legal(st, SET) && !null_arrays;
         let (s, detail) = match ty {
@@ -1273,17 +1292,8 @@ impl<'a> Fuzzer<'a> {
 
     fn op_get(&mut self, fmu: &Fmu, live: &mut Live<'_>, from: usize) {
         let st = live.m.st;
-        let ty = *self.rng.pick(&[
-            VarType::Real,
-            VarType::Real,
-            VarType::Real,
-            VarType::Integer,
-            VarType::Boolean,
-            VarType::String,
-        ]);
-        let n = self.rng.below(6);
-        let vrs: Vec<u32> = (0..n).map(|_| self.pick_vr(fmu, ty, false)).collect();
-        let null_arrays = n > 0 && self.rng.chance(0.05);
+        let (ty, vrs, null_arrays) = self.pick_access(fmu, 6, false);
+        let n = vrs.len();
         let all_valid = vrs.iter().all(|vr| fmu.spec(*vr, ty).is_some());
         let expect = if !legal(st, GET) || null_arrays || !all_valid {
             Expect::Error

@@ -95,7 +95,7 @@ fn gps_dropout_of_10_s_in_level_flight_is_dead_reckoned_inside_3_sigma() {
 fn gps_spikes_are_rejected_and_counted_never_fused() {
     let truth = level_truth(30.0, Vector3::zeros());
     let params = unfiltered_params();
-    let (mn, me) = geodesy::LocalFrame::metres_per_radian(params.earth.ref_latitude, 0.0);
+    let (mn, me) = geodesy::LocalFrame::metres_per_radian(params.earth.site.ref_latitude, 0.0);
     let mut spiked = 0;
     let mut seen = Vec::new();
     let ekf = run_filter(
@@ -234,7 +234,7 @@ fn restarted_gps_receiver_counter_going_back_is_accepted_as_new_fixes() {
 fn persistent_gps_jump_resets_the_position_after_repeated_rejections() {
     let truth = level_truth(20.0, Vector3::zeros());
     let params = unfiltered_params();
-    let (mn, _) = geodesy::LocalFrame::metres_per_radian(params.earth.ref_latitude, 0.0);
+    let (mn, _) = geodesy::LocalFrame::metres_per_radian(params.earth.site.ref_latitude, 0.0);
     let mut reset_at = None;
     let ekf = run_filter(
         &truth,
