@@ -52,7 +52,13 @@ pub enum MissionKind {
     Default,
     /// Take-off, the mission, approach and landing ([`takeoff_landing::mission`]).
     TakeoffLanding,
+    /// The handover from a long hover in wind to the transition: the default mission with
+    /// a [`HANDOVER_VERTICAL`] s first vertical phase (room to weathervane and to turn back).
+    Handover,
 }
+
+/// First vertical phase of the [`MissionKind::Handover`] mission (s).
+pub const HANDOVER_VERTICAL: f64 = 20.0;
 
 /// The two wind forms.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -161,6 +167,61 @@ fn max_error(trace: &Trace) -> f64 {
 
 /// Fly one cell.
 pub fn fly_cell(kind: Kind, mission_kind: MissionKind, form: WindForm, speed: f64, bearing_index: usize) -> Cell {
+    fly_cell_phases(kind, mission_kind, form, speed, bearing_index, None).0
+}
+
+/// Largest |position − reference| per [`Phase`] code (m) of `trace`.
+fn phase_max_errors(trace: &Trace) -> [f64; closed_loop::N_PHASES] {
+    let mut out = [0.0; closed_loop::N_PHASES];
+    for s in &trace.samples {
+        let k = s.diagnostics.phase.code() as usize;
+        out[k] = f64::max(out[k], s.pos_error());
+    }
+    out
+}
+
+/// Time history of a flight as CSV: t, phase, error, position and reference (NED), θ, wind.
+fn trace_history(trace: &Trace) -> String {
+    let mut out = String::from("t,phase,error,n,e,d,ref_n,ref_e,ref_d,theta,wind_n,wind_e,thrust\n");
+    for s in &trace.samples {
+        let (p, r) = (s.measurement.pos_ned, s.diagnostics.ref_pos_ned);
+        out.push_str(&format!(
+            "{:.2},{},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{:.4},{:.3},{:.3},{:.3}\n",
+            s.t,
+            s.diagnostics.phase.code(),
+            s.pos_error(),
+            p.x,
+            p.y,
+            p.z,
+            r.x,
+            r.y,
+            r.z,
+            s.theta,
+            s.wind.x,
+            s.wind.y,
+            s.command.thrust
+        ));
+    }
+    out
+}
+
+/// Fly one cell; also the largest error per phase code, and with `history` the time
+/// history written there ([`trace_history`]).
+pub fn fly_cell_phases(
+    kind: Kind,
+    mission_kind: MissionKind,
+    form: WindForm,
+    speed: f64,
+    bearing_index: usize,
+    history: Option<&str>,
+) -> (Cell, [f64; closed_loop::N_PHASES]) {
+    let mut phases = [0.0; closed_loop::N_PHASES];
+    let mut record = |trace: &Trace| {
+        phases = phase_max_errors(trace);
+        if let Some(path) = history {
+            let _ = std::fs::write(path, trace_history(trace));
+        }
+    };
     let start = Instant::now();
     let plant = plant();
     let w = wind(form, speed, bearing_index, plant.ground.height);
@@ -180,8 +241,14 @@ pub fn fly_cell(kind: Kind, mission_kind: MissionKind, form: WindForm, speed: f6
         wall_time_s: 0.0,
     };
     match mission_kind {
-        MissionKind::Default => {
-            let mission = MissionParams::default();
+        MissionKind::Default | MissionKind::Handover => {
+            let mission = match mission_kind {
+                MissionKind::Handover => MissionParams {
+                    t_vertical_1: HANDOVER_VERTICAL,
+                    ..MissionParams::default()
+                },
+                _ => MissionParams::default(),
+            };
             match trimmed_climb(&plant, mission.v_vertical) {
                 Err(e) => cell.failure = Some(e),
                 Ok(x0) => {
@@ -189,6 +256,7 @@ pub fn fly_cell(kind: Kind, mission_kind: MissionKind, form: WindForm, speed: f6
                     scenario.wind = w;
                     let mut c = kind.make(&mission);
                     let trace = fly(&plant, x0, &mut c, &scenario);
+                    record(&trace);
                     cell.completed = trace.completed();
                     cell.failure = trace.failure.clone();
                     cell.max_error = max_error(&trace);
@@ -207,6 +275,7 @@ pub fn fly_cell(kind: Kind, mission_kind: MissionKind, form: WindForm, speed: f6
                 let t_end = trace.samples[k].t + takeoff_landing::AFTER_LANDING;
                 trace.samples.retain(|s| s.t <= t_end + 1e-9);
             }
+            record(&trace);
             let flight = takeoff_landing::evaluate(&plant, kind, Ordering::GaussSeidel, &mission, &trace);
             let at_target = flight.miss_final < HELD_MAX_ERROR;
             cell.completed = trace.completed() && flight.landed_time.is_some() && at_target;
@@ -225,7 +294,7 @@ pub fn fly_cell(kind: Kind, mission_kind: MissionKind, form: WindForm, speed: f6
     }
     cell.held = cell.completed && cell.max_error < HELD_MAX_ERROR;
     cell.wall_time_s = start.elapsed().as_secs_f64();
-    cell
+    (cell, phases)
 }
 
 /// Every cell of `missions` × both wind forms × `kinds` × [`SPEEDS`] × [`BEARINGS_DEG`],
@@ -334,6 +403,7 @@ impl MissionKind {
         match self {
             MissionKind::Default => "default",
             MissionKind::TakeoffLanding => "takeoff_landing",
+            MissionKind::Handover => "handover",
         }
     }
 }
