@@ -32,7 +32,13 @@ fn main() {
         .collect();
     let cells: Vec<_> = jobs
         .par_iter()
-        .map(|&(s, b)| (s, b, analysis::wind_envelope::fly_cell_phases(kind, mission, form, s, b, trace.as_deref())))
+        .map(|&(s, b)| {
+            (
+                s,
+                b,
+                analysis::wind_envelope::fly_cell_phases(kind, mission, form, s, b, trace.as_deref()),
+            )
+        })
         .collect();
     for (s, b, (c, phases)) in cells {
         let ph: Vec<String> = phases.iter().map(|e| format!("{e:5.2}")).collect();
