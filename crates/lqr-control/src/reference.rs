@@ -180,6 +180,8 @@ impl LqrController {
     ) -> (TrajPoint, Vector3<f64>) {
         let heading = self.weathervane.update(&self.mission, t, &input.measurement);
         let reference = match ground {
+            // In wind headed by the weathervane (README, "Mission in wind").
+            Some(v) if self.ground_in_wind() => self.ground_point(v).turned(&heading),
             Some(v) => self.ground_point(v),
             None => self.trajectory.at(t).turned(&heading),
         };
