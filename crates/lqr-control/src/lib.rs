@@ -61,7 +61,7 @@ pub const WIND_TRIM_MAX_PITCH: f64 = 0.3490658503988659; // 20°
 /// the air-data wind an estimator makes of still air not flown).
 pub const WIND_TRIM_RAMP: (f64, f64) = (0.5, 1.5);
 
-/// Horizontal speed of the wind estimate (m/s) from which the position integrators ∫ΔN,
+/// Horizontal speed of the weathervane's wind estimate (4 s filter) (m/s) from which the position integrators ∫ΔN,
 /// ∫ΔE, ∫Δh join the mission's gains for the rest of the flight (README, "Mission in
 /// wind"); in still air they stay inert (the still-air flights bit-identical).
 pub const WIND_INTEGRAL_SPEED: f64 = 1.5;
@@ -269,7 +269,7 @@ pub struct LqrController {
     ground: GroundPhases,
     /// Whether the last sample flew a take-off / landing reference (position integrators on).
     ground_active: bool,
-    /// Whether the wind estimate has reached [`WIND_INTEGRAL_SPEED`] (latched): the position
+    /// Whether the weathervane's wind estimate has reached [`WIND_INTEGRAL_SPEED`] (latched): the position
     /// integrators are then on in the mission phases (README, "Mission in wind").
     wind_integral: bool,
     /// The last DARE solution of the 14-state design, in the Euler set `rep` (warm start).
