@@ -143,17 +143,24 @@ struct WindEnvelopeArgs {
     /// The default mission only (not the take-off-to-landing mission).
     #[arg(long)]
     default_only: bool,
+    /// Also the hover-to-transition handover (the default mission with a 20 s first
+    /// vertical phase, `MissionKind::Handover`).
+    #[arg(long)]
+    handover: bool,
 }
 
 fn wind_envelope(a: &WindEnvelopeArgs) -> Result<(), String> {
     use analysis::wind_envelope::{run, MissionKind};
-    let missions: &[MissionKind] = if a.default_only {
-        &[MissionKind::Default]
+    let mut missions = if a.default_only {
+        vec![MissionKind::Default]
     } else {
-        &[MissionKind::Default, MissionKind::TakeoffLanding]
+        vec![MissionKind::Default, MissionKind::TakeoffLanding]
     };
+    if a.handover {
+        missions.push(MissionKind::Handover);
+    }
     let start = std::time::Instant::now();
-    let cells = run(&a.out, &Kind::ALL, missions)?;
+    let cells = run(&a.out, &Kind::ALL, &missions)?;
     eprintln!(
         "wrote {}/wind_envelope.json: {} flights in {:.1} s",
         a.out.display(),

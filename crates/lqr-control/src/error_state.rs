@@ -47,7 +47,15 @@ impl LqrController {
         xt[ix::ALPHA] = r.air.y;
         xt[ix::BETA] = r.air.z;
         if let Some(v) = &r.ground {
-            self.hover_air_data(m, v, &r.point, &mut x, &mut xt);
+            if self.ground_in_wind() {
+                let vat = model::dcm_of_quat(&r.point.quat()) * (v.vel - self.wind);
+                let va = vat.norm().max(crate::MIN_AIRSPEED);
+                xt[ix::V] = va;
+                xt[ix::ALPHA] = vat.z.atan2(vat.x);
+                xt[ix::BETA] = (vat.y / va).clamp(-1.0, 1.0).asin();
+            } else {
+                self.hover_air_data(m, v, &r.point, &mut x, &mut xt);
+            }
         }
         (x, xt)
     }
@@ -78,6 +86,16 @@ impl LqrController {
     /// reference's from `DCM_t (v_ref − ŵ)`, with `V_e = max(u_a,t, 1 m/s)`: to first order
     /// the model's (V, α, β) at α = β = 0 and V = V_e, where `solve_gain` linearises (the same
     /// 1 m/s floor), and continuous through V = 0 and reversed flow.
+    /// Take-off and landing phases in wind (README, "Mission in wind"): once the wind
+    /// estimate has latched the position integrators, the reference of those phases is
+    /// headed by the weathervane and carries the air data (V, α, β) of its own velocity in
+    /// the estimated wind, `DCM_t (v_ref − ŵ)`, like the mission's vertical flight in wind,
+    /// and the gains are computed about it; in still air the near-hover air data of
+    /// [`Self::hover_air_data`].
+    pub(crate) fn ground_in_wind(&self) -> bool {
+        self.wind_integral && self.wind.iter().all(|w| w.is_finite())
+    }
+
     fn hover_air_data(&self, m: &Measurement, v: &VerticalReference, reference: &TrajPoint, x: &mut X, xt: &mut X) {
         let (sa, ca) = m.alpha.sin_cos();
         let (sb, cb) = m.beta.sin_cos();

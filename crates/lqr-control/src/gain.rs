@@ -376,6 +376,10 @@ impl LqrController {
                 && sw.reference_after_back_transition
                 && self.mission.phase_at(t).0 == Phase::Vertical2
                 && self.wind_in_air_data(m);
+        if r.ground.is_some() && self.ground_in_wind() {
+            // Take-off and landing in wind: about the reference (its air data in the wind).
+            return *xt;
+        }
         let mut x_lin = if lin_ref { *xt } else { *x };
         if r.ground.is_some() {
             x_lin[ix::ALPHA] = 0.0;

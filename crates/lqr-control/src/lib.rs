@@ -61,6 +61,11 @@ pub const WIND_TRIM_MAX_PITCH: f64 = 0.3490658503988659; // 20°
 /// the air-data wind an estimator makes of still air not flown).
 pub const WIND_TRIM_RAMP: (f64, f64) = (0.5, 1.5);
 
+/// Horizontal speed of the weathervane's wind estimate (4 s filter) (m/s) from which the position integrators ∫ΔN,
+/// ∫ΔE, ∫Δh join the mission's gains for the rest of the flight (README, "Mission in
+/// wind"); in still air they stay inert (the still-air flights bit-identical).
+pub const WIND_INTEGRAL_SPEED: f64 = 1.5;
+
 /// Time constant τ_s of the integral action on the horizontal position in wind (s).
 pub const HOVER_SHIFT_TIME: f64 = 3.0;
 /// Bound on that integral's shift of the regulated position (m).
@@ -264,6 +269,9 @@ pub struct LqrController {
     ground: GroundPhases,
     /// Whether the last sample flew a take-off / landing reference (position integrators on).
     ground_active: bool,
+    /// Whether the weathervane's wind estimate has reached [`WIND_INTEGRAL_SPEED`] (latched): the position
+    /// integrators are then on in the mission phases (README, "Mission in wind").
+    wind_integral: bool,
     /// The last DARE solution of the 14-state design, in the Euler set `rep` (warm start).
     warm_p: Option<SMatrix<f64, NR, NR>>,
     /// The two solutions before `warm_p` (same Euler set, consecutive), for extrapolation.
@@ -392,6 +400,7 @@ impl LqrController {
             wind_shift: Vector3::zeros(),
             ground: GroundPhases::new(mission, airframe.mass * airframe.gravity),
             ground_active: false,
+            wind_integral: false,
             warm_p: None,
             warm_hist: [SMatrix::zeros(); 2],
             warm_len: 0,
@@ -444,18 +453,20 @@ impl LqrController {
         &self.params
     }
 
-    /// Whether the position-error integrators are active (`position_integral = 1`).
+    /// Whether the position-error integrators are active (`position_integral = 1`, the
+    /// take-off and landing phases, or the mission in wind).
     pub fn has_position_integral(&self) -> bool {
-        self.params.position_integral != 0 || self.ground_active
+        self.params.position_integral != 0 || self.ground_active || self.wind_integral
     }
 
     /// Whether the integrator of position axis `j` (N, E, h) is active: all three with
     /// `position_integral = 1`; the height's alone in the take-off and landing phases, where
     /// the touchdown needs the height without a steady error (the descent's thrust differs
     /// from the vertical trim's; the horizontal integrators destabilise the hover
-    /// translation of the approach).
+    /// translation of the approach); all three in the mission phases once the wind estimate
+    /// has latched [`WIND_INTEGRAL_SPEED`].
     fn position_integral_on(&self, j: usize) -> bool {
-        self.params.position_integral != 0 || self.ground_active && j == 2
+        self.params.position_integral != 0 || self.ground_active && j == 2 || self.wind_integral && !self.ground_active
     }
 
     /// With `on`, every accepted warm-started gain is recomputed cold and the largest relative
@@ -658,6 +669,7 @@ impl SampledUnit for LqrController {
         for v in self.warm_hist.iter().flat_map(|m| m.iter()) {
             out(*v);
         }
+        out(f64::from(u8::from(self.wind_integral)));
     }
 
     /// Restore what [`Self::save`] wrote; `None` from `next` = truncated state.
@@ -711,6 +723,7 @@ impl SampledUnit for LqrController {
                 *v = take()?;
             }
         }
+        self.wind_integral = take()? != 0.0;
         Ok(())
     }
 

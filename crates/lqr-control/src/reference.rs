@@ -13,8 +13,8 @@ use tailsitter_physics::Surfaces;
 use crate::model;
 use crate::trajectory::TrajPoint;
 use crate::{
-    LqrController, HOVER_SHIFT_LIMIT, HOVER_SHIFT_TIME, MAX_WIND_ESTIMATE, MIN_AIRSPEED, WIND_TRIM_MAX_PITCH,
-    WIND_TRIM_RAMP,
+    LqrController, HOVER_SHIFT_LIMIT, HOVER_SHIFT_TIME, MAX_WIND_ESTIMATE, MIN_AIRSPEED, WIND_INTEGRAL_SPEED,
+    WIND_TRIM_MAX_PITCH, WIND_TRIM_RAMP,
 };
 
 /// Switches of the reference stage (from [`crate::LqrParams::effective`]).
@@ -141,6 +141,12 @@ impl LqrController {
         let ctrl_neh = pos_neh - self.wind_shift;
         if sw.wind_compensation {
             self.estimate_wind(m);
+            if sw.hover_in_wind && !self.wind_integral && self.weathervane.wind().xy().norm() >= WIND_INTEGRAL_SPEED {
+                // A steady wind (the weathervane's 4 s estimate: a 2 s gust of 5 m/s stays
+                // below): the position integrators join the gains (relinearised now).
+                self.wind_integral = true;
+                self.next_relinearisation = f64::NEG_INFINITY;
+            }
         } else {
             self.wind = Vector3::zeros();
         }
@@ -175,6 +181,8 @@ impl LqrController {
     ) -> (TrajPoint, Vector3<f64>) {
         let heading = self.weathervane.update(&self.mission, t, &input.measurement);
         let reference = match ground {
+            // In wind headed by the weathervane (README, "Mission in wind").
+            Some(v) if self.ground_in_wind() => self.ground_point(v).turned(&heading),
             Some(v) => self.ground_point(v),
             None => self.trajectory.at(t).turned(&heading),
         };
@@ -196,12 +204,16 @@ impl LqrController {
         (reference, ref_neh)
     }
 
-    /// Vertical flight in wind: where the weathervane may turn (`Weathervane::free`), it is
+    /// Vertical flight in wind: in the whole first vertical phase (also in the weathervane's
+    /// return window before the transition and in a climb too short to weathervane: README,
+    /// "Mission in wind") and where the weathervane may turn (`Weathervane::free`), it is
     /// engaged (a filtered horizontal wind ≥ its engage speed) or, before the filter has
     /// caught up with a sudden wind, the measured air data show a wind
     /// ([`Self::wind_in_air_data`]).
     fn hover_in_wind(&self, t: f64, m: &Measurement) -> bool {
-        self.weathervane.free(&self.mission, t) && (self.weathervane.engaged() || self.wind_in_air_data(m))
+        let vertical_1 = self.weathervane.params().enabled && self.mission.phase_at(t).0 == Phase::Vertical1;
+        (vertical_1 || self.weathervane.free(&self.mission, t))
+            && (self.weathervane.engaged() || self.wind_in_air_data(m))
     }
 
     /// Integral action on the horizontal position in wind (README, "Hover in wind"): the
