@@ -506,7 +506,11 @@ pub fn run(out: &Path, cfg: &Config, progress: bool) -> std::io::Result<Value> {
     // App. E.1: the printed quarter loops at 3/4 s, at the mission's and the register's V_V,
     // beside the variants that fly them (the load they ask for, `reproduction_flights`).
     let fast_tsd = crate::reproduction_flights::fast_transitions(&mission, alpha_linear_deg.to_radians());
-    let fast_rows: Vec<Value> = fast_tsd.get("rows").and_then(Value::as_array).cloned().unwrap_or_default();
+    let fast_rows: Vec<Value> = fast_tsd
+        .get("rows")
+        .and_then(Value::as_array)
+        .cloned()
+        .unwrap_or_default();
     let printed_fast: Vec<&Value> = fast_rows
         .iter()
         .filter(|r| r.get("variant").and_then(Value::as_str) == Some(crate::reproduction_flights::PRINTED))
@@ -515,7 +519,11 @@ pub fn run(out: &Path, cfg: &Config, progress: bool) -> std::io::Result<Value> {
     let printed_linear = printed_fast
         .iter()
         .any(|r| yes(r, "passed") && num(r, "alpha_max_deg") <= alpha_linear_deg);
-    let demand = printed_fast.first().and_then(|r| r.get("demand")).cloned().unwrap_or(Value::Null);
+    let demand = printed_fast
+        .first()
+        .and_then(|r| r.get("demand"))
+        .cloned()
+        .unwrap_or(Value::Null);
     claims.push(json!({
         "claim": "TSD flies 3 s and 4 s transitions with α in the linear region",
         "where": "§4.4.4, App. E.1",
@@ -697,13 +705,17 @@ pub fn run(out: &Path, cfg: &Config, progress: bool) -> std::io::Result<Value> {
                 .and_then(Value::as_f64)
                 .unwrap_or(f64::NAN)
         };
+        // Roll only where the 3-2-1 angles define it (level flight).
+        let roll = r
+            .get("d_roll_deg")
+            .and_then(Value::as_f64)
+            .map_or(String::new(), |v| format!(", Δφ {v:+.1}°"));
         format!(
-            "{}; {settle}, final error {:.2} m; Δα {:+.1}°, Δβ {:+.1}°, Δφ {:+.1}°, Δθ {:+.1}°, ΔT {:+.1} N; |Δδ| e/a/r/fc/fd/v {:.1}/{:.1}/{:.1}/{:.1}/{:.1}/{:.1}°",
+            "{}; {settle}, final error {:.2} m; Δα {:+.1}°, Δβ {:+.1}°{roll}, Δθ {:+.1}°, ΔT {:+.1} N; |Δδ| e/a/r/fc/fd/v {:.1}/{:.1}/{:.1}/{:.1}/{:.1}/{:.1}°",
             checks,
             num(r, "error_final"),
             num(r, "d_alpha_deg"),
             num(r, "d_beta_deg"),
-            num(r, "d_roll_deg"),
             num(r, "d_pitch_deg"),
             num(r, "d_thrust"),
             sf(0), sf(1), sf(2), sf(3), sf(4), sf(5),
@@ -719,8 +731,14 @@ pub fn run(out: &Path, cfg: &Config, progress: bool) -> std::io::Result<Value> {
                     continue;
                 };
                 let mut figure = format!("cfg 1: {}", step_text(c1));
+                let mut v = c1.get("verdict").cloned().unwrap_or(Value::Null);
                 if let Some(c8) = step_of(kind.name(), 1, flight, axis, 8.0) {
                     figure += &format!(" — cfg 1 at V_V = 8 m/s: {}", step_text(c8));
+                    // At the register's V_V (D-M.3) only: partly.
+                    if c8.get("verdict") != Some(&v) && c8.get("verdict").and_then(Value::as_str) == Some("reproduced")
+                    {
+                        v = json!("partly");
+                    }
                 }
                 if let Some(c0) = c0 {
                     figure += &format!(" — cfg 0: {}", step_text(c0));
@@ -730,7 +748,7 @@ pub fn run(out: &Path, cfg: &Config, progress: bool) -> std::io::Result<Value> {
                         c1.get("text").and_then(Value::as_str).unwrap_or("")),
                     "where": c1.get("where").cloned().unwrap_or(Value::Null),
                     "figure": figure,
-                    "verdict": c1.get("verdict").cloned().unwrap_or(Value::Null),
+                    "verdict": v,
                 }));
             }
         }
