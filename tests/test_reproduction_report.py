@@ -107,6 +107,19 @@ def test_fast_transitions_steps_and_chapter_6_render_from_the_files():
         assert row.endswith(f"| {c['verdict']} | {wind[c['id']]['figure']} | {wind[c['id']]['verdict']} |")
 
 
+def test_every_table_row_has_its_header_s_columns():
+    """No cell text splits a Markdown table (a `|` inside a figure would)."""
+    lines = reproduction.section(reproduction.load_into({}, DATA))
+    header = None
+    for line in lines:
+        if not line.startswith("|"):
+            header = None
+            continue
+        if header is None:
+            header = line.count("|")
+        assert line.count("|") == header, line
+
+
 def test_wind_conclusions_follow_the_arms():
     """The §6.2.6 verdicts in wind move with the campaign's figures."""
     arm = {"runs": 100, "completed": 50, "median_max_err": 5.0, "median_rms_err": 2.0}

@@ -711,7 +711,7 @@ pub fn run(out: &Path, cfg: &Config, progress: bool) -> std::io::Result<Value> {
             .and_then(Value::as_f64)
             .map_or(String::new(), |v| format!(", Δφ {v:+.1}°"));
         format!(
-            "{}; {settle}, final error {:.2} m; Δα {:+.1}°, Δβ {:+.1}°{roll}, Δθ {:+.1}°, ΔT {:+.1} N; |Δδ| e/a/r/fc/fd/v {:.1}/{:.1}/{:.1}/{:.1}/{:.1}/{:.1}°",
+            "{}; {settle}, final error {:.2} m; Δα {:+.1}°, Δβ {:+.1}°{roll}, Δθ {:+.1}°, ΔT {:+.1} N; peak Δδ e/a/r/fc/fd/v {:.1}/{:.1}/{:.1}/{:.1}/{:.1}/{:.1}°",
             checks,
             num(r, "error_final"),
             num(r, "d_alpha_deg"),

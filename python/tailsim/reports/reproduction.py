@@ -431,7 +431,7 @@ def _steps(r: dict) -> list[str]:
             "behaviour described",
             "settled (s)",
             "Δ peaks (°, N)",
-            "|Δδ| e/a/r/fc/fd/v (°)",
+            "peak Δδ e/a/r/fc/fd/v (°)",
             "checks",
             "verdict",
         ],
