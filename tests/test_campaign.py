@@ -572,3 +572,21 @@ def test_report(serial, tmp_path):
         assert needle in text
     for png in ("completion.png", "distributions.png", "paired.png", "drivers.png"):
         assert (tmp_path / png).stat().st_size > 5000
+
+
+def test_every_avionics_state_source_sets_declared_ekf_parameters():
+    """Each avionics arm flies the sensors and the EKF, with EKF parameters the EKF declares:
+    `avionics` its defaults, `avionics_app_d` the App.-D-faithful switch on."""
+    from tailsim import declarations
+    from tailsim.campaign.sampling import STATE_SOURCES
+
+    ekf = declarations.VARIABLES["tailsitter_ekf"]
+    avionics = [s for s in STATE_SOURCES if s != "perfect"]
+    assert set(avionics) == set(R.AVIONICS_EKF_PARAMS)
+    for s in avionics:
+        assert R.STATE_SOURCE_FMUS[s] == ("sensors", "ekf")
+        for name in R.AVIONICS_EKF_PARAMS[s]:
+            assert ekf[name].causality == "parameter", name
+    assert R.AVIONICS_EKF_PARAMS["avionics"] == {}
+    assert R.AVIONICS_EKF_PARAMS["avionics_app_d"] == {"app_d_configuration": True}
+    assert CampaignSpec(state_sources=("avionics_app_d",)).state_sources == ("avionics_app_d",)

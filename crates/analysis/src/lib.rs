@@ -16,6 +16,7 @@ pub mod linalg;
 pub mod modes;
 pub mod native_campaign;
 pub mod reproduction;
+pub mod reproduction_flights;
 pub mod robust;
 pub mod sensitivity;
 pub mod sweep;

@@ -41,7 +41,10 @@ FMU_NAMES = {
     "ekf": "tailsitter_ekf",
 }
 #: The FMUs a state source needs beside the plant and the controllers.
-STATE_SOURCE_FMUS = {"perfect": (), "avionics": ("sensors", "ekf")}
+STATE_SOURCE_FMUS = {"perfect": (), "avionics": ("sensors", "ekf"), "avionics_app_d": ("sensors", "ekf")}
+#: EKF parameters of each avionics state source: `avionics` the tuned estimator (the FMU's
+#: defaults), `avionics_app_d` the thesis App.-D-faithful one (Table D.1 variances, no extras).
+AVIONICS_EKF_PARAMS = {"avionics": {}, "avionics_app_d": {"app_d_configuration": True}}
 N_PHASES = len(declarations.PHASES)
 #: Command limits of the saturation metric: the plant's declared thrust limits and surface
 #: deflection limit (its parameters' defaults).
@@ -286,7 +289,7 @@ def run_job(job: Mapping[str, Any], spec_json: Mapping[str, Any], digests: Mappi
         pp.update(json.loads(job.get("overrides") or "{}"))
         cp = dict(spec.mission)
         cp.update(CONFIGURATIONS[job["configuration"]][job["controller"]])
-        if job["state_source"] == "avionics":
+        if job["state_source"] in AVIONICS_EKF_PARAMS:
             plant_ok = ctrl_ok = True  # the avionics loop instantiates its own four units
             row.update(_run_avionics(job, spec, digests, pp, cp))
             return row
@@ -366,6 +369,7 @@ def _run_avionics(
             fmus[job["controller"]],
             plant_params=pp,
             sensors_params={"seed": int(job["noise_seed"])},
+            ekf_params=AVIONICS_EKF_PARAMS[job["state_source"]],
             controller_params=cp,
         )
         failure = detail = ""

@@ -86,7 +86,7 @@ CONFIGURATIONS: dict[str, dict[str, dict[str, int]]] = {
 }
 #: The controller FMUs' `configuration` value of each configuration (the native campaign's input).
 CONFIGURATION_INDEX = {"tuned": 0, "thesis": 1}
-STATE_SOURCES = ("perfect", "avionics")
+STATE_SOURCES = ("perfect", "avionics", "avionics_app_d")
 
 #: Missions (controller parameters; identical for both controllers): the phase durations of
 #: the declared presets `default` (the controllers' defaults: 5 s climb, T1 = 5 s, 10 s level,

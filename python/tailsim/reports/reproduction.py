@@ -6,12 +6,21 @@ air, nominal plant). Every number comes from the result file."""
 
 from __future__ import annotations
 
+import argparse
+import json
 import pathlib
+import sys
+
+import numpy as np
 
 from . import load_json_into
 from .markdown import fmt_or_dash, fmt_pole, table
 
 FILE = "reproduction.json"
+#: Chapter 6's conclusions on our plant in wind, from campaign folders (`python -m
+#: tailsim.reports.reproduction --wind FOLDER... --out FOLDER`).
+WIND_FILE = "reproduction_wind.json"
+PHASES = ("vertical 1", "transition 1", "level", "transition 2", "vertical 2")
 
 METHOD_NOTES = (
     "How this matches §5.1: the thesis applies the gains of the perfect model to a linear model with an altered "
@@ -36,8 +45,90 @@ TABLE_4_4_NOTES = (
 
 
 def load_into(d: dict, folder: str | pathlib.Path) -> dict:
-    """Add `reproduction.json` of `folder` (if written) to the report data `d`."""
-    return load_json_into(d, folder, FILE, "reproduction")
+    """Add `reproduction.json` and `reproduction_wind.json` of `folder` (if written) to the report data `d`."""
+    return load_json_into(load_json_into(d, folder, FILE, "reproduction"), folder, WIND_FILE, "reproduction_wind")
+
+
+def wind_summary(folders) -> dict:
+    """Per arm of the campaign folders (controller/configuration/state source): runs,
+    completion, and over the completed runs the median largest error overall and per phase."""
+    from ..campaign import section
+
+    table, specs, _ = section._load(folders)
+    cols = {k: np.asarray(v) for k, v in table.to_pydict().items()}
+    out = {"spec": {k: specs[0].to_json()[k] for k in section.SAMPLE_SPACE}, "arms": {}}
+    for a in section.arms(cols):
+        m = section._arm_mask(cols, a)
+        ok = m & cols["completed"].astype(bool)
+
+        def med(q: str, ok=ok) -> float:
+            return float(np.median(cols[q][ok].astype(float))) if ok.any() else float("nan")
+
+        out["arms"]["/".join(a)] = {
+            "runs": int(m.sum()),
+            "completed": int(ok.sum()),
+            "p": float(ok.sum() / m.sum()) if m.any() else float("nan"),
+            "median_max_err": med("max_err"),
+            "median_rms_err": med("rms_err"),
+            "median_phase_max_err": [med(f"max_err_p{k}") for k in range(len(PHASES))],
+        }
+    return out
+
+
+def wind_conclusions(w: dict) -> list[dict]:
+    """Chapter 6's conclusions (§6.2.6) judged on the campaign in wind: figure and verdict each."""
+    arms = w["arms"]
+
+    def arm(k, c="thesis", s="perfect"):
+        return arms.get(f"{k}/{c}/{s}")
+
+    def verdict(ok: bool, partly: bool) -> str:
+        return "reproduced" if ok else ("partly" if partly else "not reproduced")
+
+    out = []
+    lq = arm("lqr")
+    if lq:
+        ph = lq["median_phase_max_err"]
+        trans, steady = max(ph[1], ph[3]), max(ph[0], ph[2], ph[4])
+        out.append(
+            {
+                "id": "lqr_phases",
+                "figure": f"LQR cfg 1, median over completed runs ({lq['completed']} of {lq['runs']}): "
+                f"largest error in the transitions {trans:.2f} m, in vertical/level flight {steady:.2f} m",
+                "verdict": verdict(trans > steady, False),
+            }
+        )
+    rows = [(k, arm(k)) for k in ("lqr", "tsd")]
+    if all(r for _, r in rows):
+        (_, l1), (_, t1) = rows
+        out.append(
+            {
+                "id": "lqr_robust",
+                "figure": f"completion on uncertain plants in wind, cfg 1: LQR {l1['p']:.3f}, TSD {t1['p']:.3f} "
+                f"(of {l1['runs']} each)",
+                "verdict": verdict(l1["p"] > t1["p"] + 0.1, l1["p"] > t1["p"]),
+            }
+        )
+        out.append(
+            {
+                "id": "tsd_better",
+                "figure": f"cfg 1: completion TSD {t1['p']:.3f} vs LQR {l1['p']:.3f}; median largest error TSD "
+                f"{t1['median_max_err']:.2f} m vs LQR {l1['median_max_err']:.2f} m",
+                "verdict": verdict(
+                    t1["p"] >= l1["p"] and t1["median_max_err"] < l1["median_max_err"],
+                    t1["median_max_err"] < l1["median_max_err"] or t1["p"] > l1["p"],
+                ),
+            }
+        )
+    tuned = [arm(k, "tuned") for k in ("lqr", "tsd")]
+    if all(tuned):
+        for o in out:
+            if o["id"] == "tsd_better":
+                o["figure"] += (
+                    f"; tuned: completion TSD {tuned[1]['p']:.3f} vs LQR {tuned[0]['p']:.3f}, median largest error "
+                    f"TSD {tuned[1]['median_max_err']:.2f} m vs LQR {tuned[0]['median_max_err']:.2f} m"
+                )
+    return out
 
 
 def _pole(p) -> str:
@@ -234,4 +325,165 @@ def section(d: dict) -> list[str]:
         ],
         rows,
     )
+    out += _fast(r) + _steps(r) + _chapter6(r, d.get("reproduction_wind"))
     return out
+
+
+def _fast(r: dict) -> list[str]:
+    f = r.get("fast_transitions")
+    if not f:
+        return []
+    out = [
+        "",
+        "### The TSD's 3/4 s transitions (App. E.1)",
+        "",
+        "The printed quarter loop (4.3.31–4.3.36) turns the path at V̄ linear in t over a quarter circle of "
+        "radius r = (V_V + V_L) T / π; at V_L its centripetal acceleration V_L²/r asks for a load n = 1 + V_L²/(r g) "
+        "at the start of T2 and 1 − V_L²/(r g) at the end of T1. With C_L0 = 0 (C.2.1) the wing gives n at "
+        "α = n m g / (q̄ S C_Lα). *Demand* lists n and that α; *T for α ≤ "
+        f"{f['alpha_linear_deg']:g}°* the shortest transitions whose quarter loop stays in the linear range.",
+        "",
+    ]
+    rows = []
+    for x in f["rows"]:
+        dm = x["demand"]
+        rows.append(
+            [
+                x["variant"],
+                f"{x['v_vertical']:g}",
+                "yes" if x["passed"] else "no",
+                fmt_or_dash(x["max_pos_error"], 2),
+                f"{fmt_or_dash(x['alpha_min_t1_deg'], 1)} / {fmt_or_dash(x['alpha_max_t2_deg'], 1)}",
+                fmt_or_dash(x["final_pitch_error_deg"], 1),
+                f"{dm['n_t1_end']:.2f} g, {dm['alpha_t1_deg']:.1f}° / "
+                f"{dm['n_t2_start']:.2f} g, {dm['alpha_t2_deg']:.1f}°",
+                f"{dm['t1_for_linear']:.1f} / {dm['t2_for_linear']:.1f} s",
+            ]
+        )
+    return out + table(
+        [
+            "TSD",
+            "V_V (m/s)",
+            "passed",
+            "max error (m)",
+            "α min T1 / max T2 (°)",
+            "final pitch error (°)",
+            "demand end T1 / start T2",
+            f"T1 / T2 for α ≤ {f['alpha_linear_deg']:g}°",
+        ],
+        rows,
+    )
+
+
+def _settled(x: dict) -> str:
+    if not x["completed"]:
+        return "lost"
+    return "no" if x["settle_time"] is None else fmt_or_dash(x["settle_time"], 1)
+
+
+def _steps(r: dict) -> list[str]:
+    st = r.get("step_responses")
+    if not st:
+        return []
+    out = [
+        "",
+        "### Position steps (§3.4.1, §4.4.2–4.4.3)",
+        "",
+        f"A {st['step']:g} m step of the reference (normal: up in level flight, toward the belly = north in the "
+        f"climb; lateral: east), followed {st['window']:g} s; the response is the difference to the same flight "
+        "without the step. Settled: within 10 % of the step. Δ = signed peak change from the value at the step; a "
+        "surface counts as used at ≥ 10 % of the largest surface's peak; \"against\" = the pair's changes are "
+        "negatively correlated. Roll is given in level flight only.",
+        "",
+    ]
+    rows = []
+    for x in st["rows"]:
+        checks = ", ".join(f"{c['check']} {'✓' if c['shown'] else '✗'}" for c in x["checks"])
+        sf = x["d_surfaces_deg"]
+        rows.append(
+            [
+                x["controller"],
+                f"cfg {x['configuration']}",
+                f"{x['flight']} (V_V {x['v_vertical']:g})" if x["flight"] == "vertical" else x["flight"],
+                x["axis"],
+                x["where"],
+                x["text"],
+                "lost"
+                if not x["completed"]
+                else fmt_or_dash(x["settle_time"], 1)
+                if x["settle_time"] is not None
+                else "no",
+                f"α {fmt_or_dash(x['d_alpha_deg'], 1)}, β {fmt_or_dash(x['d_beta_deg'], 1)}, "
+                f"φ {fmt_or_dash(x['d_roll_deg'], 1)}, θ {fmt_or_dash(x['d_pitch_deg'], 1)}, "
+                f"T {fmt_or_dash(x['d_thrust'], 1)} N",
+                "/".join(fmt_or_dash(v, 2) for v in sf),
+                checks,
+                x["verdict"],
+            ]
+        )
+    return out + table(
+        [
+            "controller",
+            "configuration",
+            "flight",
+            "step",
+            "thesis",
+            "behaviour described",
+            "settled (s)",
+            "Δ peaks (°, N)",
+            "peak Δδ e/a/r/fc/fd/v (°)",
+            "checks",
+            "verdict",
+        ],
+        rows,
+    )
+
+
+def _chapter6(r: dict, wind: dict | None) -> list[str]:
+    six = r.get("conclusions_6_2_6")
+    if not six:
+        return []
+    out = [
+        "",
+        "### Chapter 6's conclusions (§6.2.6), twice",
+        "",
+        "On the thesis's setting (above) and on our plant in wind: the campaign's uncertain plants "
+        "(global post-stall aerodynamics, wind and gusts, perfect state)"
+        + (
+            f", {wind['spec'].get('tau_aero', '')} / {wind['spec'].get('tau_mass', '')} parameter spread, "
+            f"wind ≤ {wind['spec'].get('wind_max', '')} m/s, gusts ≤ {wind['spec'].get('gust_max', '')} m/s, "
+            f"{next(iter(wind['arms'].values()))['runs']} samples per arm."
+            if wind
+            else " — not computed (`python -m tailsim.reports.reproduction --wind FOLDER... --out FOLDER`)."
+        ),
+        "",
+    ]
+    w = {c["id"]: c for c in wind_conclusions(wind)} if wind else {}
+    rows = []
+    for c in six:
+        wc = w.get(c["id"], {})
+        rows.append([c["claim"], c["where"], c["figure"], c["verdict"], wc.get("figure", "—"), wc.get("verdict", "—")])
+    return out + table(
+        ["conclusion", "thesis", "thesis's setting", "verdict", "our plant in wind (campaign)", "verdict"], rows
+    )
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(
+        prog="python -m tailsim.reports.reproduction",
+        description="Write reproduction_wind.json: chapter 6's conclusions measured on campaign folders.",
+    )
+    ap.add_argument("--wind", nargs="+", required=True, help="campaign folders (same sample space)")
+    ap.add_argument("--out", required=True, help="analysis folder to write reproduction_wind.json into")
+    a = ap.parse_args(argv)
+    w = wind_summary(a.wind)
+    w["conclusions"] = wind_conclusions(w)
+    out = pathlib.Path(a.out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / WIND_FILE).write_text(json.dumps(w, indent=1, allow_nan=True))
+    print(out / WIND_FILE)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
