@@ -78,6 +78,12 @@ pub struct Derived {
     pub pitch_offset: f64,
     /// TRIM_PITCH: normalised pitch torque of the level trim's surfaces.
     pub trim_pitch: f64,
+    /// FW_AIRSPD_MIN, VT_ARSP_TRANS (m/s).
+    pub airspeed_min: f64,
+    pub transition_airspeed: f64,
+    /// FW_T_CLMB_MAX, FW_T_SINK_MIN (m/s).
+    pub climb_max: f64,
+    pub sink_min: f64,
     /// VT_F_TRANS_DUR, VT_B_TRANS_DUR (s).
     pub front_duration: f64,
     pub back_duration: f64,
@@ -108,10 +114,27 @@ impl Derived {
         } else {
             fw.torque_of(&trim_u).y
         };
+        // Energy rates at the throttle limits at the level trim: the excess power of full
+        // throttle, and the drag power at idle (thrust 0), per unit weight.
+        let v_trim = or(p.FW_AIRSPD_TRIM, mission.v_level);
+        let weight = airframe.mass * airframe.gravity;
+        let climb_max = or(
+            p.FW_T_CLMB_MAX,
+            (p.FW_THR_MAX * airframe.thrust_max - level.thrust) * v_trim / weight,
+        );
+        let sink_min = or(p.FW_T_SINK_MIN, level.thrust * v_trim / weight);
+        // Level flight at the profile's α limit with the trimmed lift slope.
+        let pm = guidance::PointMass::from_level_trim(airframe, mission.v_level)?;
+        let stall_like = (2.0 * weight / (airframe.air_density * airframe.wing_area * pm.c_l_alpha * mission.transition_alpha_max)).sqrt();
+        let airspeed_min = or(p.FW_AIRSPD_MIN, stall_like);
         Ok(Self {
+            airspeed_min,
+            transition_airspeed: or(p.VT_ARSP_TRANS, airspeed_min),
+            climb_max,
+            sink_min,
             thr_hover: or(p.MPC_THR_HOVER, climb.thrust / airframe.thrust_max),
             thr_trim: or(p.FW_THR_TRIM, level.thrust / airframe.thrust_max),
-            airspeed_trim: or(p.FW_AIRSPD_TRIM, mission.v_level),
+            airspeed_trim: v_trim,
             pitch_offset: if p.FW_PSP_OFF >= 0.0 { p.FW_PSP_OFF } else { level.theta },
             trim_pitch,
             front_duration: or(p.VT_F_TRANS_DUR, mission.t_transition_1),
@@ -315,8 +338,8 @@ impl Px4Controller {
             i_gain_pit: p.FW_T_I_GAIN_PIT,
             ptch_damp: p.FW_T_PTCH_DAMP,
             spd_weight: p.FW_T_SPDWEIGHT,
-            clmb_max: p.FW_T_CLMB_MAX,
-            sink_min: p.FW_T_SINK_MIN,
+            clmb_max: self.derived.climb_max,
+            sink_min: self.derived.sink_min,
             sink_max: p.FW_T_SINK_MAX,
             thr_trim: self.derived.thr_trim,
             thr_min: p.FW_THR_MIN,
@@ -505,7 +528,7 @@ impl Px4Controller {
             g,
         );
         // Airspeed scaling s = V_trim / V (V at least FW_AIRSPD_MIN).
-        let s = d.airspeed_trim / tas.max(p.FW_AIRSPD_MIN);
+        let s = d.airspeed_trim / tas.max(d.airspeed_min);
         let gains = self.fw_rate_gains(s);
         let acc = self.angular_accel(&meas.rates);
         let u = self.fw_rate.update(&gains, &meas.rates, &rate_sp, &acc, dt, false);
@@ -638,7 +661,7 @@ impl SampledUnit for Px4Controller {
         let q_mc = body_attitude(meas) * body_from_mc();
         let mode = self
             .vtol
-            .update(input.t, &r, &q_mc, meas.airspeed, &self.params, &self.derived);
+            .update(input.t, &r, &q_mc, meas.airspeed, &self.derived);
         let t_max = self.airframe.thrust_max;
         let (torque, thrust_fraction, eff) = match mode {
             VtolMode::Multicopter => {

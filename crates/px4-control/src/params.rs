@@ -87,11 +87,11 @@ pub struct Px4Params {
     pub VT_F_TRANS_DUR: f64,
     /// Back transition: pitch ramp duration and time-out; ≤ 0: the mission's t_transition_2 (PX4 default 4 s).
     pub VT_B_TRANS_DUR: f64,
-    /// Front transition: airspeed at which fixed-wing flight may begin (PX4 default).
+    /// Front transition: airspeed at which fixed-wing flight may begin (PX4 default 10 m/s, below this airframe's stall speed); ≤ 0: FW_AIRSPD_MIN (PX4: between FW_AIRSPD_MIN and FW_AIRSPD_TRIM).
     pub VT_ARSP_TRANS: f64,
     /// Trim airspeed of the airspeed scaling and TECS; derived for this airframe when ≤ 0 (README, 'Derived parameters'): the mission's v_level.
     pub FW_AIRSPD_TRIM: f64,
-    /// Smallest airspeed of the airspeed scaling (PX4 default).
+    /// Smallest fixed-wing airspeed, also of the airspeed scaling (PX4 default 10 m/s, below this airframe's stall speed); derived for this airframe when ≤ 0 (README, 'Derived parameters'): level flight at the mission's transition_alpha_max, sqrt(2 m g / (ρ S C_Lα α_max)) with the trimmed lift slope.
     pub FW_AIRSPD_MIN: f64,
     /// Pitch setpoint offset of level flight; derived for this airframe when ≤ 0 (README, 'Derived parameters') (negative values are taken as derived): the level trim's pitch.
     pub FW_PSP_OFF: f64,
@@ -143,9 +143,9 @@ pub struct Px4Params {
     pub FW_T_PTCH_DAMP: f64,
     /// TECS speed weight: 0 height only, 2 speed only (PX4 default).
     pub FW_T_SPDWEIGHT: f64,
-    /// Climb rate at full throttle and trim airspeed (PX4 default).
+    /// Climb rate at full throttle and trim airspeed (PX4 default 5 m/s, which this airframe exceeds eightfold); derived for this airframe when ≤ 0 (README, 'Derived parameters'): (FW_THR_MAX T_max − T_trim) V_trim / (m g) of the level trim.
     pub FW_T_CLMB_MAX: f64,
-    /// Sink rate at idle throttle and trim airspeed (PX4 default).
+    /// Sink rate at idle throttle and trim airspeed (PX4 default 2 m/s); derived for this airframe when ≤ 0 (README, 'Derived parameters'): T_trim V_trim / (m g) of the level trim (idle thrust 0).
     pub FW_T_SINK_MIN: f64,
     /// Largest sink-rate setpoint (PX4 default).
     pub FW_T_SINK_MAX: f64,
@@ -266,6 +266,10 @@ impl Px4Params {
                     | "FW_THR_TRIM"
                     | "TRIM_PITCH"
                     | "FW_P_LIM_MIN"
+                    | "FW_T_CLMB_MAX"
+                    | "FW_AIRSPD_MIN"
+                    | "VT_ARSP_TRANS"
+                    | "FW_T_SINK_MIN"
             );
             if !signed && value < 0.0 {
                 return Err(ParamError(format!("{name} = {value}: must be ≥ 0")));
@@ -276,9 +280,6 @@ impl Px4Params {
             ("FW_R_TC", self.FW_R_TC),
             ("FW_T_ALT_TC", self.FW_T_ALT_TC),
             ("FW_T_TAS_TC", self.FW_T_TAS_TC),
-            ("FW_T_CLMB_MAX", self.FW_T_CLMB_MAX),
-            ("FW_T_SINK_MIN", self.FW_T_SINK_MIN),
-            ("FW_AIRSPD_MIN", self.FW_AIRSPD_MIN),
             ("FW_L1_PERIOD", self.FW_L1_PERIOD),
             ("FW_L1_DAMPING", self.FW_L1_DAMPING),
             ("MPC_THR_MAX", self.MPC_THR_MAX),

@@ -16,7 +16,7 @@
 //! Attitudes in the multicopter frame (README, "Frames"), as PX4's transitions are flown by
 //! the multicopter attitude controller.
 
-use crate::{body_from_mc, Derived, Px4Params, Reference};
+use crate::{body_from_mc, Derived, Reference};
 use nalgebra::{Quaternion, Unit, UnitQuaternion, Vector3};
 
 /// Multicopter pitch below which the front transition may end (PX4 `PITCH_TRANSITION_FRONT_P1`) (rad).
@@ -104,7 +104,6 @@ impl Vtol {
         r: &Reference,
         q_mc: &UnitQuaternion<f64>,
         airspeed: f64,
-        p: &Px4Params,
         d: &Derived,
     ) -> VtolMode {
         let pitch = q_mc.euler_angles().1;
@@ -122,7 +121,7 @@ impl Vtol {
                 VtolMode::FrontTransition
             }
             (true, VtolMode::FrontTransition) => {
-                if pitch <= PITCH_TRANSITION_FRONT && airspeed >= p.VT_ARSP_TRANS {
+                if pitch <= PITCH_TRANSITION_FRONT && airspeed >= d.transition_airspeed {
                     VtolMode::FixedWing
                 } else {
                     VtolMode::FrontTransition
