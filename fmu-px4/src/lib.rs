@@ -40,7 +40,12 @@ mod tests {
         model.initialize(&mut vars, 0.0, &mut log).unwrap();
         // Start values are the trimmed climb: the hover thrust is derived from that trim,
         // so the first command is its thrust.
-        assert!((vars.thrust_cmd - vars.thrust).abs() < 0.5, "{} vs {}", vars.thrust_cmd, vars.thrust);
+        assert!(
+            (vars.thrust_cmd - vars.thrust).abs() < 0.5,
+            "{} vs {}",
+            vars.thrust_cmd,
+            vars.thrust
+        );
         assert_eq!(vars.phase, 0);
         let first = vars.thrust_cmd;
         vars.accel_x = 12.0;

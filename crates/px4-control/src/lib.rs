@@ -125,7 +125,9 @@ impl Derived {
         let sink_min = or(p.FW_T_SINK_MIN, level.thrust * v_trim / weight);
         // Level flight at the profile's α limit with the trimmed lift slope.
         let pm = guidance::PointMass::from_level_trim(airframe, mission.v_level)?;
-        let stall_like = (2.0 * weight / (airframe.air_density * airframe.wing_area * pm.c_l_alpha * mission.transition_alpha_max)).sqrt();
+        let stall_like = (2.0 * weight
+            / (airframe.air_density * airframe.wing_area * pm.c_l_alpha * mission.transition_alpha_max))
+            .sqrt();
         let airspeed_min = or(p.FW_AIRSPD_MIN, stall_like);
         Ok(Self {
             airspeed_min,
@@ -659,9 +661,7 @@ impl SampledUnit for Px4Controller {
             Err((phase, thrust)) => return Ok(self.on_gear(meas, phase, thrust)),
         };
         let q_mc = body_attitude(meas) * body_from_mc();
-        let mode = self
-            .vtol
-            .update(input.t, &r, &q_mc, meas.airspeed, &self.derived);
+        let mode = self.vtol.update(input.t, &r, &q_mc, meas.airspeed, &self.derived);
         let t_max = self.airframe.thrust_max;
         let (torque, thrust_fraction, eff) = match mode {
             VtolMode::Multicopter => {
