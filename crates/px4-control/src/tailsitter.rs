@@ -36,11 +36,14 @@ pub enum VtolMode {
 
 impl VtolMode {
     fn from_code(c: f64) -> Option<Self> {
-        Some(match c {
-            x if x == 0.0 => Self::Multicopter,
-            x if x == 1.0 => Self::FrontTransition,
-            x if x == 2.0 => Self::FixedWing,
-            x if x == 3.0 => Self::BackTransition,
+        if c.fract() != 0.0 {
+            return None;
+        }
+        Some(match c as i64 {
+            0 => Self::Multicopter,
+            1 => Self::FrontTransition,
+            2 => Self::FixedWing,
+            3 => Self::BackTransition,
             _ => return None,
         })
     }
