@@ -559,23 +559,6 @@ impl Px4Controller {
     }
 }
 
-/// Input check: every measurement, the time and the reference offset finite.
-fn check_input(input: &ControllerInput) -> Result<(), ControlError> {
-    if let Some(name) = input.measurement.first_non_finite() {
-        return Err(ControlError(format!(
-            "measurement '{name}' is not finite at t = {} s",
-            input.t
-        )));
-    }
-    if !input.t.is_finite() || !input.ref_offset_ned.iter().all(|v| v.is_finite()) {
-        return Err(ControlError(format!(
-            "non-finite time or reference offset at t = {} s",
-            input.t
-        )));
-    }
-    Ok(())
-}
-
 impl SampledUnit for Px4Controller {
     type Config = Px4Config;
     type Input = ControllerInput;
@@ -654,7 +637,7 @@ impl SampledUnit for Px4Controller {
 
     /// One sample: reference → VTOL mode → the loops of the mode → allocation.
     fn sample(&mut self, input: &ControllerInput) -> Result<ControllerOutput, ControlError> {
-        check_input(input)?;
+        input.check()?;
         let meas = &input.measurement;
         let r = match self.reference(input) {
             Ok(r) => r,
