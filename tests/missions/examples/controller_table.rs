@@ -65,6 +65,32 @@ fn main() {
             }
         }
     }
+    // Steady wind (m/s, from the four quarters): the default mission, Gauss-Seidel.
+    println!();
+    println!(
+        "| steady wind | controller | completed | criteria | largest position error (m) | final pitch error (deg) |"
+    );
+    println!("|---|---|---|---|---|---|");
+    let mission = MissionParams::default();
+    let x0 = plant.trim_vertical_climb(mission.v_vertical).unwrap().state;
+    let theta = plant.trim_level(mission.v_level).unwrap().theta;
+    for speed in [3.0, 6.0] {
+        for (from, bearing) in [("N", 0.0), ("E", 90.0), ("S", 180.0), ("W", 270.0)] {
+            for name in names {
+                let mut s = Scenario::mission(mission);
+                s.wind = closed_loop::Wind::Constant(closed_loop::wind_from(f64::to_radians(bearing), speed));
+                let trace = fly_any(name, mission, &plant, x0, &s);
+                let check = MissionCheck::of(&trace, &mission, theta);
+                println!(
+                    "| {speed} m/s from {from} | {name} | {} | {} | {:.2} | {:.2} |",
+                    trace.completed_cell(),
+                    check.verdict(),
+                    trace.max_pos_error(),
+                    check.final_pitch_error.to_degrees()
+                );
+            }
+        }
+    }
     // Take-off → landing on the global aerodynamics with the ground plane.
     let mission = analysis::takeoff_landing::mission();
     let (tplant, x0) = analysis::takeoff_landing::plant();

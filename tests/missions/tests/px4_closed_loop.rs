@@ -44,7 +44,12 @@ fn run(mission: MissionParams, ordering: Ordering) -> (Trace, MissionCheck, Vec<
 
 /// First time (s) of `mode` in the run, if any.
 fn first(trace: &Trace, modes: &[VtolMode], mode: VtolMode) -> Option<f64> {
-    trace.samples.iter().zip(modes).find(|(_, m)| **m == mode).map(|(s, _)| s.t)
+    trace
+        .samples
+        .iter()
+        .zip(modes)
+        .find(|(_, m)| **m == mode)
+        .map(|(s, _)| s.t)
 }
 
 fn assert_default_mission(ordering: Ordering) {
@@ -155,6 +160,10 @@ fn vertical_position_steps_settle() {
             }
         }
         let final_err = trace.samples.last().unwrap().pos_error();
-        assert!(last_out - 5.0 < bound && final_err < 0.2, "{offset}: {} s, {final_err} m", last_out - 5.0);
+        assert!(
+            last_out - 5.0 < bound && final_err < 0.2,
+            "{offset}: {} s, {final_err} m",
+            last_out - 5.0
+        );
     }
 }
