@@ -32,8 +32,8 @@ from fmu_util import PLANT_STATES_BUT_FLAPS, fmu_path
 from tailsim import ClosedLoop, Fmu
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
-MODELS = ["tailsitter_plant", "tailsitter_lqr", "tailsitter_tsd"]
-CONTROLLERS = ["tailsitter_lqr", "tailsitter_tsd"]
+MODELS = ["tailsitter_plant", "tailsitter_lqr", "tailsitter_tsd", "tailsitter_px4"]
+CONTROLLERS = ["tailsitter_lqr", "tailsitter_tsd", "tailsitter_px4"]
 
 # Every function of the FMI 2.0 C API (fmi2Functions.h, both interfaces).
 FMI2_FUNCTIONS = """
@@ -208,6 +208,7 @@ PAIRINGS = [
     ("win64", "linux64", "tailsitter_tsd"),
     ("linux64", "win64", "tailsitter_lqr"),
     ("linux64", "win64", "tailsitter_tsd"),
+    ("linux64", "win64", "tailsitter_px4"),
 ]
 
 

@@ -120,6 +120,12 @@ pub const CRATES: &[CrateDefaults] = &[
         structs: &[plain("TsdParams", "tsd", "")],
     },
     CrateDefaults {
+        krate: "px4-control",
+        file: "tailsitter_px4.json",
+        out: "px4_params_generated.rs",
+        structs: &[plain("Px4Params", "px4", "")],
+    },
+    CrateDefaults {
         krate: "sensor-model",
         file: "tailsitter_sensors.json",
         out: "sensor_params_generated.rs",

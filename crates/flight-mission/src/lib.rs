@@ -412,6 +412,26 @@ pub struct ControllerInput {
     pub ref_offset_ned: Vector3<f64>,
 }
 
+impl ControllerInput {
+    /// Every measurement, the time and the reference offset finite; otherwise an error
+    /// naming the first non-finite measurement (or the time / offset).
+    pub fn check(&self) -> Result<(), ControlError> {
+        if let Some(name) = self.measurement.first_non_finite() {
+            return Err(ControlError(format!(
+                "measurement '{name}' is not finite at t = {} s",
+                self.t
+            )));
+        }
+        if !self.t.is_finite() || !self.ref_offset_ned.iter().all(|v| v.is_finite()) {
+            return Err(ControlError(format!(
+                "non-finite time or reference offset at t = {} s",
+                self.t
+            )));
+        }
+        Ok(())
+    }
+}
+
 /// Diagnostic outputs, the same in both controllers (docs/DESIGN.md §2).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Diagnostics {

@@ -134,23 +134,6 @@ struct SampleSignals<'a> {
     d: LoopDesign,
 }
 
-/// Input check: every measurement, the time and the reference offset finite.
-fn check_input(input: &ControllerInput) -> Result<(), ControlError> {
-    if let Some(name) = input.measurement.first_non_finite() {
-        return Err(TsdController::err(format!(
-            "measurement '{name}' is not finite at t = {} s",
-            input.t
-        )));
-    }
-    if !input.t.is_finite() || !input.ref_offset_ned.iter().all(|v| v.is_finite()) {
-        return Err(TsdController::err(format!(
-            "non-finite time or reference offset at t = {} s",
-            input.t
-        )));
-    }
-    Ok(())
-}
-
 /// The TSD controller.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TsdController {
@@ -353,7 +336,7 @@ impl SampledUnit for TsdController {
     /// One sample of the TSD controller: the stages of Figs. 4.1–4.2 in signal order
     /// (crate README, "Where each block of Figs. 4.1–4.2 lives in the code").
     fn sample(&mut self, input: &ControllerInput) -> Result<ControllerOutput, ControlError> {
-        check_input(input)?;
+        input.check()?;
         let meas = &input.measurement;
         let dev = self.deviations();
         // Reference (§4.3.3), or the take-off / landing phases around it.

@@ -79,7 +79,10 @@ assert len(TABLE_5_1) == 25
 #: controller flies on: `perfect` = the plant's outputs; `avionics` = the estimate of
 #: `tailsitter_ekf` fed by `tailsitter_sensors` (tailsim.masters.avionics, Gauss-Seidel), the
 #: sensors seeded with the sample's `noise_seed`.
-CONTROLLERS = controllers.KEYS
+#: The campaign's controller arms: the declared controllers with a `configuration` parameter
+#: (the configuration axes set it, and the native campaign's controllers, crates/analysis
+#: `Kind`, are those); a controller without one (`tailsitter_px4`) is not an arm yet.
+CONTROLLERS = tuple(k for k in controllers.KEYS if "configuration" in declarations.VARIABLES[controllers.NAMES[k]])
 CONFIGURATIONS: dict[str, dict[str, dict[str, int]]] = {
     "tuned": {k: {} for k in CONTROLLERS},
     "thesis": {k: {"configuration": 1} for k in CONTROLLERS},

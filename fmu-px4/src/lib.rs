@@ -1,0 +1,109 @@
+//! `tailsitter_px4`: PX4-Autopilot's tail-sitter VTOL control path
+//! ([`px4_control::Px4Controller`]) bound to the generic FMI 2.0 Co-Simulation export layer
+//! through the one adapter of every co-simulation unit ([`controller_fmu::UnitFmu`]).
+//! Only the parameters live here; the variables are declared in
+//! `modelDescription/tailsitter_px4.json`, the ports in its controller-interface
+//! fragment, and timing, state and messages in `controller-fmu` (docs/DESIGN.md §2).
+
+use px4_control::{Px4Config, Px4Controller};
+
+/// Generated from the declaration: `Variables`, `vr`, `GUID`, `MODEL_IDENTIFIER`, `MODEL_DESCRIPTION_XML`.
+#[allow(clippy::all)]
+mod generated {
+    include!(concat!(env!("OUT_DIR"), "/variables.rs"));
+}
+pub use generated::{vr, Variables, GUID, MODEL_DESCRIPTION_XML, MODEL_IDENTIFIER};
+
+// The design model (parameter group `design_airframe`, default = the plant's nominal
+// airframe) gives the effectiveness, the trims and the derived parameters.
+controller_fmu::flight_controller_binding!(Px4, Px4Controller, "PX4", |vars| Px4Config {
+    airframe: vars.design_airframe(),
+    mission: vars.mission(),
+    params: vars.px4(),
+});
+
+/// One controller instance.
+pub type Px4Model = controller_fmu::UnitFmu<Px4>;
+
+fmi2_export::export_fmu!(Px4Model);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use fmi2_export::{FmuModel, Logger, StateReader, StateWriter, VariableStore};
+
+    #[test]
+    fn initialization_commands_the_climb_and_steps_hold_between_samples() {
+        let mut vars = Variables::with_start_values();
+        let mut model = Px4Model::new(&vars);
+        let mut log = Logger::null();
+        model.initialize(&mut vars, 0.0, &mut log).unwrap();
+        // Start values are the trimmed climb: the hover thrust is derived from that trim,
+        // so the first command is its thrust.
+        assert!(
+            (vars.thrust_cmd - vars.thrust).abs() < 0.5,
+            "{} vs {}",
+            vars.thrust_cmd,
+            vars.thrust
+        );
+        assert_eq!(vars.phase, 0);
+        let first = vars.thrust_cmd;
+        vars.accel_x = 12.0;
+        model.do_step(&mut vars, 0.0, 0.005, &mut log).unwrap();
+        assert_eq!(vars.thrust_cmd, first);
+        model.do_step(&mut vars, 0.005, 0.005, &mut log).unwrap();
+        assert_eq!(vars.thrust_cmd, first);
+        // At 0.02 the controller samples the changed input (the D term of the velocity loop
+        // and the integrators see it).
+        vars.vel_d = 1.0;
+        model.do_step(&mut vars, 0.02, 0.005, &mut log).unwrap();
+        assert_ne!(vars.thrust_cmd, first);
+        vars.q = f64::NAN;
+        let e = model.do_step(&mut vars, 0.04, 0.02, &mut log).unwrap_err();
+        assert!(format!("{e:?}").contains("'q'"), "{e:?}");
+    }
+
+    #[test]
+    fn invalid_parameter_is_an_error_naming_it() {
+        let mut vars = Variables::with_start_values();
+        vars.MC_ROLL_P = f64::NAN;
+        let mut model = Px4Model::new(&vars);
+        let e = model.initialize(&mut vars, 0.0, &mut Logger::null()).unwrap_err();
+        assert!(format!("{e:?}").contains("MC_ROLL_P"), "{e:?}");
+        let mut vars = Variables::with_start_values();
+        vars.mass = 0.0;
+        let mut model = Px4Model::new(&vars);
+        let e = model.initialize(&mut vars, 0.0, &mut Logger::null()).unwrap_err();
+        assert!(format!("{e:?}").contains("mass"), "{e:?}");
+    }
+
+    #[test]
+    fn parameter_start_values_are_the_crate_defaults() {
+        assert_eq!(Variables::with_start_values().px4(), px4_control::Px4Params::default());
+        assert_eq!(
+            Variables::with_start_values().design_airframe(),
+            tailsitter_physics::Airframe::default()
+        );
+    }
+
+    #[test]
+    fn state_round_trip() {
+        let mut vars = Variables::with_start_values();
+        let mut model = Px4Model::new(&vars);
+        let mut log = Logger::null();
+        model.initialize(&mut vars, 0.0, &mut log).unwrap();
+        vars.accel_x = 11.0;
+        model.do_step(&mut vars, 0.02, 0.02, &mut log).unwrap();
+        let mut w = StateWriter::new();
+        model.write_state(&mut w);
+        let bytes = w.into_bytes();
+        let mut other = Px4Model::new(&vars);
+        other.read_state(&mut StateReader::new(&bytes)).unwrap();
+        let mut a = vars.clone();
+        let mut b = vars;
+        model.do_step(&mut a, 0.04, 0.02, &mut log).unwrap();
+        other.do_step(&mut b, 0.04, 0.02, &mut log).unwrap();
+        assert_eq!(a.thrust_cmd, b.thrust_cmd);
+        assert_eq!(a.elevator_cmd, b.elevator_cmd);
+    }
+}
