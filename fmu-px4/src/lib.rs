@@ -67,14 +67,10 @@ mod tests {
     fn invalid_parameter_is_an_error_naming_it() {
         let mut vars = Variables::with_start_values();
         vars.MC_ROLL_P = f64::NAN;
-        let mut model = Px4Model::new(&vars);
-        let e = model.initialize(&mut vars, 0.0, &mut Logger::null()).unwrap_err();
-        assert!(format!("{e:?}").contains("MC_ROLL_P"), "{e:?}");
+        controller_fmu::testing::assert_initialize_refuses::<Px4Model>(vars, "MC_ROLL_P");
         let mut vars = Variables::with_start_values();
         vars.mass = 0.0;
-        let mut model = Px4Model::new(&vars);
-        let e = model.initialize(&mut vars, 0.0, &mut Logger::null()).unwrap_err();
-        assert!(format!("{e:?}").contains("mass"), "{e:?}");
+        controller_fmu::testing::assert_initialize_refuses::<Px4Model>(vars, "mass");
     }
 
     #[test]
@@ -88,22 +84,10 @@ mod tests {
 
     #[test]
     fn state_round_trip() {
-        let mut vars = Variables::with_start_values();
-        let mut model = Px4Model::new(&vars);
-        let mut log = Logger::null();
-        model.initialize(&mut vars, 0.0, &mut log).unwrap();
-        vars.accel_x = 11.0;
-        model.do_step(&mut vars, 0.02, 0.02, &mut log).unwrap();
-        let mut w = StateWriter::new();
-        model.write_state(&mut w);
-        let bytes = w.into_bytes();
-        let mut other = Px4Model::new(&vars);
-        other.read_state(&mut StateReader::new(&bytes)).unwrap();
-        let mut a = vars.clone();
-        let mut b = vars;
-        model.do_step(&mut a, 0.04, 0.02, &mut log).unwrap();
-        other.do_step(&mut b, 0.04, 0.02, &mut log).unwrap();
-        assert_eq!(a.thrust_cmd, b.thrust_cmd);
-        assert_eq!(a.elevator_cmd, b.elevator_cmd);
+        controller_fmu::testing::assert_state_round_trip::<Px4Model>(
+            Variables::with_start_values(),
+            |v| v.accel_x = 11.0,
+            |v| vec![v.thrust_cmd, v.elevator_cmd],
+        );
     }
 }

@@ -2,7 +2,7 @@
 
 use fmi2_export::fmi_sys::fmi2::{fmi2Status_fmi2Error as ERROR, fmi2Status_fmi2OK as OK};
 use fmi2_export::test_host::restore_forged;
-use fmi2_export::FmuModel;
+use fmi2_export::{FmuModel, Logger, StateReader, StateWriter};
 
 /// A serialized FMU state of the controller `M` is checked like values set by the host:
 /// a forged mission parameter (a state re-sealed with a valid checksum after its payload
@@ -36,4 +36,39 @@ pub fn assert_forged_mission_parameter_is_refused<M: FmuModel>() {
     let r = restore_forged::<M>("t_level", 12.345_678_9, 20.0);
     assert_eq!(r.deserialize.0, OK, "{:?}", r.deserialize.1);
     assert_eq!(r.set_state.0, OK, "{:?}", r.set_state.1);
+}
+
+/// Initialising `M` from `vars` (one parameter set out of range by the caller) fails with an
+/// error naming `parameter`.
+pub fn assert_initialize_refuses<M: FmuModel>(mut vars: M::Vars, parameter: &str) {
+    let mut model = M::new(&vars);
+    let e = model
+        .initialize(&mut vars, 0.0, &mut Logger::null())
+        .expect_err("initialize accepted an invalid parameter");
+    assert!(format!("{e:?}").contains(parameter), "{parameter}: {e:?}");
+}
+
+/// The state written after one sample (`perturb` changes an input first) and read into a
+/// fresh instance steps on exactly as the original: the values `outputs` reads agree bit for bit.
+pub fn assert_state_round_trip<M: FmuModel>(
+    mut vars: M::Vars,
+    perturb: impl Fn(&mut M::Vars),
+    outputs: impl Fn(&M::Vars) -> Vec<f64>,
+) where
+    M::Vars: Clone,
+{
+    let mut model = M::new(&vars);
+    let mut log = Logger::null();
+    model.initialize(&mut vars, 0.0, &mut log).unwrap();
+    perturb(&mut vars);
+    model.do_step(&mut vars, 0.02, 0.02, &mut log).unwrap();
+    let mut w = StateWriter::new();
+    model.write_state(&mut w);
+    let bytes = w.into_bytes();
+    let mut other = M::new(&vars);
+    other.read_state(&mut StateReader::new(&bytes)).unwrap();
+    let (mut a, mut b) = (vars.clone(), vars);
+    model.do_step(&mut a, 0.04, 0.02, &mut log).unwrap();
+    other.do_step(&mut b, 0.04, 0.02, &mut log).unwrap();
+    assert_eq!(outputs(&a), outputs(&b));
 }

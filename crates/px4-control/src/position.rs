@@ -192,6 +192,12 @@ mod tests {
         }
     }
 
+    /// One update of `pc` towards `sp` from rest at the origin.
+    fn at_rest(pc: &mut PositionControl, sp: &PositionSetpoint) -> Vector3<f64> {
+        let zero = Vector3::zeros();
+        pc.update(&gains(), sp, &zero, &zero, &zero, 0.02)
+    }
+
     #[test]
     fn hover_at_the_setpoint_asks_hover_thrust_upright() {
         let mut pc = PositionControl::default();
@@ -200,14 +206,7 @@ mod tests {
             vel: Vector3::zeros(),
             acc: Vector3::zeros(),
         };
-        let t = pc.update(
-            &gains(),
-            &sp,
-            &Vector3::zeros(),
-            &Vector3::zeros(),
-            &Vector3::zeros(),
-            0.02,
-        );
+        let t = at_rest(&mut pc, &sp);
         assert!((t - Vector3::new(0.0, 0.0, -0.5)).norm() < 1e-12, "{t}");
     }
 
@@ -221,14 +220,7 @@ mod tests {
         };
         let mut t = Vector3::zeros();
         for _ in 0..500 {
-            t = pc.update(
-                &gains(),
-                &sp,
-                &Vector3::zeros(),
-                &Vector3::zeros(),
-                &Vector3::zeros(),
-                0.02,
-            );
+            t = at_rest(&mut pc, &sp);
         }
         let tilt = (-t.z / t.norm()).acos();
         assert!(tilt <= 45f64.to_radians() + 1e-9, "{}", tilt.to_degrees());
