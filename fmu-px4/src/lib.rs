@@ -30,7 +30,7 @@ fmi2_export::export_fmu!(Px4Model);
 #[cfg(test)]
 mod tests {
     use super::*;
-    use fmi2_export::{FmuModel, Logger, StateReader, StateWriter, VariableStore};
+    use fmi2_export::{FmuModel, Logger, VariableStore};
 
     #[test]
     fn initialization_commands_the_climb_and_steps_hold_between_samples() {

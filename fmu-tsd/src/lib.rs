@@ -30,7 +30,7 @@ fmi2_export::export_fmu!(TsdModel);
 #[cfg(test)]
 mod tests {
     use super::*;
-    use fmi2_export::{FmuModel, Logger, StateReader, StateWriter, VariableStore};
+    use fmi2_export::{FmuModel, Logger, VariableStore};
 
     #[test]
     fn initialization_holds_the_trim_command_and_steps_hold_between_samples() {
