@@ -30,37 +30,31 @@ fmi2_export::export_fmu!(Px4Model);
 #[cfg(test)]
 mod tests {
     use super::*;
-    use fmi2_export::{FmuModel, Logger, VariableStore};
+    use fmi2_export::VariableStore;
 
     #[test]
     fn initialization_commands_the_climb_and_steps_hold_between_samples() {
-        let mut vars = Variables::with_start_values();
-        let mut model = Px4Model::new(&vars);
-        let mut log = Logger::null();
-        model.initialize(&mut vars, 0.0, &mut log).unwrap();
-        // Start values are the trimmed climb: the hover thrust is derived from that trim,
-        // so the first command is its thrust.
-        assert!(
-            (vars.thrust_cmd - vars.thrust).abs() < 0.5,
-            "{} vs {}",
-            vars.thrust_cmd,
-            vars.thrust
+        controller_fmu::testing::assert_sampled_between_steps::<Px4Model>(
+            Variables::with_start_values(),
+            // Start values are the trimmed climb: the hover thrust is derived from that trim,
+            // so the first command is close to its thrust.
+            |v| {
+                assert!(
+                    (v.thrust_cmd - v.thrust).abs() < 0.5,
+                    "{} vs {}",
+                    v.thrust_cmd,
+                    v.thrust
+                );
+                assert_eq!(v.phase, 0);
+            },
+            // The D term of the velocity loop and the integrators see a vertical speed.
+            |v| {
+                v.accel_x = 12.0;
+                v.vel_d = 1.0;
+            },
+            |v| v.thrust_cmd,
+            (|v: &mut Variables| v.q = f64::NAN, "q"),
         );
-        assert_eq!(vars.phase, 0);
-        let first = vars.thrust_cmd;
-        vars.accel_x = 12.0;
-        model.do_step(&mut vars, 0.0, 0.005, &mut log).unwrap();
-        assert_eq!(vars.thrust_cmd, first);
-        model.do_step(&mut vars, 0.005, 0.005, &mut log).unwrap();
-        assert_eq!(vars.thrust_cmd, first);
-        // At 0.02 the controller samples the changed input (the D term of the velocity loop
-        // and the integrators see it).
-        vars.vel_d = 1.0;
-        model.do_step(&mut vars, 0.02, 0.005, &mut log).unwrap();
-        assert_ne!(vars.thrust_cmd, first);
-        vars.q = f64::NAN;
-        let e = model.do_step(&mut vars, 0.04, 0.02, &mut log).unwrap_err();
-        assert!(format!("{e:?}").contains("'q'"), "{e:?}");
     }
 
     #[test]

@@ -34,27 +34,17 @@ mod tests {
 
     #[test]
     fn initialization_holds_the_trim_command_and_steps_hold_between_samples() {
-        let mut vars = Variables::with_start_values();
-        let mut model = TsdModel::new(&vars);
-        let mut log = Logger::null();
-        model.initialize(&mut vars, 0.0, &mut log).unwrap();
-        // Start values are the trimmed climb: the first command is the measured trim.
-        assert!((vars.thrust_cmd - vars.thrust).abs() < 1e-9, "{}", vars.thrust_cmd);
-        assert_eq!(vars.phase, 0);
-        let first = vars.thrust_cmd;
-        // A step of 5 ms at 0 (already sampled in initialization) holds.
-        vars.accel_x = 12.0;
-        model.do_step(&mut vars, 0.0, 0.005, &mut log).unwrap();
-        assert_eq!(vars.thrust_cmd, first);
-        model.do_step(&mut vars, 0.005, 0.005, &mut log).unwrap();
-        assert_eq!(vars.thrust_cmd, first);
-        // At 0.02 the controller samples the changed input.
-        model.do_step(&mut vars, 0.02, 0.005, &mut log).unwrap();
-        assert_ne!(vars.thrust_cmd, first);
-        // Non-finite input: an error naming it.
-        vars.q = f64::NAN;
-        let e = model.do_step(&mut vars, 0.04, 0.02, &mut log).unwrap_err();
-        assert!(format!("{e:?}").contains("'q'"), "{e:?}");
+        controller_fmu::testing::assert_sampled_between_steps::<TsdModel>(
+            Variables::with_start_values(),
+            // Start values are the trimmed climb: the first command is the measured trim.
+            |v| {
+                assert!((v.thrust_cmd - v.thrust).abs() < 1e-9, "{}", v.thrust_cmd);
+                assert_eq!(v.phase, 0);
+            },
+            |v| v.accel_x = 12.0,
+            |v| v.thrust_cmd,
+            (|v: &mut Variables| v.q = f64::NAN, "q"),
+        );
     }
 
     #[test]

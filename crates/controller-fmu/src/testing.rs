@@ -72,3 +72,31 @@ pub fn assert_state_round_trip<M: FmuModel>(
     other.do_step(&mut b, 0.04, 0.02, &mut log).unwrap();
     assert_eq!(outputs(&a), outputs(&b));
 }
+
+/// Sampling through the FMU (sample time 0.02 s, state after `initialize` checked by
+/// `initial`): steps of 5 ms hold the command `command` reads although `perturb` changed an
+/// input; the step that reaches the next sample acts on it; an input made non-finite by
+/// `poison` is then an error naming `poisoned`.
+pub fn assert_sampled_between_steps<M: FmuModel>(
+    mut vars: M::Vars,
+    initial: impl Fn(&M::Vars),
+    perturb: impl Fn(&mut M::Vars),
+    command: impl Fn(&M::Vars) -> f64,
+    (poison, poisoned): (impl Fn(&mut M::Vars), &str),
+) {
+    let mut model = M::new(&vars);
+    let mut log = Logger::null();
+    model.initialize(&mut vars, 0.0, &mut log).unwrap();
+    initial(&vars);
+    let first = command(&vars);
+    perturb(&mut vars);
+    for t in [0.0, 0.005] {
+        model.do_step(&mut vars, t, 0.005, &mut log).unwrap();
+        assert_eq!(command(&vars), first, "changed between samples at {t} s");
+    }
+    model.do_step(&mut vars, 0.02, 0.005, &mut log).unwrap();
+    assert_ne!(command(&vars), first, "the sample at 0.02 s ignored the changed input");
+    poison(&mut vars);
+    let e = model.do_step(&mut vars, 0.04, 0.02, &mut log).unwrap_err();
+    assert!(format!("{e:?}").contains(&format!("'{poisoned}'")), "{e:?}");
+}
