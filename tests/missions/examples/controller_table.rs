@@ -119,14 +119,8 @@ fn main() {
     println!();
     println!("| step | controller | completed | settling < 0.5 m on the stepped axis (s) | final error on that axis (m) | largest position error (m) |");
     println!("|---|---|---|---|---|---|");
-    let vertical = MissionParams {
-        t_vertical_1: 40.0,
-        ..Default::default()
-    };
-    let level = MissionParams {
-        t_level: 40.0,
-        ..Default::default()
-    };
+    let vertical = MissionParams::preset("step_vertical").unwrap();
+    let level = MissionParams::preset("step_level").unwrap();
     let cases = [
         ("vertical, north 5 m", vertical, 5.0, Vector3::new(5.0, 0.0, 0.0), 35.0),
         ("vertical, east 5 m", vertical, 5.0, Vector3::new(0.0, 5.0, 0.0), 35.0),

@@ -140,10 +140,7 @@ fn takeoff_to_landing() {
 /// settles within 0.5 m in 2.0 s (north, along the belly) and 3.4 s (east, along the wing).
 #[test]
 fn vertical_position_steps_settle() {
-    let mission = MissionParams {
-        t_vertical_1: 40.0,
-        ..Default::default()
-    };
+    let mission = MissionParams::preset("step_vertical").unwrap();
     let plant = Plant::new(Airframe::default());
     let x0 = plant.trim_vertical_climb(mission.v_vertical).unwrap().state;
     for (offset, bound) in [(Vector3::new(5.0, 0.0, 0.0), 3.0), (Vector3::new(0.0, 5.0, 0.0), 5.0)] {

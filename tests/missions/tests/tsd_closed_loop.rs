@@ -133,14 +133,8 @@ fn step_response(mission: MissionParams, t_step: f64, offset: Vector3<f64>, t_en
 #[test]
 fn position_steps_settle() {
     // Vertical: a long first vertical phase. Level: a long level phase.
-    let vertical = MissionParams {
-        t_vertical_1: 40.0,
-        ..Default::default()
-    };
-    let level = MissionParams {
-        t_level: 40.0,
-        ..Default::default()
-    };
+    let vertical = MissionParams::preset("step_vertical").unwrap();
+    let level = MissionParams::preset("step_level").unwrap();
     let cases = [
         (
             "vertical, normal (north) 5 m",
