@@ -408,6 +408,42 @@ mod tests {
         assert_eq!(r.metrics["t_end"], Some(0.0));
     }
 
+    /// Completed = flown to the end within the error limit: the same crosswind flight is an
+    /// `error` below its largest error and completed above it.
+    #[test]
+    fn a_flight_beyond_the_error_limit_is_an_error() {
+        let mut j = job("tsd");
+        j.stop_time = 3.0;
+        j.wind.steady_e = 5.0f64.to_bits();
+        let r = run(&j);
+        let max_err = r.metrics["max_err"].unwrap();
+        assert!(r.completed && max_err > 0.05, "{r:?}");
+        j.error_limit_m = 0.5 * max_err;
+        let r = run(&j);
+        assert!(
+            !r.completed && r.failure == "error" && r.detail.contains("largest position error"),
+            "{r:?}"
+        );
+        assert_eq!(r.metrics["max_err"], Some(max_err));
+    }
+
+    /// With turbulence the wind is the atmosphere's, whose steady part is the job's wind.
+    #[test]
+    fn turbulent_job_flies_the_atmosphere_with_the_steady_wind() {
+        let mut j = job("tsd");
+        j.wind.steady_n = (-3.0f64).to_bits();
+        j.wind.steady_e = 4.0f64.to_bits();
+        assert!(matches!(wind_of(&j, 10.0), Wind::SteadyAndGust { .. }));
+        j.wind.turbulence_intensity = 2;
+        j.wind.turbulence_seed = 9;
+        let Wind::Atmosphere(p) = wind_of(&j, 10.0) else {
+            panic!("not the atmosphere")
+        };
+        assert_eq!((p.turbulence_model, p.turbulence_intensity, p.seed), (1, 2, 9));
+        assert_eq!((p.wind_profile, p.origin_height), (0, 10.0));
+        assert!((Wind::Atmosphere(p).at(0.0) - Vector3::new(-3.0, 4.0, 0.0)).norm() < 1e-12);
+    }
+
     #[test]
     fn nominal_short_flight_completes_in_the_vertical_phase() {
         let r = run(&job("tsd"));
