@@ -216,7 +216,7 @@ pub fn run(job: &Job) -> Row {
     // The completion criterion of a run flown to the end (`tailsim.campaign.runner.error_failure`).
     if failure.is_empty() {
         let max_err = metrics.get("max_err").copied().flatten().unwrap_or(f64::NAN);
-        if !(max_err <= job.error_limit_m) {
+        if max_err.is_nan() || max_err > job.error_limit_m {
             failure = "error".into();
             detail = format!("largest position error {max_err:.2} m > {} m", job.error_limit_m);
         }
