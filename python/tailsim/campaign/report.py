@@ -179,9 +179,7 @@ def completion_by_wind(cols, A, lab, color, out: pathlib.Path) -> list[str]:
     centres = [0.5 * (lo + hi) for lo, hi in WIND_BANDS]
     for a in A:
         counts = wind_band_counts(cols, _arm_mask(cols, a))
-        md.append(
-            f"| {lab[a]} | " + " | ".join(f"{k}/{n} ({k / n:.2f})" if n else "–" for k, n in counts) + " |"
-        )
+        md.append(f"| {lab[a]} | " + " | ".join(f"{k}/{n} ({k / n:.2f})" if n else "–" for k, n in counts) + " |")
         pts = [(c, k / n, *wilson_interval(k, n)) for c, (k, n) in zip(centres, counts, strict=True) if n]
         if pts:
             x, p, lo, hi = (np.array(v) for v in zip(*pts, strict=True))
