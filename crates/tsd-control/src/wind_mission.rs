@@ -153,22 +153,23 @@ mod tests {
     /// the horizontal specific force `f_h` (NED, m/s²) against it.
     fn hovering(w: Vector3<f64>, f_h: Vector3<f64>) -> Measurement {
         let r = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), core::f64::consts::FRAC_PI_2);
-        let v_air_b = r.inverse() * (-w);
-        let v = v_air_b.norm();
-        let q = r.quaternion();
+        // Air velocity −w in body axes: airspeed, α and β of (2.2.12–2.2.13).
+        let a = r.inverse() * (-w);
+        let (v, q) = (a.norm(), r.quaternion());
+        let zero = Vector3::zeros();
         Measurement {
-            pos_ned: Vector3::zeros(),
-            vel_ned: Vector3::zeros(),
-            vel_body: Vector3::zeros(),
-            rates: Vector3::zeros(),
+            pos_ned: zero,
+            vel_ned: zero,
+            vel_body: zero,
+            rates: zero,
             quat: Vector4::new(q.i, q.j, q.k, q.w),
             airspeed: v,
-            alpha: v_air_b.z.atan2(v_air_b.x),
-            beta: if v > 0.0 { (v_air_b.y / v).asin() } else { 0.0 },
-            thrust: 90.0,
+            alpha: a.z.atan2(a.x),
+            beta: if v > 0.0 { (a.y / v).asin() } else { 0.0 },
+            thrust: 0.0,
             surfaces: [0.0; 6],
             specific_force_body: r.inverse() * (f_h - Vector3::new(0.0, 0.0, 9.81)),
-            induced_velocity: 10.0,
+            induced_velocity: 0.0,
         }
     }
 
