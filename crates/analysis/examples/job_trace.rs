@@ -15,7 +15,7 @@ fn main() {
     let mut sc = Scenario::mission(mission);
     sc.stop_time = job.stop_time;
     sc.comm_step = job.step_size;
-    sc.wind = wind_of(&job);
+    sc.wind = wind_of(&job, plant.ground.height);
     sc.measured_wind = MeasuredWind::HeldInput;
     let params = TsdParams {
         configuration: job.configuration,

@@ -43,6 +43,12 @@ pub struct JobWind {
     pub gust_d: u64,
     pub gust_start: u64,
     pub gust_duration: u64,
+    /// Dryden turbulence intensity (the atmosphere's `turbulence_intensity`, 0 none) and its
+    /// seed: with turbulence the wind is the atmosphere's ([`wind_of`]).
+    #[serde(default)]
+    pub turbulence_intensity: i32,
+    #[serde(default)]
+    pub turbulence_seed: i32,
 }
 
 /// One run (see the module documentation).
@@ -67,6 +73,14 @@ pub struct Job {
     pub step_size: f64,
     /// The run is a divergence once the controller's `pos_error` exceeds this (m).
     pub divergence_m: f64,
+    /// A run flown to the stop time is completed only if its largest `pos_error` stays within
+    /// this (m); beyond it the failure is `error` (infinite if absent).
+    #[serde(default = "no_error_limit")]
+    pub error_limit_m: f64,
+}
+
+fn no_error_limit() -> f64 {
+    f64::INFINITY
 }
 
 /// One row: the outcome and the metrics (NaN where not reached, as the fmpy rows).
@@ -121,10 +135,31 @@ pub fn mission_of(job: &Job) -> Result<MissionParams, String> {
     Ok(m)
 }
 
-/// The job's wind profile.
-pub fn wind_of(job: &Job) -> Wind {
+/// The job's wind: with turbulence the atmosphere of the `tailsitter_atmosphere` FMU as the
+/// fmpy runner sets it (`tailsim.campaign.sampling.atmosphere_parameters`: the steady wind
+/// uniform with height, Dryden turbulence of the job's intensity and seed, the 1 − cos gust,
+/// the ground `origin_height` below the origin), else the steady wind plus the gust.
+pub fn wind_of(job: &Job, origin_height: f64) -> Wind {
     let w = job.wind;
     let f = f64::from_bits;
+    if w.turbulence_intensity > 0 {
+        let (n, e) = (f(w.steady_n), f(w.steady_e));
+        return Wind::Atmosphere(atmosphere::Params {
+            wind_speed: n.hypot(e),
+            wind_from: (-e).atan2(-n).rem_euclid(2.0 * std::f64::consts::PI),
+            wind_profile: 0,
+            origin_height,
+            turbulence_model: 1,
+            turbulence_intensity: w.turbulence_intensity,
+            seed: w.turbulence_seed,
+            gust_amplitude_n: f(w.gust_n),
+            gust_amplitude_e: f(w.gust_e),
+            gust_amplitude_d: f(w.gust_d),
+            gust_start: f(w.gust_start),
+            gust_duration: f(w.gust_duration),
+            ..atmosphere::Params::default()
+        });
+    }
     Wind::SteadyAndGust {
         steady: Vector3::new(f(w.steady_n), f(w.steady_e), 0.0),
         t_start: f(w.gust_start),
@@ -177,12 +212,21 @@ pub fn run(job: &Job) -> Row {
             }
         }
     }
+    let metrics = plant.map_or_else(metrics_of_nothing, |p| metrics(&p, &samples));
+    // The completion criterion of a run flown to the end (`tailsim.campaign.runner.error_failure`).
+    if failure.is_empty() {
+        let max_err = metrics.get("max_err").copied().flatten().unwrap_or(f64::NAN);
+        if max_err.is_nan() || max_err > job.error_limit_m {
+            failure = "error".into();
+            detail = format!("largest position error {max_err:.2} m > {} m", job.error_limit_m);
+        }
+    }
     Row {
         key: job.key.clone(),
         completed: failure.is_empty(),
         failure,
         detail,
-        metrics: plant.map_or_else(metrics_of_nothing, |p| metrics(&p, &samples)),
+        metrics,
         cpu_time_s: cpu_time() - c0,
         wall_time_s: t0.elapsed().as_secs_f64(),
     }
@@ -200,7 +244,7 @@ fn fly_job(job: &Job) -> Result<(Plant, Trace), String> {
     let mut scenario = Scenario::mission(mission);
     scenario.stop_time = job.stop_time;
     scenario.comm_step = job.step_size;
-    scenario.wind = wind_of(job);
+    scenario.wind = wind_of(job, plant.ground.height);
     // The fmpy master reads the plant outputs before it sets the new wind (tailsim.master).
     scenario.measured_wind = MeasuredWind::HeldInput;
     // The controllers' design model: the nominal airframe (their `design_airframe` defaults).
@@ -320,10 +364,13 @@ mod tests {
                 gust_d: 0,
                 gust_start: 0,
                 gust_duration: 1.0f64.to_bits(),
+                turbulence_intensity: 0,
+                turbulence_seed: 0,
             },
             stop_time: 1.0,
             step_size: 0.02,
             divergence_m: 50.0,
+            error_limit_m: 5.0,
         }
     }
 
@@ -359,6 +406,42 @@ mod tests {
         let r = run(&j);
         assert_eq!(r.failure, "divergence");
         assert_eq!(r.metrics["t_end"], Some(0.0));
+    }
+
+    /// Completed = flown to the end within the error limit: the same crosswind flight is an
+    /// `error` below its largest error and completed above it.
+    #[test]
+    fn a_flight_beyond_the_error_limit_is_an_error() {
+        let mut j = job("tsd");
+        j.stop_time = 3.0;
+        j.wind.steady_e = 5.0f64.to_bits();
+        let r = run(&j);
+        let max_err = r.metrics["max_err"].unwrap();
+        assert!(r.completed && max_err > 0.05, "{r:?}");
+        j.error_limit_m = 0.5 * max_err;
+        let r = run(&j);
+        assert!(
+            !r.completed && r.failure == "error" && r.detail.contains("largest position error"),
+            "{r:?}"
+        );
+        assert_eq!(r.metrics["max_err"], Some(max_err));
+    }
+
+    /// With turbulence the wind is the atmosphere's, whose steady part is the job's wind.
+    #[test]
+    fn turbulent_job_flies_the_atmosphere_with_the_steady_wind() {
+        let mut j = job("tsd");
+        j.wind.steady_n = (-3.0f64).to_bits();
+        j.wind.steady_e = 4.0f64.to_bits();
+        assert!(matches!(wind_of(&j, 10.0), Wind::SteadyAndGust { .. }));
+        j.wind.turbulence_intensity = 2;
+        j.wind.turbulence_seed = 9;
+        let Wind::Atmosphere(p) = wind_of(&j, 10.0) else {
+            panic!("not the atmosphere")
+        };
+        assert_eq!((p.turbulence_model, p.turbulence_intensity, p.seed), (1, 2, 9));
+        assert_eq!((p.wind_profile, p.origin_height), (0, 10.0));
+        assert!((Wind::Atmosphere(p).at(0.0) - Vector3::new(-3.0, 4.0, 0.0)).norm() < 1e-12);
     }
 
     #[test]

@@ -165,7 +165,7 @@ pub fn air_data_wind(m: &Measurement) -> Vector3<f64> {
 }
 
 /// Wrap an angle to (−π, π].
-fn wrap_pi(a: f64) -> f64 {
+pub fn wrap_pi(a: f64) -> f64 {
     let t = std::f64::consts::TAU;
     let x = a.rem_euclid(t);
     if x > std::f64::consts::PI {
@@ -173,6 +173,18 @@ fn wrap_pi(a: f64) -> f64 {
     } else {
         x
     }
+}
+
+/// The heading nearest `heading` that puts the belly (ψ = `bearing`) or the back
+/// (ψ = `bearing` + π) towards `bearing`: `heading` plus the difference wrapped to ±π/2.
+pub fn nearer_face(heading: f64, bearing: f64) -> f64 {
+    let mut d = wrap_pi(bearing - heading);
+    if d > std::f64::consts::FRAC_PI_2 {
+        d -= std::f64::consts::PI;
+    } else if d <= -std::f64::consts::FRAC_PI_2 {
+        d += std::f64::consts::PI;
+    }
+    heading + d
 }
 
 impl Weathervane {
@@ -240,22 +252,33 @@ impl Weathervane {
         if !self.engaged {
             return self.heading;
         }
-        // Bearing the wind comes from: belly into the wind at ψ_w = b, back at b + π; the
-        // nearer of the two is the present heading plus the difference wrapped to ±π/2.
-        let b = (-w.y).atan2(-w.x);
-        let mut d = wrap_pi(b - self.heading);
-        if d > std::f64::consts::FRAC_PI_2 {
-            d -= std::f64::consts::PI;
-        } else if d <= -std::f64::consts::FRAC_PI_2 {
-            d += std::f64::consts::PI;
-        }
-        self.heading + d
+        // Bearing the wind comes from: belly into the wind at ψ_w = b, back at b + π.
+        nearer_face(self.heading, (-w.y).atan2(-w.x))
     }
 
     /// Update with the measurement of the sample at mission time `t` (sample time `ts` (s))
     /// and return the heading reference. Disabled: always zero. Non-finite values are never
     /// committed.
     pub fn update(&mut self, mission: &MissionParams, t: f64, m: &Measurement) -> HeadingRef {
+        self.update_towards(mission, t, m, None)
+    }
+
+    /// The heading of the present sample (rad).
+    pub fn heading(&self) -> f64 {
+        self.heading
+    }
+
+    /// [`Self::update`] with the target heading (rad) and the largest rate (rad/s) given by
+    /// the caller, `target = Some((heading, max_rate))`, instead of the wind's (a controller's
+    /// own mission logic in wind); `None`: the wind's, as [`Self::update`]. The wind estimate
+    /// and the approach's time constant are the same.
+    pub fn update_towards(
+        &mut self,
+        mission: &MissionParams,
+        t: f64,
+        m: &Measurement,
+        target: Option<(f64, f64)>,
+    ) -> HeadingRef {
         if !self.params.enabled {
             return HeadingRef::default();
         }
@@ -268,9 +291,11 @@ impl Weathervane {
                 raw
             };
         }
-        let target = self.target(mission, t);
-        let rate =
-            ((target - self.heading) / self.params.time_constant).clamp(-self.params.max_rate, self.params.max_rate);
+        let (target, max_rate) = match target {
+            Some((x, r)) if x.is_finite() && r > 0.0 => (x, r),
+            _ => (self.target(mission, t), self.params.max_rate),
+        };
+        let rate = ((target - self.heading) / self.params.time_constant).clamp(-max_rate, max_rate);
         let next = self.heading + rate * mission.sample_time;
         if next.is_finite() {
             self.heading = next;

@@ -54,6 +54,7 @@ mod nvd;
 pub mod params;
 mod reference;
 pub mod trajectory;
+pub mod wind_mission;
 
 pub use design::{FlightCondition, LoopDesign};
 pub use params::{
@@ -77,8 +78,9 @@ use nalgebra::Vector3;
 use tailsitter_physics::Airframe;
 
 /// Number of f64 values written by [`TsdController::save`]: the loops' six, the
-/// weathervane's and the take-off / landing phases'.
-pub const STATE_LEN: usize = 6 + guidance::weathervane::WEATHERVANE_STATE_LEN + GroundPhases::SAVED_LEN;
+/// weathervane's, the take-off / landing phases' and the mission logic in wind's.
+pub const STATE_LEN: usize =
+    6 + guidance::weathervane::WEATHERVANE_STATE_LEN + GroundPhases::SAVED_LEN + wind_mission::WIND_MISSION_STATE_LEN;
 
 /// Internal signals of the last sample, for tests, plots and tuning.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -150,6 +152,9 @@ pub struct TsdController {
     internals: Internals,
     /// Heading reference in vertical flight (README, "Weathervaning").
     weathervane: Weathervane,
+    /// Heading through the handover, the transitions and level flight in wind (README,
+    /// "Missions in wind").
+    wind_mission: wind_mission::WindMission,
 }
 
 /// Names of the commands, bit order of the saturation mask.
@@ -203,6 +208,7 @@ impl TsdController {
                 WeathervaneParams::disabled()
             })
             .map_err(ParamError)?,
+            wind_mission: wind_mission::WindMission::default(),
         })
     }
 
@@ -302,6 +308,7 @@ impl SampledUnit for TsdController {
         out(self.saturated as f64);
         self.weathervane.save(out);
         self.ground.save(out);
+        self.wind_mission.save(out);
     }
 
     /// Restore what [`Self::save`] wrote; a truncated state is an error and leaves `self` unchanged.
@@ -330,6 +337,8 @@ impl SampledUnit for TsdController {
         self.ground
             .restore(&mut || rest.next())
             .ok_or_else(|| ControlError("truncated TSD controller state".into()))?;
+        self.wind_mission
+            .restore(&v[STATE_LEN - wind_mission::WIND_MISSION_STATE_LEN..]);
         Ok(())
     }
 

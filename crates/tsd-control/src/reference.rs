@@ -80,7 +80,16 @@ impl TsdController {
         let heading = if sigma_ground.is_some() {
             guidance::HeadingRef::default()
         } else {
-            self.weathervane.update(&self.mission, t_mission, meas)
+            // Mission logic in wind (README, "Missions in wind"): the heading of the
+            // handover, the transitions and level flight.
+            let target = self.wind_mission.target(
+                &self.weathervane,
+                &self.mission,
+                t_mission,
+                meas,
+                &reference.specific_accel,
+            );
+            self.weathervane.update_towards(&self.mission, t_mission, meas, target)
         };
         ReferenceStage::Flying(ReferenceSignals {
             t_mission,

@@ -26,7 +26,16 @@ from typing import Any
 
 from .. import cli, declarations
 from .runner import FMU_NAMES, STATE_SOURCE_FMUS, digest, install_fmus, load_fmu_bytes, metric_columns, run_job
-from .sampling import CONFIGURATIONS, CONTROLLERS, MISSIONS, STATE_SOURCES, CampaignSpec, jobs, sample_columns
+from .sampling import (
+    CONFIGURATIONS,
+    CONTROLLERS,
+    MISSIONS,
+    STATE_SOURCES,
+    TURBULENCE_LEVELS,
+    CampaignSpec,
+    jobs,
+    sample_columns,
+)
 
 ROOT = pathlib.Path(__file__).resolve().parents[3]
 #: Columns that depend on where and when a run was executed, not on what was run.
@@ -387,7 +396,7 @@ def parser() -> cli.Parser:
     ap.add_argument(
         "--wind-max",
         type=cli.declared(atmosphere, "wind_speed"),
-        default=5.0,
+        default=10.0,
         help=f"largest steady horizontal wind (m/s), within the declared [{wind.min:g}, {wind.max:g}] of `wind_speed`",
     )
     ap.add_argument(
@@ -396,6 +405,19 @@ def parser() -> cli.Parser:
         default=5.0,
         help=f"largest 1-cos gust amplitude (m/s), ≥ 0 and within the declared gust amplitudes "
         f"[{gust.min:g}, {gust.max:g}]",
+    )
+    ap.add_argument(
+        "--turbulence-max",
+        type=int,
+        choices=TURBULENCE_LEVELS,
+        help="largest Dryden turbulence intensity drawn (0 none, 1 light, 2 moderate, 3 severe; uniform on "
+        "0..max; default 2, 0 with the avionics state source, which flies without the atmosphere)",
+    )
+    ap.add_argument(
+        "--error-limit",
+        type=cli.number(0.0, lo_open=True),
+        default=5.0,
+        help="a run flown to the end is completed only if its largest position error stays within this (m), > 0",
     )
     ap.add_argument(
         "--timeout", type=cli.number(0.0, lo_open=True), default=300.0, help="wall-time limit of one run (s), > 0"
@@ -448,6 +470,10 @@ def _main(a: argparse.Namespace) -> int:
             aero_model=a.aero_model,
             wind_max=a.wind_max,
             gust_max=a.gust_max,
+            turbulence_max=(
+                a.turbulence_max if a.turbulence_max is not None else (0 if "avionics" in a.state_sources else 2)
+            ),
+            error_limit_m=a.error_limit,
             mission_name=a.mission,
             mission=dict(MISSIONS[a.mission]),
             timeout_s=a.timeout,

@@ -84,10 +84,12 @@ def native_job(job: Mapping[str, Any], spec: CampaignSpec, nominal: Mapping[str,
                 ("gust_start", "gust_start"),
                 ("gust_duration", "gust_duration"),
             )
-        },
+        }
+        | {k: int(job.get(k, 0)) for k in ("turbulence_intensity", "turbulence_seed")},
         "stop_time": spec.stop_time,
         "step_size": spec.step_size,
         "divergence_m": spec.divergence_m,
+        "error_limit_m": spec.error_limit_m,
     }
 
 

@@ -141,6 +141,63 @@ def _fmt(x: float, nd: int = 2) -> str:
     return "—" if x is None or not np.isfinite(x) else f"{x:.{nd}f}"
 
 
+#: Steady-wind speed bands of the completion-against-wind table and chart (m/s).
+WIND_BANDS = ((0.0, 2.0), (2.0, 4.0), (4.0, 6.0), (6.0, 8.0), (8.0, 10.0))
+
+
+def wind_band_counts(cols: Mapping[str, np.ndarray], mask: np.ndarray) -> list[tuple[int, int]]:
+    """(completed, runs) of the runs in `mask` per steady-wind band of `WIND_BANDS` (the last
+    band closed above)."""
+    speed = np.hypot(cols["wind_steady_n"].astype(float), cols["wind_steady_e"].astype(float))
+    done = cols["completed"].astype(bool)
+    out = []
+    for i, (lo, hi) in enumerate(WIND_BANDS):
+        inside = (speed >= lo) & ((speed <= hi) if i == len(WIND_BANDS) - 1 else (speed < hi))
+        m = mask & inside
+        out.append((int((done & m).sum()), int(m.sum())))
+    return out
+
+
+def completion_by_wind(cols, A, lab, color, out: pathlib.Path) -> list[str]:
+    """The completion per steady-wind band (table, and `completion_wind.png`: P(complete) with
+    its 95 % Wilson interval against the band's centre, one line per arm)."""
+    import matplotlib.pyplot as plt
+
+    if "wind_steady_n" not in cols or not len(cols["completed"]):
+        return []
+    bands = [f"{lo:g}–{hi:g}" for lo, hi in WIND_BANDS]
+    md = [
+        "### Completion against the steady wind",
+        "",
+        "Completed / runs per band of the steady wind speed (m/s); every band mixes the turbulence intensities "
+        "and gusts drawn.",
+        "",
+        "| controller | " + " | ".join(bands) + " |",
+        "|---|" + "---|" * len(bands),
+    ]
+    fig, ax = plt.subplots(figsize=(5.5, 3.5))
+    centres = [0.5 * (lo + hi) for lo, hi in WIND_BANDS]
+    for a in A:
+        counts = wind_band_counts(cols, _arm_mask(cols, a))
+        md.append(f"| {lab[a]} | " + " | ".join(f"{k}/{n} ({k / n:.2f})" if n else "–" for k, n in counts) + " |")
+        pts = [(c, k / n, *wilson_interval(k, n)) for c, (k, n) in zip(centres, counts, strict=True) if n]
+        if pts:
+            x, p, lo, hi = (np.array(v) for v in zip(*pts, strict=True))
+            ax.errorbar(x, p, yerr=[p - lo, hi - p], color=color[a], marker="o", capsize=4, label=lab[a])
+    ax.set(
+        ylim=(0, 1.05),
+        xlabel="steady wind speed (m/s)",
+        ylabel="P(complete)",
+        title="completion against the steady wind (95 % Wilson)",
+    )
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out / "completion_wind.png", dpi=110)
+    plt.close(fig)
+    return [*md, "", "![completion against the wind](completion_wind.png)", ""]
+
+
 def write_report(out: str | pathlib.Path, spec: CampaignSpec | None = None, table=None) -> pathlib.Path:
     import matplotlib
 
@@ -170,8 +227,12 @@ def write_report(out: str | pathlib.Path, spec: CampaignSpec | None = None, tabl
             "random "
             f"direction, amplitude ≤ {spec.gust_max:g} m/s, duration "
             f"{spec.gust_duration[0]:g}–{spec.gust_duration[1]:g} s "
-            f"and start time. A run fails on an FMI error, a divergence (position error > {spec.divergence_m:g} m or a "
-            f"non-finite plant output) or a wall-time limit ({spec.timeout_s:g} s).",
+            f"and start time; Dryden turbulence of intensity 0–{spec.turbulence_max} (0 none, 1 light, 2 moderate, "
+            "3 severe; the atmosphere FMU). "
+            f"A run fails on an FMI error, a divergence (position error > {spec.divergence_m:g} m or a "
+            f"non-finite plant output), a wall-time limit ({spec.timeout_s:g} s), or, flown to the end, a largest "
+            f"position error above {spec.error_limit_m:g} m (`error`): completed = flown to the end within "
+            f"{spec.error_limit_m:g} m.",
             "",
         ]
 
@@ -215,6 +276,7 @@ def write_report(out: str | pathlib.Path, spec: CampaignSpec | None = None, tabl
     fig.savefig(out / "completion.png", dpi=110)
     plt.close(fig)
     md += ["![completion](completion.png)", ""]
+    md += completion_by_wind(cols, A, lab, color, out)
 
     # 2. distributions (completed runs)
     md += [

@@ -32,16 +32,22 @@ from fmpy.fmi1 import FMICallException
 
 from .. import controllers, declarations, fmilog
 from ..masters import AvionicsLoop, ClosedLoop, Fmu, NonFinite, pos_error
-from .sampling import CONFIGURATIONS, CampaignSpec, plant_parameters, wind_function
+from .sampling import CONFIGURATIONS, CampaignSpec, atmosphere_parameters, plant_parameters, wind_function
 
 FMU_NAMES = {
     "plant": "tailsitter_plant",
     **controllers.NAMES,
     "sensors": "tailsitter_sensors",
     "ekf": "tailsitter_ekf",
+    "atmosphere": "tailsitter_atmosphere",
 }
-#: The FMUs a state source needs beside the plant and the controllers.
-STATE_SOURCE_FMUS = {"perfect": (), "avionics": ("sensors", "ekf"), "avionics_app_d": ("sensors", "ekf")}
+#: The FMUs a state source needs beside the plant and the controllers (the perfect state
+#: source flies the samples with turbulence through the atmosphere).
+STATE_SOURCE_FMUS = {
+    "perfect": ("atmosphere",),
+    "avionics": ("sensors", "ekf"),
+    "avionics_app_d": ("sensors", "ekf"),
+}
 #: EKF parameters of each avionics state source: `avionics` the tuned estimator (the FMU's
 #: defaults), `avionics_app_d` the thesis App.-D-faithful one (Table D.1 variances, no extras).
 AVIONICS_EKF_PARAMS = {"avionics": {}, "avionics_app_d": {"app_d_configuration": True}}
@@ -52,7 +58,9 @@ THRUST_LIMITS = declarations.THRUST_LIMITS
 DEFLECTION_LIMIT = declarations.DEFLECTION_LIMIT
 #: The commands, thrust first.
 COMMANDS = list(declarations.COMMANDS)
-FAILURES = ("fmi_error", "divergence", "timeout", "exception")
+#: `error`: flown to the stop time, but the largest position error exceeded the spec's
+#: `error_limit_m`.
+FAILURES = ("fmi_error", "divergence", "timeout", "exception", "error")
 
 
 def digest(data: bytes) -> str:
@@ -169,17 +177,25 @@ def fly(
     step_size: float,
     divergence_m: float = math.inf,
     deadline: float = math.inf,
+    atmosphere: tuple[Fmu, Any, Mapping[str, float]] | None = None,
 ) -> tuple[dict[str, np.ndarray], str, str]:
     """Fly instances `p`, `c` (freshly instantiated or reset) through `ClosedLoop`'s
     system (Gauss-Seidel, zero ref_offset), stopping early on divergence or timeout.
+    `atmosphere` = (FMU, instance, parameters): the wind from the atmosphere unit instead of
+    the function `wind`.
 
     Returns the recorded signals (up to where it stopped) — time, phase, pos_error,
     ref_pos_d, pos_d, alpha and the seven commands, as ClosedLoop records them —
     and (failure, detail) with failure '' when it reached the stop time.
     """
-    system = ClosedLoop(plant, controller, plant_params, controller_params).system(
-        wind, None, RECORD_PLANT, RECORD_CONTROLLER, finite_sources=["plant"]
-    )
+    slaves = {"plant": p, "controller": c}
+    if atmosphere is None:
+        loop = ClosedLoop(plant, controller, plant_params, controller_params)
+    else:
+        fmu, slaves["atmosphere"], params = atmosphere
+        loop = ClosedLoop(plant, controller, plant_params, controller_params, atmosphere=fmu, atmosphere_params=params)
+        wind = None
+    system = loop.system(wind, None, RECORD_PLANT, RECORD_CONTROLLER, finite_sources=["plant"])
     i_err = system.signal_names().index("pos_error")
 
     def monitor(k: int, t: float, row: np.ndarray) -> None:
@@ -191,7 +207,7 @@ def fly(
 
     failure = detail = ""
     try:
-        r = system.run(stop_time, step_size, slaves={"plant": p, "controller": c}, monitor=monitor)
+        r = system.run(stop_time, step_size, slaves=slaves, monitor=monitor)
     except (Diverged, NonFinite) as exc:
         failure, detail, r = "divergence", str(exc), exc.partial_result
     except TimedOut as exc:
@@ -294,7 +310,18 @@ def run_job(job: Mapping[str, Any], spec_json: Mapping[str, Any], digests: Mappi
             row.update(_run_avionics(job, spec, digests, pp, cp))
             return row
         ps, cs = _instance(pd_, "plant"), _instance(cd_, "controller")
-        for s in (ps, cs):
+        held = [ps, cs]
+        atmosphere = None
+        if int(job.get("turbulence_intensity", 0)) > 0:
+            ad_ = digests["atmosphere"]
+            if ad_ not in _fmus:
+                raise RuntimeError(f"FMU {ad_[:12]} not installed on this worker (plugin missing?)")
+            as_ = _instance(ad_, "atmosphere")
+            held.append(as_)
+            ap = atmosphere_parameters(job)
+            ap["origin_height"] = float(pp.get("ground_height", nominal["ground_height"]))
+            atmosphere = (_fmus[ad_], as_.slave, ap)
+        for s in held:
             if s.used:
                 s.slave.reset()  # fmi2Reset: back to the instantiated state, then set parameters
             s.used = True
@@ -312,6 +339,7 @@ def run_job(job: Mapping[str, Any], spec_json: Mapping[str, Any], digests: Mappi
             spec.step_size,
             spec.divergence_m,
             t0 + spec.timeout_s,
+            atmosphere,
         )
         row.update(run_metrics(sig))
         if failure == "fmi_error":
@@ -319,8 +347,10 @@ def run_job(job: Mapping[str, Any], spec_json: Mapping[str, Any], digests: Mappi
             if any("left its envelope" in m for m in logs):
                 failure = "divergence"  # the plant's own tumble check (an error status by design)
             detail = " | ".join([detail, *logs])
-        row.update(completed=not failure, failure=failure, detail=detail)
         plant_ok = ctrl_ok = not failure
+        if not failure:
+            failure, detail = error_failure(row["max_err"], spec.error_limit_m)
+        row.update(completed=not failure, failure=failure, detail=detail)
     except Exception as exc:  # noqa: BLE001 - a failed run is a result, not a crash
         kind = "fmi_error" if isinstance(exc, FMICallException) else "exception"
         logs = _error_logs(pd_, cd_)
@@ -331,6 +361,8 @@ def run_job(job: Mapping[str, Any], spec_json: Mapping[str, Any], digests: Mappi
             _discard(pd_)
         if not ctrl_ok:
             _discard(cd_)
+        if not plant_ok and "atmosphere" in digests:
+            _discard(digests["atmosphere"])
         row["wall_time_s"] = time.perf_counter() - t0
         row["cpu_time_s"] = time.thread_time() - c0  # CPU time of this run's thread (load-independent cost)
     return row
@@ -400,8 +432,18 @@ def _run_avionics(
             )
             sig = {n: v[: k + 1] for n, v in sig.items()}
         out = run_metrics(sig)
+    if not failure:
+        failure, detail = error_failure(out.get("max_err", math.nan), spec.error_limit_m)
     out.update(completed=not failure, failure=failure, detail=detail)
     return out
+
+
+def error_failure(max_err: float, limit: float) -> tuple[str, str]:
+    """The completion criterion of a run flown to the stop time: ('', '') if its largest
+    position error is within `limit` (m), else ('error', why)."""
+    if max_err <= limit:
+        return "", ""
+    return "error", f"largest position error {max_err:.2f} m > {limit:g} m"
 
 
 def _error_logs(*digests: str) -> list[str]:

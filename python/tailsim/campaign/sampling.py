@@ -4,8 +4,9 @@ A *sample* is one draw of everything random: the 25 uncertain parameters of the
 thesis's Table 5.1 (each scaled by an independent log-uniform factor within
 [1/τ, τ], τ = 1.5 for the aerodynamic derivatives and 1.1 for the mass and the
 inertias, as in the thesis's sweep (5.1.1)), a steady horizontal wind, a 1 − cos
-gust of random direction, amplitude and timing, and a sensor-noise seed (for the
-avionics state source: the sensors' `seed`).
+gust of random direction, amplitude and timing, a sensor-noise seed (for the
+avionics state source: the sensors' `seed`), and a Dryden turbulence intensity and seed
+(the `tailsitter_atmosphere` FMU's `turbulence_intensity` and `seed`).
 
 A *run* is one sample flown on one point of the configuration axes:
 controller × configuration × state source. Every run of a sample sees the same
@@ -99,6 +100,10 @@ MISSIONS: dict[str, dict[str, float]] = {
 }
 
 
+#: The atmosphere's `turbulence_intensity` values (0 none, 1 light, 2 moderate, 3 severe).
+TURBULENCE_LEVELS = (0, 1, 2, 3)
+
+
 def mission_stop_time(mission: Mapping[str, float]) -> float:
     return declarations.stop_time(dict(mission))
 
@@ -115,7 +120,7 @@ class CampaignSpec:
     tau_aero: float = 1.5
     tau_mass: float = 1.1
     #: Largest steady horizontal wind speed (m/s); heading uniform.
-    wind_max: float = 5.0
+    wind_max: float = 10.0
     #: Largest 1 − cos gust amplitude (m/s); direction uniform on the sphere.
     gust_max: float = 5.0
     #: Range of the gust duration (s).
@@ -123,8 +128,14 @@ class CampaignSpec:
     mission_name: str = "default"
     mission: Mapping[str, float] = field(default_factory=lambda: dict(MISSIONS["default"]))
     step_size: float = 0.02
+    #: Largest Dryden turbulence intensity drawn (the atmosphere's `turbulence_intensity`:
+    #: 0 none, 1 light, 2 moderate, 3 severe), uniform on 0..turbulence_max.
+    turbulence_max: int = 2
     #: A run is stopped as diverged once the controller's pos_error exceeds this (m).
     divergence_m: float = 50.0
+    #: A run that reached the stop time counts as completed only if its largest position
+    #: error stayed within this (m); beyond it the run is a failure `error`.
+    error_limit_m: float = 5.0
     #: A run is stopped as timed out after this wall time (s).
     timeout_s: float = 300.0
     #: Extra plant-parameter values for some samples {sample_id: {name: value}}:
@@ -155,6 +166,12 @@ class CampaignSpec:
             raise ValueError(f"aero_model = {self.aero_model!r}: expected 0 (thesis) or 1 (global)")
         if not (self.tau_aero >= 1.0 and self.tau_mass >= 1.0):
             raise ValueError("tau_aero and tau_mass must be ≥ 1")
+        if self.turbulence_max not in TURBULENCE_LEVELS:
+            raise ValueError(f"turbulence_max = {self.turbulence_max!r}: expected one of {TURBULENCE_LEVELS}")
+        if self.turbulence_max > 0 and "avionics" in self.state_sources:
+            raise ValueError("the avionics state source flies without the atmosphere unit: turbulence_max must be 0")
+        if not self.error_limit_m > 0.0:
+            raise ValueError(f"error_limit_m = {self.error_limit_m!r}: must be > 0")
 
     @property
     def stop_time(self) -> float:
@@ -194,7 +211,8 @@ def draw_sample(spec: CampaignSpec, i: int) -> dict[str, Any]:
 
     Draw order (fixed, so that adding configuration axes never changes a draw):
     25 log-uniform exponents, steady wind (speed, heading), gust (amplitude,
-    direction, duration, start), noise seed.
+    direction, duration, start), noise seed, turbulence (seed, intensity): a later draw
+    never changes an earlier one.
     """
     rng = sample_generator(spec.seed, i)
     s: dict[str, Any] = {"sample_id": int(i)}
@@ -216,6 +234,8 @@ def draw_sample(spec: CampaignSpec, i: int) -> dict[str, Any]:
     s["gust_duration"] = float(dur)
     # The sensors' `seed` of the avionics runs (all runs of a sample share it: paired noise).
     s["noise_seed"] = int(rng.integers(0, 2**31 - 1))
+    s["turbulence_seed"] = int(rng.integers(0, 2**31 - 1))
+    s["turbulence_intensity"] = int(rng.integers(0, spec.turbulence_max + 1))
     return s
 
 
@@ -224,6 +244,7 @@ def sample_columns() -> list[str]:
         ["sample_id"]
         + [f"k_{p.name}" for p in TABLE_5_1]
         + ["wind_steady_n", "wind_steady_e", "gust_n", "gust_e", "gust_d", "gust_start", "gust_duration", "noise_seed"]
+        + ["turbulence_seed", "turbulence_intensity"]
     )
 
 
@@ -254,6 +275,27 @@ def wind_function(sample: Mapping[str, Any]):
         return (wn, we, 0.0)
 
     return wind
+
+
+def atmosphere_parameters(sample: Mapping[str, Any]) -> dict[str, float]:
+    """The `tailsitter_atmosphere` parameters of a sample with turbulence: its steady wind
+    (uniform with height, so equal to the wind function's), Dryden turbulence of the sample's
+    intensity and seed, and its 1 − cos gust (the atmosphere's, same form as `wind_function`)."""
+    wn, we = float(sample["wind_steady_n"]), float(sample["wind_steady_e"])
+    return {
+        "wind_speed": math.hypot(wn, we),
+        # The bearing the wind blows FROM: the air moves along (wn, we).
+        "wind_from": math.atan2(-we, -wn) % (2.0 * math.pi),
+        "wind_profile": 0,
+        "turbulence_model": 1,
+        "turbulence_intensity": int(sample["turbulence_intensity"]),
+        "seed": int(sample["turbulence_seed"]),
+        "gust_amplitude_n": float(sample["gust_n"]),
+        "gust_amplitude_e": float(sample["gust_e"]),
+        "gust_amplitude_d": float(sample["gust_d"]),
+        "gust_start": float(sample["gust_start"]),
+        "gust_duration": float(sample["gust_duration"]),
+    }
 
 
 def run_key(sample_id: int, controller: str, configuration: str, state_source: str) -> str:

@@ -1,0 +1,219 @@
+//! Mission logic in wind (tuned configuration; README, "Missions in wind"): the heading
+//! ψ_w of the prescribed normal vector (§4.3.2.1) from the last seconds of the first
+//! vertical phase through the front transition, level flight and the back transition into
+//! the last vertical phase.
+//!
+//! A tail-sitter makes force along its nose (thrust) and its belly (the normal force of
+//! the wing and of the surfaces in the slip-stream, pitch); along the span it has only the
+//! weak rudder and vertical flaps. Unbanked, its plane of symmetry is the vertical plane of
+//! bearing ψ_w in hover (belly towards ψ_w) as in level flight (nose towards ψ_w), so the
+//! heading chooses which horizontal forces are made in the strong plane. The target is the
+//! bearing of the horizontal specific force the flight needs, belly or back towards it
+//! (whichever is nearer): the reference's own Σ^RE (4.3.35–4.3.36) — the push-over's
+//! acceleration and the pull-up's deceleration, along the track — plus the wind load, the
+//! low-passed difference between the measured horizontal specific force and Σ^RE. In hover
+//! in a crosswind the load dominates and the belly faces the wind, as the weathervane turns
+//! it, so the handover from the weathervane is continuous; as the front transition
+//! accelerates along the track the target turns towards the track; in level flight the
+//! heading does not act (γ = 0 makes the prescribed normal vector vertical, and the
+//! computed one of (4.3.29–4.3.30) takes over); the back transition's deceleration turns
+//! it back towards the track.
+//!
+//! Engaged with the weathervane (its filtered air-data wind at or above its engage speed,
+//! released below its release speed), at its rate limit: in still air the logic is idle
+//! and the calm mission is flown exactly as without it.
+
+use flight_mission::{Measurement, MissionParams, Phase};
+use guidance::weathervane::nearer_face;
+use guidance::Weathervane;
+use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+
+/// Time constant of the low-passed wind load (s).
+pub const LOAD_FILTER_TIME: f64 = 1.0;
+/// Horizontal specific force below which the heading is held (m/s²).
+pub const MIN_HORIZONTAL_FORCE: f64 = 0.5;
+
+/// Number of f64 values [`WindMission::save`] writes.
+pub const WIND_MISSION_STATE_LEN: usize = 3;
+
+/// State of the mission logic in wind: the low-passed horizontal wind load and whether the
+/// logic is engaged.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WindMission {
+    /// Low-passed horizontal (measured − reference) specific force, N and E (m/s²); NaN
+    /// before the first sample.
+    load: [f64; 2],
+    engaged: bool,
+}
+
+impl Default for WindMission {
+    fn default() -> Self {
+        Self {
+            load: [f64::NAN; 2],
+            engaged: false,
+        }
+    }
+}
+
+/// The measured specific force in earth axes (NED) (m/s²).
+fn specific_force_earth(m: &Measurement) -> Vector3<f64> {
+    let q = &m.quat;
+    let r = UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]));
+    r * m.specific_force_body
+}
+
+impl WindMission {
+    /// Whether the phase at mission time `t` is flown with this heading: the last
+    /// `return_window` of the first vertical phase (where the weathervane alone would return
+    /// to the mission's heading), the transitions and level flight, and the last vertical
+    /// phase until the weathervane follows the wind again.
+    pub fn in_window(wv: &Weathervane, mission: &MissionParams, t: f64) -> bool {
+        let p = wv.params();
+        let (phase, tau) = mission.phase_at(t);
+        p.enabled
+            && match phase {
+                Phase::Vertical1 => mission.t_vertical_1 - tau <= p.return_window(),
+                Phase::TransitionToLevel | Phase::Level | Phase::TransitionToVertical => true,
+                Phase::Vertical2 => tau < p.settle_time,
+                _ => false,
+            }
+    }
+
+    /// Whether the logic is engaged (the wind estimate's hysteresis).
+    pub fn engaged(&self) -> bool {
+        self.engaged
+    }
+
+    /// Update with the sample's measurement `m` and the reference's Σ^RE (NED) at mission
+    /// time `t`; the target heading (rad) and its largest rate (rad/s) for
+    /// [`Weathervane::update_towards`], or `None` (the weathervane's own). `wv` is the
+    /// weathervane before its update at this sample.
+    pub fn target(
+        &mut self,
+        wv: &Weathervane,
+        mission: &MissionParams,
+        t: f64,
+        m: &Measurement,
+        sigma_ref: &Vector3<f64>,
+    ) -> Option<(f64, f64)> {
+        let p = wv.params();
+        if !p.enabled {
+            return None;
+        }
+        let f = specific_force_earth(m) - sigma_ref;
+        if f.x.is_finite() && f.y.is_finite() {
+            if self.load[0].is_finite() && self.load[1].is_finite() {
+                let k = 1.0 - (-mission.sample_time / LOAD_FILTER_TIME).exp();
+                self.load[0] += k * (f.x - self.load[0]);
+                self.load[1] += k * (f.y - self.load[1]);
+            } else {
+                self.load = [f.x, f.y];
+            }
+        }
+        let w = wv.wind();
+        let speed = w.x.hypot(w.y);
+        if speed >= p.engage_speed {
+            self.engaged = true;
+        } else if speed.is_nan() || speed < p.release_speed {
+            self.engaged = false;
+        }
+        if !(self.engaged && Self::in_window(wv, mission, t)) {
+            return None;
+        }
+        let (n, e) = (sigma_ref.x + self.load[0], sigma_ref.y + self.load[1]);
+        let heading = wv.heading();
+        let size = n.hypot(e);
+        if size.is_nan() || size < MIN_HORIZONTAL_FORCE {
+            return Some((heading, p.max_rate));
+        }
+        Some((nearer_face(heading, e.atan2(n)), p.max_rate))
+    }
+
+    /// Write the state ([`WIND_MISSION_STATE_LEN`] values).
+    pub fn save(&self, out: &mut impl FnMut(f64)) {
+        out(self.load[0]);
+        out(self.load[1]);
+        out(if self.engaged { 1.0 } else { 0.0 });
+    }
+
+    /// Restore what [`Self::save`] wrote (`v`: [`WIND_MISSION_STATE_LEN`] values).
+    pub fn restore(&mut self, v: &[f64]) {
+        self.load = [v[0], v[1]];
+        self.engaged = v[2] != 0.0;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use guidance::WeathervaneParams;
+    use nalgebra::Vector4;
+
+    /// Nose up, belly north, hovering still in the horizontal wind `w` (NED) while making
+    /// the horizontal specific force `f_h` (NED, m/s²) against it.
+    fn hovering(w: Vector3<f64>, f_h: Vector3<f64>) -> Measurement {
+        let r = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), core::f64::consts::FRAC_PI_2);
+        // Air velocity −w in body axes: airspeed, α and β of (2.2.12–2.2.13).
+        let a = r.inverse() * (-w);
+        let (v, q) = (a.norm(), r.quaternion());
+        let zero = Vector3::zeros();
+        Measurement {
+            pos_ned: zero,
+            vel_ned: zero,
+            vel_body: zero,
+            rates: zero,
+            quat: Vector4::new(q.i, q.j, q.k, q.w),
+            airspeed: v,
+            alpha: a.z.atan2(a.x),
+            beta: if v > 0.0 { (a.y / v).asin() } else { 0.0 },
+            thrust: 0.0,
+            surfaces: [0.0; 6],
+            specific_force_body: r.inverse() * (f_h - Vector3::new(0.0, 0.0, 9.81)),
+            induced_velocity: 0.0,
+        }
+    }
+
+    /// Still air: idle everywhere. A crosswind from the east held by a force towards the
+    /// east: in the first vertical phase's return window the belly turns east (90°); in the
+    /// front transition the reference's acceleration north turns it towards the track.
+    #[test]
+    fn idle_in_still_air_and_the_belly_towards_the_needed_force_in_wind() {
+        let mission = MissionParams::default();
+        let s = mission.phase_starts();
+        let g = Vector3::new(0.0, 0.0, -9.81);
+        let mut wv = Weathervane::new(WeathervaneParams::tuned()).unwrap();
+        let mut wm = WindMission::default();
+        for k in 0..200 {
+            let t = k as f64 * mission.sample_time;
+            assert_eq!(
+                wm.target(&wv, &mission, t, &hovering(Vector3::zeros(), Vector3::zeros()), &g),
+                None
+            );
+        }
+        // 8 m/s from the east, 5 m/s² of horizontal force towards the east.
+        let m = hovering(Vector3::new(0.0, -8.0, 0.0), Vector3::new(0.0, 5.0, 0.0));
+        let mut last = None;
+        for k in 0..((s[1] - 0.1) / mission.sample_time) as usize {
+            let t = k as f64 * mission.sample_time;
+            last = wm.target(&wv, &mission, t, &m, &g);
+            wv.update_towards(&mission, t, &m, last);
+        }
+        assert!(wm.engaged() && WindMission::in_window(&wv, &mission, s[1] - 0.1));
+        let (target, rate) = last.unwrap();
+        assert!(
+            (target - core::f64::consts::FRAC_PI_2).abs() < 0.05,
+            "{}",
+            target.to_degrees()
+        );
+        assert_eq!(rate, wv.params().max_rate);
+        // In T1 with 5 m/s² along the track the bearing of (5, 5) is 45°.
+        let sigma = Vector3::new(5.0, 0.0, -9.81);
+        let m = hovering(Vector3::new(0.0, -8.0, 0.0), Vector3::new(5.0, 5.0, 0.0));
+        let (target, _) = wm.target(&wv, &mission, s[1] + 0.5, &m, &sigma).unwrap();
+        assert!(
+            (target - core::f64::consts::FRAC_PI_4).abs() < 0.05,
+            "{}",
+            target.to_degrees()
+        );
+    }
+}
