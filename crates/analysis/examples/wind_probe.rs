@@ -6,7 +6,6 @@ use analysis::controllers::Kind;
 use analysis::takeoff_landing;
 use analysis::wind_envelope::{fly_cell, plant, trimmed_climb, wind, MissionKind, WindForm};
 use closed_loop::{fly, Scenario};
-use flight_mission::MissionParams;
 
 fn main() {
     let a: Vec<String> = std::env::args().collect();
@@ -65,8 +64,8 @@ fn main() {
     let dt: f64 = a.get(6).map_or(1.0, |s| s.parse().unwrap());
     let p = plant();
     let (mission, x0, stop) = match mk {
-        MissionKind::Default => {
-            let m = MissionParams::default();
+        MissionKind::Default | MissionKind::Handover => {
+            let m = mk.mission();
             (m, trimmed_climb(&p, m.v_vertical).unwrap(), m.end_time() + 5.0)
         }
         MissionKind::TakeoffLanding => {

@@ -60,6 +60,21 @@ pub enum MissionKind {
 /// First vertical phase of the [`MissionKind::Handover`] mission (s).
 pub const HANDOVER_VERTICAL: f64 = 20.0;
 
+impl MissionKind {
+    /// The mission flown: the declared defaults, with [`HANDOVER_VERTICAL`] for the
+    /// handover, the take-off-to-landing mission for [`MissionKind::TakeoffLanding`].
+    pub fn mission(self) -> MissionParams {
+        match self {
+            MissionKind::Default => MissionParams::default(),
+            MissionKind::Handover => MissionParams {
+                t_vertical_1: HANDOVER_VERTICAL,
+                ..MissionParams::default()
+            },
+            MissionKind::TakeoffLanding => takeoff_landing::mission(),
+        }
+    }
+}
+
 /// The two wind forms.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -242,13 +257,7 @@ pub fn fly_cell_phases(
     };
     match mission_kind {
         MissionKind::Default | MissionKind::Handover => {
-            let mission = match mission_kind {
-                MissionKind::Handover => MissionParams {
-                    t_vertical_1: HANDOVER_VERTICAL,
-                    ..MissionParams::default()
-                },
-                _ => MissionParams::default(),
-            };
+            let mission = mission_kind.mission();
             match trimmed_climb(&plant, mission.v_vertical) {
                 Err(e) => cell.failure = Some(e),
                 Ok(x0) => {
