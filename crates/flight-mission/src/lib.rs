@@ -480,6 +480,26 @@ pub struct ControllerOutput {
     pub notice: Option<Notice>,
 }
 
+impl ControllerOutput {
+    /// The output on the gear: only `thrust` (clamped to `[thrust_min, thrust_max]`), the
+    /// surfaces neutral, the reference at the measured position (no error) and no notice.
+    pub fn on_gear(meas: &Measurement, phase: Phase, thrust: f64, thrust_min: f64, thrust_max: f64) -> Self {
+        Self {
+            command: Command {
+                thrust: thrust.clamp(thrust_min, thrust_max),
+                ..Command::default()
+            },
+            diagnostics: Diagnostics {
+                ref_pos_ned: meas.pos_ned,
+                ref_airspeed: 0.0,
+                phase,
+                pos_error: 0.0,
+            },
+            notice: None,
+        }
+    }
+}
+
 impl HeldOutput for ControllerOutput {
     const SAVED_LEN: usize = 13;
 

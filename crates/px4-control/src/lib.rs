@@ -399,19 +399,7 @@ impl Px4Controller {
     /// On the gear: no loop runs; every integrator and the mode reset.
     fn on_gear(&mut self, meas: &Measurement, phase: Phase, thrust: f64) -> ControllerOutput {
         self.reset_loops();
-        ControllerOutput {
-            command: Command {
-                thrust: thrust.clamp(self.airframe.thrust_min, self.airframe.thrust_max),
-                ..Command::default()
-            },
-            diagnostics: Diagnostics {
-                ref_pos_ned: meas.pos_ned,
-                ref_airspeed: 0.0,
-                phase,
-                pos_error: 0.0,
-            },
-            notice: None,
-        }
+        ControllerOutput::on_gear(meas, phase, thrust, self.airframe.thrust_min, self.airframe.thrust_max)
     }
 
     fn reset_loops(&mut self) {

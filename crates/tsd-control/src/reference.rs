@@ -5,7 +5,7 @@
 
 use crate::trajectory::Reference;
 use crate::TsdController;
-use flight_mission::{Command, ControllerInput, ControllerOutput, Diagnostics, Measurement, Phase};
+use flight_mission::{ControllerInput, ControllerOutput, Measurement, Phase};
 use guidance::GroundMode;
 use nalgebra::Vector3;
 
@@ -105,19 +105,6 @@ impl TsdController {
     pub(crate) fn on_gear(&mut self, meas: &Measurement, phase: Phase, thrust: f64) -> ControllerOutput {
         self.initialized = false;
         self.saturated = 0;
-        let command = Command {
-            thrust: thrust.clamp(self.airframe.thrust_min, self.airframe.thrust_max),
-            ..Command::default()
-        };
-        ControllerOutput {
-            command,
-            diagnostics: Diagnostics {
-                ref_pos_ned: meas.pos_ned,
-                ref_airspeed: 0.0,
-                phase,
-                pos_error: 0.0,
-            },
-            notice: None,
-        }
+        ControllerOutput::on_gear(meas, phase, thrust, self.airframe.thrust_min, self.airframe.thrust_max)
     }
 }
