@@ -182,7 +182,7 @@ fn phase_max_errors(trace: &Trace) -> [f64; closed_loop::N_PHASES] {
 
 /// Time history of a flight as CSV: t, phase, error, position and reference (NED), θ, wind.
 fn trace_history(trace: &Trace) -> String {
-    let mut out = String::from("t,phase,error,n,e,d,ref_n,ref_e,ref_d,theta,wind_n,wind_e,thrust\n");
+    let mut out = String::from("t,phase,error,n,e,d,ref_n,ref_e,ref_d,theta,wind_n,wind_e,thrust,phi321,psi321,airspeed,alpha,beta,ref_airspeed,elevator,aileron,rudder,flap_c,flap_d,vflap\n");
     for s in &trace.samples {
         let (p, r) = (s.measurement.pos_ned, s.diagnostics.ref_pos_ned);
         out.push_str(&format!(
@@ -200,6 +200,25 @@ fn trace_history(trace: &Trace) -> String {
             s.wind.x,
             s.wind.y,
             s.command.thrust
+        ));
+        let eul = tailsitter_physics::euler_321_from_quat(&s.measurement.quat);
+        let m = &s.measurement;
+        let c = &s.command;
+        out.pop();
+        out.push_str(&format!(
+            ",{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3},{:.3}\n",
+            eul.x,
+            eul.z,
+            m.airspeed,
+            m.alpha,
+            m.beta,
+            s.diagnostics.ref_airspeed,
+            c.elevator,
+            c.aileron,
+            c.rudder,
+            c.flap_collective,
+            c.flap_differential,
+            c.vertical_flap
         ));
     }
     out
