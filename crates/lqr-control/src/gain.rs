@@ -62,6 +62,10 @@ pub(crate) struct GainScheduleSwitches {
     /// the slowing climb, relinearise about the reference instead of the measured state
     /// (README, "Gusts"); the thesis always relinearises about the measured state.
     pub reference_after_back_transition: bool,
+    /// Tuned configuration: in the front transition in a steady wind stronger than the
+    /// climb (README, "Mission in wind"), relinearise about the reference instead of the
+    /// measured state.
+    pub reference_in_transition_wind: bool,
 }
 
 /// Discretised model, gain and closed-loop spectral-radius bound of one design.
@@ -375,7 +379,8 @@ impl LqrController {
             || r.ground.is_none()
                 && sw.reference_after_back_transition
                 && self.mission.phase_at(t).0 == Phase::Vertical2
-                && self.wind_in_air_data(m);
+                && self.wind_in_air_data(m)
+            || r.ground.is_none() && sw.reference_in_transition_wind && self.transition_in_wind(t);
         if r.ground.is_some() && self.ground_in_wind() {
             // Take-off and landing in wind: about the reference (its air data in the wind).
             return *xt;
@@ -386,6 +391,24 @@ impl LqrController {
             x_lin[ix::BETA] = 0.0;
         }
         x_lin
+    }
+
+    /// The front transition in a steady wind (the position integrators latched) whose
+    /// estimate (the weathervane's 4 s filter) exceeds the climb speed V_V and is not within
+    /// 45° of a tailwind along the track: the wind then dominates the air velocity of the
+    /// transition's slow start (air angles > 45°; across the track β = 0.78–0.98 rad
+    /// measured at 8 m/s), and the measured state, swinging through those angles, is no
+    /// valid point for the model's linearisation (README, "Mission in wind"); the reference
+    /// carries the wind-consistent air data instead. In a tailwind the measured state is
+    /// the better point (about the reference a 10 m/s tailwind was lost, 361 m).
+    fn transition_in_wind(&self, t: f64) -> bool {
+        if !(self.wind_integral && self.mission.phase_at(t).0 == Phase::TransitionToLevel) {
+            return false;
+        }
+        let w = self.weathervane.wind();
+        let (s, c) = self.trajectory.at(t).euler_321.z.sin_cos();
+        let (along, across) = (w.x * c + w.y * s, (w.y * c - w.x * s).abs());
+        w.xy().norm() > self.mission.v_vertical && along < across
     }
 
     /// Measured air angles beyond [`HOVER_WIND_AIR_ANGLE`] with an unfiltered air-data wind of

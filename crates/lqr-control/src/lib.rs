@@ -313,6 +313,7 @@ impl LqrParams {
             gain: GainScheduleSwitches {
                 relinearisation_period: self.relinearisation_period,
                 reference_after_back_transition: tuned,
+                reference_in_transition_wind: tuned,
             },
             integrator: IntegratorSwitches {
                 integrator_limit: self.integrator_limit,
