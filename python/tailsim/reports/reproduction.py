@@ -13,6 +13,7 @@ import sys
 
 import numpy as np
 
+from .. import declarations
 from . import load_json_into
 from .markdown import fmt_or_dash, fmt_pole, table
 
@@ -20,7 +21,6 @@ FILE = "reproduction.json"
 #: Chapter 6's conclusions on our plant in wind, from campaign folders (`python -m
 #: tailsim.reports.reproduction --wind FOLDER... --out FOLDER`).
 WIND_FILE = "reproduction_wind.json"
-PHASES = ("vertical 1", "transition 1", "level", "transition 2", "vertical 2")
 
 METHOD_NOTES = (
     "How this matches §5.1: the thesis applies the gains of the perfect model to a linear model with an altered "
@@ -70,7 +70,7 @@ def wind_summary(folders) -> dict:
             "p": float(ok.sum() / m.sum()) if m.any() else float("nan"),
             "median_max_err": med("max_err"),
             "median_rms_err": med("rms_err"),
-            "median_phase_max_err": [med(f"max_err_p{k}") for k in range(len(PHASES))],
+            "median_phase_max_err": [med(f"max_err_p{k}") for k in range(len(declarations.PHASES))],
         }
     return out
 
