@@ -334,7 +334,6 @@ impl Weathervane {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nalgebra::Vector4;
 
     /// Nose up, belly towards bearing `psi`, hovering still in the horizontal wind `w` (NED):
     /// the measurement's air data are those of the air velocity −w.
@@ -342,22 +341,10 @@ mod tests {
         // Body → earth: pitch up 90° about the body y axis, then heading ψ about down.
         let r = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), psi)
             * UnitQuaternion::from_axis_angle(&Vector3::y_axis(), std::f64::consts::FRAC_PI_2);
-        let v_air_b = r.inverse() * (-w);
-        let v = v_air_b.norm();
-        let q = r.quaternion();
         Measurement {
-            pos_ned: Vector3::zeros(),
-            vel_ned: Vector3::zeros(),
-            vel_body: Vector3::zeros(),
-            rates: Vector3::zeros(),
-            quat: Vector4::new(q.i, q.j, q.k, q.w),
-            airspeed: v,
-            alpha: v_air_b.z.atan2(v_air_b.x),
-            beta: if v > 0.0 { (v_air_b.y / v).asin() } else { 0.0 },
             thrust: 90.0,
-            surfaces: [0.0; 6],
-            specific_force_body: Vector3::zeros(),
             induced_velocity: 10.0,
+            ..Measurement::still_in_air(&r, &(r.inverse() * (-w)))
         }
     }
 

@@ -147,29 +147,14 @@ impl WindMission {
 mod tests {
     use super::*;
     use guidance::WeathervaneParams;
-    use nalgebra::Vector4;
 
     /// Nose up, belly north, hovering still in the horizontal wind `w` (NED) while making
     /// the horizontal specific force `f_h` (NED, m/s²) against it.
     fn hovering(w: Vector3<f64>, f_h: Vector3<f64>) -> Measurement {
         let r = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), core::f64::consts::FRAC_PI_2);
-        // Air velocity −w in body axes: airspeed, α and β of (2.2.12–2.2.13).
-        let a = r.inverse() * (-w);
-        let (v, q) = (a.norm(), r.quaternion());
-        let zero = Vector3::zeros();
         Measurement {
-            pos_ned: zero,
-            vel_ned: zero,
-            vel_body: zero,
-            rates: zero,
-            quat: Vector4::new(q.i, q.j, q.k, q.w),
-            airspeed: v,
-            alpha: a.z.atan2(a.x),
-            beta: if v > 0.0 { (a.y / v).asin() } else { 0.0 },
-            thrust: 0.0,
-            surfaces: [0.0; 6],
             specific_force_body: r.inverse() * (f_h - Vector3::new(0.0, 0.0, 9.81)),
-            induced_velocity: 0.0,
+            ..Measurement::still_in_air(&r, &(r.inverse() * (-w)))
         }
     }
 
