@@ -754,7 +754,7 @@ mod tests {
 
     #[test]
     fn controllers_are_the_models_including_the_controller_interface() {
-        assert_eq!(*CONTROLLERS, ["tailsitter_lqr", "tailsitter_tsd"]);
+        assert_eq!(*CONTROLLERS, ["tailsitter_lqr", "tailsitter_px4", "tailsitter_tsd"]);
     }
 
     #[test]
