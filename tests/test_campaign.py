@@ -191,6 +191,15 @@ def test_wilson_interval_matches_newcombe_1998():
         assert wilson_interval(k, n) == pytest.approx((lo, hi), abs=6e-5)
 
 
+def test_wilson_interval_contains_the_proportion():
+    """Regression: round-off put the lower bound at k = 0 above 0 (2.8e-17), and the upper one at
+    k = n below 1, so the error bars of the campaign's wind plot got a negative length."""
+    for n in range(1, 300):
+        for k in range(n + 1):
+            lo, hi = wilson_interval(k, n)
+            assert 0.0 <= lo <= k / n <= hi <= 1.0, (k, n, lo, hi)
+
+
 def test_spearman_and_bootstrap():
     # ranks of y = 1, 2, 3.5, 5, 3.5: ρ = 8/√(10·9.5) (by hand)
     assert spearman([1, 2, 3, 4, 5], [5, 6, 7, 8, 7]) == pytest.approx(8 / math.sqrt(95), rel=1e-12)
