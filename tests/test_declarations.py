@@ -102,3 +102,28 @@ def test_the_guard_sees_a_hand_copy(tmp_path):
     found = _hand_copies(bad)
     for what in ("phase-duration names", "thrust limit", "deflection limit"):
         assert any(what in f for f in found), (what, found)
+
+
+def test_the_product_names_no_internal_issue():
+    """Regression: variable descriptions (and so every modelDescription.xml and its docs) and a
+    report module's docstring once cited internal issue numbers; the product carries results,
+    the history stays in git."""
+    import re
+
+    pattern = re.compile(r"\bissues?\s*#?\d+", re.IGNORECASE)
+    files = [
+        *MODULES,
+        PACKAGE / "declarations.json",
+        *sorted((ROOT / "modelDescription").glob("*.json")),
+        *sorted((ROOT / "modelDescription" / "fragments").glob("*.json")),
+        *sorted((ROOT / "modelDescription" / "generated").glob("*.md")),
+        *sorted((ROOT / "modelDescription" / "generated").glob("*.xml")),
+        ROOT / "README.md",
+    ]
+    found = [
+        f"{f.relative_to(ROOT)}:{n}: {m.group(0)}"
+        for f in files
+        for n, line in enumerate(f.read_text(encoding="utf-8").splitlines(), 1)
+        if (m := pattern.search(line))
+    ]
+    assert not found, "\n".join(found)

@@ -1,4 +1,4 @@
-"""Issue 16, goal 1 — the transitions: the `envelope_transitions` key of the analysis
+"""The transition envelope: the `envelope_transitions` key of the analysis
 `report.json` (written by `crates/analysis/src/envelope_transitions.rs`) as a Markdown
 section and a plot of the fastest transitions each controller flies inside α ≤ 15°.
 
@@ -9,9 +9,14 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from .. import declarations
 from .markdown import fmt_or_dash, shortest
 
-ISSUE_TIMINGS = [(5.0, 10.0), (3.0, 4.0), (2.0, 3.0)]
+#: (T1, T2) of the declared missions default, fast and fast_limited: the thesis configurations'
+#: rows shown (the tuned ones are shown at every timing).
+MISSION_TIMINGS = [
+    (m["t_transition_1"], m["t_transition_2"]) for m in map(declarations.mission, ("default", "fast", "fast_limited"))
+]
 
 
 def section(d: dict) -> list[str]:
@@ -40,7 +45,7 @@ def section(d: dict) -> list[str]:
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in e["rows"]:
-        if (r["t1"], r["t2"]) not in ISSUE_TIMINGS and r["configuration"] != 0:
+        if (r["t1"], r["t2"]) not in MISSION_TIMINGS and r["configuration"] != 0:
             continue
         out.append(
             f"| {r['controller']} | {'tuned' if r['configuration'] == 0 else 'thesis'} | {r['ordering']} | "
