@@ -3,7 +3,7 @@
 //! SPEEDS and BEARING_INDICES comma-separated. With a trace file (one cell) the time history
 //! (t, phase, error, position, reference, θ, heading, wind) is written.
 use analysis::controllers::Kind;
-use analysis::wind_envelope::{fly_cell, MissionKind, WindForm, BEARINGS_DEG};
+use analysis::wind_envelope::{MissionKind, WindForm, BEARINGS_DEG};
 use rayon::prelude::*;
 
 fn main() {
@@ -54,5 +54,4 @@ fn main() {
             c.failure.unwrap_or_default()
         );
     }
-    let _ = fly_cell;
 }
