@@ -79,7 +79,7 @@ def read_mat4(path: pathlib.Path) -> dict[str, np.ndarray]:
     names = ["".join(chr(c) for c in col).rstrip("\0 ") for col in matrices["name"].astype(int)]
     info = matrices["dataInfo"]
     out = {}
-    for name, (matrix, column, *_) in zip(names, info):
+    for name, (matrix, column, *_) in zip(names, info, strict=True):
         if matrix == 2 or name == "time":
             out[name] = np.sign(column) * matrices["data_2"][:, abs(int(column)) - 1]
     return out
@@ -191,7 +191,11 @@ def fly(binary: str, ssp: pathlib.Path, workdir: pathlib.Path, dist: pathlib.Pat
     `dist` (none if `dist` is None)."""
     run = run_omsimulator(binary, ssp, workdir)
     figures = {"ssp": ssp.name, "returncode": run["returncode"], "stop_time": run["stop_time"]}
-    figures["errors_logged"] = sum(line.startswith("error:") for line in run["log"].splitlines())
+    lines = run["log"].splitlines()
+    figures["errors_logged"] = sum(line.startswith("error:") for line in lines)
+    # OMSimulator validates the SSD against SSP 1.0 when it finds the schemas (docs/OMSIMULATOR.md)
+    figures["schema_validated"] = not any("could not load the ssd schema" in line for line in lines)
+    figures["schema_violations"] = sum("does not conform to the SSP standard" in line for line in lines)
     if "signals" not in run:
         figures["log_tail"] = run["log"][-2000:]
         return figures
@@ -226,7 +230,8 @@ def main(argv: list[str] | None = None) -> int:
                 (pn, pd), (cn, cd) = f["largest_plant_output_difference"], f["largest_controller_output_difference"]
                 print(
                     f"{f['ssp']}: to {f['final_time']:g} s, final phase {f['final_phase']}, "
-                    f"max pos error {f['max_pos_error_m']:.10f} m (fmpy Jacobi {f['reference_max_pos_error_m']:.10f} m), "
+                    f"max pos error {f['max_pos_error_m']:.10f} m "
+                    f"(fmpy Jacobi {f['reference_max_pos_error_m']:.10f} m), "
                     f"position distance {f['max_position_distance_m']:.2e} m, largest output difference: "
                     f"plant {pn} {pd:.2e}, controller {cn} {cd:.2e}"
                 )

@@ -180,6 +180,7 @@ def test_omsimulator_flies_the_closed_loop_like_the_fmpy_jacobi_master(controlle
     figures = omsimulator.fly(BINARY, ssp_path(controller), tmp_path)
     print(f"\n{controller} in OMSimulator: {figures}")
     assert figures["returncode"] == 0 and figures["errors_logged"] == 0
+    assert figures["schema_violations"] == 0
     assert figures["final_time"] == 35.0 and figures["final_phase"] == 4
     assert figures["rows"] == 1751
     assert figures["max_position_distance_m"] < 1e-9
