@@ -864,7 +864,8 @@ mod tests {
         for name in ["controller", "plant", "atmosphere"] {
             assert!(ssd.contains(&format!(r#"<ssv:ParameterSet version="1.0" name="{name}">"#)));
         }
-        let controller_set = &ssd[ssd.find(r#"name="controller">"#).unwrap()..ssd.find(r#"<ssd:Component name="plant""#).unwrap()];
+        let controller_set =
+            &ssd[ssd.find(r#"name="controller">"#).unwrap()..ssd.find(r#"<ssd:Component name="plant""#).unwrap()];
         let n = MISSION.len() + DESIGN_AIRFRAME.len();
         assert_eq!(count(controller_set, "<ssv:Parameter "), n);
         // the mission first, then the design model
