@@ -237,10 +237,11 @@ def test_omsimulator_library_honours_the_ssd_stop_time(tmp_path):
 @needs_omsimulator
 @pytest.mark.parametrize("controller", CLOSED_LOOP)
 def test_omsimulator_avionics_equal_fmpy_jacobi_with_the_estimator_started_on_the_commands(controller, tmp_path):
-    """OMSimulator initialises every connection together, so the estimator's command inputs
-    start at the controller's initial commands; the fmpy master initialises the estimator
-    before the controller (command inputs at their start values). Given those commands, the
-    fmpy Jacobi master flies OMSimulator's trajectory."""
+    """The estimator starts its actuator states on its command inputs. OMSimulator initialises
+    every connection together, so they are the controller's initial commands (for the LQR a
+    fixed point 10.8 N below the plant's trim thrust); the fmpy master initialises the
+    estimator before the controller (command inputs at their start values, the trim). Given
+    OMSimulator's initial commands, the fmpy Jacobi master flies OMSimulator's trajectory."""
     from tailsim import Fmu
     from tailsim.masters.avionics import AvionicsLoop
 
