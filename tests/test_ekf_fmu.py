@@ -152,7 +152,7 @@ def test_initial_outputs_do_not_depend_on_the_commands(ekf):
         s.freeInstance()
         return during, after
 
-    trim = {n: ekf.var[n].start for n in COMMANDS}
+    trim = {n: float(ekf.var[n].start) for n in COMMANDS}
     assert trim["thrust_cmd"] == pytest.approx(88.376, abs=1e-3)
     # The LQR's first command under OMSimulator's former fixed point, then far-off values.
     off = [{**trim, "thrust_cmd": 77.56}, dict(zip(COMMANDS, (40.0, 0.3, -0.2, 0.1, 0.25, -0.15, 0.05), strict=True))]
@@ -161,7 +161,7 @@ def test_initial_outputs_do_not_depend_on_the_commands(ekf):
     during, after = initial(off)
     assert during == [reference, reference] and after == reference
     thrust, elevator = (reference[outputs.index(n)] for n in ("thrust", "elevator"))
-    assert (thrust, elevator) == (ekf.var["init_thrust"].start, 0.0)
+    assert (thrust, elevator) == (float(ekf.var["init_thrust"].start), 0.0)
     # The parameters set the start (clamped to the limits as the plant's actuators).
     _, moved = initial(off, init_thrust=70.0, init_elevator=0.1)
     assert (moved[outputs.index("thrust")], moved[outputs.index("elevator")]) == (70.0, 0.1)

@@ -11,11 +11,12 @@ libcosim accept too —
   value read back is the SSD's and not the FMU's default.
 
 With an `OMSimulator` binary ($OMSIMULATOR or PATH; skipped otherwise), through
-scripts/omsimulator.py: each closed-loop SSP flies the default mission to the SSD's stop time
-and matches the fmpy Jacobi master to 1e-9 m; an edited mission value reaches the controller;
-OMSimulator's library honours the SSD's stop time (its command line replaces it by
-`--stopTime`); the avionics systems match the fmpy Jacobi master once its estimator starts
-from the controller's initial commands, as OMSimulator's initialisation gives it.
+scripts/omsimulator.py: each SSP, closed loop and avionics, flies the default mission to the
+SSD's stop time and matches the fmpy Jacobi master to 1e-9 m; the avionics systems start with
+the estimator's motor and servos where the plant's are (its initial outputs depend on no
+command, so OMSimulator's initialisation of every connection at once has no loop to solve); an
+edited mission value reaches the controller; OMSimulator's library honours the SSD's stop time
+(its command line replaces it by `--stopTime`).
 """
 
 from __future__ import annotations
@@ -175,10 +176,12 @@ def test_every_declared_binding_reaches_the_fmu_under_fmpy(name, tmp_path):
 
 
 @needs_omsimulator
-@pytest.mark.parametrize("controller", CLOSED_LOOP)
-def test_omsimulator_flies_the_closed_loop_like_the_fmpy_jacobi_master(controller, tmp_path):
-    figures = omsimulator.fly(BINARY, ssp_path(controller), tmp_path)
-    print(f"\n{controller} in OMSimulator: {figures}")
+@pytest.mark.parametrize("name", SSPS)
+def test_omsimulator_flies_like_the_fmpy_jacobi_master(name, tmp_path):
+    """The closed loops and the avionics systems, each as shipped: nothing is given to either
+    master but the SSP's FMUs and bindings."""
+    figures = omsimulator.fly(BINARY, ssp_path(name), tmp_path)
+    print(f"\n{name} in OMSimulator: {figures}")
     assert figures["returncode"] == 0 and figures["errors_logged"] == 0
     assert figures["schema_violations"] == 0
     assert figures["final_time"] == 35.0 and figures["final_phase"] == 4
@@ -236,32 +239,22 @@ def test_omsimulator_library_honours_the_ssd_stop_time(tmp_path):
 
 @needs_omsimulator
 @pytest.mark.parametrize("controller", CLOSED_LOOP)
-def test_omsimulator_avionics_equal_fmpy_jacobi_with_the_estimator_started_on_the_commands(controller, tmp_path):
-    """The estimator starts its actuator states on its command inputs. OMSimulator initialises
-    every connection together, so they are the controller's initial commands (for the LQR a
-    fixed point 10.8 N below the plant's trim thrust); the fmpy master initialises the
-    estimator before the controller (command inputs at their start values, the trim). Given
-    OMSimulator's initial commands, the fmpy Jacobi master flies OMSimulator's trajectory."""
-    from tailsim import Fmu
-    from tailsim.masters.avionics import AvionicsLoop
-
+def test_omsimulator_starts_the_avionics_estimator_on_the_plants_actuators(controller, tmp_path):
+    """OMSimulator initialises every connection at once, the controller's initial commands
+    included. The estimator's motor and servos start at `init_thrust`, `init_elevator` (the
+    trim the plant is released in), not at its command inputs, so at t = 0 its actuator
+    outputs are the plant's, and the controller's first command is the fmpy master's (which
+    initialises the estimator before the controller): the same start."""
     ssp = ssp_path(f"{controller}_avionics")
     run = omsimulator.run_omsimulator(BINARY, ssp, tmp_path)
-    s = omsimulator.last_per_time(run["signals"])
-    ekf = Fmu(DIST / "tailsitter_ekf.fmu")
-    commands = {n: float(s[f"controller.{n}"][0]) for n in ekf.names("input") if n.endswith("_cmd")}
-    assert len(commands) == 7
-    loop = AvionicsLoop(
-        Fmu(DIST / "tailsitter_plant.fmu"),
-        Fmu(DIST / "tailsitter_sensors.fmu"),
-        ekf,
-        Fmu(DIST / f"{controller}.fmu"),
-        ekf_params=commands,
-        ordering="jacobi",
-    )
-    ref = loop.run(stop_time=35.0)
-    n = len(ref.time)
-    distance = np.sqrt(sum((s[f"plant.pos_{k}"][:n] - ref[f"pos_{k}"]) ** 2 for k in "ned"))
-    print(f"\n{controller} avionics: OMSimulator vs fmpy Jacobi (estimator on the commands) {distance.max():.2e} m")
-    # OMSimulator solves the initialisation loop iteratively, to a tolerance (LQR: 4.9e-7 m)
-    assert distance.max() < 1e-5
+    assert run["returncode"] == 0, run["log"][-2000:]
+    sig = run["signals"]
+    start = sig["time"] == 0.0
+    for n in ("thrust", "elevator", "aileron", "rudder", "flap_collective", "flap_differential", "vertical_flap"):
+        est, plant = sig[f"estimator.{n}"][start], sig[f"plant.{n}"][start]
+        assert np.all(np.abs(est - plant) < 1e-9), (n, est, plant)
+    assert sig["plant.thrust"][start][0] == pytest.approx(88.376, abs=1e-3)
+    ref = omsimulator.fmpy_jacobi(ssp)
+    s = omsimulator.last_per_time(sig)
+    # The command for the sample at t_k: tailsim records it at t_k, OMSimulator at t_k + h.
+    assert s["controller.thrust_cmd"][1] == pytest.approx(ref["thrust_cmd"][0], abs=1e-9)

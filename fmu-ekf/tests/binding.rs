@@ -555,7 +555,7 @@ fn initial_outputs_do_not_depend_on_the_commands() {
         .iter()
         .filter(|s| s.causality == fmi2_export::Causality::Output && s.value_type == fmi2_export::ValueType::Real)
         .collect();
-    assert!(outputs.len() > 40);
+    assert!(outputs.len() > 30);
     for s in &outputs {
         let (a, b) = (
             trim.get_real(s.value_reference).unwrap(),
