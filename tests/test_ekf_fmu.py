@@ -13,6 +13,7 @@ import pytest
 from fmpy.fmi2 import FMU2Slave
 
 from fmu_util import ROOT, LogRecorder, Unpacked
+from tailsim.declarations import COMMANDS
 
 H = 0.02
 CLIMB = 3.0  # m/s, the plant's default trimmed climb
@@ -117,17 +118,6 @@ def test_tracks_a_climb_rejects_a_spike_and_restores_state(ekf):
         assert ekf.get(s, *names) == expected
     s.terminate()
     s.freeInstance()
-
-
-COMMANDS = (
-    "thrust_cmd",
-    "elevator_cmd",
-    "aileron_cmd",
-    "rudder_cmd",
-    "flap_collective_cmd",
-    "flap_differential_cmd",
-    "vertical_flap_cmd",
-)
 
 
 def test_initial_outputs_do_not_depend_on_the_commands(ekf):

@@ -561,7 +561,12 @@ fn initial_outputs_do_not_depend_on_the_commands() {
             trim.get_real(s.value_reference).unwrap(),
             moved.get_real(s.value_reference).unwrap(),
         );
-        assert_eq!(a.to_bits(), b.to_bits(), "{} changed with the commands: {a} -> {b}", s.name);
+        assert_eq!(
+            a.to_bits(),
+            b.to_bits(),
+            "{} changed with the commands: {a} -> {b}",
+            s.name
+        );
     }
     // The parameters set the actuators' start, each within its limits.
     let started = init(&|v| {

@@ -29,7 +29,9 @@ fn declared_dependencies_hold() {
     let commands: Vec<_> = model
         .variables
         .iter()
-        .filter(|v| v.decl.causality == model_description::Causality::Input && v.decl.group.as_deref() == Some("commands"))
+        .filter(|v| {
+            v.decl.causality == model_description::Causality::Input && v.decl.group.as_deref() == Some("commands")
+        })
         .map(|v| v.decl.name.as_str())
         .collect();
     assert_eq!(commands.len(), 7);
@@ -38,8 +40,17 @@ fn declared_dependencies_hold() {
         assert!(initial.probed.iter().any(|p| p == c), "{c} not probed");
         assert!(!read.contains(c), "{c} confirmed");
     }
-    let vr = |n: &str| model.variables.iter().find(|v| v.decl.name == n).unwrap().value_reference;
-    assert!(init_decl.iter().all(|(_, deps)| commands.iter().all(|c| !deps.contains(&vr(c)))));
+    let vr = |n: &str| {
+        model
+            .variables
+            .iter()
+            .find(|v| v.decl.name == n)
+            .unwrap()
+            .value_reference
+    };
+    assert!(init_decl
+        .iter()
+        .all(|(_, deps)| commands.iter().all(|c| !deps.contains(&vr(c)))));
     // The actuators' start parameters are real dependencies of the initial thrust and elevator.
     for p in ["init_thrust", "init_elevator"] {
         assert!(read.contains(p), "{p} changes no initial output");

@@ -288,7 +288,10 @@ impl EstimatorParams {
             }
         }
         if !self.tuning.init_elevator.is_finite() {
-            return Err(format!("init_elevator = {} rad must be finite", self.tuning.init_elevator));
+            return Err(format!(
+                "init_elevator = {} rad must be finite",
+                self.tuning.init_elevator
+            ));
         }
         if !(self.filter.bandwidth.is_finite() && self.filter.bandwidth > 0.0) {
             return Err(format!(
