@@ -31,8 +31,31 @@ fn takeoff_landing() -> (MissionParams, Plant, StateVector, f64) {
     (mission, plant, x0, stop)
 }
 
+/// PX4's parameters, with `TECS_PIT=<FW_T_I_GAIN_PIT>`, `TECS_THR=<FW_T_I_GAIN_THR>` from the environment.
+fn params() -> px4_control::Px4Params {
+    let mut p = px4_control::Px4Params::default();
+    let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f64>().ok());
+    if let Some(v) = env("TECS_PIT") {
+        p.FW_T_I_GAIN_PIT = v;
+    }
+    if let Some(v) = env("TECS_THR") {
+        p.FW_T_I_GAIN_THR = v;
+    }
+    if let Some(v) = env("ALT_TC") {
+        p.FW_T_ALT_TC = v;
+    }
+    if let Some(v) = env("SPDW") {
+        p.FW_T_SPDWEIGHT = v;
+    }
+    p
+}
+
+fn controller(mission: MissionParams) -> Px4Controller {
+    Px4Controller::new(Airframe::default(), mission, params()).unwrap()
+}
+
 fn run(plant: &Plant, x0: StateVector, mission: MissionParams, s: &Scenario) -> (Trace, MissionCheck) {
-    let mut ctl = Px4Controller::with_mission(mission).unwrap();
+    let mut ctl = controller(mission);
     let trace = fly(plant, x0, &mut ctl, s);
     let theta = Plant::new(Airframe::default()).trim_level(mission.v_level).unwrap().theta;
     let check = MissionCheck::of(&trace, &mission, theta);
@@ -165,7 +188,7 @@ fn trace(args: &[String]) {
         s.stop_time = std::env::var("STOP").ok().and_then(|x| x.parse().ok()).unwrap_or(stop);
     }
     let every: usize = std::env::var("EVERY").ok().and_then(|v| v.parse().ok()).unwrap_or(25);
-    let mut ctl = Px4Controller::with_mission(mission).unwrap();
+    let mut ctl = controller(mission);
     let mut probe = ctl.clone();
     let trace = fly(&plant, x0, &mut ctl, &s);
     for (k, smp) in trace.samples.iter().enumerate() {
@@ -181,7 +204,8 @@ fn trace(args: &[String]) {
         let i = *probe.internals();
         let m = &smp.measurement;
         println!(
-            "t {:6.2} ph {:2} m {} pos ({:7.2} {:6.2} {:7.2}) ref ({:7.2} {:6.2} {:7.2}) V {:5.2} Vref {:5.2} θ {:6.1} α {:6.1} T {:6.1} thr/θsp ({:.2} {:5.1}) err {:6.2}",
+            "Vsp {:5.2} t {:6.2} ph {:2} m {} pos ({:7.2} {:6.2} {:7.2}) ref ({:7.2} {:6.2} {:7.2}) V {:5.2} Vref {:5.2} θ {:6.1} α {:6.1} T {:6.1} thr/θsp ({:.2} {:5.1}) err {:6.2}",
+            i.airspeed_sp,
             smp.t,
             smp.diagnostics.phase as i32,
             i.mode.map_or(-1, |m| m as i32),
