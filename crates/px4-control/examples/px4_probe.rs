@@ -44,6 +44,9 @@ fn params() -> px4_control::Px4Params {
     if let Some(v) = env("ALT_TC") {
         p.FW_T_ALT_TC = v;
     }
+    if let Some(v) = env("ARSP_TRANS") {
+        p.VT_ARSP_TRANS = v;
+    }
     if let Some(v) = env("SPDW") {
         p.FW_T_SPDWEIGHT = v;
     }
@@ -186,6 +189,11 @@ fn trace(args: &[String]) {
         let v: Vec<f64> = step.split(',').map(|x| x.parse().unwrap()).collect();
         s.ref_offset_steps = vec![(v[0], Vector3::new(v[1], v[2], v[3]))];
         s.stop_time = std::env::var("STOP").ok().and_then(|x| x.parse().ok()).unwrap_or(stop);
+    }
+    if let Some(w) = std::env::var("WIND").ok() {
+        // WIND="speed,from_bearing_deg"
+        let v: Vec<f64> = w.split(',').map(|x| x.parse().unwrap()).collect();
+        s.wind = closed_loop::Wind::Constant(closed_loop::wind_from(v[1].to_radians(), v[0]));
     }
     let every: usize = std::env::var("EVERY").ok().and_then(|v| v.parse().ok()).unwrap_or(25);
     let mut ctl = controller(mission);

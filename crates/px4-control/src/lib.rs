@@ -78,7 +78,7 @@ pub struct Derived {
     pub pitch_offset: f64,
     /// TRIM_PITCH: normalised pitch torque of the level trim's surfaces.
     pub trim_pitch: f64,
-    /// FW_AIRSPD_MIN, VT_ARSP_TRANS (m/s).
+    /// FW_AIRSPD_MIN, VT_ARSP_TRANS (m/s) (the latter FW_AIRSPD_TRIM when derived).
     pub airspeed_min: f64,
     pub transition_airspeed: f64,
     /// FW_T_CLMB_MAX, FW_T_SINK_MIN (m/s).
@@ -141,7 +141,7 @@ impl Derived {
             .fold(2.0 * mission.v_vertical, f64::max);
         Ok(Self {
             airspeed_min,
-            transition_airspeed: or(p.VT_ARSP_TRANS, airspeed_min),
+            transition_airspeed: or(p.VT_ARSP_TRANS, v_trim),
             climb_max,
             sink_min,
             climb_rate_max: or(p.MPC_Z_VEL_MAX_UP, profile_climb),

@@ -87,7 +87,7 @@ pub struct Px4Params {
     pub VT_F_TRANS_DUR: f64,
     /// Back transition: pitch ramp duration and time-out; ≤ 0: the mission's t_transition_2 (PX4 default 4 s).
     pub VT_B_TRANS_DUR: f64,
-    /// Front transition: airspeed at which fixed-wing flight may begin (PX4 default 10 m/s, below this airframe's stall speed); ≤ 0: FW_AIRSPD_MIN (PX4: between FW_AIRSPD_MIN and FW_AIRSPD_TRIM).
+    /// Front transition: airspeed at which fixed-wing flight may begin (PX4 default 10 m/s, below this airframe's stall speed; PX4: between FW_AIRSPD_MIN and FW_AIRSPD_TRIM); derived when ≤ 0 (README, 'Derived parameters'): FW_AIRSPD_TRIM, the speed the mission's front transition ends at.
     pub VT_ARSP_TRANS: f64,
     /// Trim airspeed of the airspeed scaling and TECS; derived for this airframe when ≤ 0 (README, 'Derived parameters'): the mission's v_level.
     pub FW_AIRSPD_TRIM: f64,
