@@ -60,7 +60,10 @@ fn controller(mission: MissionParams) -> Px4Controller {
 fn run(plant: &Plant, x0: StateVector, mission: MissionParams, s: &Scenario) -> (Trace, MissionCheck) {
     let mut ctl = controller(mission);
     let trace = fly(plant, x0, &mut ctl, s);
-    let theta = Plant::new(Airframe::default()).trim_level(mission.v_level).unwrap().theta;
+    let theta = Plant::new(Airframe::default())
+        .trim_level(mission.v_level)
+        .unwrap()
+        .theta;
     let check = MissionCheck::of(&trace, &mission, theta);
     (trace, check)
 }
@@ -234,7 +237,10 @@ fn trace(args: &[String]) {
         );
     }
     println!("failure: {:?}", trace.failure);
-    let theta = Plant::new(Airframe::default()).trim_level(mission.v_level).unwrap().theta;
+    let theta = Plant::new(Airframe::default())
+        .trim_level(mission.v_level)
+        .unwrap()
+        .theta;
     print!("{}", MissionCheck::of(&trace, &mission, theta));
     println!("max pos error {:.2} m", trace.max_pos_error());
 }
