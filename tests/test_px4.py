@@ -109,7 +109,7 @@ def test_level_position_step_settles(fmus, offset, bound):
         ref_offset=step(t_step, offset),
     )
     axis = np.array(offset) / np.linalg.norm(offset)
-    e = np.abs(sum((result[f"pos_{k}"] - result[f"ref_pos_{k}"]) * a for k, a in zip("ned", axis)))
+    e = np.abs(sum((result[f"pos_{k}"] - result[f"ref_pos_{k}"]) * a for k, a in zip("ned", axis, strict=True)))
     ts = settling_time(result.time, e, t_step + 0.02, band=0.5)
     print(f"\nPX4 level step {offset}: settling {ts:.2f} s, final {e[-1]:.3f} m")
     assert ts < bound and e[-1] < 0.2
