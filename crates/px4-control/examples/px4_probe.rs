@@ -3,7 +3,12 @@
 //! position steps, under Gauss-Seidel and Jacobi, and the default mission in steady wind;
 //! or one run sample by sample.
 //!
-//! `cargo run --release -p px4-control --example px4_probe -- [table | wind | trace <preset> [jacobi]]`
+//! `cargo run --release -p px4-control --example px4_probe -- [table | wind | profile <preset> | trace <preset> [jacobi]]`
+//!
+//! Environment: `TECS_PIT`, `TECS_THR`, `ALT_TC`, `SPDW`, `ARSP_TRANS` override
+//! FW_T_I_GAIN_PIT, FW_T_I_GAIN_THR, FW_T_ALT_TC, FW_T_SPDWEIGHT, VT_ARSP_TRANS; for
+//! `trace`, `EVERY` (samples between lines), `STEP="t,n,e,d"` and `STOP` (a reference step
+//! and the end time), `WIND="speed,from_bearing_deg"` (steady wind).
 
 use closed_loop::{fly, MissionCheck, Ordering, Scenario, Trace};
 use flight_mission::{MissionParams, Phase, SampledUnit};
@@ -187,13 +192,13 @@ fn trace(args: &[String]) {
     if jacobi {
         s.ordering = Ordering::Jacobi;
     }
-    if let Some(step) = std::env::var("STEP").ok() {
+    if let Ok(step) = std::env::var("STEP") {
         // STEP="t,n,e,d"
         let v: Vec<f64> = step.split(',').map(|x| x.parse().unwrap()).collect();
         s.ref_offset_steps = vec![(v[0], Vector3::new(v[1], v[2], v[3]))];
         s.stop_time = std::env::var("STOP").ok().and_then(|x| x.parse().ok()).unwrap_or(stop);
     }
-    if let Some(w) = std::env::var("WIND").ok() {
+    if let Ok(w) = std::env::var("WIND") {
         // WIND="speed,from_bearing_deg"
         let v: Vec<f64> = w.split(',').map(|x| x.parse().unwrap()).collect();
         s.wind = closed_loop::Wind::Constant(closed_loop::wind_from(v[1].to_radians(), v[0]));
