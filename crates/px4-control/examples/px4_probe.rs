@@ -116,11 +116,28 @@ fn table() {
             .filter(|s| (s.diagnostics.phase as usize) < 5)
             .map(closed_loop::Sample::pos_error)
             .fold(0.0, f64::max);
+        // Contact lost after the first touchdown (the gear's rebound), and its height.
+        let contact: Vec<u32> = trace
+            .samples
+            .iter()
+            .map(|s| tplant.ground.contact_state(&tplant.airframe, &s.x).points)
+            .collect();
+        let airborne = contact.iter().position(|&c| c == 0).unwrap_or(0);
+        let td = (airborne..contact.len()).find(|&k| contact[k] > 0);
+        let (bounced, rebound) = td.map_or((false, 0.0), |k| {
+            let d0 = trace.samples[k].measurement.pos_ned.z;
+            let rise = trace.samples[k..]
+                .iter()
+                .map(|s| d0 - s.measurement.pos_ned.z)
+                .fold(0.0, f64::max);
+            (contact[k..].contains(&0), rise)
+        });
         println!(
-            "TL       {master:6} completed {} landed {} miss {miss:.2} m tilt {:.1}° max err in the mission {flight:.2} m",
+            "TL       {master:6} completed {} landed {} miss {miss:.2} m tilt {:.1}° max err in the mission {flight:.2} m bounced {bounced} (rise {:.1} mm)",
             trace.completed(),
             last.diagnostics.phase == Phase::Landed,
-            90.0 - last.theta.to_degrees()
+            90.0 - last.theta.to_degrees(),
+            1000.0 * rebound
         );
     }
     let vertical = MissionParams::preset("step_vertical").unwrap();
