@@ -131,8 +131,9 @@ def test_take_off_to_landing(fmus, ordering):
     assert td["lifted_off"] and td["touched_down"] and td["landed"]
     assert 0.0 < td["touchdown_speed"] < 0.5
     # Under Jacobi the gear leaves the ground for one 0.02 s step 0.1 s after the touchdown
-    # (the CG rises 4.1 mm above its touchdown height on the gear's spring): the strict "no
-    # bounce" holds under Gauss-Seidel only.
+    # (the CG rises 4.1 mm above its touchdown height on the gear's spring, as it did before
+    # the fixed-wing and back-transition changes): the strict "no bounce" holds under
+    # Gauss-Seidel only.
     if ordering == "gauss-seidel":
         assert not td["bounced"]
     k = int(np.flatnonzero(r.time >= td["touchdown_time"])[0])
