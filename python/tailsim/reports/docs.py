@@ -115,7 +115,6 @@ def interval(ci, nd: int = 3, signed: bool = False) -> str:
 
 from . import docs_blocks  # noqa: E402,F401  (registers BLOCKS)
 
-
 # --- regeneration ------------------------------------------------------------------------------------------------
 
 
@@ -145,9 +144,7 @@ def keys_in(text: str) -> list[str]:
     return [m["key"] for m in BLOCK_RE.finditer(text)]
 
 
-def regenerate(
-    root: pathlib.Path = ROOT, write: bool = True, override: Mapping[str, Any] | None = None
-) -> list[str]:
+def regenerate(root: pathlib.Path = ROOT, write: bool = True, override: Mapping[str, Any] | None = None) -> list[str]:
     """Rewrite the generated blocks of every `docs/*.md` under `root`; the files that were stale
     (relative to `root`)."""
     src = Sources(root, override)
@@ -179,7 +176,9 @@ _STRIP = [
         r"\s*[A-E]?[\d.]+(?:[–-][A-E]?[\d.]+)?(?:\s*(?:,|and|/)\s*[A-E]?[\d.]+)*"
     ),
     re.compile(r"\b[DO]-(?:[A-Z]|\d)(?:\.[\dx]+)?(?:[–-][DO]?-?[\w.]+)?"),  # register ids D-4.27, O-17
-    re.compile(r"\b(?:FMI|SSP|glibc|GLIBC_|Wine|Windows|Python|C\+\+|MIL-F-|WMM|Debian|RHEL/CentOS|RK|DP|x86_|x86-)[\s_]?[\d.]+x?"),
+    re.compile(
+        r"\b(?:FMI|SSP|glibc|GLIBC_|Wine|Windows|Python|C\+\+|MIL-F-|WMM|Debian|RHEL/CentOS|RK|DP|x86_|x86-)[\s_]?[\d.]+x?"
+    ),
     re.compile(r"\b\w*[A-Za-z_]\d[\w.]*"),  # identifiers with digits (c1000, t_transition_1, aarch64, 2D)
     re.compile(r"\b\d+(?:st|nd|rd|th)\b"),
 ]
@@ -200,7 +199,8 @@ def figures(text: str) -> list[tuple[int, str]]:
             tok = m[0].strip()
             has_unit = not re.fullmatch(r"[−+-]?[\d,]+(?:\.\d+)?(?:e[−-]?\d+)?", tok)
             number = re.match(r"[−+-]?[\d,]+(?:\.\d+)?(?:e[−-]?\d+)?", tok)[0]
-            if not has_unit and "." not in number and "e" not in number and abs(int(number.replace(",", "").replace("−", "-"))) <= SMALL:
+            plain = "." not in number and "e" not in number
+            if not has_unit and plain and abs(int(number.replace(",", "").replace("−", "-"))) <= SMALL:
                 continue
             out.append((n, tok))
     return out
@@ -298,7 +298,10 @@ def main(argv: list[str] | None = None) -> int:
             if not a.write:
                 ap.error("argument --reproduction: only with --write")
             full = json.loads(pathlib.Path(a.reproduction).read_text())
-            cmd = "cargo run --release -p analysis -- reproduction --out out/analysis; python -m tailsim.reports.docs --write --reproduction out/analysis/reproduction.json"
+            cmd = (
+                "cargo run --release -p analysis -- reproduction --out out/analysis; "
+                "python -m tailsim.reports.docs --write --reproduction out/analysis/reproduction.json"
+            )
             taken = docs_blocks.take_reproduction(full, cmd)
             (ROOT / DOCS_DIR / "reproduction.json").write_text(json.dumps(taken, indent=1, sort_keys=True) + "\n")
         stale = regenerate(write=a.write) + verdict.regenerate(write=a.write)

@@ -10,6 +10,7 @@ Keys `def.<scope>.<name>` are definitions resolved by `definition` (no registrat
 
 from __future__ import annotations
 
+import json
 import math
 import re
 import statistics
@@ -17,7 +18,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from .. import declarations
-from .docs import Sources, block, f, fa, g, interval, pct
+from .docs import Sources, block, f, g, interval, pct
 
 FULL = "campaign_full_run.json"
 RERUN = "campaign_rerun_200.json"
@@ -27,13 +28,26 @@ REPRO = "reproduction.json"
 # --- definitions ------------------------------------------------------------------------------------------------
 
 #: Units of the campaign's defaults (`CampaignSpec` fields).
-_SPEC_UNITS = {"wind_max": "m/s", "gust_max": "m/s", "divergence_m": "m", "error_limit_m": "m", "timeout_s": "s", "step_size": "s"}
+_SPEC_UNITS = {
+    "wind_max": "m/s",
+    "gust_max": "m/s",
+    "divergence_m": "m",
+    "error_limit_m": "m",
+    "timeout_s": "s",
+    "step_size": "s",
+}
+_LIMITS = {"thrust_max": (declarations.THRUST_LIMITS[1], "N"), "deflection": (declarations.DEFLECTION_LIMIT, "rad")}
+
+
+#: How a declared unit is written in prose.
+_UNIT_TEXT = {"m2": "m²", "m/s2": "m/s²", "kg/m3": "kg/m³", "kg.m2": "kg m²"}
 
 
 def with_unit(x: float, unit: str | None) -> str:
+    """A declared value in its unit as the docs write it (angles in degrees)."""
     if unit == "rad":
         return f"{math.degrees(x):.4g}°"
-    return f"{x:.4g}" + (f" {unit}" if unit else "")
+    return f"{x:.4g}" + (f" {_UNIT_TEXT.get(unit, unit)}" if unit else "")
 
 
 def _mission_unit(name: str) -> str | None:
@@ -59,9 +73,7 @@ def definition(key: str) -> str:
     elif scope == "mission":
         x, unit = declarations.MISSION_DEFAULTS[name], _mission_unit(name)
     elif scope == "limits":
-        x, unit = {"thrust_max": (declarations.THRUST_LIMITS[1], "N"), "deflection": (declarations.DEFLECTION_LIMIT, "rad")}[
-            name
-        ]
+        x, unit = _LIMITS[name]
     elif scope in declarations.VARIABLES:
         v = declarations.VARIABLES[scope][name]
         x, unit = v.start, v.unit
@@ -73,6 +85,36 @@ def definition(key: str) -> str:
 def mission_text(name: str) -> str:
     m = declarations.mission(name)
     return ", ".join(g(m[k]) for k in declarations.PHASE_DURATIONS) + f" s; {g(declarations.stop_time(m))} s"
+
+
+@block("mission.fast", "declarations")
+def _mission_fast(src: Sources) -> str:
+    m = declarations.mission("fast")
+    return f"T1 = {g(m['t_transition_1'])} s, T2 = {g(m['t_transition_2'])} s"
+
+
+@block("mission.short", "declarations")
+def _mission_short(src: Sources) -> str:
+    m = declarations.mission("short")
+    return ", ".join(g(m[k]) for k in declarations.PHASE_DURATIONS) + " s"
+
+
+@block("plant.thrust_to_weight", "declarations")
+def _thrust_to_weight(src: Sources) -> str:
+    v = declarations.VARIABLES["tailsitter_plant"]
+    return f"{v['thrust_max'].start / (v['mass'].start * v['gravity'].start):.1f}"
+
+
+@block("plant.n_airframe", "modelDescription/tailsitter_plant.json")
+def _n_airframe(src: Sources) -> str:
+    doc = json.loads((src.root / "modelDescription" / "tailsitter_plant.json").read_text())
+
+    def count(x) -> int:
+        if isinstance(x, dict):
+            return (x.get("group") == "airframe") + sum(count(v) for v in x.values())
+        return sum(count(v) for v in x) if isinstance(x, list) else 0
+
+    return str(count(doc))
 
 
 @block("campaign.missions", "declarations")
@@ -222,7 +264,7 @@ def _rerun_reading(src: Sources) -> str:
 
     av = "tuned/avionics"
     return (
-        f"Reading: with the sensors at Table D.1 today's avionics give "
+        "Reading: with the sensors at Table D.1 today's avionics give "
         + ", ".join(f"{label(k)} {p(s, f'{k}/{av}')} (full run {p(full, f'{k}/{av}')})" for k in ks)
         + f" on these {n} samples; the medians of the largest error of completed runs are "
         + ", ".join(f"{label(k)} {med(s, f'{k}/{av}')} m (full run {med(full, f'{k}/{av}')} m)" for k in ks)
@@ -318,7 +360,7 @@ def _table_5_1(src: Sources) -> str:
     return (
         f"thesis configurations: Spearman ρ LQR {rho['lqr_cfg1']:.2f}, TSD {rho['tsd_cfg1']:.2f} against Table 5.1; "
         f"median entry over the thesis's: LQR {med['lqr_cfg1']:.2f}, TSD {med['tsd_cfg1']:.2f} "
-        "(the analysis report, \"Reproduction of the thesis\")"
+        '(the analysis report, "Reproduction of the thesis")'
     )
 
 
