@@ -60,10 +60,10 @@ def _mission_unit(name: str) -> str | None:
 def definition(key: str) -> str:
     """`def.campaign.<field>` (CampaignSpec default), `def.mission.<name>` (mission default),
     `def.limits.thrust_max` / `def.limits.deflection`, `def.<model>.<variable>` (start value);
-    a trailing `.value` drops the unit."""
+    a trailing `.value` drops the unit, `.ms` writes seconds in ms."""
     parts = key.split(".")[1:]
-    bare = parts[-1] == "value"
-    if bare:
+    bare, ms = parts[-1] == "value", parts[-1] == "ms"
+    if bare or ms:
         parts = parts[:-1]
     scope, name = parts[0], ".".join(parts[1:])
     if scope == "campaign":
@@ -79,12 +79,21 @@ def definition(key: str) -> str:
         x, unit = v.start, v.unit
     else:
         raise KeyError(f"no definition {key!r}")
+    if ms:
+        if unit != "s":
+            raise KeyError(f"{key!r}: .ms of a value in {unit!r}")
+        return f"{1e3 * x:.4g} ms"
     return with_unit(x, None if bare and unit != "rad" else unit)
 
 
 def mission_text(name: str) -> str:
     m = declarations.mission(name)
     return ", ".join(g(m[k]) for k in declarations.PHASE_DURATIONS) + f" s; {g(declarations.stop_time(m))} s"
+
+
+@block("mission.default.stop", "declarations")
+def _default_stop(src: Sources) -> str:
+    return f"{g(declarations.stop_time(declarations.mission('default')))} s"
 
 
 @block("mission.fast", "declarations")
@@ -107,7 +116,10 @@ def _thrust_to_weight(src: Sources) -> str:
 
 @block("plant.n_airframe", "modelDescription/tailsitter_plant.json")
 def _n_airframe(src: Sources) -> str:
-    doc = json.loads((src.root / "modelDescription" / "tailsitter_plant.json").read_text())
+    from .docs import ROOT
+
+    # a declaration, like the package's declarations: always the checkout's
+    doc = json.loads((ROOT / "modelDescription" / "tailsitter_plant.json").read_text())
 
     def count(x) -> int:
         if isinstance(x, dict):
