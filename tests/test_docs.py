@@ -49,7 +49,7 @@ def test_a_changed_result_file_or_a_hand_edit_is_found(tmp_path):
     text = thesis.read_text()
     body = docs.BLOCK_RE.search(text)
     thesis.write_text(text[: body.start("body")] + body["body"].replace("0", "9", 1) + text[body.end("body") :])
-    assert docs.regenerate(root, write=False) == ["docs/THESIS.md"]
+    assert docs.regenerate(root, write=False, override={docs_blocks.FULL: full}) == ["docs/THESIS.md"]
 
 
 def test_no_hand_typed_measured_figure_outside_the_blocks():
