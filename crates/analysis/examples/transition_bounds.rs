@@ -37,7 +37,9 @@ const ALPHAS_DEG: [f64; 2] = [12.0, 15.0];
 const V_LEVEL: f64 = 25.0;
 
 fn main() {
-    let out = std::env::args().nth(1).unwrap_or_else(|| "docs/transition_bounds.json".into());
+    let out = std::env::args()
+        .nth(1)
+        .unwrap_or_else(|| "docs/transition_bounds.json".into());
     let trims: Vec<Value> = TrimLaw::ALL
         .iter()
         .map(|&trim| {

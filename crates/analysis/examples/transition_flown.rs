@@ -5,7 +5,7 @@
 //! `cargo run --release -p analysis --example transition_flown -- docs/transition_flown.json`
 //! (then `python -m tailsim.reports.docs --write`).
 use analysis::controllers::Kind;
-use analysis::transition_bound::{flown, mission, T2_VALUES, POS_ERROR_LIMIT};
+use analysis::transition_bound::{flown, mission, POS_ERROR_LIMIT, T2_VALUES};
 use rayon::prelude::*;
 use serde_json::json;
 use tailsitter_physics::AeroModel;
@@ -20,7 +20,9 @@ fn num(x: f64) -> serde_json::Value {
 }
 
 fn main() {
-    let out = std::env::args().nth(1).unwrap_or_else(|| "docs/transition_flown.json".into());
+    let out = std::env::args()
+        .nth(1)
+        .unwrap_or_else(|| "docs/transition_flown.json".into());
     let jobs: Vec<(AeroModel, Kind, f64)> = [AeroModel::Thesis, AeroModel::Global]
         .into_iter()
         .flat_map(|m| Kind::ALL.into_iter().flat_map(move |k| T2_VALUES.map(|t2| (m, k, t2))))

@@ -7,9 +7,11 @@ transition_flown`: the controllers on the default mission with T2 shortened) and
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from typing import Any
 
+from .. import declarations
 from .docs import Sources, block, g
 
 FLOWN = "transition_flown.json"
@@ -132,7 +134,6 @@ def _flown_findings(src: Sources) -> str:
     return "\n".join(lines)
 
 
-@block("transition.flown.range", FLOWN)
 def _flown_range(src: Sources) -> str:
     """The flown transition times at and below the fastest requested T2, all controllers."""
     ctls = _controllers(src)
@@ -146,12 +147,10 @@ def _flown_range(src: Sources) -> str:
     return f"{min(ts):.1f}–{max(ts):.1f} s for T2 ≤ {g(t2_stop)} s, following the profile to {dev:.2f} s"
 
 
-@block("transition.flown.range_short", FLOWN)
 def _flown_range_short(src: Sources) -> str:
     return _flown_range(src).split(" for ")[0]
 
 
-@block("transition.flown.profile_min", FLOWN)
 def _profile_min(src: Sources) -> str:
     prof = [_row(src, _controllers(src)[0], t2) for t2 in _t2s(src)]
     return (
@@ -191,8 +190,8 @@ def _trim_table(src: Sources) -> str:
     b = src.json(BOUNDS)
     v = g(b["v_level"])
     md = [
-        f"| trim | C_Lt/α (small α) | C_Lt(12°) | C_Lt(15°) | n = L/(m g) at {v} m/s, 15° | with thrust: (L + T sin α)/(m g), "
-        f"T = T_trim … T_max | δ at {v} m/s, 15°, T = 0 |",
+        f"| trim | C_Lt/α (small α) | C_Lt(12°) | C_Lt(15°) | n = L/(m g) at {v} m/s, 15° "
+        f"| with thrust: (L + T sin α)/(m g), T = T_trim … T_max | δ at {v} m/s, 15°, T = 0 |",
         "|---|---|---|---|---|---|---|",
     ]
     for t in b["trims"]:
@@ -201,7 +200,8 @@ def _trim_table(src: Sources) -> str:
         d0 = a15[0]
         delta = f"δe {_signed(d0['delta_e_deg'])}°"
         if t["trim"] != "elevator only":
-            delta += f", δfc {_signed(d0['delta_fc_deg'])}°" + (" (saturated)" if d0["saturated"] else "")
+            at_limit = abs(d0["delta_fc_deg"]) >= math.degrees(declarations.DEFLECTION_LIMIT) - 1e-6
+            delta += f", δfc {_signed(d0['delta_fc_deg'])}°" + (" (saturated)" if at_limit else "")
         md.append(
             f"| {t['trim']} | {t['cl_slope_small_alpha']:.2f} /rad | {by[12.0]['cl_trimmed']:.3f} | "
             f"{by[15.0]['cl_trimmed']:.3f} | {_span([x['n_aero'] for x in a15])} | "
@@ -226,7 +226,8 @@ def _switching(b: dict, first: bool) -> str:
 def _bound_table(src: Sources) -> str:
     lag = src.json(BOUNDS)["alpha_lag"]
     md = [
-        f"| manoeuvre | trim | α_max | τ_α = 0 (α direct) | τ_α = {g(lag)} s | peak n (τ_α = 0) | switching (τ_α = 0) |",
+        f"| manoeuvre | trim | α_max | τ_α = 0 (α direct) | τ_α = {g(lag)} s | peak n (τ_α = 0) "
+        "| switching (τ_α = 0) |",
         "|---|---|---|---|---|---|---|",
     ]
     for man in ("rotation", "complete"):
@@ -257,7 +258,13 @@ def _bound_findings(src: Sources) -> str:
         return " / ".join(f"{_bound(src, t, a, **kw)[man]['time']:.2f}" for t, a in rows)
 
     peak_v = [_bound(src, t, a)["rotation"]["v_at_peak"] for t, a in rows]
-    n15 = [x["n_aero"] for t in b["trims"] for a in t["alpha"] if a["alpha_deg"] == max(_alphas(src)) for x in a["at_25_m_s"]]
+    n15 = [
+        x["n_aero"]
+        for t in b["trims"]
+        for a in t["alpha"]
+        if a["alpha_deg"] == max(_alphas(src))
+        for x in a["at_25_m_s"]
+    ]
     flap = {a: _bound(src, "flap mixing", a)["complete"]["max_flap_deg"] for a in _alphas(src)}
     return "\n".join(
         [
@@ -297,7 +304,8 @@ def _comparison(src: Sources) -> str:
         f"{flown_min - e['complete']['time']:.0f} s of the flown {_flown_range_short(src)} are the profile's law, not "
         "the airframe (its ingredients — speed held near V_L while the path turns, at most "
         f"{g(src.json(FLOWN)['mission']['transition_thrust_fraction'])} T_max, thrust floor, smootherstep tracking, "
-        "speed shed as the path nears vertical — were not separated here). With the TSD's flap mixing the airframe allows {f_lo['rotation']['time']:.2f} s and "
+        "speed shed as the path nears vertical — were not separated here). With the TSD's flap mixing the airframe "
+        f"allows {f_lo['rotation']['time']:.2f} s and "
         f"{f_lo['complete']['time']:.2f} s at {g(a_lo)}°; at α_max = {g(a_hi)}° {f_hi['rotation']['time']:.2f} s "
         f"and {f_hi['complete']['time']:.2f} s. A back transition in ≤ 3 s to the steady climb is therefore "
         + (
@@ -308,3 +316,72 @@ def _comparison(src: Sources) -> str:
             f"({_span(reach, 1)} s); with the elevator alone ≥ {min(e_hi):.1f} s."
         )
     )
+
+
+@block("transition.alpha_lag", BOUNDS)
+def _alpha_lag(src: Sources) -> str:
+    return f"{g(src.json(BOUNDS)['alpha_lag'])} s"
+
+
+@block("transition.trim.findings", BOUNDS)
+def _trim_findings(src: Sources) -> str:
+    b = src.json(BOUNDS)
+    t = {x["trim"]: x for x in b["trims"]}
+    e, fm = t["elevator only"]["cl_slope_small_alpha"], t["flap mixing"]["cl_slope_small_alpha"]
+    wing = declarations.VARIABLES["tailsitter_plant"]["c_L_alpha_a0"].start
+    flaps = {a["alpha_deg"]: a["at_25_m_s"][0]["delta_fc_deg"] for a in t["flap mixing"]["alpha"]}
+    limit = math.degrees(declarations.DEFLECTION_LIMIT)
+    hi, lo = max(flaps), min(flaps)
+    flap_hi = (
+        f"flaps reach their {limit:.0f}° limit (the remaining moment goes to the elevator)"
+        if abs(flaps[hi]) >= limit - 1e-6
+        else f"flaps need {abs(flaps[hi]):.0f}°"
+    )
+    return (
+        f"The elevator-only slope equals the profile's C_Lα from the level trim ({e:.2f} /rad: the elevator's "
+        f"download costs {100 * (1 - e / wing):.0f} % of the wing's {wing:.2f} /rad). The mixed actuator has a "
+        "small *negative* lift derivative and trims nose-up with a negative δm, so its trim lift *adds* to the "
+        f"wing's: {_signed(100 * (fm / wing - 1), 0)} % instead of {_signed(100 * (e / wing - 1), 0)} %. At "
+        f"{g(hi)}° and low thrust the {flap_hi}, at {g(lo)}° they need {abs(flaps[lo]):.0f}°."
+    )
+
+
+@block("transition.bound.global_change", BOUNDS)
+def _global_change(src: Sources) -> str:
+    d = []
+    for t in _trims(src):
+        for a in _alphas(src):
+            gl, th = _bound(src, t, a, aero="global"), _bound(src, t, a)
+            d += [gl[m]["time"] - th[m]["time"] for m in ("rotation", "complete")]
+    return f"{_signed(min(d), 2)} … {_signed(max(d), 2)} s"
+
+
+def _complete_bounds(src: Sources) -> list[dict]:
+    return [b["complete"] for b in src.json(BOUNDS)["bounds"] if b["complete"] is not None and b["aero"] == "thesis"]
+
+
+@block("transition.bound.holds", BOUNDS)
+def _holds(src: Sources) -> str:
+    cs = _complete_bounds(src)
+    n = sum(c["holds"] for c in cs)
+    return "all cases do" if n == len(cs) else f"{n} of {len(cs)} cases do"
+
+
+@block("transition.bound.entry", BOUNDS)
+def _entry(src: Sources) -> str:
+    return _span([c["time"] - c["entry"] for c in _complete_bounds(src)], unit=" s")
+
+
+@block("transition.flown.setting", FLOWN)
+def _flown_setting(src: Sources) -> str:
+    m = src.json(FLOWN)["mission"]
+    return (
+        f"Default mission (T1 = {g(m['t_transition_1'])} s, level {g(m['t_level'])} s, T2 varied, vertical "
+        f"{g(m['t_vertical_2'])} s; profile α_max = {m['transition_alpha_max_deg']:.0f}°, thrust fraction "
+        f"{g(m['transition_thrust_fraction'])}, Gauss-Seidel, {g(1e3 * m['sample_time'])} ms)"
+    )
+
+
+@block("transition.flown.pos_limit", FLOWN)
+def _pos_limit(src: Sources) -> str:
+    return f"{g(src.json(FLOWN)['pos_error_limit'])} m"
