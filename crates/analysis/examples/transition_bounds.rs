@@ -7,9 +7,9 @@
 //! `cargo run --release -p analysis --example transition_bounds -- docs/transition_bounds.json`
 //! (then `python -m tailsim.reports.docs --write`).
 use analysis::transition_bound::{
-    complete_bound, mission, profile_time, profile_time_within, rotation_bound, Bound, Model, TrimLaw, ALPHA_LAG,
+    complete_bound, fastest_profile_limits, mission, profile_time, profile_time_within, rotation_bound, Bound, Model,
+    TrimLaw, ALPHA_LAG,
 };
-use guidance::ProfileLimits;
 use rayon::prelude::*;
 use serde_json::{json, Value};
 use tailsitter_physics::AeroModel;
@@ -105,12 +105,7 @@ fn main() {
     let profile: Vec<Value> = ALPHAS_DEG
         .iter()
         .map(|&deg| {
-            let limits = ProfileLimits {
-                alpha_max: deg.to_radians(),
-                thrust_fraction: 1.0,
-                thrust_floor: 0.1,
-                push_over_fraction: 1.0,
-            };
+            let limits = fastest_profile_limits(deg.to_radians());
             let m = mission(0.5);
             json!({
                 "t2": 0.5, "alpha_max_deg": deg,

@@ -1,23 +1,28 @@
 """The figures of the documentation (`docs/*.md`), generated from committed result files.
 
-A figure a reader meets in `docs/` is one of three kinds:
+A figure a reader meets in `docs/` is one of these kinds:
 
 * **generated**: it sits in a marked block, `<!-- generated:KEY -->…<!-- /generated -->`
   (a whole table or paragraph on lines of its own, or a few words inside a sentence), whose
-  content `BLOCKS[KEY]` writes from a committed result file under `docs/` (each records the
-  command that produced it) or from the declarations (`python/tailsim/declarations.json`,
-  the campaign's `CampaignSpec` defaults: a definition is generated too, so it cannot drift);
+  content `BLOCKS[KEY]` writes (generators in `docs_blocks` and `docs_transition`) from a
+  committed result file under `docs/` (each records the command that produced it) or from
+  the declarations (`python/tailsim/declarations.json`, the campaign's `CampaignSpec`
+  defaults: keys `def.<scope>.<name>`, so a definition cannot drift either);
 * **history**: a dated measurement kept as a record, inside
-  `<!-- history: … -->…<!-- /history -->` (and `docs/PERFORMANCE.md`, the dated history of
-  the performance work, as a whole); never regenerated;
-* **definition** left as prose: a number of the thesis, a reference (equation, table, §), a
-  version or an entry of `ALLOWED` (see `untagged`).
+  `<!-- history: DATE, how -->…<!-- /history -->` (and `docs/PERFORMANCE.md`, the dated
+  history of the performance work, as a whole); never regenerated;
+* left as prose and listed in `docs/figures_allowed.json`: **definitions** (numbers of the
+  thesis, parameters and limits that are not declared, counts, test bounds) and **pending**
+  (measured figures not yet generated). References (equations, tables, §, register ids),
+  versions, identifiers and code are not figures (`strip_lines`).
 
 `python -m tailsim.reports.docs --write` rewrites every generated block (and the tables the
 verdict generates in README.md and docs/CAMPAIGN.md, `tailsim.reports.verdict --docs`);
-`--check` only compares (exit 1 when a block is stale). After new result files (a campaign
-summarised into `docs/*.json`, `analysis reproduction`), re-run this one command.
-`tests/test_docs.py` fails on a stale block and on a measured figure outside any block.
+`--check` only compares (exit 1 when a block is stale); `--inventory` counts the figures by
+kind. After new result files (a campaign summarised into `docs/*.json`, an analysis run:
+`--reproduction out/analysis/reproduction.json`), re-run this one command.
+`tests/test_docs.py` fails on a stale block, on a figure outside any block that the
+allow-list does not hold, and on an allow-list entry no figure uses.
 """
 
 from __future__ import annotations
