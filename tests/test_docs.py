@@ -141,3 +141,14 @@ def test_inventory_counts_every_figure():
     assert all(c["untagged"] == 0 for c in inv.values()), inv
     assert sum(c["generated"] for c in inv.values()) > 0
     assert inv["docs/PERFORMANCE.md"]["history"] > 0 and inv["docs/PERFORMANCE.md"]["pending"] == 0
+
+
+def test_markers_leave_the_markdown_intact():
+    """A line that starts with an HTML comment is an HTML block to CommonMark (GitHub): the rest of
+    the line would be shown raw. Markers at the start of a line therefore stand alone on it."""
+    import re
+
+    for p in docs.doc_files():
+        for n, line in enumerate(p.read_text().splitlines(), 1):
+            m = re.match(r"<!--.*?-->", line)
+            assert not m or m.end() == len(line.rstrip()), f"{p.name}:{n}: {line[:80]}"

@@ -135,7 +135,7 @@ def _missions(src: Sources) -> str:
     from ..campaign.sampling import CampaignSpec
 
     return (
-        f"Missions (`--mission`): `default` = the controllers' defaults ({g(m['t_vertical_1'])} s climb, "
+        f"`default` = the controllers' defaults ({g(m['t_vertical_1'])} s climb, "
         f"T1 = {g(m['t_transition_1'])} s, {g(m['t_level'])} s level, T2 = {g(m['t_transition_2'])} s, "
         f"{g(m['t_vertical_2'])} s vertical; {g(declarations.stop_time(m))} s), `short` ({mission_text('short')}, "
         f"for tests). Communication step {g(CampaignSpec().step_size)} s."
@@ -177,7 +177,8 @@ def spec_text(s: Mapping[str, Any], n_campaigns: int | None = None) -> str:
 def _full_spec(src: Sources) -> str:
     s = src.json(FULL)
     n = len(s["runtime"])
-    return spec_text(s) + f"; {n} campaigns of the same sample space, rows merged by sample"
+    t = spec_text(s)
+    return t[0].lower() + t[1:] + f"; {n} campaigns of the same sample space, rows merged by sample"
 
 
 @block("campaign.full_run.wind_max", FULL)
@@ -225,7 +226,7 @@ def _full_reading(src: Sources) -> str:
     av = [k for k in ks if f"{k}/tuned/avionics" in s["arms"]]
     n_av = max(_arm(s, f"{k}/tuned/avionics")["runs"] for k in av)
     return (
-        f"Reading: on uncertain plants in wind {completion_sentence(s, 'tuned/perfect')}; where both complete the "
+        f"on uncertain plants in wind {completion_sentence(s, 'tuned/perfect')}; where both complete the "
         f"paired RMS position error differs by {f(tp['mean'], 1)} m (TSD − LQR, {interval(tp['ci95'], 1)}). With the "
         "sensors and the estimator in the loop both lose some ("
         + ", ".join(f"{label(k)} {_p3(_arm(s, f'{k}/tuned/avionics')['p'])}" for k in av)
@@ -276,7 +277,7 @@ def _rerun_reading(src: Sources) -> str:
 
     av = "tuned/avionics"
     return (
-        "Reading: with the sensors at Table D.1 today's avionics give "
+        "with the sensors at Table D.1 today's avionics give "
         + ", ".join(f"{label(k)} {p(s, f'{k}/{av}')} (full run {p(full, f'{k}/{av}')})" for k in ks)
         + f" on these {n} samples; the medians of the largest error of completed runs are "
         + ", ".join(f"{label(k)} {med(s, f'{k}/{av}')} m (full run {med(full, f'{k}/{av}')} m)" for k in ks)

@@ -298,7 +298,7 @@ def _comparison(src: Sources) -> str:
     flown_min = min(r["transition"] for r in src.json(FLOWN)["rows"] if r["transition"] is not None)
     reach = [f0_hi["complete"]["time"], f_hi["complete"]["time"]]
     return (
-        f"At the missions' α_max = {g(a_m)}° the profile's own model (elevator-only lift, τ_α = {g(lag)} s) allows a "
+        f"α_max = {g(a_m)}° the profile's own model (elevator-only lift, τ_α = {g(lag)} s) allows a "
         f"rotation in {e['rotation']['time']:.2f} s and a complete transition in {e['complete']['time']:.2f} s; the "
         f"profile takes {_profile_min(src)}, and the controllers fly it. About "
         f"{flown_min - e['complete']['time']:.0f} s of the flown {_flown_range_short(src)} are the profile's law, not "
@@ -338,7 +338,7 @@ def _trim_findings(src: Sources) -> str:
         else f"flaps need {abs(flaps[hi]):.0f}°"
     )
     return (
-        f"The elevator-only slope equals the profile's C_Lα from the level trim ({e:.2f} /rad: the elevator's "
+        f"equals the profile's C_Lα from the level trim ({e:.2f} /rad: the elevator's "
         f"download costs {100 * (1 - e / wing):.0f} % of the wing's {wing:.2f} /rad). The mixed actuator has a "
         "small *negative* lift derivative and trims nose-up with a negative δm, so its trim lift *adds* to the "
         f"wing's: {_signed(100 * (fm / wing - 1), 0)} % instead of {_signed(100 * (e / wing - 1), 0)} %. At "
@@ -376,7 +376,7 @@ def _entry(src: Sources) -> str:
 def _flown_setting(src: Sources) -> str:
     m = src.json(FLOWN)["mission"]
     return (
-        f"Default mission (T1 = {g(m['t_transition_1'])} s, level {g(m['t_level'])} s, T2 varied, vertical "
+        f"(T1 = {g(m['t_transition_1'])} s, level {g(m['t_level'])} s, T2 varied, vertical "
         f"{g(m['t_vertical_2'])} s; profile α_max = {m['transition_alpha_max_deg']:.0f}°, thrust fraction "
         f"{g(m['transition_thrust_fraction'])}, Gauss-Seidel, {g(1e3 * m['sample_time'])} ms)"
     )
