@@ -113,7 +113,7 @@ def pct(p: float) -> str:
 
 def interval(ci, nd: int = 3, signed: bool = False) -> str:
     fmt = f"{{:+.{nd}f}}" if signed else f"{{:.{nd}f}}"
-    return "[" + ", ".join(fmt.format(v) for v in ci) + "]"
+    return "[" + ", ".join(fmt.format(v).replace("-", "−") for v in ci) + "]"
 
 
 # --- the blocks are registered by the modules below ------------------------------------------------------------
