@@ -15,9 +15,7 @@ DATA = ROOT / "tests" / "data" / "analysis"
 
 @pytest.fixture(scope="module")
 def titles(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("plots")
-    for f in DATA.iterdir():
-        shutil.copy(f, folder / f.name)
+    folder = shutil.copytree(DATA, tmp_path_factory.mktemp("plots") / "analysis")
     seen: dict[str, list[str]] = {}
     save = analysis_plots.save
 

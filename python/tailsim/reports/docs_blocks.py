@@ -160,6 +160,11 @@ def _native_tol(src: Sources) -> str:
 # --- the campaign summaries -------------------------------------------------------------------------------------
 
 
+def n_samples(s: Mapping[str, Any]) -> int:
+    """The largest number of samples of an arm of a campaign summary."""
+    return max(s["samples"].values())
+
+
 def _arm(s: Mapping[str, Any], key: str) -> Mapping[str, Any]:
     return s["arms"][key]
 
@@ -241,12 +246,10 @@ def _full_reading(src: Sources) -> str:
 @block("campaign.rerun.spec", RERUN)
 def _rerun_spec(src: Sources) -> str:
     s = src.json(RERUN)
-    n = max(s["samples"].values())
+    t = spec_text(s)
     return (
-        f"The arms were re-run on the first {n} samples of the same sample space ("
-        + spec_text(s)[0].lower()
-        + spec_text(s)[1:]
-        + ", no turbulence, completion = flown to the end)"
+        f"The arms were re-run on the first {n_samples(s)} samples of the same sample space ({t[0].lower()}{t[1:]}, "
+        "no turbulence, completion = flown to the end)"
     )
 
 
@@ -267,7 +270,7 @@ def _rerun_reading(src: Sources) -> str:
 
     s, full = src.json(RERUN), src.json(FULL)
     ks = _labels(s)
-    n = max(s["samples"].values())
+    n = n_samples(s)
 
     def p(sm, arm):
         return _p3(_arm(sm, arm)["p"])
@@ -297,7 +300,7 @@ def _thesis_app_d(src: Sources) -> str:
     from .verdict import label
 
     s = src.json(RERUN)
-    n = max(s["samples"].values())
+    n = n_samples(s)
     return (
         f"App.-D-faithful estimator against today's on {n} campaign samples (uncertain plants, wind, tuned "
         "controllers): completion "
