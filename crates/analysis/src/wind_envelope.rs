@@ -660,10 +660,10 @@ pub fn summary(cells: &[Cell]) -> Vec<serde_json::Value> {
     for k in keys {
         let row: Vec<&Cell> = cells.iter().filter(|c| summary_key(c) == k).collect();
         let (configuration, state, ordering, mission, wind, controller, speed) = k;
-        let largest =
-            row.iter()
-                .map(|c| c.max_error)
-                .fold(0.0, |m: f64, e| if e.is_nan() { f64::INFINITY } else { m.max(e) });
+        let largest = row
+            .iter()
+            .map(|c| c.max_error)
+            .fold(0.0, |m: f64, e| if e.is_nan() { f64::INFINITY } else { m.max(e) });
         out.push(serde_json::json!({
             "configuration": configuration,
             "state": state,

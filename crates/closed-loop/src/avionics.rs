@@ -183,3 +183,45 @@ impl StateSource for AvionicsSource {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The estimator is told the Jacobi master's delays (one step each) and nothing under
+    /// Gauss-Seidel; it shares the sensors' site and filter; `app_d` is its App.-D switch.
+    #[test]
+    fn parameters_follow_the_ordering_and_the_sensors() {
+        let gs = Avionics::new(7, false, Ordering::GaussSeidel, 0.02);
+        assert_eq!((gs.estimator.filter.latency, gs.estimator.prediction.lead), (0.0, 0.0));
+        assert_eq!(gs.sensors.seed, 7);
+        assert_eq!(gs.estimator.earth.site, gs.sensors.site);
+        assert_eq!(gs.estimator.filter.bandwidth, gs.sensors.filter_bandwidth);
+        assert!(gs.estimator.tuning.relative_to_start);
+        let jacobi = Avionics::new(7, true, Ordering::Jacobi, 0.02);
+        assert_eq!(
+            (jacobi.estimator.filter.latency, jacobi.estimator.prediction.lead),
+            (0.02, 0.02)
+        );
+        assert!(!jacobi.estimator.tuning.relative_to_start && !jacobi.estimator.prediction.model);
+    }
+
+    /// The chain starts on a resting aircraft: the estimate's position is the start (the
+    /// tuned estimator's positions are relative to it) and its attitude within a few degrees.
+    #[test]
+    fn the_chain_starts_at_the_start() {
+        let mut plant = Plant::new(tailsitter_physics::Airframe::default());
+        plant.ground = tailsitter_physics::Ground::default();
+        let x0 = plant.resting_on_ground(0.0, 0.0, 0.0);
+        let a = Avionics::new(1, false, Ordering::GaussSeidel, 0.02);
+        let s = AvionicsSource::start(&a, &plant, &x0, &InputVector::zeros()).unwrap();
+        let e = s.estimate();
+        assert!(e.pos_ned.norm() < 1e-9, "{:?}", e.pos_ned);
+        let q_true = x0.fixed_rows::<4>(idx::Q1).into_owned();
+        let att = state_estimator::attitude_error(
+            &tailsitter_physics::dcm_earth_to_body(&q_true),
+            &tailsitter_physics::dcm_earth_to_body(&e.quat),
+        );
+        assert!(att.norm() < 5f64.to_radians(), "{att:?}");
+    }
+}
