@@ -25,7 +25,8 @@
 //! trimmed vertical climb at `v_vertical` at the origin, the take-off-to-landing mission at
 //! rest on the gear. Per cell: completed (reached the stop time; for the landing mission:
 //! landed, i.e. the controller's `landed` phase, within the error limit of the target; the
-//! flight stops [`takeoff_landing::AFTER_LANDING`] after it), the largest distance of the
+//! flight stops [`takeoff_landing::AFTER_LANDING`] after it; a flight farther than
+//! [`LOST_ERROR`] from its reference is lost and stopped there), the largest distance of the
 //! true position to the controller's own reference over the flight (on the gear the
 //! reference is the measured position; with the tuned estimator, whose positions are
 //! relative to the start, the true position relative to the start), the landing distance from the target at rest and
@@ -62,6 +63,9 @@ pub const STEP_TIME: f64 = 2.0;
 pub const HELD_MAX_ERROR: f64 = 3.0;
 /// Largest distance of the true position to the reference of a held cell with avionics (m).
 pub const HELD_MAX_ERROR_AVIONICS: f64 = 5.0;
+/// A flight farther than this from its reference is lost: stopped there (m) (the
+/// divergence of the Monte-Carlo campaign).
+pub const LOST_ERROR: f64 = 50.0;
 /// `turbulence_intensity` of the turbulent cases: moderate (W20 = 30 kt).
 pub const TURBULENCE_INTENSITY: i32 = 2;
 
@@ -408,7 +412,8 @@ fn trace_history(trace: &Trace) -> String {
 }
 
 /// Fly `controller` through `scenario` from `x0` (commands `u0` held there) on `state`,
-/// the sensors seeded with `seed`, stopping after the first sample `stop` is true for. The
+/// the sensors seeded with `seed`, stopping after the first sample `stop` is true for, or
+/// lost (failed) at the first sample farther than [`LOST_ERROR`] from the reference. The
 /// samples' `measurement` is the truth in the frame the controller flies in: with the tuned
 /// estimator (positions relative to the start) the NED frame moved to the start position.
 #[allow(clippy::too_many_arguments)]
@@ -420,29 +425,49 @@ pub fn fly_on(
     scenario: &Scenario,
     state: StateKind,
     seed: u64,
-    stop: impl FnMut(&Sample) -> bool,
+    mut stop: impl FnMut(&Sample) -> bool,
 ) -> Trace {
     let app_d = match state {
-        StateKind::Perfect => return fly_with(plant, x0, controller, scenario, &mut Perfect, stop),
-        StateKind::Avionics => false,
-        StateKind::AvionicsAppD => true,
+        StateKind::Perfect => None,
+        StateKind::Avionics => Some(false),
+        StateKind::AvionicsAppD => Some(true),
     };
-    let avionics = Avionics::new(seed, app_d, scenario.ordering, scenario.comm_step);
-    let mut trace = match AvionicsSource::start(&avionics, plant, &x0, u0) {
-        Ok(mut source) => fly_with(plant, x0, controller, scenario, &mut source, stop),
-        Err(e) => Trace {
-            failure: Some(e),
-            ..Trace::default()
+    let avionics = app_d.map(|a| Avionics::new(seed, a, scenario.ordering, scenario.comm_step));
+    // The estimate's positions are relative to the start with the tuned estimator: the
+    // controller flies in the frame whose origin is the true start position (on the gear
+    // 10 m below the NED origin).
+    let origin = match &avionics {
+        Some(a) if a.estimator.tuning.relative_to_start => Vector3::new(x0[idx::POS_N], x0[idx::POS_E], x0[idx::POS_D]),
+        _ => Vector3::zeros(),
+    };
+    let error = |s: &Sample| (s.measurement.pos_ned - origin - s.diagnostics.ref_pos_ned).norm();
+    let mut lost = None;
+    let until = |s: &Sample| {
+        if error(s) > LOST_ERROR {
+            lost = Some(format!(
+                "lost: {:.0} m from the reference at t = {:.2} s",
+                error(s),
+                s.t
+            ));
+            return true;
+        }
+        stop(s)
+    };
+    let mut trace = match &avionics {
+        None => fly_with(plant, x0, controller, scenario, &mut Perfect, until),
+        Some(a) => match AvionicsSource::start(a, plant, &x0, u0) {
+            Ok(mut source) => fly_with(plant, x0, controller, scenario, &mut source, until),
+            Err(e) => Trace {
+                failure: Some(e),
+                ..Trace::default()
+            },
         },
     };
-    if avionics.estimator.tuning.relative_to_start {
-        // The estimate's positions are relative to the start: the controller flies in the
-        // frame whose origin is the true start position (on the gear 10 m below the NED
-        // origin). The truth recorded in that frame.
-        let p0 = Vector3::new(x0[idx::POS_N], x0[idx::POS_E], x0[idx::POS_D]);
-        for s in &mut trace.samples {
-            s.measurement.pos_ned -= p0;
-        }
+    if trace.failure.is_none() {
+        trace.failure = lost;
+    }
+    for s in &mut trace.samples {
+        s.measurement.pos_ned -= origin;
     }
     trace
 }
