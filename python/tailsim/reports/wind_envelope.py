@@ -104,6 +104,15 @@ def _speeds(w: dict) -> list[float]:
     return sorted({c["speed"] for c in w["cells"]})
 
 
+def held_per_speed(cells: list[dict], speeds: list[float]) -> list[tuple[int, int]]:
+    """(cells held, cells) at each of `speeds`."""
+    out = []
+    for s in speeds:
+        row = [c for c in cells if c["speed"] == s]
+        out.append((sum(bool(c["held"]) for c in row), len(row)))
+    return out
+
+
 def held_table(w: dict) -> list[str]:
     """Cells held out of those flown per controller × axis × mission × wind form at each
     speed, and the largest error of the completed cells (m)."""
@@ -121,10 +130,7 @@ def held_table(w: dict) -> list[str]:
                     cells = _cells(w, mission, wind, k, axis)
                     if not cells:
                         continue
-                    counts = []
-                    for s in speeds:
-                        row = [c for c in cells if c["speed"] == s]
-                        counts.append(f"{sum(c['held'] for c in row)}/{len(row)}" if row else "–")
+                    counts = [f"{h}/{n}" if n else "–" for h, n in held_per_speed(cells, speeds)]
                     done = [c["max_error"] for c in cells if c["completed"] and c["max_error"] is not None]
                     largest = _err(max(done)) if done else "–"
                     configuration, state, ordering = axis
@@ -289,10 +295,7 @@ def _held_against_speed(plt, w: dict):
                     cells = _cells(w, mission, wind, k, axis)
                     if not cells:
                         continue
-                    frac = []
-                    for s in speeds:
-                        row = [c for c in cells if c["speed"] == s]
-                        frac.append(sum(c["held"] for c in row) / len(row) if row else float("nan"))
+                    frac = [h / n if n else float("nan") for h, n in held_per_speed(cells, speeds)]
                     ax.plot(
                         speeds,
                         frac,
