@@ -10,9 +10,7 @@ use nalgebra::Vector3;
 use state_estimator::{Ekf, EstimatorParams};
 use std::hint::black_box;
 
-#[path = "../tests/support/chain.rs"]
-mod chain;
-use chain::{measurement, to_estimator, truth};
+use closed_loop::avionics::{measurement_of as measurement, to_estimator, truth};
 use tailsitter_physics::{idx, Airframe, Plant};
 use tsd_control::{TsdController, TsdParams};
 

@@ -9,8 +9,7 @@ use state_estimator::{Ekf, EstimatorParams, Measurements};
 use tailsitter_physics::{dcm_earth_to_body, idx, Airframe, Plant};
 use tsd_control::{TsdController, TsdParams};
 
-mod support;
-use support::chain::{measurement, to_estimator, truth};
+use closed_loop::avionics::{measurement_of as measurement, to_estimator, truth};
 
 struct Flight {
     /// Max distance of the true position from the reference (m).
