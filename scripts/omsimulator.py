@@ -101,7 +101,12 @@ def run_omsimulator(binary: str, ssp: pathlib.Path, workdir: pathlib.Path) -> di
     cmd = [binary, str(ssp.resolve()), f"--stopTime={stop!r}", f"--resultFile={result.name}", "--tempDir=."]
     proc = subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, timeout=600)
     shown = ["OMSimulator", ssp.name, *cmd[2:]]
-    run = {"command": " ".join(shown), "returncode": proc.returncode, "log": proc.stdout + proc.stderr, "stop_time": stop}
+    run = {
+        "command": " ".join(shown),
+        "returncode": proc.returncode,
+        "log": proc.stdout + proc.stderr,
+        "stop_time": stop,
+    }
     if proc.returncode == 0 and result.exists():
         full = read_mat4(result)
         # `<model>.<system>.<component>.<variable>` -> `component.variable`

@@ -129,11 +129,11 @@ def _initialisation(src: Sources) -> str:
             + "."
         )
     out = [
-        f"OMSimulator initialises every connection at once and solves the loop the avionics system has at "
-        f"initialisation (the controller's commands feed the estimator, whose actuator states the controller "
-        f"reads; the FMUs declare no dependencies); tailsim's master initialises the units one after the other "
-        f"(plant, sensors, estimator, controller), so the estimator starts on its command inputs' start values. "
-        f"OMSimulator's initial values at t = 0:"
+        "OMSimulator initialises every connection at once and solves the loop the avionics system has at "
+        "initialisation (the controller's commands feed the estimator, whose actuator states the controller "
+        "reads; the FMUs declare no dependencies); tailsim's master initialises the units one after the other "
+        "(plant, sensors, estimator, controller), so the estimator starts on its command inputs' start values. "
+        "OMSimulator's initial values at t = 0:"
     ]
     for n in sorted(differ):
         r = avionics[n]
