@@ -26,21 +26,31 @@ def _same(src: Sources, run: dict[str, Any]) -> bool:
     return run["max_position_distance_m"] <= src.json(RUN)["same_flight_m"]
 
 
+def _e(x: float) -> str:
+    """Two significant digits, exponent without padding (`4.9e-7`)."""
+    mantissa, exponent = f"{x:.1e}".split("e")
+    return f"{mantissa}e{int(exponent)}"
+
+
 def _m(x: float) -> str:
     """A distance: two decimals from a centimetre up, else two significant digits."""
-    return f"{x:.2f} m" if x >= 0.01 else f"{x:.1e} m"
+    return f"{x:.2f} m" if x >= 0.01 else f"{_e(x)} m"
+
+
+#: How a declared unit is written in prose.
+_UNIT_TEXT = {"m/s2": "m/s²", "rad/s2": "rad/s²"}
 
 
 def _unit(name: str) -> str:
     for model in declarations.VARIABLES.values():
         if name in model and model[name].unit:
-            return f", {model[name].unit}"
+            return f", {_UNIT_TEXT.get(model[name].unit, model[name].unit)}"
     return ""
 
 
 def _output(diff: list) -> str:
     name, x = diff
-    return f"{x:.1e} ({name}{_unit(name)})"
+    return f"{_e(x)} ({name}{_unit(name)})"
 
 
 def _n(x: float, nd: int) -> str:
