@@ -127,6 +127,10 @@ def test_result_files_record_their_command():
     campaign = (ROOT / "docs" / "CAMPAIGN.md").read_text()
     for name in (docs_blocks.FULL, docs_blocks.RERUN):
         assert f"tailsim.campaign.section --write docs/{name}" in " ".join(campaign.split()), name
+    trims = json.loads((ROOT / "docs" / "design_trims.json").read_text())
+    assert "--example design_trims -- docs/design_trims.json" in trims["command"]
+    oms = json.loads((ROOT / "docs" / "omsimulator_run.json").read_text())
+    assert oms["command"].startswith("python scripts/omsimulator.py") and oms["commit"] in oms["omsimulator"]
 
 
 def test_history_documents_are_labelled():
