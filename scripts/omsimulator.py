@@ -122,9 +122,9 @@ def last_per_time(signals: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     return {n: v[keep] for n, v in signals.items()}
 
 
-def fmpy_jacobi(ssp: pathlib.Path, dist: pathlib.Path = DIST):
+def fmpy_jacobi(ssp: pathlib.Path, dist: pathlib.Path = DIST, ekf_params: dict[str, float] | None = None):
     """The same system under tailsim's fmpy master, Jacobi ordering, at the FMUs' defaults
-    (the FMUs of `dist`)."""
+    (the FMUs of `dist`; `ekf_params` set on the estimator of an avionics system)."""
     from tailsim import ClosedLoop, Fmu
     from tailsim.masters.avionics import AvionicsLoop
 
@@ -134,7 +134,9 @@ def fmpy_jacobi(ssp: pathlib.Path, dist: pathlib.Path = DIST):
     fmu = {n: Fmu(dist / f"{n}.fmu") for n in ("tailsitter_plant", controller)}
     if avionics:
         sensors, ekf = Fmu(dist / "tailsitter_sensors.fmu"), Fmu(dist / "tailsitter_ekf.fmu")
-        loop = AvionicsLoop(fmu["tailsitter_plant"], sensors, ekf, fmu[controller], ordering="jacobi")
+        loop = AvionicsLoop(
+            fmu["tailsitter_plant"], sensors, ekf, fmu[controller], ekf_params=ekf_params, ordering="jacobi"
+        )
     else:
         atmosphere = dist / "tailsitter_atmosphere.fmu"
         loop = ClosedLoop(
@@ -236,7 +238,6 @@ def avionics_initialisation(signals: dict[str, np.ndarray], ssp: pathlib.Path, d
     fmpy Jacobi one, the distance to the fmpy Jacobi master started with the estimator on
     OMSimulator's initial commands (its `ekf_params`)."""
     from tailsim import Fmu
-    from tailsim.masters.avionics import AvionicsLoop
 
     s = last_per_time(signals)
     out = {
@@ -246,19 +247,10 @@ def avionics_initialisation(signals: dict[str, np.ndarray], ssp: pathlib.Path, d
             "plant.thrust": float(s["plant.thrust"][0]),
         }
     }
-    ekf = Fmu(dist / "tailsitter_ekf.fmu")
-    commands = {n: float(s[f"controller.{n}"][0]) for n in ekf.names("input") if n.endswith("_cmd")}
-    controller = ssp.stem.removesuffix("_avionics")
+    inputs = Fmu(dist / "tailsitter_ekf.fmu").names("input")
+    commands = {n: float(s[f"controller.{n}"][0]) for n in inputs if n.endswith("_cmd")}
     try:
-        loop = AvionicsLoop(
-            Fmu(dist / "tailsitter_plant.fmu"),
-            Fmu(dist / "tailsitter_sensors.fmu"),
-            ekf,
-            Fmu(dist / f"{controller}.fmu"),
-            ekf_params=commands,
-            ordering="jacobi",
-        )
-        ref = loop.run(stop_time=default_stop_time(ssp))
+        ref = fmpy_jacobi(ssp, dist, ekf_params=commands)
     except Exception as e:  # an estimator that no longer takes its actuator states from the commands
         out["started_on_initial_commands_error"] = f"{type(e).__name__}: {e}"
         return out

@@ -34,7 +34,9 @@ fn main() -> Result<(), String> {
     for (name, model) in [("thesis", AeroModel::Thesis), ("global", AeroModel::Global)] {
         let mut plant = Plant::new(airframe);
         plant.aero.model = model;
-        let level = plant.trim_level(mission.v_level).map_err(|e| format!("{name} level trim: {e}"))?;
+        let level = plant
+            .trim_level(mission.v_level)
+            .map_err(|e| format!("{name} level trim: {e}"))?;
         let climb = plant
             .trim_vertical_climb(mission.v_vertical)
             .map_err(|e| format!("{name} climb trim: {e}"))?;

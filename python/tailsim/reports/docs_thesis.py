@@ -12,23 +12,21 @@ from .docs import Sources, block
 REPRO = "reproduction.json"
 
 
-def _mission(src: Sources, key: str) -> dict:
-    return src.json(REPRO)["missions"][key]
+def _lqr(src: Sources, what: str, text) -> str:
+    """`text(printed, tuned)` of the LQR's default mission, configuration 1 against 0, and the
+    source."""
+    m = src.json(REPRO)["missions"]
+    where = f"`analysis reproduction`, reproduction.json `missions`: {src.json(REPRO)['setting']['plant']}"
+    return f"default mission {what} {text(m['lqr_cfg1_default'], m['lqr_cfg0_default'])} ({where})"
 
 
 @block("thesis.lqr_cfg1_whole", REPRO)
 def _lqr_cfg1_whole(src: Sources) -> str:
-    printed, tuned = _mission(src, "lqr_cfg1_default"), _mission(src, "lqr_cfg0_default")
-    return (
-        f"default mission max position error {printed['max_pos_error']:.2f} m vs tuned {tuned['max_pos_error']:.2f} m "
-        f"(`analysis reproduction`, reproduction.json `missions`: {src.json(REPRO)['setting']['plant']})"
+    return _lqr(
+        src, "max position error", lambda p, t: f"{p['max_pos_error']:.2f} m vs tuned {t['max_pos_error']:.2f} m"
     )
 
 
 @block("thesis.lqr_alpha_max", REPRO)
 def _lqr_alpha_max(src: Sources) -> str:
-    printed, tuned = _mission(src, "lqr_cfg1_default"), _mission(src, "lqr_cfg0_default")
-    return (
-        f"default mission max α {printed['alpha_max_deg']:.1f}° → {tuned['alpha_max_deg']:.1f}° "
-        f"(`analysis reproduction`, reproduction.json `missions`: {src.json(REPRO)['setting']['plant']})"
-    )
+    return _lqr(src, "max α", lambda p, t: f"{p['alpha_max_deg']:.1f}° → {t['alpha_max_deg']:.1f}°")
