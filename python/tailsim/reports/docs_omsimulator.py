@@ -193,3 +193,18 @@ def _initialisation(src: Sources) -> str:
             f"not the bindings: the SSD cannot set it."
         )
     return " ".join(out)
+
+
+@block("omsim.schema", RUN)
+def _schema(src: Sources) -> str:
+    runs = src.json(RUN)["runs"]
+    if not all(r.get("schema_validated") for r in runs):
+        return "in the recorded run it could not load the schemas for " + ", ".join(
+            f"`{r['ssp']}`" for r in runs if not r.get("schema_validated")
+        )
+    bad = [r for r in runs if r.get("schema_violations")]
+    if not bad:
+        return f"in the recorded run all {len(runs)} shipped SSDs pass without a message"
+    return (
+        "in the recorded run " + ", ".join(f"`{r['ssp']}` ({r['schema_violations']} messages)" for r in bad) + " do not"
+    )
