@@ -14,11 +14,16 @@ ordering="jacobi" (ClosedLoop with the atmosphere; AvionicsLoop for `*_avionics.
 FMUs' defaults, which are the SSD's bindings (tests/test_ssp_omsimulator.py checks that).
 
     python scripts/omsimulator.py [--json FILE] [SSP ...]
+
+By default (every SSP of dist/) the figures go to docs/omsimulator_run.json, with the
+OMSimulator version and commit and the commands, and the generated blocks of the docs
+(docs/OMSIMULATOR.md) are rewritten from it (`python -m tailsim.reports.docs --write`).
 """
 
 from __future__ import annotations
 
 import argparse
+import datetime
 import json
 import os
 import pathlib
@@ -36,6 +41,10 @@ NS = {"ssd": "http://ssp-standard.org/SSP1/SystemStructureDescription"}
 # Euler angles swing by pi at theta = 90 deg for tiny attitude changes (gimbal lock): compared
 # through the quaternion instead.
 GIMBAL = {"phi", "psi"}
+#: The committed record of the last run (docs/OMSIMULATOR.md is generated from it).
+RECORD = ROOT / "docs" / "omsimulator_run.json"
+#: A flight this close to the reference is the same flight (the closed loops reach ~1e-11 m).
+SAME_FLIGHT_M = 1e-6
 
 
 def find_omsimulator(explicit: str | None = None) -> str | None:
@@ -91,7 +100,13 @@ def run_omsimulator(binary: str, ssp: pathlib.Path, workdir: pathlib.Path) -> di
     result = workdir / f"{ssp.stem}.mat"
     cmd = [binary, str(ssp.resolve()), f"--stopTime={stop!r}", f"--resultFile={result.name}", "--tempDir=."]
     proc = subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, timeout=600)
-    run = {"command": cmd, "returncode": proc.returncode, "log": proc.stdout + proc.stderr, "stop_time": stop}
+    shown = ["OMSimulator", ssp.name, *cmd[2:]]
+    run = {
+        "command": " ".join(shown),
+        "returncode": proc.returncode,
+        "log": proc.stdout + proc.stderr,
+        "stop_time": stop,
+    }
     if proc.returncode == 0 and result.exists():
         full = read_mat4(result)
         # `<model>.<system>.<component>.<variable>` -> `component.variable`
@@ -107,9 +122,9 @@ def last_per_time(signals: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     return {n: v[keep] for n, v in signals.items()}
 
 
-def fmpy_jacobi(ssp: pathlib.Path, dist: pathlib.Path = DIST):
+def fmpy_jacobi(ssp: pathlib.Path, dist: pathlib.Path = DIST, ekf_params: dict[str, float] | None = None):
     """The same system under tailsim's fmpy master, Jacobi ordering, at the FMUs' defaults
-    (the FMUs of `dist`)."""
+    (the FMUs of `dist`; `ekf_params` set on the estimator of an avionics system)."""
     from tailsim import ClosedLoop, Fmu
     from tailsim.masters.avionics import AvionicsLoop
 
@@ -119,7 +134,9 @@ def fmpy_jacobi(ssp: pathlib.Path, dist: pathlib.Path = DIST):
     fmu = {n: Fmu(dist / f"{n}.fmu") for n in ("tailsitter_plant", controller)}
     if avionics:
         sensors, ekf = Fmu(dist / "tailsitter_sensors.fmu"), Fmu(dist / "tailsitter_ekf.fmu")
-        loop = AvionicsLoop(fmu["tailsitter_plant"], sensors, ekf, fmu[controller], ordering="jacobi")
+        loop = AvionicsLoop(
+            fmu["tailsitter_plant"], sensors, ekf, fmu[controller], ekf_params=ekf_params, ordering="jacobi"
+        )
     else:
         atmosphere = dist / "tailsitter_atmosphere.fmu"
         loop = ClosedLoop(
@@ -163,6 +180,7 @@ def compare(oms: dict[str, np.ndarray], reference, outputs: dict[str, set[str]])
             owners.setdefault(name, []).append(comp)
 
     def largest(component: str, shift: int) -> tuple[str, float]:
+        """The output of `component` farthest from the reference (`shift` rows later)."""
         diffs = {
             name: float(np.max(np.abs(o[f"{component}.{name}"][shift : n + shift] - reference[name][:n])))
             for name in sorted(outputs.get(component, ()))
@@ -183,6 +201,11 @@ def compare(oms: dict[str, np.ndarray], reference, outputs: dict[str, set[str]])
         "max_position_distance_m": float(distance.max()),
         "largest_plant_output_difference": largest("plant", 0),
         "largest_controller_output_difference": largest("controller", 1),
+        # the same quantities read from one OMSimulator row (the recording offset, docs)
+        "same_row_max_pos_error_m": float(
+            np.sqrt(sum((o[f"plant.pos_{k}"][:n] - o[f"controller.ref_pos_{k}"][:n]) ** 2 for k in "ned")).max()
+        ),
+        "same_row_controller_output_difference": largest("controller", 0),
     }
 
 
@@ -204,7 +227,37 @@ def fly(binary: str, ssp: pathlib.Path, workdir: pathlib.Path, dist: pathlib.Pat
     figures["final_phase"] = int(sig["controller.phase"][-1])
     if dist is not None:
         figures.update(compare(sig, fmpy_jacobi(ssp, dist), output_connectors(ssp)))
+        if ssp.stem.endswith("_avionics"):
+            figures.update(avionics_initialisation(sig, ssp, dist))
     return figures
+
+
+def avionics_initialisation(signals: dict[str, np.ndarray], ssp: pathlib.Path, dist: pathlib.Path) -> dict:
+    """The avionics system's initial values in OMSimulator (t = 0: the controller's thrust
+    command, the estimator's and the plant's thrust) and, when the flight differs from the
+    fmpy Jacobi one, the distance to the fmpy Jacobi master started with the estimator on
+    OMSimulator's initial commands (its `ekf_params`)."""
+    from tailsim import Fmu
+
+    s = last_per_time(signals)
+    out = {
+        "initial": {
+            "controller.thrust_cmd": float(s["controller.thrust_cmd"][0]),
+            "estimator.thrust": float(s["estimator.thrust"][0]),
+            "plant.thrust": float(s["plant.thrust"][0]),
+        }
+    }
+    inputs = Fmu(dist / "tailsitter_ekf.fmu").names("input")
+    commands = {n: float(s[f"controller.{n}"][0]) for n in inputs if n.endswith("_cmd")}
+    try:
+        ref = fmpy_jacobi(ssp, dist, ekf_params=commands)
+    except Exception as e:  # an estimator that no longer takes its actuator states from the commands
+        out["started_on_initial_commands_error"] = f"{type(e).__name__}: {e}"
+        return out
+    n = min(len(ref.time), len(s["time"]))
+    distance = np.sqrt(sum((s[f"plant.pos_{k}"][:n] - ref[f"pos_{k}"][:n]) ** 2 for k in "ned"))
+    out["started_on_initial_commands_distance_m"] = float(distance.max())
+    return out
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -212,7 +265,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("ssp", nargs="*", type=pathlib.Path, help="SSP files (default: dist/*.ssp)")
     parser.add_argument("--omsimulator", help="the OMSimulator binary")
     parser.add_argument("--dist", type=pathlib.Path, default=DIST, help="the FMUs and SSPs (default: dist/)")
-    parser.add_argument("--json", type=pathlib.Path, help="write the figures here")
+    parser.add_argument(
+        "--json",
+        type=pathlib.Path,
+        help="write the figures here (default: docs/omsimulator_run.json and rewrite the docs, "
+        "when every SSP of dist/ is flown)",
+    )
     args = parser.parse_args(argv)
     binary = find_omsimulator(args.omsimulator)
     if binary is None:
@@ -220,6 +278,7 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     ssps = args.ssp or sorted(args.dist.glob("*.ssp"))
     version = subprocess.run([binary, "--version"], capture_output=True, text=True).stdout.strip()
+    record_path = args.json or (RECORD if not args.ssp and args.dist == DIST else None)
     print(f"{version}: {len(ssps)} SSPs")
     results = []
     with tempfile.TemporaryDirectory(prefix="omsimulator-") as tmp:
@@ -237,9 +296,25 @@ def main(argv: list[str] | None = None) -> int:
                 )
             else:
                 print(f"{f['ssp']:>32}: FAILED (exit {f['returncode']})\n{f.get('log_tail', '')}")
-    if args.json:
-        args.json.write_text(json.dumps({"omsimulator": version, "runs": results}, indent=1) + "\n")
-    return 0 if all("max_pos_error_m" in f for f in results) else 1
+    ok = all("max_pos_error_m" in f for f in results)
+    if record_path:
+        record = {
+            "omsimulator": version,
+            # `OMSimulator <commit>-<platform>`
+            "commit": version.split()[-1].split("-")[0] if version else None,
+            "command": "python scripts/omsimulator.py" + (f" --json {args.json}" if args.json else ""),
+            "date": datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d"),
+            "same_flight_m": SAME_FLIGHT_M,
+            "runs": results,
+        }
+        record_path.write_text(json.dumps(record, indent=1) + "\n")
+        print(f"wrote {record_path}")
+        if record_path == RECORD and ok:
+            from tailsim.reports import docs
+
+            for file in docs.regenerate(ROOT):
+                print(f"{file}: rewritten")
+    return 0 if ok else 1
 
 
 if __name__ == "__main__":

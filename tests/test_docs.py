@@ -127,6 +127,10 @@ def test_result_files_record_their_command():
     campaign = (ROOT / "docs" / "CAMPAIGN.md").read_text()
     for name in (docs_blocks.FULL, docs_blocks.RERUN):
         assert f"tailsim.campaign.section --write docs/{name}" in " ".join(campaign.split()), name
+    trims = json.loads((ROOT / "docs" / "design_trims.json").read_text())
+    assert "--example design_trims -- docs/design_trims.json" in trims["command"]
+    oms = json.loads((ROOT / "docs" / "omsimulator_run.json").read_text())
+    assert oms["command"].startswith("python scripts/omsimulator.py") and oms["commit"] in oms["omsimulator"]
 
 
 def test_history_documents_are_labelled():
@@ -152,3 +156,35 @@ def test_markers_leave_the_markdown_intact():
         for n, line in enumerate(p.read_text().splitlines(), 1):
             m = re.match(r"<!--.*?-->", line)
             assert not m or m.end() == len(line.rstrip()), f"{p.name}:{n}: {line[:80]}"
+
+
+def test_the_omsimulator_page_follows_its_run_record(tmp_path):
+    """docs/OMSIMULATOR.md's figures come from docs/omsimulator_run.json (scripts/omsimulator.py):
+    a changed run changes the page, and the avionics paragraph says whether the two masters'
+    initialisations agree from the recorded distances, not from a fixed text."""
+    from tailsim.reports import docs_omsimulator
+
+    run = json.loads((ROOT / "docs" / docs_omsimulator.RUN).read_text())
+    src = docs.Sources(ROOT)
+    assert run["command"] in docs.render("omsim.run.intro", src)
+    assert run["commit"] in docs.render("omsim.run.intro", src)
+    table = docs.render("omsim.run.table", src)
+    assert len([r for r in table.splitlines() if r.startswith("| `")]) == len(run["runs"])
+
+    def with_distance(d: float) -> dict:
+        out = json.loads(json.dumps(run))
+        for r in out["runs"]:
+            if r["ssp"].endswith("_avionics.ssp"):
+                r["max_position_distance_m"] = d
+                r["initial"] = {"controller.thrust_cmd": 88.0, "estimator.thrust": 80.0, "plant.thrust": 88.0}
+        return out
+
+    same = docs.render("omsim.initialisation", docs.Sources(ROOT, {docs_omsimulator.RUN: with_distance(1e-12)}))
+    differ = docs.render("omsim.initialisation", docs.Sources(ROOT, {docs_omsimulator.RUN: with_distance(0.5)}))
+    assert same.startswith("Both masters") and "apart" not in same
+    assert "8.0 N apart" in differ and "0.50 m away" in differ
+    root = copy_docs(tmp_path)
+    assert docs.regenerate(root, write=False) == []
+    moved = json.loads(json.dumps(run))
+    moved["runs"][0]["max_pos_error_m"] += 0.01
+    assert docs.regenerate(root, write=False, override={docs_omsimulator.RUN: moved}) == ["docs/OMSIMULATOR.md"]

@@ -56,3 +56,25 @@ def test_robustness_names_each_model_in_its_own_panels(titles):
         assert any(analysis_plots.aero(m) in t for t in ts), (m, ts)
     assert analysis_plots.aero(0) == "thesis (linear) aerodynamics (aero_model 0)"
     assert analysis_plots.aero(1) == "global (post-stall) aerodynamics (aero_model 1)"
+
+
+def test_the_envelope_plot_names_the_aero_model_and_configuration():
+    import json
+
+    import matplotlib.pyplot as plt
+
+    from tailsim.reports import envelope
+
+    d = json.loads((DATA / "report.json").read_text())
+    fig = envelope.figure(d)
+    assert fig is not None
+    text = fig.axes[0].get_title()
+    plt.close(fig)
+    e = d["envelope_transitions"]
+    assert analysis_plots.aero(e["aero_model"]) in text, text
+    assert "configuration 0" in text and "Gauss-Seidel" in text, text
+    # the model is the report's, not a constant of the plot
+    other = {**d, "envelope_transitions": {**e, "aero_model": 1 - int(e["aero_model"])}}
+    fig = envelope.figure(other)
+    assert analysis_plots.aero(1 - int(e["aero_model"])) in fig.axes[0].get_title()
+    plt.close(fig)

@@ -118,7 +118,7 @@ def interval(ci, nd: int = 3, signed: bool = False) -> str:
 
 # --- the blocks are registered by the modules below ------------------------------------------------------------
 
-from . import docs_blocks, docs_transition  # noqa: E402,F401  (register BLOCKS)
+from . import docs_blocks, docs_omsimulator, docs_thesis, docs_transition, docs_trims  # noqa: E402,F401  (register BLOCKS)
 
 # --- regeneration ------------------------------------------------------------------------------------------------
 
