@@ -149,7 +149,7 @@ pub fn used_units(model: &Model) -> Vec<&'static units::Unit> {
     units::UNITS.iter().filter(|u| used.contains(u.name)).collect()
 }
 
-fn unit_definitions(w: &mut W, model: &Model) -> Result<()> {
+pub fn unit_definitions(w: &mut W, model: &Model) -> Result<()> {
     let used = used_units(model);
     if used.is_empty() {
         return Ok(());
@@ -178,7 +178,7 @@ fn unit_definitions(w: &mut W, model: &Model) -> Result<()> {
     })
 }
 
-fn log_categories(w: &mut W) -> Result<()> {
+pub fn log_categories(w: &mut W) -> Result<()> {
     element(w, "LogCategories", [], |w| {
         LOG_CATEGORIES
             .iter()
