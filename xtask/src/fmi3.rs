@@ -48,7 +48,12 @@ impl Platform {
 
 /// Write `<out>/fmi3/<id>.fmu` for every model of `ids`, with the libraries of every
 /// platform in `platforms` (already built).
-pub fn write_archives(root: &Path, out: &Path, ids: &[&str], platforms: &[Platform]) -> std::result::Result<(), String> {
+pub fn write_archives(
+    root: &Path,
+    out: &Path,
+    ids: &[&str],
+    platforms: &[Platform],
+) -> std::result::Result<(), String> {
     let folder = out.join("fmi3");
     std::fs::create_dir_all(&folder).map_err(|e| format!("{}: {e}", folder.display()))?;
     for id in ids {
@@ -56,16 +61,19 @@ pub fn write_archives(root: &Path, out: &Path, ids: &[&str], platforms: &[Platfo
         let path = folder.join(format!("{id}.fmu"));
         let file = std::fs::File::create(&path).map_err(|e| format!("{}: {e}", path.display()))?;
         let mut zip = zip::ZipWriter::new(file);
-        let options =
-            zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
-        let mut entries = vec![("modelDescription.xml".to_string(), model_description(&model).into_bytes())];
+        let options = zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
+        let mut entries = vec![(
+            "modelDescription.xml".to_string(),
+            model_description(&model).into_bytes(),
+        )];
         for platform in platforms {
             let lib = platform.built_path(root, id);
             let bytes = std::fs::read(&lib).map_err(|e| format!("{}: {e}", lib.display()))?;
             entries.push((platform.fmi3_archive_path(id), bytes));
         }
         for (name, bytes) in &entries {
-            zip.start_file(name.as_str(), options).map_err(|e| format!("{name}: {e}"))?;
+            zip.start_file(name.as_str(), options)
+                .map_err(|e| format!("{name}: {e}"))?;
             zip.write_all(bytes).map_err(|e| format!("{name}: {e}"))?;
         }
         zip.finish().map_err(|e| e.to_string())?;
@@ -210,7 +218,10 @@ fn model_structure(w: &mut W, model: &Model) -> Result<()> {
         empty(
             w,
             name,
-            [("valueReference", own.as_str()), ("dependencies", deps.join(" ").as_str())],
+            [
+                ("valueReference", own.as_str()),
+                ("dependencies", deps.join(" ").as_str()),
+            ],
         )
     };
     element(w, "ModelStructure", [], |w| {
