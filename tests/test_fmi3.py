@@ -1,10 +1,10 @@
 """The FMI 3.0 units (`dist/fmi3/<id>.fmu`, `cargo xtask dist`): the same declarations and
 the same libraries as the FMI 2.0 units, exported through crates/fmi3-export.
 
-- every unit validates (fmpy: the FMI 3.0 XSDs and its semantic checks), carries the
-  x86_64-linux, aarch64-linux and x86_64-windows libraries (those the FMI 2.0 archives
-  carry: all three by default), and declares the FMI 2.0
-  interface (names, value references, causality, variability, start values, dependencies);
+- every unit validates (fmpy: the FMI 3.0 XSDs and its semantic checks; fmutool's FMI 3.0
+  checks), carries the x86_64-linux, aarch64-linux and x86_64-windows libraries (those the
+  FMI 2.0 archives carry: all three by default), and declares the FMI 2.0 interface (names,
+  value references, causality, variability, start values, dependencies);
 - fmpy flies the default mission with plant + controller as FMI 3.0 Co-Simulation, with the
   master loop of tailsim's ClosedLoop, and matches the FMI 2.0 run (tailsim, fmpy) to
   POSITION_TOL;
@@ -23,8 +23,10 @@ from __future__ import annotations
 
 import math
 import pathlib
+import re
 import shutil
 import subprocess
+import sys
 import zipfile
 
 import numpy as np
@@ -50,6 +52,7 @@ POSITIONS = ["pos_n", "pos_e", "pos_d"]
 POSITION_TOL = 1e-9
 STATUS = ["OK", "Warning", "Discard", "Error", "Fatal"]
 QEMU = ["qemu-aarch64", "-L", "/usr/aarch64-linux-gnu"]
+FMUTOOL = pathlib.Path(sys.executable).with_name("fmutool")
 TYPE_2_TO_3 = {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean", "String": "String"}
 
 
@@ -128,6 +131,16 @@ def test_unit_validates_and_carries_every_platform(unit):
     assert [(v.name, v.type) for v in independent] == [("time", "Float64")]
     others = [v.valueReference for v in md.modelVariables if v.causality != "independent"]
     assert independent[0].valueReference == max(others) + 1
+
+
+@pytest.mark.parametrize("unit", UNITS)
+def test_fmutool_finds_no_fmi3_error(unit):
+    """fmu-manipulation-toolbox's schema and semantic checks of the FMI 3.0 standard."""
+    proc = subprocess.run([str(FMUTOOL), "-input", str(fmi3_path(unit)), "-check"], capture_output=True, text=True)
+    out = proc.stdout + proc.stderr
+    assert proc.returncode == 0, f"fmutool -check exit code {proc.returncode} (7 = errors):\n{out}"
+    assert "compliant with FMI-3.0" in out and "No semantic error" in out, out
+    assert not re.search(r"^\s*(ERROR|WARNING)\b", out, re.M), out
 
 
 def _unknowns(unknowns) -> list[tuple[str, list[str]]]:
