@@ -143,6 +143,35 @@ def test_fmutool_finds_no_fmi3_error(unit):
     assert not re.search(r"^\s*(ERROR|WARNING)\b", out, re.M), out
 
 
+def _fmi3_functions() -> set[str]:
+    """Every function of fmi3FunctionTypes.h (the headers of the fmi-sys crate)."""
+    from test_aarch64 import fmi2_headers
+
+    header = fmi2_headers().parent.parent / "fmi-standard3" / "headers" / "fmi3FunctionTypes.h"
+    return set(re.findall(r"\b(fmi3\w+)TYPE\s*\(", header.read_text()))
+
+
+@pytest.mark.parametrize("unit", UNITS)
+def test_every_library_exports_every_fmi3_function(unit, tmp_path):
+    """fmpy resolves the FMI 3.0 functions as it calls them; other importers resolve all of
+    them at load: every platform's library exports the complete set."""
+    wanted = _fmi3_functions()
+    assert len(wanted) > 70
+    tools = {
+        "x86_64-linux": ["nm", "-D", "--defined-only"],
+        "aarch64-linux": [_tool("aarch64-linux-gnu-nm"), "-D", "--defined-only"],
+        "x86_64-windows": [_tool("x86_64-w64-mingw32-objdump"), "-p"],
+    }
+    with zipfile.ZipFile(fmi3_path(unit)) as z:
+        libraries = [n for n in z.namelist() if n.startswith("binaries/")]
+        z.extractall(tmp_path, members=libraries)
+    for name in libraries:
+        folder = name.split("/")[1]
+        listing = subprocess.run([*tools[folder], str(tmp_path / name)], capture_output=True, text=True, check=True)
+        exported = set(re.findall(r"\b(fmi3\w+)$", listing.stdout, re.M))
+        assert wanted <= exported, (name, sorted(wanted - exported))
+
+
 def _unknowns(unknowns) -> list[tuple[str, list[str]]]:
     return [(u.variable.name, sorted(d.name for d in (u.dependencies or []))) for u in unknowns]
 
