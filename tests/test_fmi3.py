@@ -24,7 +24,6 @@ from __future__ import annotations
 import math
 import pathlib
 import re
-import shutil
 import subprocess
 import sys
 import zipfile
@@ -51,7 +50,6 @@ POSITIONS = ["pos_n", "pos_e", "pos_d"]
 #: FMI 3.0 vs FMI 2.0 (m): the same library, model and call sequence; only the ABI differs.
 POSITION_TOL = 1e-9
 STATUS = ["OK", "Warning", "Discard", "Error", "Fatal"]
-QEMU = ["qemu-aarch64", "-L", "/usr/aarch64-linux-gnu"]
 FMUTOOL = pathlib.Path(sys.executable).with_name("fmutool")
 TYPE_2_TO_3 = {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean", "String": "String"}
 
@@ -143,11 +141,19 @@ def test_fmutool_finds_no_fmi3_error(unit):
     assert not re.search(r"^\s*(ERROR|WARNING)\b", out, re.M), out
 
 
-def _fmi3_functions() -> set[str]:
-    """Every function of fmi3FunctionTypes.h (the headers of the fmi-sys crate)."""
+def _fmi3_headers() -> pathlib.Path:
+    """The FMI 3.0 headers shipped with the fmi-sys crate the workspace builds with."""
     from test_aarch64 import fmi2_headers
 
-    header = fmi2_headers().parent.parent / "fmi-standard3" / "headers" / "fmi3FunctionTypes.h"
+    headers = fmi2_headers().parent.parent / "fmi-standard3" / "headers"
+    assert (headers / "fmi3Functions.h").exists(), headers
+    return headers
+
+
+def _fmi3_functions() -> set[str]:
+    """Every function of fmi3FunctionTypes.h (the headers of the fmi-sys crate)."""
+
+    header = _fmi3_headers() / "fmi3FunctionTypes.h"
     return set(re.findall(r"\b(fmi3\w+)TYPE\s*\(", header.read_text()))
 
 
@@ -155,12 +161,14 @@ def _fmi3_functions() -> set[str]:
 def test_every_library_exports_every_fmi3_function(unit, tmp_path):
     """fmpy resolves the FMI 3.0 functions as it calls them; other importers resolve all of
     them at load: every platform's library exports the complete set."""
+    from test_aarch64 import tool
+
     wanted = _fmi3_functions()
     assert len(wanted) > 70
     tools = {
         "x86_64-linux": ["nm", "-D", "--defined-only"],
-        "aarch64-linux": [_tool("aarch64-linux-gnu-nm"), "-D", "--defined-only"],
-        "x86_64-windows": [_tool("x86_64-w64-mingw32-objdump"), "-p"],
+        "aarch64-linux": [tool("aarch64-linux-gnu-nm"), "-D", "--defined-only"],
+        "x86_64-windows": [tool("x86_64-w64-mingw32-objdump"), "-p"],
     }
     with zipfile.ZipFile(fmi3_path(unit)) as z:
         libraries = [n for n in z.namelist() if n.startswith("binaries/")]
@@ -267,89 +275,54 @@ def test_fmpy_flies_the_default_mission_as_fmi2(units3, fmus, controller):
 # ------------------------------------------------------------------ Model Exchange
 
 
-def fly_model_exchange_fmi3(plant: Unit3, controller, rtol: float, stop_time: float | None = None):
-    """tests/test_model_exchange.py's CVode closed loop with the plant as FMI 3.0 Model
-    Exchange (the controller: the FMI 2.0 unit of that test)."""
-    from fmpy.sundials import CVodeSolver
+class Fmi3ModelAsFmi2:
+    """The FMI 3.0 plant (fmpy's FMU3Model) behind the calls of fmpy's FMU2Model that
+    tests/test_model_exchange.py's master makes: the calls FMI 3.0 renamed or merged are
+    mapped, every other one passes through."""
 
-    from test_model_exchange import COMPARED, _NoInput
+    def __init__(self, plant: Unit3, log: Log):
+        md = plant.md
+        self.m = FMU3Model(
+            guid=md.guid, unzipDirectory=plant.dir, modelIdentifier=md.modelExchange.modelIdentifier, instanceName="me"
+        )
+        self.m.instantiate(logMessage=log)
+        self.experiment: dict = {}
 
-    md = plant.md
-    assert md.modelExchange is not None and md.numberOfEventIndicators == 0
-    nx = len(md.derivatives)
-    pv = plant.variables
-    m = FMU3Model(
-        guid=md.guid, unzipDirectory=plant.dir, modelIdentifier=md.modelExchange.modelIdentifier, instanceName="me"
-    )
-    log = Log()
-    m.instantiate(logMessage=log)
-    assert m.getNumberOfContinuousStates() == nx
-    assert m.getNumberOfEventIndicators() == 0
-    c = controller.instantiate("controller")
-    cv = controller.variables
-    c_in = [n for n in controller.names("input") if n in pv and pv[n].causality == "output"]
-    c_out = [n for n in controller.names("output") if n in pv and pv[n].causality == "input"]
-    p_out_vr, p_in_vr, rec_vr = plant.vrs(c_in), plant.vrs(c_out), plant.vrs(COMPARED)
-    c_in_vr = [cv[n].valueReference for n in c_in]
-    c_out_vr = [cv[n].valueReference for n in c_out]
-    h = float(controller.md.defaultExperiment.stepSize)
-    n = int(round(float(stop_time or controller.md.defaultExperiment.stopTime) / h))
+    def setupExperiment(self, tolerance=None, startTime=0.0):
+        self.experiment = {"tolerance": tolerance, "startTime": startTime}
 
-    m.enterInitializationMode(tolerance=rtol, startTime=0.0)
-    m.exitInitializationMode()
-    assert m.updateDiscreteStates() == (False, False, False, False, False, 0.0)
-    m.enterContinuousTimeMode()
-    c.setupExperiment(startTime=0.0)
-    c.enterInitializationMode()
-    c.setReal(c_in_vr, m.getFloat64(p_out_vr))
-    c.exitInitializationMode()
-    solver = CVodeSolver(
-        nx=nx,
-        nz=0,
-        get_x=m.getContinuousStates,
-        set_x=m.setContinuousStates,
-        get_dx=m.getContinuousStateDerivatives,
-        get_z=m.getEventIndicators,
-        get_nominals=m.getNominalsOfContinuousStates,
-        set_time=m.setTime,
-        input=_NoInput(),
-        startTime=0.0,
-        maxStep=h,
-        relativeTolerance=rtol,
-    )
-    time = np.arange(n + 1) * h
-    data = np.full((n + 1, len(COMPARED)), np.nan)
-    for k in range(n + 1):
-        t = time[k]
-        c.setReal(c_in_vr, m.getFloat64(p_out_vr))
-        c.doStep(currentCommunicationPoint=t, communicationStepSize=h)
-        u = c.getReal(c_out_vr)
-        data[k] = m.getFloat64(rec_vr)
-        if k == n:
-            break
-        m.enterEventMode()
-        m.setFloat64(p_in_vr, u)
-        assert m.updateDiscreteStates()[:2] == (False, False)
-        m.enterContinuousTimeMode()
-        solver.reset(t)
-        _, _, t_reached = solver.step(t, time[k + 1])
-        assert t_reached == pytest.approx(time[k + 1], abs=1e-12)
-        m.setTime(time[k + 1])
-        assert m.completedIntegratorStep() == (False, False)
-    for s in (m, c):
-        s.terminate()
-        s.freeInstance()
-    assert [msg for s, _, msg in log.messages if s == "Error"] == []
-    return time, {name: data[:, i] for i, name in enumerate(COMPARED)}
+    def enterInitializationMode(self):
+        self.m.enterInitializationMode(**self.experiment)
+
+    def newDiscreteStates(self):
+        return self.m.updateDiscreteStates()
+
+    def getReal(self, vr):
+        return self.m.getFloat64(vr)
+
+    def setReal(self, vr, values):
+        self.m.setFloat64(vr, values)
+
+    def getDerivatives(self, dx, nx):
+        return self.m.getContinuousStateDerivatives(dx, nx)
+
+    def __getattr__(self, name):
+        return getattr(self.m, name)
 
 
 def test_plant_model_exchange_matches_fmi2_model_exchange(units3, fmus):
-    """The same closed loop, CVode, tolerance and call sequence; the plant once through
-    FMI 2.0 and once through FMI 3.0 Model Exchange."""
+    """tests/test_model_exchange.py's closed loop (CVode, its tolerance, the LQR as
+    Co-Simulation) with the plant once through FMI 2.0 and once through FMI 3.0 Model
+    Exchange."""
     from test_model_exchange import RTOL, fly_model_exchange
 
     controller = fmus["tailsitter_lqr"]
-    t3, me3 = fly_model_exchange_fmi3(units3[PLANT], controller, RTOL)
+    log = Log()
+    plant3 = Fmi3ModelAsFmi2(units3[PLANT], log)
+    nx = plant3.getNumberOfContinuousStates()
+    assert nx == len(units3[PLANT].md.derivatives) and plant3.getNumberOfEventIndicators() == 0
+    t3, me3 = fly_model_exchange(fmus[PLANT], controller, plant=plant3)
+    assert [m for s, _, m in log.messages if s == "Error"] == []
     t2, me2 = fly_model_exchange(fmus[PLANT], controller)
     assert np.array_equal(t3, t2)
     assert np.max(np.hypot(me3["u"], me3["w"])) > 20.0, "the mission reached level flight"
@@ -357,7 +330,8 @@ def test_plant_model_exchange_matches_fmi2_model_exchange(units3, fmus):
     name, err = max(worst.items(), key=lambda kv: kv[1])
     dpos = max(worst[p] for p in POSITIONS)
     print(
-        f"\nME FMI 3.0 vs FMI 2.0 (CVode, rtol {RTOL:g}, {t3[-1]:g} s): position {dpos:.3g} m, max {err:.3g} ({name})"
+        f"\nME FMI 3.0 vs FMI 2.0 (CVode, rtol {RTOL:g}, {t3[-1]:g} s, {nx} states): "
+        f"position {dpos:.3g} m, largest of any state {err:.3g} ({name})"
     )
     assert dpos <= POSITION_TOL
 
@@ -449,28 +423,14 @@ def test_every_unit_refuses_illegal_calls(units3, unit):
 # ------------------------------------------------------------------ aarch64 under qemu
 
 
-def _tool(name: str) -> str:
-    path = shutil.which(name)
-    assert path, f"{name} missing: run scripts/setup.sh (Debian gcc-aarch64-linux-gnu, qemu-user)"
-    return path
-
-
 @pytest.fixture(scope="module")
 def masters3(tmp_path_factory) -> dict[str, list[str]]:
-    """tests/c-master/master_fmi3.c built for the host and for aarch64."""
-    from test_aarch64 import fmi2_headers
+    """tests/c-master/master_fmi3.c built for the host and for aarch64 (as test_aarch64's
+    FMI 2.0 master)."""
+    from test_aarch64 import build_masters
 
-    headers = fmi2_headers().parent.parent / "fmi-standard3" / "headers"
-    assert (headers / "fmi3Functions.h").exists(), headers
-    tmp = tmp_path_factory.mktemp("c-master3")
-    out = {}
-    for arch, cc in [("x86_64", shutil.which("cc") or "gcc"), ("aarch64", _tool("aarch64-linux-gnu-gcc"))]:
-        exe = tmp / f"master3-{arch}"
-        flags = ["-std=c11", "-D_POSIX_C_SOURCE=200809L", "-O2", "-Wall", "-Wextra", "-Werror"]
-        source = ROOT / "tests" / "c-master" / "master_fmi3.c"
-        subprocess.run([cc, *flags, f"-I{headers}", str(source), "-o", str(exe), "-ldl"], check=True)
-        out[arch] = [*(([_tool(QEMU[0]), *QEMU[1:]]) if arch == "aarch64" else []), str(exe)]
-    return out
+    source = ROOT / "tests" / "c-master" / "master_fmi3.c"
+    return build_masters(source, _fmi3_headers(), tmp_path_factory.mktemp("c-master3"))
 
 
 def _fly_c(master: list[str], folder: str, controller: str, units3, fmus, tmp: pathlib.Path):

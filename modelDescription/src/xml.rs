@@ -203,37 +203,46 @@ fn scalar_variable(w: &mut W, model: &Model, v: &Variable) -> Result<()> {
             VarType::Boolean => "Boolean",
             VarType::String => "String",
         };
-        let mut attrs: Vec<(&str, String)> = Vec::new();
-        if let Some(u) = &d.unit {
-            attrs.push(("unit", u.clone()));
-        }
-        if let Some(du) = &v.display_unit {
-            attrs.push(("displayUnit", du.clone()));
-        }
-        let number = |x: f64| match d.var_type {
-            VarType::Integer => format!("{}", x as i64),
-            _ => fmt_f64(x),
-        };
-        if let Some(lo) = d.min {
-            attrs.push(("min", number(lo)));
-        }
-        if let Some(hi) = d.max {
-            attrs.push(("max", number(hi)));
-        }
-        if let Some(x) = d.nominal {
-            attrs.push(("nominal", fmt_f64(x)));
-        }
-        match &d.start {
-            Some(Start::Number(x)) => attrs.push(("start", number(*x))),
-            Some(Start::Bool(b)) => attrs.push(("start", b.to_string())),
-            Some(Start::Text(s)) => attrs.push(("start", s.clone())),
-            None => {}
-        }
+        let mut attrs = value_attributes(v, true);
         if let Some(state) = &d.derivative_of {
             attrs.push(("derivative", index_of(model, state).to_string()));
         }
         empty(w, tag, attrs.iter().map(|(k, v)| (*k, v.as_str())))
     })
+}
+
+/// The attributes of a variable's type element, in schema order: `unit`, `displayUnit`,
+/// `min`, `max`, `nominal`, `start` (a String's start only with `string_start`: FMI 3.0
+/// writes it as a child element). Shared by the FMI 2.0 and FMI 3.0 writers.
+pub fn value_attributes(v: &Variable, string_start: bool) -> Vec<(&'static str, String)> {
+    let d = &v.decl;
+    let mut attrs: Vec<(&'static str, String)> = Vec::new();
+    if let Some(u) = &d.unit {
+        attrs.push(("unit", u.clone()));
+    }
+    if let Some(du) = &v.display_unit {
+        attrs.push(("displayUnit", du.clone()));
+    }
+    let number = |x: f64| match d.var_type {
+        VarType::Integer => format!("{}", x as i64),
+        _ => fmt_f64(x),
+    };
+    if let Some(lo) = d.min {
+        attrs.push(("min", number(lo)));
+    }
+    if let Some(hi) = d.max {
+        attrs.push(("max", number(hi)));
+    }
+    if let Some(x) = d.nominal {
+        attrs.push(("nominal", fmt_f64(x)));
+    }
+    match &d.start {
+        Some(Start::Number(x)) => attrs.push(("start", number(*x))),
+        Some(Start::Bool(b)) => attrs.push(("start", b.to_string())),
+        Some(Start::Text(s)) if string_start => attrs.push(("start", s.clone())),
+        _ => {}
+    }
+    attrs
 }
 
 /// 1-based index of a variable in ModelVariables.

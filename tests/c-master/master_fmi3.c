@@ -12,8 +12,7 @@
 #include <string.h>
 
 #include "fmi3Functions.h"
-
-#define MAX_VARS 256
+#include "master_common.h"
 
 typedef struct {
     void *lib;
@@ -28,30 +27,12 @@ typedef struct {
     fmi3FreeInstanceTYPE *free_instance;
 } Unit;
 
-typedef struct {
-    size_t n;
-    fmi3ValueReference src[MAX_VARS], dst[MAX_VARS];
-} Links;
-
 static void logger(fmi3InstanceEnvironment env, fmi3Status status, fmi3String category, fmi3String message) {
     fprintf(stderr, "[%s] %d %s: %s\n", (const char *)env, (int)status, category, message);
 }
 
-static void *symbol(void *lib, const char *name) {
-    void *f = dlsym(lib, name);
-    if (!f) {
-        fprintf(stderr, "missing symbol %s\n", name);
-        exit(1);
-    }
-    return f;
-}
-
 static void load(Unit *u, const char *path) {
-    u->lib = dlopen(path, RTLD_NOW | RTLD_LOCAL);
-    if (!u->lib) {
-        fprintf(stderr, "dlopen %s: %s\n", path, dlerror());
-        exit(1);
-    }
+    u->lib = open_library(path);
     u->instantiate = (fmi3InstantiateCoSimulationTYPE *)symbol(u->lib, "fmi3InstantiateCoSimulation");
     u->enter_init = (fmi3EnterInitializationModeTYPE *)symbol(u->lib, "fmi3EnterInitializationMode");
     u->exit_init = (fmi3ExitInitializationModeTYPE *)symbol(u->lib, "fmi3ExitInitializationMode");
@@ -60,27 +41,6 @@ static void load(Unit *u, const char *path) {
     u->do_step = (fmi3DoStepTYPE *)symbol(u->lib, "fmi3DoStep");
     u->terminate = (fmi3TerminateTYPE *)symbol(u->lib, "fmi3Terminate");
     u->free_instance = (fmi3FreeInstanceTYPE *)symbol(u->lib, "fmi3FreeInstance");
-}
-
-static void parse(Links *l, const char *text, int pairs) {
-    char *copy = strdup(text), *save = NULL;
-    l->n = 0;
-    for (char *tok = strtok_r(copy, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
-        if (l->n == MAX_VARS) {
-            fprintf(stderr, "more than %d references\n", MAX_VARS);
-            exit(1);
-        }
-        char *end;
-        l->src[l->n] = (fmi3ValueReference)strtoul(tok, &end, 10);
-        l->dst[l->n] = l->src[l->n];
-        if (pairs && *end == ':') l->dst[l->n] = (fmi3ValueReference)strtoul(end + 1, &end, 10);
-        if (*end != '\0') {
-            fprintf(stderr, "bad reference %s\n", tok);
-            exit(1);
-        }
-        l->n++;
-    }
-    free(copy);
 }
 
 static void check(fmi3Status s, const char *what, double t) {

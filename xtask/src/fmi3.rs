@@ -12,7 +12,9 @@
 //! FMI 2.0 description with value references in place of indices.
 
 use crate::Platform;
-use model_description::xml::{document, element, empty, log_categories, unit_definitions, XmlWriter};
+use model_description::xml::{
+    document, element, empty, log_categories, unit_definitions, value_attributes, XmlWriter,
+};
 use model_description::{fmt_f64, Model, Start, VarType, Variable, AUTHOR, GENERATION_TOOL};
 use std::io::{Result, Write};
 use std::path::Path;
@@ -164,33 +166,12 @@ fn variable(w: &mut W, model: &Model, v: &Variable) -> Result<()> {
         ("causality", d.causality.as_str().to_string()),
         ("variability", v.variability.as_str().to_string()),
     ];
-    if let Some(u) = &d.unit {
-        attrs.push(("unit", u.clone()));
-    }
-    if let Some(du) = &v.display_unit {
-        attrs.push(("displayUnit", du.clone()));
-    }
-    let number = |x: f64| match d.var_type {
-        VarType::Integer => format!("{}", x as i64),
-        _ => fmt_f64(x),
-    };
-    if let Some(lo) = d.min {
-        attrs.push(("min", number(lo)));
-    }
-    if let Some(hi) = d.max {
-        attrs.push(("max", number(hi)));
-    }
-    if let Some(x) = d.nominal {
-        attrs.push(("nominal", fmt_f64(x)));
-    }
+    attrs.extend(value_attributes(v, false));
     // A String's start value is a child element in FMI 3.0.
-    let mut string_start = None;
-    match &d.start {
-        Some(Start::Number(x)) => attrs.push(("start", number(*x))),
-        Some(Start::Bool(b)) => attrs.push(("start", b.to_string())),
-        Some(Start::Text(s)) => string_start = Some(s.clone()),
-        None => {}
-    }
+    let string_start = match &d.start {
+        Some(Start::Text(s)) => Some(s.as_str()),
+        _ => None,
+    };
     if let Some(state) = &d.derivative_of {
         let vr = model
             .variables
@@ -202,7 +183,7 @@ fn variable(w: &mut W, model: &Model, v: &Variable) -> Result<()> {
     }
     let attrs = attrs.iter().map(|(k, v)| (*k, v.as_str()));
     match string_start {
-        Some(s) => element(w, tag, attrs, |w| empty(w, "Start", [("value", s.as_str())])),
+        Some(s) => element(w, tag, attrs, |w| empty(w, "Start", [("value", s)])),
         None => empty(w, tag, attrs),
     }
 }

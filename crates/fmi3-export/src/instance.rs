@@ -32,17 +32,11 @@ pub fn state_name(state: FmiState) -> &'static str {
 /// configuration mode, no clocks).
 pub mod mask {
     use super::*;
-    pub const ANY: StateMask = StateMask::of(&[
-        Instantiated,
-        InitializationMode,
-        StepComplete,
-        StepInProgress,
-        StepFailed,
-        StepCanceled,
-        Terminated,
-        EventMode,
-        ContinuousTimeMode,
-    ]);
+    use fmi2_export::instance::mask as fmi2;
+    /// Every state; Set{…} as in FMI 2.0 (the causality/variability checks of the core
+    /// decide per variable).
+    pub const ANY: StateMask = fmi2::ANY;
+    pub const SET: StateMask = fmi2::SET;
     pub const ENTER_INITIALIZATION_MODE: StateMask = StateMask::of(&[Instantiated]);
     pub const EXIT_INITIALIZATION_MODE: StateMask = StateMask::of(&[InitializationMode]);
     pub const GET: StateMask = StateMask::of(&[
@@ -50,13 +44,6 @@ pub mod mask {
         StepComplete,
         StepFailed,
         Terminated,
-        EventMode,
-        ContinuousTimeMode,
-    ]);
-    pub const SET: StateMask = StateMask::of(&[
-        Instantiated,
-        InitializationMode,
-        StepComplete,
         EventMode,
         ContinuousTimeMode,
     ]);

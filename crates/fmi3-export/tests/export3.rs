@@ -53,6 +53,16 @@ fn env(log: &Log) -> fmi3InstanceEnvironment {
 }
 
 fn instantiate_cs(log: &Log, name: &str, token: &str, event_mode_used: bool) -> fmi3Instance {
+    instantiate_with(name, token, event_mode_used, env(log), Some(record))
+}
+
+fn instantiate_with(
+    name: &str,
+    token: &str,
+    event_mode_used: bool,
+    env: fmi3InstanceEnvironment,
+    logger: fmi3LogMessageCallback,
+) -> fmi3Instance {
     let (name, token) = (cstring(name), cstring(token));
     unsafe {
         fmi3InstantiateCoSimulation(
@@ -60,13 +70,13 @@ fn instantiate_cs(log: &Log, name: &str, token: &str, event_mode_used: bool) -> 
             token.as_ptr(),
             null(),
             false,
-            false,
+            logger.is_none(),
             event_mode_used,
             false,
             null(),
             0,
-            env(log),
-            Some(record),
+            env,
+            logger,
             None,
         )
     }
@@ -270,22 +280,7 @@ fn instantiation_is_refused_with_a_message() {
     };
     assert!(se.is_null());
     // A host without a logger is legal in FMI 3.0.
-    let quiet = unsafe {
-        fmi3InstantiateCoSimulation(
-            name.as_ptr(),
-            token.as_ptr(),
-            null(),
-            false,
-            true,
-            false,
-            false,
-            null(),
-            0,
-            null_mut(),
-            None,
-            None,
-        )
-    };
+    let quiet = instantiate_with("toy3", TOY_GUID, false, null_mut(), None);
     assert!(!quiet.is_null());
     unsafe {
         assert_eq!(fmi3ExitInitializationMode(quiet), ERROR);
