@@ -76,24 +76,30 @@ fn write_all(w: &mut W, model: &Model) -> Result<()> {
             model_exchange(w, model)?;
         }
         co_simulation(w, model)?;
-        unit_definitions(w, model)?;
-        log_categories(w)?;
-        let e = &model.default_experiment;
-        let (start, stop, step) = (fmt_f64(e.start_time), fmt_f64(e.stop_time), fmt_f64(e.step_size));
-        empty(
-            w,
-            "DefaultExperiment",
-            [
-                ("startTime", start.as_str()),
-                ("stopTime", stop.as_str()),
-                ("stepSize", step.as_str()),
-            ],
-        )?;
+        units_categories_experiment(w, model)?;
         element(w, "ModelVariables", [], |w| {
             model.variables.iter().try_for_each(|v| scalar_variable(w, model, v))
         })?;
         model_structure(w, model)
     })
+}
+
+/// UnitDefinitions, LogCategories and DefaultExperiment, which FMI 2.0 and FMI 3.0 write
+/// alike, between the interface elements and ModelVariables.
+pub fn units_categories_experiment(w: &mut W, model: &Model) -> Result<()> {
+    unit_definitions(w, model)?;
+    log_categories(w)?;
+    let e = &model.default_experiment;
+    let (start, stop, step) = (fmt_f64(e.start_time), fmt_f64(e.stop_time), fmt_f64(e.step_size));
+    empty(
+        w,
+        "DefaultExperiment",
+        [
+            ("startTime", start.as_str()),
+            ("stopTime", stop.as_str()),
+            ("stepSize", step.as_str()),
+        ],
+    )
 }
 
 /// `<ModelExchange>`: the same binary (same modelIdentifier) serves both interfaces,
@@ -149,7 +155,7 @@ pub fn used_units(model: &Model) -> Vec<&'static units::Unit> {
     units::UNITS.iter().filter(|u| used.contains(u.name)).collect()
 }
 
-pub fn unit_definitions(w: &mut W, model: &Model) -> Result<()> {
+fn unit_definitions(w: &mut W, model: &Model) -> Result<()> {
     let used = used_units(model);
     if used.is_empty() {
         return Ok(());
@@ -178,7 +184,7 @@ pub fn unit_definitions(w: &mut W, model: &Model) -> Result<()> {
     })
 }
 
-pub fn log_categories(w: &mut W) -> Result<()> {
+fn log_categories(w: &mut W) -> Result<()> {
     element(w, "LogCategories", [], |w| {
         LOG_CATEGORIES
             .iter()

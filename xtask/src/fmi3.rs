@@ -12,10 +12,8 @@
 //! FMI 2.0 description with value references in place of indices.
 
 use crate::Platform;
-use model_description::xml::{
-    document, element, empty, log_categories, unit_definitions, value_attributes, XmlWriter,
-};
-use model_description::{fmt_f64, Model, Start, VarType, Variable, AUTHOR, GENERATION_TOOL};
+use model_description::xml::{document, element, empty, units_categories_experiment, value_attributes, XmlWriter};
+use model_description::{Model, Start, VarType, Variable, AUTHOR, GENERATION_TOOL};
 use std::io::{Result, Write};
 use std::path::Path;
 
@@ -118,19 +116,7 @@ fn write_all(w: &mut W, model: &Model) -> Result<()> {
                 .into_iter()
                 .chain([("canHandleVariableCommunicationStepSize", "true")]),
         )?;
-        unit_definitions(w, model)?;
-        log_categories(w)?;
-        let e = &model.default_experiment;
-        let (start, stop, step) = (fmt_f64(e.start_time), fmt_f64(e.stop_time), fmt_f64(e.step_size));
-        empty(
-            w,
-            "DefaultExperiment",
-            [
-                ("startTime", start.as_str()),
-                ("stopTime", stop.as_str()),
-                ("stepSize", step.as_str()),
-            ],
-        )?;
+        units_categories_experiment(w, model)?;
         element(w, "ModelVariables", [], |w| {
             let time = time_value_reference(model).to_string();
             empty(
