@@ -21,6 +21,7 @@ Figures: .venv/bin/python -m pytest tests/test_fmi3.py -s
 
 from __future__ import annotations
 
+import ctypes
 import math
 import pathlib
 import re
@@ -393,6 +394,39 @@ def test_bad_input_gives_an_error_status_never_a_crash(units3):
     assert _raises(log, p.doStep, 0.02, 0.02) == "fmi3DoStep: illegal call in state Terminated"
     p.freeInstance()
     assert throttle is None or throttle[0] >= 0
+
+
+def test_model_exchange_bad_input_gives_an_error_status(units3):
+    plant = units3[PLANT]
+    nx = len(plant.md.derivatives)
+    log = Log()
+    m = FMU3Model(guid=plant.md.guid, unzipDirectory=plant.dir, modelIdentifier=PLANT, instanceName="bad_me")
+    m.instantiate(logMessage=log)
+    x = (ctypes.c_double * nx)()
+    assert "illegal call in state Instantiated" in _raises(log, m.getContinuousStates, x, nx)
+    m.enterInitializationMode(startTime=0.0)
+    m.exitInitializationMode()
+    assert "illegal call in state EventMode" in _raises(log, m.setContinuousStates, x, nx)
+    flag, last = ctypes.c_bool(), ctypes.c_double()
+    args = (m.component, 0.0, 0.01, True, *(ctypes.byref(flag) for _ in range(3)), ctypes.byref(last))
+    assert "illegal call in state EventMode" in _raises(log, m.fmi3DoStep, *args)
+    m.enterContinuousTimeMode()
+    m.getContinuousStates(x, nx)
+    assert all(math.isfinite(v) for v in x)
+    assert f"but the model has {nx} continuous states" in _raises(log, m.getContinuousStateDerivatives, x, nx - 1)
+    assert "has none" in _raises(log, m.getEventIndicators, x, 1)
+    good = list(x)
+    x[3] = math.nan
+    assert "is not finite" in _raises(log, m.setContinuousStates, x, nx)
+    assert "time = inf is not finite" in _raises(log, m.setTime, math.inf)
+    # Nothing was taken over: the derivatives at the states before the refused calls.
+    x[3] = good[3]
+    m.setContinuousStates(x, nx)
+    dx = (ctypes.c_double * nx)()
+    m.getContinuousStateDerivatives(dx, nx)
+    assert all(math.isfinite(v) for v in dx)
+    m.terminate()
+    m.freeInstance()
 
 
 @pytest.mark.parametrize("unit", UNITS)
