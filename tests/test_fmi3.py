@@ -14,7 +14,9 @@ the same libraries as the FMI 2.0 units, exported through crates/fmi3-export.
 - bad input (calls in the wrong state, unknown value references, NaN, wrong times) gives
   an error status and a log message, never a crash, and the instance stays usable;
 - the aarch64 library loads and flies under qemu-user (tests/c-master/master_fmi3.c built
-  for the host and for aarch64) and matches x86-64.
+  for the host and for aarch64) and matches x86-64; the x86_64-windows library flies under
+  Wine (the same master built with MinGW) and matches x86-64 Linux;
+- every platform's library exports every function of fmi3FunctionTypes.h.
 
 Figures: .venv/bin/python -m pytest tests/test_fmi3.py -s
 """
@@ -23,6 +25,7 @@ from __future__ import annotations
 
 import ctypes
 import math
+import os
 import pathlib
 import re
 import subprocess
@@ -472,7 +475,7 @@ def _fly_c(master: list[str], folder: str, controller: str, units3, fmus, tmp: p
     libs = []
     for u in (PLANT, controller):
         with zipfile.ZipFile(fmi3_path(u)) as z:
-            libs.append(z.extract(f"binaries/{folder}/{u}.so", tmp / folder))
+            libs.append(z.extract(f"binaries/{folder}/{u}.{PLATFORMS[folder]}", tmp / folder))
     links = [wire(fmus[PLANT], fmus[controller]), commands_driven(fmus[PLANT], fmus[controller])]
     for names, src in zip(links, [plant, ctrl], strict=True):
         assert {src.variables[n].type for n in names} == {"Float64"}, "the C master links Float64 only"
@@ -509,3 +512,29 @@ def test_aarch64_fmi3_library_flies_under_qemu_as_x86_64(masters3, units3, fmus,
     assert max(np.ptp(x86[p]) for p in POSITIONS) > 50.0
     assert d_arm <= POSITION_TOL
     assert d_fmi2 <= POSITION_TOL
+
+
+def test_win64_fmi3_library_flies_under_wine_as_x86_64(units3, fmus, tmp_path):
+    """The x86_64-windows library, driven by the same C master built with MinGW, under Wine
+    (with test_win64's bcryptprimitives stand-in next to the master): the x86_64-linux
+    flight within test_win64's tolerance (only libm's last bits differ)."""
+    from test_win64 import MINGW_GCC, WIN64_TOL, _prng_shim, _wine64
+
+    wine = _wine64()
+    os.environ.setdefault("WINEDEBUG", "-all")
+    exe = tmp_path / "master_fmi3.exe"
+    flags = ["-std=c11", "-D_POSIX_C_SOURCE=200809L", "-O2", "-Wall", "-Wextra", "-Werror"]
+    source = ROOT / "tests" / "c-master" / "master_fmi3.c"
+    subprocess.run([MINGW_GCC, *flags, f"-I{_fmi3_headers()}", str(source), "-o", str(exe)], check=True)
+    _prng_shim(tmp_path)
+    controller = "tailsitter_lqr"
+    t_win, win = _fly_c([wine, str(exe)], "x86_64-windows", controller, units3, fmus, tmp_path)
+    from test_aarch64 import build_masters
+
+    host = build_masters(source, _fmi3_headers(), tmp_path)["x86_64"]
+    t_lin, lin = _fly_c(host, "x86_64-linux", controller, units3, fmus, tmp_path)
+    assert np.array_equal(t_win, t_lin)
+    assert max(np.ptp(win[p]) for p in POSITIONS) > 50.0
+    dpos = max(float(np.max(np.abs(win[p] - lin[p]))) for p in POSITIONS)
+    print(f"\n{controller}, C master on FMI 3.0: x86_64-windows (Wine) - x86_64-linux {dpos:.3g} m")
+    assert dpos <= WIN64_TOL

@@ -4,7 +4,6 @@
 #ifndef MASTER_COMMON_H
 #define MASTER_COMMON_H
 
-#include <dlfcn.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,6 +16,24 @@ typedef struct {
     unsigned int src[MAX_VARS], dst[MAX_VARS];
 } Links;
 
+#ifdef _WIN32
+/* win64 (MinGW), run under Wine by tests/test_fmi3.py. */
+#include <windows.h>
+
+static void *open_library(const char *path) {
+    HMODULE lib = LoadLibraryA(path);
+    if (!lib) {
+        fprintf(stderr, "LoadLibrary %s: error %lu\n", path, (unsigned long)GetLastError());
+        exit(1);
+    }
+    return (void *)lib;
+}
+
+static void *symbol(void *lib, const char *name) {
+    void *f = (void *)GetProcAddress((HMODULE)lib, name);
+#else
+#include <dlfcn.h>
+
 static void *open_library(const char *path) {
     void *lib = dlopen(path, RTLD_NOW | RTLD_LOCAL);
     if (!lib) {
@@ -28,6 +45,7 @@ static void *open_library(const char *path) {
 
 static void *symbol(void *lib, const char *name) {
     void *f = dlsym(lib, name);
+#endif
     if (!f) {
         fprintf(stderr, "missing symbol %s\n", name);
         exit(1);

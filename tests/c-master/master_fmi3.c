@@ -1,12 +1,12 @@
 /* The FMI 3.0 counterpart of master.c: plant + controller as FMI 3.0 Co-Simulation
  * instances, Gauss-Seidel with the timing of tailsim's ClosedLoop (see master.c). Built
- * for the host and for aarch64 by tests/test_fmi3.py, which flies the libraries of
- * dist/fmi3/<id>.fmu (binaries/x86_64-linux, binaries/aarch64-linux under qemu-user).
+ * for the host, for aarch64 and for win64 (MinGW) by tests/test_fmi3.py, which flies the
+ * libraries of dist/fmi3/<id>.fmu (binaries/x86_64-linux; binaries/aarch64-linux under
+ * qemu-user; binaries/x86_64-windows under Wine).
  *
  * usage: master_fmi3 PLANT.so PLANT_TOKEN CONTROLLER.so CONTROLLER_TOKEN H T_STOP
  *                    TO_CONTROLLER TO_PLANT RECORD
  * (arguments, output and exit status as master.c; the tokens are the instantiationTokens). */
-#include <dlfcn.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
