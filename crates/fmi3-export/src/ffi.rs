@@ -12,11 +12,11 @@
 #![allow(clippy::missing_safety_doc)]
 
 use crate::instance::{mask, Instance3, State3};
-use fmi2_export::ffi::panic_message;
+use fmi2_export::ffi::{c_str, guard, out_ptr, panic_message, slice, slice_mut};
 use fmi2_export::instance::{FmiState, StateMask};
 use fmi2_export::{Fmi2Error, FmuModel, Instance, Level, LogSink, ValueType, VariableStore};
 use fmi_sys::fmi3::*;
-use std::ffi::{c_char, CStr};
+use std::ffi::c_char;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 pub const OK: fmi3Status = fmi3Status_fmi3OK;
@@ -37,11 +37,6 @@ fn status_of(level: Level) -> fmi3Status {
         Level::Info | Level::Debug => OK,
         Level::Error => ERROR,
     }
-}
-
-/// Run `f`, turning any panic into `fallback`.
-fn guard<T>(fallback: T, f: impl FnOnce() -> T) -> T {
-    catch_unwind(AssertUnwindSafe(f)).unwrap_or(fallback)
 }
 
 /// The instance behind `c`, if `c` is a live FMI 3.0 instance of model `M`.
@@ -91,39 +86,6 @@ unsafe fn call<M: FmuModel>(
             }
         }
     })
-}
-
-unsafe fn slice<'a, T>(p: *const T, n: usize, what: &str) -> Result3<&'a [T]> {
-    if n == 0 {
-        return Ok(&[]);
-    }
-    if p.is_null() {
-        return err(format!("{what} is NULL (n = {n})"));
-    }
-    if n > isize::MAX as usize / std::mem::size_of::<T>().max(1) || !p.is_aligned() {
-        return err(format!("{what}: invalid array (n = {n})"));
-    }
-    // SAFETY: non-NULL, aligned, and valid for n elements per the C contract.
-    Ok(unsafe { std::slice::from_raw_parts(p, n) })
-}
-
-unsafe fn slice_mut<'a, T>(p: *mut T, n: usize, what: &str) -> Result3<&'a mut [T]> {
-    // SAFETY: as `slice`; the caller's output array is exclusively ours during the call.
-    let s = unsafe { slice(p.cast_const(), n, what)? };
-    Ok(unsafe { std::slice::from_raw_parts_mut(s.as_ptr().cast_mut(), s.len()) })
-}
-
-fn out_ptr<'a, T>(p: *mut T, what: &str) -> Result3<&'a mut T> {
-    if p.is_null() || !p.is_aligned() {
-        return err(format!("{what} is NULL"));
-    }
-    // SAFETY: non-NULL output argument per the C contract.
-    Ok(unsafe { &mut *p })
-}
-
-unsafe fn c_str<'a>(p: *const c_char) -> Option<&'a CStr> {
-    // SAFETY: non-NULL strings are NUL-terminated per the C contract.
-    (!p.is_null()).then(|| unsafe { CStr::from_ptr(p) })
 }
 
 /// The value-reference array of a get/set: every variable of this layer is a scalar,
