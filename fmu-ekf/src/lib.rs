@@ -136,3 +136,5 @@ impl Binding for EkfBinding {
 pub type EkfModel = controller_fmu::UnitFmu<EkfBinding>;
 
 fmi2_export::export_fmu!(EkfModel);
+// The same model as an FMI 3.0 FMU (fmi3* symbols; dist/fmi3/<id>.fmu).
+fmi3_export::export_fmu3!(EkfModel);
