@@ -212,9 +212,8 @@ impl LqrController {
     /// ([`Self::wind_in_air_data`]).
     fn hover_in_wind(&self, t: f64, m: &Measurement) -> bool {
         let vertical_1 = self.weathervane.params().enabled && self.mission.phase_at(t).0 == Phase::Vertical1;
-        let vane = &self.weathervane;
-        let steady = vertical_1 && vane.wind().xy().norm() >= vane.params().engage_speed;
-        (vertical_1 || vane.free(&self.mission, t)) && (vane.engaged() || steady || self.wind_in_air_data(m))
+        (vertical_1 || self.weathervane.free(&self.mission, t))
+            && (self.weathervane.engaged() || self.wind_in_air_data(m))
     }
 
     /// Integral action on the horizontal position in wind (README, "Hover in wind"): the
