@@ -181,7 +181,8 @@ impl TsdController {
         t: f64,
     ) -> Result<LoopDesign, ControlError> {
         let (fc_airspeed, fc_alpha) = if r.ground_phase() {
-            (air.axial_airspeed.max(0.0), 0.0)
+            let hover_wind_speed = meas.airspeed * HOVER_WIND_DESIGN_SPEED_FACTOR;
+            (lerp(air.axial_airspeed.max(0.0), hover_wind_speed, air.hover_wind), 0.0)
         } else {
             (
                 meas.airspeed * lerp(1.0, HOVER_WIND_DESIGN_SPEED_FACTOR, air.hover_wind),
@@ -195,7 +196,7 @@ impl TsdController {
             induced_velocity: meas.induced_velocity,
             axial_airspeed: air.axial_airspeed,
             reference_airspeed: r.reference.airspeed,
-            hover_wind: air.hover_wind_loops,
+            hover_wind: air.hover_wind,
             crossflow: air.crossflow,
         })
         .map_err(|what| Self::err(format!("{what} gains not computable at t = {t} s")))

@@ -110,13 +110,7 @@ impl WindMission {
                 self.load = [f.x, f.y];
             }
         }
-        let w = wv.wind();
-        let speed = w.x.hypot(w.y);
-        if speed >= p.engage_speed {
-            self.engaged = true;
-        } else if speed.is_nan() || speed < p.release_speed {
-            self.engaged = false;
-        }
+        self.engage(wv);
         if !(self.engaged && Self::in_window(wv, mission, t)) {
             return None;
         }
@@ -127,6 +121,35 @@ impl WindMission {
             return Some((heading, p.max_rate));
         }
         Some((nearer_face(heading, e.atan2(n)), p.max_rate))
+    }
+
+    /// The engagement's hysteresis on the weathervane's filtered air-data wind.
+    fn engage(&mut self, wv: &Weathervane) {
+        let p = wv.params();
+        let w = wv.wind();
+        let speed = w.x.hypot(w.y);
+        if speed >= p.engage_speed {
+            self.engaged = true;
+        } else if speed.is_nan() || speed < p.release_speed {
+            self.engaged = false;
+        }
+    }
+
+    /// The heading target of the take-off and landing phases (README, "Take-off and landing
+    /// in wind"), for [`Weathervane::update_towards`]: engaged, the belly or the back into the
+    /// wind (the weathervane's); released, the heading held. `None` with the weathervane off.
+    pub fn ground_target(&mut self, wv: &Weathervane) -> Option<(f64, f64)> {
+        let p = wv.params();
+        if !p.enabled {
+            return None;
+        }
+        self.engage(wv);
+        let heading = wv.heading();
+        let w = wv.wind();
+        if !(self.engaged && w.x.is_finite() && w.y.is_finite()) {
+            return Some((heading, p.max_rate));
+        }
+        Some((nearer_face(heading, (-w.y).atan2(-w.x)), p.max_rate))
     }
 
     /// Write the state ([`WIND_MISSION_STATE_LEN`] values).
