@@ -33,6 +33,14 @@ pub const LOAD_FILTER_TIME: f64 = 1.0;
 /// Horizontal specific force below which the heading is held (m/s²).
 pub const MIN_HORIZONTAL_FORCE: f64 = 0.5;
 
+/// Collective-flap trim per m/s of wind into the belly in the landing phases (rad s/m):
+/// the slope of the plant's still, upright hover trim (−5.2°, −9.8°, −13.8° of collective
+/// flaps at 1, 2, 3 m/s face-on, `cargo run --release -p analysis --example tsd_wind_bounds`).
+pub const LANDING_FLAP_TRIM_GAIN: f64 = 4.6 * core::f64::consts::PI / 180.0;
+/// Largest collective-flap trim in the landing phases (rad): the trim of the upright hover
+/// is −20° from 5 m/s; the rest of the ±25° is left to the normal loop.
+pub const LANDING_FLAP_TRIM_LIMIT: f64 = 17.0 * core::f64::consts::PI / 180.0;
+
 /// Number of f64 values [`WindMission::save`] writes.
 pub const WIND_MISSION_STATE_LEN: usize = 3;
 
@@ -60,6 +68,31 @@ fn specific_force_earth(m: &Measurement) -> Vector3<f64> {
     let q = &m.quat;
     let r = UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]));
     r * m.specific_force_body
+}
+
+/// Direct-force trim of the collective flaps in the landing phases (approach, descent,
+/// flare) (rad), from the filtered air-data wind `wind` (NED) and the measured attitude
+/// (README, "Take-off and landing in wind"). Nose up, the flaps sit in the propellers'
+/// slip-stream (≈ 23 m/s in hover): a wind into the belly turns the slip-stream's flow over
+/// the wing, whose normal force then needs 30° of tilt at 3 m/s and 41° at 5 m/s to be held
+/// (measured at touchdown), far outside an upright landing. The collective flaps deflected
+/// against the wind cancel that force with the nose vertical (the plant's trim: −13.8° at
+/// 3 m/s, −20° at 5–8 m/s; the elevator trims the moment). The trim is
+/// −[`LANDING_FLAP_TRIM_GAIN`] × (wind into the belly), within ±[`LANDING_FLAP_TRIM_LIMIT`];
+/// 0 in other phases and without a wind estimate.
+pub fn landing_flap_trim(m: &Measurement, phase: Phase, wind: &Vector3<f64>) -> f64 {
+    if !matches!(phase, Phase::Approach | Phase::Descent | Phase::Flare) || !(wind.x.is_finite() && wind.y.is_finite())
+    {
+        return 0.0;
+    }
+    let q = &m.quat;
+    let belly = UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2])) * Vector3::z();
+    let size = belly.xy().norm();
+    if size < 0.5 {
+        return 0.0;
+    }
+    let into_belly = -wind.xy().dot(&belly.xy()) / size;
+    -(LANDING_FLAP_TRIM_GAIN * into_belly).clamp(-LANDING_FLAP_TRIM_LIMIT, LANDING_FLAP_TRIM_LIMIT)
 }
 
 impl WindMission {
