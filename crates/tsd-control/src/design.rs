@@ -167,7 +167,9 @@ impl TsdController {
     ///
     /// In the take-off and landing phases (vertical, slow, the air possibly from behind in
     /// the descent, α → π) the loops are designed for hover at the axial airspeed: the
-    /// attached-flow models of (4.2.x) at α ≈ π would reverse the surfaces' sign. Tuned
+    /// attached-flow models of (4.2.x) at α ≈ π would reverse the surfaces' sign; in wind
+    /// (tuned configuration) blended towards the hover-in-wind condition with the measured
+    /// wind's weight (README, "Take-off and landing in wind"). Tuned
     /// configuration, hover (the reference at the vertical speed) in wind: at α = 0 and
     /// HOVER_WIND_DESIGN_SPEED_FACTOR × V̄, blended in with the crossflow (README, "Hover in a
     /// wind step"). At the measured condition (a wind step puts α at ±60° or β at ±65°, V̄ at

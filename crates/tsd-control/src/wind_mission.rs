@@ -81,8 +81,8 @@ fn specific_force_earth(m: &Measurement) -> Vector3<f64> {
 /// −[`LANDING_FLAP_TRIM_GAIN`] × (wind into the belly), within ±[`LANDING_FLAP_TRIM_LIMIT`];
 /// 0 in other phases and without a wind estimate.
 pub fn landing_flap_trim(m: &Measurement, phase: Phase, wind: &Vector3<f64>) -> f64 {
-    if !matches!(phase, Phase::Approach | Phase::Descent | Phase::Flare) || !(wind.x.is_finite() && wind.y.is_finite())
-    {
+    let landing = matches!(phase, Phase::Approach | Phase::Descent | Phase::Flare);
+    if !(landing && wind.x.is_finite() && wind.y.is_finite()) {
         return 0.0;
     }
     let q = &m.quat;
