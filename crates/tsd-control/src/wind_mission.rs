@@ -257,4 +257,53 @@ mod tests {
             target.to_degrees()
         );
     }
+
+    /// The take-off and landing phases: still air holds the heading exactly (the calm
+    /// flights unchanged); a steady 8 m/s wind from the east turns the belly or the back
+    /// into it (±90°) once the filtered estimate has engaged.
+    #[test]
+    fn ground_heading_holds_in_still_air_and_faces_the_wind() {
+        let mission = MissionParams::default();
+        let mut wv = Weathervane::new(WeathervaneParams::tuned()).unwrap();
+        let mut wm = WindMission::default();
+        let calm = hovering(Vector3::zeros(), Vector3::zeros());
+        for k in 0..100 {
+            let target = wm.ground_target(&wv);
+            assert_eq!(target, Some((0.0, wv.params().max_rate)));
+            wv.update_towards(&mission, k as f64 * mission.sample_time, &calm, target);
+            assert_eq!(wv.heading(), 0.0);
+        }
+        let m = hovering(Vector3::new(0.0, -8.0, 0.0), Vector3::zeros());
+        for k in 0..1500 {
+            let target = wm.ground_target(&wv);
+            wv.update_towards(&mission, k as f64 * mission.sample_time, &m, target);
+        }
+        assert!(wm.engaged());
+        let (target, _) = wm.ground_target(&wv).unwrap();
+        assert!(
+            (target.abs() - core::f64::consts::FRAC_PI_2).abs() < 0.02,
+            "{}",
+            target.to_degrees()
+        );
+        assert!((wv.heading() - target).abs() < 0.02, "{}", wv.heading().to_degrees());
+    }
+
+    /// The collective-flap trim: −4.6° per m/s of wind into the belly, ±17° at most, the
+    /// sign following the face, only in the landing phases.
+    #[test]
+    fn landing_flap_trim_opposes_the_wind_into_the_belly() {
+        let m = hovering(Vector3::zeros(), Vector3::zeros());
+        let from_north = |v: f64| Vector3::new(-v, 0.0, 0.0);
+        let deg = |x: f64| x.to_degrees();
+        let t = landing_flap_trim(&m, Phase::Descent, &from_north(3.0));
+        assert!((deg(t) + 13.8).abs() < 1e-9, "{}", deg(t));
+        let t = landing_flap_trim(&m, Phase::Flare, &from_north(-3.0));
+        assert!((deg(t) - 13.8).abs() < 1e-9, "{}", deg(t));
+        let t = landing_flap_trim(&m, Phase::Approach, &from_north(10.0));
+        assert!((deg(t) + 17.0).abs() < 1e-9, "{}", deg(t));
+        // Along the span: no trim; outside the landing phases or without an estimate: none.
+        assert!(landing_flap_trim(&m, Phase::Descent, &Vector3::new(0.0, 8.0, 0.0)).abs() < 1e-12);
+        assert_eq!(landing_flap_trim(&m, Phase::Vertical2, &from_north(5.0)), 0.0);
+        assert_eq!(landing_flap_trim(&m, Phase::Descent, &Vector3::repeat(f64::NAN)), 0.0);
+    }
 }
