@@ -125,10 +125,10 @@ pub struct AvionicsSource {
 }
 
 impl AvionicsSource {
-    /// Start the chain at t = 0 on the plant in `x0` with the commands `u0` held (the
-    /// estimator's motor and servo models start at their steady state) and no wind at the
-    /// plant's inputs: the sensors take their first samples, the estimator initialises from
-    /// them (attitude by levelling and magnetometer, position and velocity from the fix).
+    /// Start the chain at t = 0 on the plant in `x0` with the commands `u0` held and no wind
+    /// at the plant's inputs: the sensors take their first samples, the estimator initialises
+    /// from them (attitude by levelling and magnetometer, position and velocity from the fix;
+    /// its motor and servo models at its `init_thrust` / `init_elevator`, as the estimator FMU).
     pub fn start(avionics: &Avionics, plant: &Plant, x0: &StateVector, u0: &InputVector) -> Result<Self, String> {
         let mut sensors = SensorModel::new(avionics.sensors).map_err(|e| format!("sensors: {e}"))?;
         let mut ekf = Ekf::new(avionics.estimator.clone()).map_err(|e| format!("estimator: {e}"))?;
@@ -136,7 +136,7 @@ impl AvionicsSource {
             .start(&truth(plant, x0, u0, &Vector3::zeros()), 0.0)
             .map_err(|e| format!("sensors at t = 0: {e}"))?;
         let m0 = to_estimator(&m0);
-        ekf.initialize(&m0, u0);
+        ekf.initialize(&m0);
         Ok(Self {
             sensors,
             ekf,
