@@ -66,8 +66,8 @@ enum Cmd {
     /// The Monte-Carlo campaign's jobs flown natively (`python -m tailsim.campaign_native`
     /// writes them): one JSON job per line in, one JSON row per line out, in job order.
     CampaignJobs(CampaignJobs),
-    /// Wind envelope over whole missions (wind_envelope.json, wind_envelope.csv): both
-    /// tuned controllers, steady wind stepping in and turbulent from the start, every
+    /// Wind envelope over whole missions (wind_envelope.json, wind_envelope.csv): every
+    /// controller (LQR and TSD tuned, PX4), steady wind stepping in and turbulent from the start, every
     /// speed and bearing (`analysis::wind_envelope`).
     WindEnvelope(WindEnvelopeArgs),
     /// One native flight of the default mission through the atmosphere, as CSV (for the
@@ -79,7 +79,7 @@ enum Cmd {
 
 #[derive(clap::Args, Clone)]
 struct WindTraceArgs {
-    /// "lqr" or "tsd".
+    /// "lqr", "tsd" or "px4".
     #[arg(long, default_value = "tsd")]
     controller: String,
     /// "gauss-seidel" or "jacobi".
@@ -109,11 +109,10 @@ struct WindTraceArgs {
 
 fn wind_trace(a: &WindTraceArgs) -> Result<(), String> {
     use closed_loop::Ordering;
-    let kind = match a.controller.as_str() {
-        "lqr" => Kind::Lqr,
-        "tsd" => Kind::Tsd,
-        other => return Err(format!("controller '{other}': lqr or tsd")),
-    };
+    let kind = Kind::ALL
+        .into_iter()
+        .find(|k| k.name().eq_ignore_ascii_case(&a.controller))
+        .ok_or_else(|| format!("controller '{}': lqr, tsd or px4", a.controller))?;
     let ordering = match a.ordering.as_str() {
         "gauss-seidel" => Ordering::GaussSeidel,
         "jacobi" => Ordering::Jacobi,

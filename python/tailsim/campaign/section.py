@@ -3,9 +3,10 @@
 The controllers are compared on the same random plants, winds and gusts (paired
 samples, `tailsim.campaign`), not on one nominal mission: completion probability of
 each arm (controller × configuration × state source) with its 95 % Wilson interval,
-and the paired differences TSD − LQR on the same samples with 95 % percentile-bootstrap
-intervals — completion (all samples), RMS and max position error (samples both
-completed).
+and the paired differences of every two controllers of one configuration and state source
+(TSD − LQR, PX4 − LQR, PX4 − TSD: the later-declared minus the earlier) on the same samples
+with 95 % percentile-bootstrap intervals — completion (all samples), RMS and max position
+error (samples both completed).
 
 Two sources, both shown when present:
 
@@ -32,7 +33,7 @@ from typing import Any
 import numpy as np
 
 from .. import cli
-from .report import _arm_mask, arms, bootstrap_mean_ci, paired, wilson_interval
+from .report import _arm_mask, arms, bootstrap_mean_ci, controller_pairs, paired, wilson_interval
 from .sampling import CampaignSpec
 
 ROOT = pathlib.Path(__file__).resolve().parents[3]
@@ -106,20 +107,24 @@ def summarize(folders: Iterable[str | pathlib.Path]) -> dict[str, Any]:
             "failures": reasons,
             "median_completed": med,
         }
-    for a in A:
-        if a[0] != "tsd" or ("lqr", a[1], a[2]) not in A:
-            continue
-        b = ("lqr", a[1], a[2])
+    for b, a in controller_pairs(A):
         _, cb, ca = paired(cols, b, a, "completed")
         d = ca.astype(float) - cb.astype(float)
-        res = {"completion": _ci(d)}
+        res = {"pair": [a[0], b[0]], "completion": _ci(d)}
         both = (cb > 0) & (ca > 0)
         for q in ("rms_err", "max_err"):
             _, vb, va = paired(cols, b, a, q)
             dd = (va - vb)[both]
             res[q] = _ci(dd[np.isfinite(dd)])
-        out["paired"][f"{a[1]}/{a[2]}"] = res
+        out["paired"][pair_key(b, a)] = res
     return out
+
+
+def pair_key(b, a) -> str:
+    """The summary's key of the paired difference a − b: `configuration/state source` for
+    TSD − LQR (as every summary before the third controller wrote it), else with the pair."""
+    group = f"{a[1]}/{a[2]}"
+    return group if (b[0], a[0]) == ("lqr", "tsd") else f"{group}: {a[0].upper()} − {b[0].upper()}"
 
 
 def _ci(d: np.ndarray) -> dict[str, float]:
@@ -137,7 +142,7 @@ def _f(x: float, nd: int = 3) -> str:
 
 
 def markdown(summary: Mapping[str, Any], title: str) -> list[str]:
-    """Markdown of a summary: completion per arm, paired TSD − LQR, runtime."""
+    """Markdown of a summary: completion per arm, the paired differences, runtime."""
     s = summary["spec"]
     n_samples = max(summary["samples"].values()) if summary["samples"] else 0
     md = [
@@ -165,13 +170,15 @@ def markdown(summary: Mapping[str, Any], title: str) -> list[str]:
     if summary["paired"]:
         md += [
             "",
-            "Paired difference TSD − LQR on the same samples (completion: all paired samples, +1 = only the TSD "
+            "Paired differences A − B on the same samples (completion: all paired samples, +1 = only A "
             "completed; errors: samples both completed), mean with a 95 % percentile-bootstrap interval, median:",
             "",
-            "| configuration/state source | quantity | samples | mean TSD − LQR | 95 % interval | median |",
-            "|---|---|---|---|---|---|",
+            "| configuration/state source | A − B | quantity | samples | mean A − B | 95 % interval | median |",
+            "|---|---|---|---|---|---|---|",
         ]
-        for pair, res in summary["paired"].items():
+        for key, res in summary["paired"].items():
+            a, b = res.get("pair", ["tsd", "lqr"])
+            group, name = key.split(":")[0], f"{a.upper()} − {b.upper()}"
             for q, label in (
                 ("completion", "completion"),
                 ("rms_err", "RMS position error (m)"),
@@ -179,7 +186,7 @@ def markdown(summary: Mapping[str, Any], title: str) -> list[str]:
             ):
                 r = res[q]
                 md.append(
-                    f"| {pair} | {label} | {r['n']} | {_f(r['mean'])} | [{_f(r['ci95'][0])}, {_f(r['ci95'][1])}] | "
+                    f"| {group} | {name} | {label} | {r['n']} | {_f(r['mean'])} | [{_f(r['ci95'][0])}, {_f(r['ci95'][1])}] | "
                     f"{_f(r['median'])} |"
                 )
     rt = [r for r in summary["runtime"] if r.get("runs_done_now")]

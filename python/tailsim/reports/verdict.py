@@ -54,6 +54,8 @@ class Finding:
     short: str = ""
     """The condition in a few words, for the one-sentence summary."""
     detail: list[str] = field(default_factory=list)
+    cells: dict[str, str] = field(default_factory=dict)
+    """Each controller's figure under the condition (its key → Markdown), for the side-by-side table."""
 
 
 def label(key: str) -> str:
@@ -163,6 +165,10 @@ def campaign_findings(folder: str | pathlib.Path) -> list[Finding]:
                 by=f"completed: {per}; paired: " + "; ".join(diffs),
                 source=source,
                 short=f"{config} configuration, uncertain plants, {state} state",
+                cells={
+                    a[0]: f"P(complete) {_f(stats[a][1] / max(stats[a][0], 1), 3)} {_interval(stats[a][2], 3)}"
+                    for a in members
+                },
             )
         )
     if found:
@@ -218,6 +224,10 @@ def nominal_findings(path: str | pathlib.Path) -> list[Finding]:
                 by="; ".join(cells) + " (one run each, no interval)",
                 source=str(path),
                 short=f"nominal {mission} mission",
+                cells={
+                    k: (f"completed, largest error {_f(worst(runs[k]))} m" if runs[k]["completed"] else "not completed")
+                    for k in ranked
+                },
             )
         )
     return found
@@ -252,6 +262,7 @@ def wind_findings(path: str | pathlib.Path) -> list[Finding]:
                 + " (a grid, no interval)",
                 source=str(path),
                 short=f"wind envelope, {mission} mission, {wind} wind",
+                cells={k: f"{count[k]}/{len(held[k])} cells held, {_reach(held[k])}" for k in ranked},
             )
         )
     return found
@@ -309,11 +320,32 @@ def markdown(findings: list[Finding], heading: str = "## Verdict") -> list[str]:
     ]
     for f in findings:
         md.append(f"| {f.condition} | {label(f.better) if f.better else 'not separated'} | {f.by} |")
+    md += side_by_side(findings)
     for f in findings:
         for d in f.detail:
             md += ["", d]
     sources = sorted({f.source for f in findings})
     md += ["", "Read from this run's " + ", ".join(f"`{s}`" for s in sources) + "."]
+    return md
+
+
+def side_by_side(findings: list[Finding]) -> list[str]:
+    """The controllers side by side: one column per controller, one row per condition (the
+    campaign's completion with its 95 % Wilson interval, the wind envelope's cells held, the
+    nominal missions' largest error); – where a controller was not flown under it."""
+    ctrls = list(dict.fromkeys(k for f in findings for k in f.cells))
+    if len(ctrls) < 2:
+        return []
+    md = [
+        "",
+        "Side by side:",
+        "",
+        "| condition | " + " | ".join(label(k) for k in ctrls) + " | better |",
+        "|---|" + "---|" * (len(ctrls) + 1),
+    ]
+    for f in findings:
+        cells = " | ".join(f.cells.get(k, "–") for k in ctrls)
+        md.append(f"| {f.short or f.condition} | {cells} | {label(f.better) if f.better else 'not separated'} |")
     return md
 
 
