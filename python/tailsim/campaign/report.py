@@ -14,7 +14,7 @@ import numpy as np
 
 from .. import controllers
 from ..metrics import PHASES
-from .sampling import TABLE_5_1, CampaignSpec
+from .sampling import ORDER, TABLE_5_1, CampaignSpec
 
 Z95 = 1.959963984540054  # standard normal 97.5 % quantile
 COLORS = controllers.COLORS
@@ -85,8 +85,8 @@ def arms(cols: Mapping[str, np.ndarray]) -> list[tuple[str, str, str]]:
 
 def controller_pairs(A) -> list[tuple[tuple[str, str, str], tuple[str, str, str]]]:
     """(earlier, later) arms of every two controllers of one configuration and state source,
-    in declaration order (`tailsim.controllers.KEYS`): (LQR, TSD), (LQR, PX4), (TSD, PX4)."""
-    order = {k: i for i, k in enumerate(controllers.KEYS)}
+    in the reports' order (`sampling.ORDER`): (LQR, TSD), (LQR, PX4), (TSD, PX4)."""
+    order = {k: i for i, k in enumerate(ORDER)}
 
     def rank(a) -> int:
         return order.get(a[0], len(order))

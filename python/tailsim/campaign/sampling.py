@@ -92,6 +92,9 @@ CONFIGURATIONS: dict[str, dict[str, dict[str, int]]] = {
         k: {"configuration": 1} for k in CONTROLLERS if "configuration" in declarations.VARIABLES[controllers.NAMES[k]]
     },
 }
+#: The order the reports list controllers in: the thesis's (those with its `configuration`)
+#: first, each group in declaration order (LQR, TSD, then PX4).
+ORDER = tuple(sorted(CONTROLLERS, key=lambda k: k not in CONFIGURATIONS["thesis"]))
 #: The controller FMUs' `configuration` value of each configuration (the native campaign's input).
 CONFIGURATION_INDEX = {"tuned": 0, "thesis": 1}
 STATE_SOURCES = ("perfect", "avionics", "avionics_app_d")

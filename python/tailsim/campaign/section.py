@@ -4,7 +4,7 @@ The controllers are compared on the same random plants, winds and gusts (paired
 samples, `tailsim.campaign`), not on one nominal mission: completion probability of
 each arm (controller × configuration × state source) with its 95 % Wilson interval,
 and the paired differences of every two controllers of one configuration and state source
-(TSD − LQR, PX4 − LQR, PX4 − TSD: the later-declared minus the earlier) on the same samples
+(TSD − LQR, PX4 − LQR, PX4 − TSD: the later minus the earlier in `sampling.ORDER`) on the same samples
 with 95 % percentile-bootstrap intervals — completion (all samples), RMS and max position
 error (samples both completed).
 
@@ -186,8 +186,8 @@ def markdown(summary: Mapping[str, Any], title: str) -> list[str]:
             ):
                 r = res[q]
                 md.append(
-                    f"| {group} | {name} | {label} | {r['n']} | {_f(r['mean'])} | [{_f(r['ci95'][0])}, {_f(r['ci95'][1])}] | "
-                    f"{_f(r['median'])} |"
+                    f"| {group} | {name} | {label} | {r['n']} | {_f(r['mean'])} | "
+                    f"[{_f(r['ci95'][0])}, {_f(r['ci95'][1])}] | {_f(r['median'])} |"
                 )
     rt = [r for r in summary["runtime"] if r.get("runs_done_now")]
     if rt:

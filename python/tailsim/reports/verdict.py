@@ -333,7 +333,11 @@ def side_by_side(findings: list[Finding]) -> list[str]:
     """The controllers side by side: one column per controller, one row per condition (the
     campaign's completion with its 95 % Wilson interval, the wind envelope's cells held, the
     nominal missions' largest error); – where a controller was not flown under it."""
-    ctrls = list(dict.fromkeys(k for f in findings for k in f.cells))
+    from ..campaign.sampling import ORDER
+
+    order = {k: i for i, k in enumerate(ORDER)}
+    seen = list(dict.fromkeys(k for f in findings for k in f.cells))
+    ctrls = sorted(seen, key=lambda k: (order.get(k, len(order)), seen.index(k)))  # declaration order
     if len(ctrls) < 2:
         return []
     md = [
