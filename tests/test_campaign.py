@@ -701,6 +701,20 @@ def test_comparison_section_pairs_every_two_controllers(tmp_path):
     md = "\n".join(S.markdown(s, "three"))
     assert "| tuned/perfect | PX4 − LQR | completion | 8 | -0.500 |" in md
     assert "| tuned/perfect | TSD − LQR | RMS position error (m) | 8 | -0.500 |" in md
+    # Merged into a documented run (`--base`): each arm from the summary with more runs.
+    base = {
+        "spec": s["spec"],
+        "samples": {"lqr/tuned/perfect": 100},
+        "arms": {"lqr/tuned/perfect": {**s["arms"]["lqr/tuned/perfect"], "runs": 100}},
+        "paired": {},
+        "runtime": [{"folder": "old"}],
+    }
+    m = S.merge(base, s)
+    assert m["arms"]["lqr/tuned/perfect"]["runs"] == 100 and m["samples"]["lqr/tuned/perfect"] == 100
+    assert m["arms"]["px4/tuned/perfect"] == s["arms"]["px4/tuned/perfect"]
+    assert m["paired"] == s["paired"] and m["runtime"][0] == {"folder": "old"}
+    with pytest.raises(SystemExit, match="seed"):
+        S.merge({**base, "spec": {**s["spec"], "seed": 99}}, s)
 
 
 def test_report(serial, tmp_path):

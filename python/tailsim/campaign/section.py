@@ -127,6 +127,27 @@ def pair_key(b, a) -> str:
     return group if (b[0], a[0]) == ("lqr", "tsd") else f"{group}: {a[0].upper()} − {b[0].upper()}"
 
 
+def merge(base: Mapping[str, Any], new: Mapping[str, Any]) -> dict[str, Any]:
+    """Two summaries of one sample space as one: each arm and each paired difference from the
+    summary that measured it on more samples (the base on a tie), the runtimes of both. For
+    adding arms to a documented run without its folders (`--base`)."""
+    bad = [k for k in SAMPLE_SPACE if base["spec"].get(k) != new["spec"].get(k)]
+    if bad:
+        raise SystemExit(f"summaries of different sample spaces cannot be merged ({', '.join(bad)} differ)")
+    out = {"spec": dict(base["spec"]), "samples": {}, "arms": {}, "paired": {}, "runtime": []}
+    for k in dict.fromkeys([*base["arms"], *new["arms"]]):
+        b, n = base["arms"].get(k), new["arms"].get(k)
+        src = base if n is None or (b is not None and b["runs"] >= n["runs"]) else new
+        out["arms"][k] = src["arms"][k]
+        out["samples"][k] = src["samples"][k]
+    for k in dict.fromkeys([*base["paired"], *new["paired"]]):
+        b, n = base["paired"].get(k), new["paired"].get(k)
+        better_b = n is None or (b is not None and b["completion"]["n"] >= n["completion"]["n"])
+        out["paired"][k] = b if better_b else n
+    out["runtime"] = [*base["runtime"], *new["runtime"]]
+    return out
+
+
 def _ci(d: np.ndarray) -> dict[str, float]:
     lo, hi = bootstrap_mean_ci(d)
     return {
@@ -240,7 +261,14 @@ def main(argv: list[str] | None = None) -> int:
     ap = cli.Parser(prog="python -m tailsim.campaign.section", description=__doc__.split("\n\n")[0])
     ap.add_argument("folders", nargs="+", help="campaign folders of one sample space (rows merged, paired by sample)")
     ap.add_argument("--write", help="write the summary JSON here (e.g. docs/campaign_full_run.json)")
+    ap.add_argument(
+        "--base",
+        help="a summary JSON of the same sample space to merge with (each arm and paired difference from the "
+        "summary with more samples), e.g. docs/campaign_full_run.json when adding a controller",
+    )
     a = ap.parse_args(argv)
+    if a.base and not pathlib.Path(a.base).is_file():
+        ap.error(f"argument --base: {a.base!r} is not a file")
     for f in a.folders:
         for name in ("campaign.json", "results.parquet"):
             if not (pathlib.Path(f) / name).is_file():
@@ -250,6 +278,8 @@ def main(argv: list[str] | None = None) -> int:
 
     def run() -> int:
         s = summarize(a.folders)
+        if a.base:
+            s = merge(json.loads(pathlib.Path(a.base).read_text()), s)
         if a.write:
             pathlib.Path(a.write).write_text(json.dumps(s, indent=1) + "\n")
         print("\n".join(markdown(s, "Paired Monte-Carlo")))
