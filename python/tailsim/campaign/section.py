@@ -131,7 +131,9 @@ def merge(base: Mapping[str, Any], new: Mapping[str, Any]) -> dict[str, Any]:
     """Two summaries of one sample space as one: each arm and each paired difference from the
     summary that measured it on more samples (the base on a tie), the runtimes of both. For
     adding arms to a documented run without its folders (`--base`)."""
-    bad = [k for k in SAMPLE_SPACE if base["spec"].get(k) != new["spec"].get(k)]
+    # As JSON (a summary read from a file has lists where a fresh one has tuples).
+    norm = json.loads(json.dumps([base["spec"], new["spec"]]))
+    bad = [k for k in SAMPLE_SPACE if norm[0].get(k) != norm[1].get(k)]
     if bad:
         raise SystemExit(f"summaries of different sample spaces cannot be merged ({', '.join(bad)} differ)")
     out = {"spec": dict(base["spec"]), "samples": {}, "arms": {}, "paired": {}, "runtime": []}

@@ -329,15 +329,21 @@ def markdown(findings: list[Finding], heading: str = "## Verdict") -> list[str]:
     return md
 
 
+def _ordered(keys) -> list[str]:
+    """Distinct controller keys in the reports' order (`tailsim.campaign.sampling.ORDER`: the
+    thesis's controllers first), unknown keys after them as they come."""
+    from ..campaign.sampling import ORDER
+
+    order = {k: i for i, k in enumerate(ORDER)}
+    seen = list(dict.fromkeys(keys))
+    return sorted(seen, key=lambda k: (order.get(k, len(order)), seen.index(k)))
+
+
 def side_by_side(findings: list[Finding]) -> list[str]:
     """The controllers side by side: one column per controller, one row per condition (the
     campaign's completion with its 95 % Wilson interval, the wind envelope's cells held, the
     nominal missions' largest error); – where a controller was not flown under it."""
-    from ..campaign.sampling import ORDER
-
-    order = {k: i for i, k in enumerate(ORDER)}
-    seen = list(dict.fromkeys(k for f in findings for k in f.cells))
-    ctrls = sorted(seen, key=lambda k: (order.get(k, len(order)), seen.index(k)))  # declaration order
+    ctrls = _ordered(k for f in findings for k in f.cells)
     if len(ctrls) < 2:
         return []
     md = [
@@ -375,21 +381,28 @@ def headline_table(summary: Mapping[str, Any]) -> list[str]:
     summary (`tailsim.campaign.section.summarize`, e.g. `docs/campaign_full_run.json`).
     Better: the controller whose completion interval lies above every other's."""
     arms_ = {tuple(k.split("/")): v for k, v in summary["arms"].items()}
-    ctrls = list(dict.fromkeys(a[0] for a in arms_))
+    ctrls = _ordered(a[0] for a in arms_)
     groups = sorted({a[1:] for a in arms_}, key=lambda g: (g[1] != "perfect", g[0] != "tuned", g))
-    header = ["configuration, state", "samples", *(f"{label(k)}: P(complete) [95 %], median RMS error" for k in ctrls)]
+    header = [
+        "configuration, state",
+        "samples",
+        *(f"{label(k)}: P(complete) [95 %], median RMS error" for k in ctrls),
+    ]
     header.append("better")
     md = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     for g in groups:
         cells, present = [], [k for k in ctrls if (k, *g) in arms_]
+        n = max(arms_[(k, *g)]["runs"] for k in present)
         for k in ctrls:
             r = arms_.get((k, *g))
-            cells.append(
-                f"{_f(r['p'], 3)} {_interval(r['wilson95'], 3)}, {_f(r['median_completed']['rms_err'])} m" if r else "–"
-            )
+            if r is None:
+                cells.append("–")
+                continue
+            err = f"{_f(r['median_completed']['rms_err'])} m" if r["completed"] else "no run completed"
+            fewer = f" ({r['runs']} samples)" if r["runs"] != n else ""
+            cells.append(f"{_f(r['p'], 3)} {_interval(r['wilson95'], 3)}, {err}{fewer}")
         top = max(present, key=lambda k: arms_[(k, *g)]["p"])
         sep = all(arms_[(top, *g)]["wilson95"][0] > arms_[(k, *g)]["wilson95"][1] for k in present if k != top)
-        n = max(arms_[(k, *g)]["runs"] for k in present)
         md.append(f"| {g[0]}, {g[1]} | {n} | " + " | ".join(cells) + f" | {label(top) if sep else 'not separated'} |")
     s = summary["spec"]
     md += [
