@@ -90,7 +90,7 @@ def test_samples_are_reproducible_subsets_and_log_uniform():
     a, b = CampaignSpec(seed=11, n_samples=5), CampaignSpec(seed=11, n_samples=500)
     assert draw_sample(a, 3) == draw_sample(b, 3)  # sample i depends on (seed, i) only
     assert draw_sample(a, 3) != draw_sample(CampaignSpec(seed=12), 3)
-    assert [j["sample_id"] for j in jobs(a)] == [0, 0, 1, 1, 2, 2, 3, 3, 4, 4]  # paired: both controllers
+    assert [j["sample_id"] for j in jobs(a)] == [i for i in range(5) for _ in CONTROLLERS]  # paired: every controller
     n = 4000
     samples = [draw_sample(b, i) for i in range(n)]
     for p in (TABLE_5_1[0], TABLE_5_1[-1]):
