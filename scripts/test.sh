@@ -13,8 +13,8 @@ echo "== build and package the FMUs (dist/)"
 cargo xtask dist
 echo "== Rust tests"
 cargo test --workspace --locked
-echo "== the export layer's tests on aarch64 (qemu-user)"
-cargo test -p fmi2-export --locked --target aarch64-unknown-linux-gnu
+echo "== the export layers' tests on aarch64 (qemu-user)"
+cargo test -p fmi2-export -p fmi3-export --locked --target aarch64-unknown-linux-gnu
 echo "== ruff check / ruff format --check (python/, tests/, scripts/)"
 .venv/bin/ruff check python tests scripts
 .venv/bin/ruff format --check python tests scripts

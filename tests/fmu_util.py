@@ -144,9 +144,12 @@ class CosimRun:
     series: object
 
 
-def libcosim_fly_ssp(path: pathlib.Path, n_slaves: int, stop_ns: int = 35 * 10**9) -> CosimRun:
+def libcosim_fly_ssp(
+    path: pathlib.Path, n_slaves: int, stop_ns: int = 35 * 10**9, observe: tuple[str, ...] = ("airspeed",)
+) -> CosimRun:
     """Load `path` with libcosim's `from_ssp_file` (step size from its annotation), check it
-    holds `n_slaves` components and run it to `stop_ns`, observing the plant's airspeed."""
+    holds `n_slaves` components and run it to `stop_ns`, observing the series of the plant's
+    Real outputs `observe`."""
     from libcosimpy.CosimEnums import CosimVariableType
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
@@ -163,7 +166,8 @@ def libcosim_fly_ssp(path: pathlib.Path, n_slaves: int, stop_ns: int = 35 * 10**
     last = CosimObserver.create_last_value()
     series = CosimObserver.create_time_series()
     assert execution.add_observer(last) and execution.add_observer(series)
-    assert series.start_time_series(plant, pv["airspeed"], CosimVariableType.REAL)
+    for name in observe:
+        assert series.start_time_series(plant, pv[name], CosimVariableType.REAL)
     assert execution.simulate_until(stop_ns)
     assert execution.status().current_time == stop_ns
     return CosimRun(execution, plant, ctrl, pv, cv, last, series)

@@ -69,18 +69,21 @@ def tool(name: str) -> str:
     return path
 
 
-@pytest.fixture(scope="module")
-def masters(tmp_path_factory) -> dict[str, list[str]]:
-    """The C master built for the host and for aarch64: the command prefix of each."""
-    tmp = tmp_path_factory.mktemp("c-master")
-    headers = fmi2_headers()
+def build_masters(source: pathlib.Path, headers: pathlib.Path, tmp: pathlib.Path) -> dict[str, list[str]]:
+    """A C master built for the host and for aarch64: the command prefix of each."""
     out = {}
     for arch, cc in [("x86_64", shutil.which("cc") or "gcc"), ("aarch64", tool("aarch64-linux-gnu-gcc"))]:
-        exe = tmp / f"master-{arch}"
+        exe = tmp / f"{source.stem}-{arch}"
         flags = ["-std=c11", "-D_POSIX_C_SOURCE=200809L", "-O2", "-Wall", "-Wextra", "-Werror"]
-        subprocess.run([cc, *flags, f"-I{headers}", str(MASTER), "-o", str(exe), "-ldl"], check=True)
+        subprocess.run([cc, *flags, f"-I{headers}", str(source), "-o", str(exe), "-ldl"], check=True)
         out[arch] = [*(([tool(QEMU[0]), *QEMU[1:]]) if arch == "aarch64" else []), str(exe)]
     return out
+
+
+@pytest.fixture(scope="module")
+def masters(tmp_path_factory) -> dict[str, list[str]]:
+    """tests/c-master/master.c built for the host and for aarch64."""
+    return build_masters(MASTER, fmi2_headers(), tmp_path_factory.mktemp("c-master"))
 
 
 def library(folder: pathlib.Path, model: str, tmp: pathlib.Path) -> pathlib.Path:

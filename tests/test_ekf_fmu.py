@@ -1,7 +1,8 @@
 """The estimator FMU (tailsitter_ekf) under fmpy: ports named like the plant outputs,
 tracking a straight climb from noise-free sensors, a GPS spike rejected, counted and
 logged, a NaN input refused with an error, FMU state serialize/restore continuing
-bit-identically."""
+bit-identically; the initial estimate independent of the command inputs (no initialisation
+loop through the controller), as the ModelStructure declares."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ import pytest
 from fmpy.fmi2 import FMU2Slave
 
 from fmu_util import ROOT, LogRecorder, Unpacked
+from tailsim.declarations import COMMANDS
 
 H = 0.02
 CLIMB = 3.0  # m/s, the plant's default trimmed climb
@@ -116,3 +118,49 @@ def test_tracks_a_climb_rejects_a_spike_and_restores_state(ekf):
         assert ekf.get(s, *names) == expected
     s.terminate()
     s.freeInstance()
+
+
+def test_initial_outputs_do_not_depend_on_the_commands(ekf):
+    """A master that initialises every connection at once (OMSimulator) sets the controller's
+    commands on the estimator in Initialization Mode and reads its outputs back, iterating
+    until they agree. The outputs read in Initialization Mode and after it are the same, bit
+    for bit, whatever the commands: there is no loop. The motor and servos start at
+    `init_thrust`, `init_elevator`; the InitialUnknowns declare the measurements, no command."""
+    outputs = [v.name for v in ekf.md.modelVariables if v.causality == "output" and v.type == "Real"]
+
+    def initial(commands: list[dict[str, float]], **params: float) -> tuple[list[list[float]], list[float]]:
+        s = ekf.initializing_slave("init")
+        if params:
+            ekf.set(s, **params)
+        during = []
+        for c in commands:
+            ekf.set(s, **c)
+            during.append(ekf.get(s, *outputs))
+        s.exitInitializationMode()
+        after = ekf.get(s, *outputs)
+        s.terminate()
+        s.freeInstance()
+        return during, after
+
+    trim = {n: float(ekf.var[n].start) for n in COMMANDS}
+    assert trim["thrust_cmd"] == pytest.approx(88.376, abs=1e-3)
+    # The LQR's first command under OMSimulator's former fixed point, then far-off values.
+    off = [{**trim, "thrust_cmd": 77.56}, dict(zip(COMMANDS, (40.0, 0.3, -0.2, 0.1, 0.25, -0.15, 0.05), strict=True))]
+    (reference,), after = initial([trim])
+    assert after == reference
+    during, after = initial(off)
+    assert during == [reference, reference] and after == reference
+    thrust, elevator = (reference[outputs.index(n)] for n in ("thrust", "elevator"))
+    assert (thrust, elevator) == (float(ekf.var["init_thrust"].start), 0.0)
+    # The parameters set the start (clamped to the limits as the plant's actuators).
+    _, moved = initial(off, init_thrust=70.0, init_elevator=0.1)
+    assert (moved[outputs.index("thrust")], moved[outputs.index("elevator")]) == (70.0, 0.1)
+
+    commands = {ekf.var[n] for n in COMMANDS}
+    unknowns = ekf.md.initialUnknowns
+    assert len(unknowns) >= len(outputs)
+    for u in unknowns:
+        assert u.dependencies is not None, u.variable.name
+        assert not commands & set(u.dependencies), f"{u.variable.name} declares a command"
+    pos_n = next(u for u in unknowns if u.variable.name == "pos_n")
+    assert ekf.var["gps_latitude"] in pos_n.dependencies

@@ -41,11 +41,14 @@ class _NoInput:
         return None
 
 
-def fly_model_exchange(plant_fmu, controller, stop_time=None):
+def fly_model_exchange(plant_fmu, controller, stop_time=None, plant=None):
     """The closed loop with the plant integrated by CVode as Model Exchange.
 
     Returns (time, {plant output: values}) sampled like tailsim's ClosedLoop: row k is
-    t_k = k h, plant outputs at t_k, after the controller sampled them."""
+    t_k = k h, plant outputs at t_k, after the controller sampled them. `plant`: an
+    instantiated Model Exchange instance of the plant with the FMI 2.0 calls of fmpy's
+    FMU2Model (tests/test_fmi3.py passes the FMI 3.0 plant behind them); default: the
+    FMI 2.0 plant of `plant_fmu`."""
     from fmpy.sundials import CVodeSolver
 
     md = read_model_description(str(fmu_path("tailsitter_plant")))
@@ -53,13 +56,14 @@ def fly_model_exchange(plant_fmu, controller, stop_time=None):
     assert md.numberOfEventIndicators == 0
     nx = len(md.derivatives)
     pv = {v.name: v for v in md.modelVariables}
-    plant = FMU2Model(
-        guid=md.guid,
-        unzipDirectory=plant_fmu.dir,
-        modelIdentifier=md.modelExchange.modelIdentifier,
-        instanceName="plant_me",
-    )
-    plant.instantiate()
+    if plant is None:
+        plant = FMU2Model(
+            guid=md.guid,
+            unzipDirectory=plant_fmu.dir,
+            modelIdentifier=md.modelExchange.modelIdentifier,
+            instanceName="plant_me",
+        )
+        plant.instantiate()
     c = controller.instantiate("controller")
     cv = controller.variables
     c_in = [n for n in controller.names("input") if n in pv and pv[n].causality == "output"]

@@ -144,9 +144,13 @@ def test_ssd_binds_the_mission_and_default_experiment(controller):
 
     ssd = read_ssd(str(ssp_path(controller)))
     comps = {c.name: c for c in ssd.system.elements}
+    # One binding, one set per component (OMSimulator applies only a component's last inline
+    # binding, libcosim only its first): the mission, then the design model.
     sets = {ps.name: ps for b in comps["controller"].parameterBindings for ps in b.parameterValues}
-    assert set(sets) == {"mission", "design_model"}
-    assert {p.name: float(p.value) for p in sets["mission"].parameters} == MISSION
+    assert len(comps["controller"].parameterBindings) == 1 and set(sets) == {"controller"}
+    bound = [p.name for p in sets["controller"].parameters]
+    assert bound[: len(MISSION)] == list(MISSION)
+    assert {p.name: float(p.value) for p in sets["controller"].parameters if p.name in MISSION} == MISSION
     plant = {
         p.name: p.value for b in comps["plant"].parameterBindings for ps in b.parameterValues for p in ps.parameters
     }
@@ -162,17 +166,17 @@ def test_ssd_binds_the_mission_and_default_experiment(controller):
 @pytest.mark.parametrize("controller", CONTROLLERS)
 def test_design_model_is_bound_to_the_plants_declared_airframe(controller):
     """The controller's design model (its `design_airframe` parameters, the plant's names) is
-    bound in the set `design_model` to the plant FMU's declared start values — every one of
+    bound on the controller, after the mission, to the plant FMU's declared start values — every one of
     them — and is not connected to the plant's parameters: a parameter set that changes the
     plant's airframe leaves the controller designing on the nominal aircraft (the honest
-    default: a controller never knows the aircraft it flies) unless it changes
-    `design_model` too."""
+    default: a controller never knows the aircraft it flies) unless it changes the
+    controller's values too."""
     from fmpy.ssp.ssd import read_ssd
 
     ssd = read_ssd(str(ssp_path(controller)))
     comps = {c.name: c for c in ssd.system.elements}
     sets = {ps.name: ps for b in comps["controller"].parameterBindings for ps in b.parameterValues}
-    design = {p.name: float(p.value) for p in sets["design_model"].parameters}
+    design = {p.name: float(p.value) for p in sets["controller"].parameters if p.name not in MISSION}
     with zipfile.ZipFile(ssp_path(controller)) as z:
         plant_md = model_description(z.read("resources/tailsitter_plant.fmu"))
         ctrl_md = model_description(z.read(f"resources/{controller}.fmu"))

@@ -3,7 +3,8 @@ by `cargo xtask ssp` / `cargo xtask dist` when the sensor and estimator FMUs are
 plant → sensors → estimator → controller → plant and controller → estimator, every
 connection explicit and by name, plus the atmosphere (plant ↔ atmosphere by name, bound
 calm) when its FMU was packaged. Structure and schema under fmpy, flights under fmpy's
-simulate_ssp and libcosim (both Jacobi masters: see tests/test_ssp.py for their limits).
+simulate_ssp and libcosim (both Jacobi masters: see tests/test_ssp.py for their limits);
+libcosim's flight is tailsim's fmpy Jacobi master's.
 """
 
 from __future__ import annotations
@@ -160,3 +161,34 @@ def test_libcosim_flies_the_avionics_system(controller):
     assert final_pitch <= CRITERIA["final_pitch_error_max"]
     assert level_error <= CRITERIA["level_airspeed_error_max"]
     assert np.all(np.isfinite(v))
+
+
+@pytest.mark.parametrize("controller", CONTROLLERS)
+def test_libcosim_flies_the_avionics_system_like_the_fmpy_jacobi_master(controller):
+    """libcosim initialises by passing the connections' values round (controller → estimator
+    → controller included), tailsim's master one unit after the other. The estimator's
+    initial outputs depend on no command (its motor and servos start at `init_thrust`,
+    `init_elevator`), so both start alike and fly the same trajectory."""
+    from tailsim import Fmu
+    from tailsim.masters.avionics import AvionicsLoop
+
+    run = libcosim_fly_ssp(ssp_path(controller), len(ELEMENTS) + 1, observe=("pos_n", "pos_e", "pos_d"))
+    ref = AvionicsLoop(
+        Fmu(DIST / "tailsitter_plant.fmu"),
+        Fmu(DIST / "tailsitter_sensors.fmu"),
+        Fmu(DIST / "tailsitter_ekf.fmu"),
+        Fmu(DIST / f"{controller}.fmu"),
+        ordering="jacobi",
+    ).run(stop_time=35.0)
+    columns = []
+    for k in "ned":
+        times, _, values = run.series.time_series_real_samples(
+            run.plant, run.pv[f"pos_{k}"], from_step=0, sample_count=len(ref.time)
+        )
+        columns.append(np.array(values))
+    n = len(times)
+    assert n >= 1750
+    np.testing.assert_allclose(np.array(times) / 1e9, ref.time[:n], rtol=0, atol=1e-9)
+    distance = np.sqrt(sum((c - ref[f"pos_{k}"][:n]) ** 2 for c, k in zip(columns, "ned", strict=True)))
+    print(f"\n{controller} avionics: libcosim vs fmpy Jacobi {distance.max():.2e} m")
+    assert distance.max() < 1e-9

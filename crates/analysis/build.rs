@@ -1,6 +1,6 @@
 //! Hashes the source of every crate whose code decides the sweep results
 //! (physics, mission, guidance, closed loop and its mission criteria, both controllers, the
-//! declarations their parameter defaults are generated from, this crate) into
+//! atmosphere, sensors and estimator, the declarations their parameter defaults are generated from, this crate) into
 //! `RESULTS_SOURCE_HASH`, part of every cache key: editing any of them
 //! invalidates the cached results instead of serving stale ones.
 
@@ -14,6 +14,12 @@ const SOURCES: &[&str] = &[
     "../lqr-control/src",
     "../lqr-control/resources",
     "../tsd-control/src",
+    "../atmosphere/src",
+    "../sensor-model/src",
+    "../state-estimator/src",
+    "../../modelDescription/tailsitter_atmosphere.json",
+    "../../modelDescription/tailsitter_sensors.json",
+    "../../modelDescription/tailsitter_ekf.json",
     "../../modelDescription/fragments",
     "../../modelDescription/tailsitter_plant.json",
     "../../modelDescription/tailsitter_lqr.json",

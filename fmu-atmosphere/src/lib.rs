@@ -98,3 +98,5 @@ impl Binding for AtmosphereBinding {
 pub type AtmosphereModel = controller_fmu::UnitFmu<AtmosphereBinding>;
 
 fmi2_export::export_fmu!(AtmosphereModel);
+// The same model as an FMI 3.0 FMU (fmi3* symbols; dist/fmi3/<id>.fmu).
+fmi3_export::export_fmu3!(AtmosphereModel);

@@ -8,7 +8,7 @@
 //! Timing: `fmi2DoStep(t, h)` fuses the measurements set for t, predicts to t + h with the
 //! IMU sample held and advances the motor and servo models with the commands set for t
 //! (those for [t, t + h)); the outputs then hold the estimate at t + h. No output depends
-//! directly on an input.
+//! directly on an input, and the outputs after initialisation on no command.
 
 use controller_fmu::flight_mission::{ControlError, ParamError, SteppedUnit, UnitLog};
 use controller_fmu::Binding;
@@ -37,9 +37,9 @@ impl SteppedUnit for Estimator {
 
     /// Initialise from the inputs set for the start time: attitude by accelerometer levelling
     /// and magnetometer (TRIAD), position and velocity from a valid GPS fix, motor and servos
-    /// at the steady state of the commands ([`Ekf::initialize`]); logged.
-    fn start(&mut self, (m, u): &Self::Input, _t0: f64, log: &mut dyn UnitLog) -> Result<(), ControlError> {
-        let r = self.0.initialize(m, u);
+    /// at `init_thrust`, `init_elevator`, not at the commands ([`Ekf::initialize`]); logged.
+    fn start(&mut self, (m, _): &Self::Input, _t0: f64, log: &mut dyn UnitLog) -> Result<(), ControlError> {
+        let r = self.0.initialize(m);
         let tuning = &self.0.params().tuning;
         if !r.from_gps {
             log.warning(format_args!(
@@ -136,3 +136,5 @@ impl Binding for EkfBinding {
 pub type EkfModel = controller_fmu::UnitFmu<EkfBinding>;
 
 fmi2_export::export_fmu!(EkfModel);
+// The same model as an FMI 3.0 FMU (fmi3* symbols; dist/fmi3/<id>.fmu).
+fmi3_export::export_fmu3!(EkfModel);

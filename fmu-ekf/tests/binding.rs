@@ -521,3 +521,64 @@ fn start_values_alone_give_the_plants_default_climb() {
     assert!((vars.thrust - x[idx::THRUST]).abs() < 1e-9);
     assert!((vars.airspeed - 3.0).abs() < 1e-9 && vars.alpha.abs() < 1e-9);
 }
+
+/// The estimate after initialisation is that of the measurements alone: commands far from
+/// the trim set in Initialization Mode change no output (bit for bit), so a master that
+/// initialises the estimator and the controller together (OMSimulator) has no loop to solve.
+/// The motor and servos start at `init_thrust`, `init_elevator` (the other surfaces at 0).
+#[test]
+fn initial_outputs_do_not_depend_on_the_commands() {
+    let init = |set: &dyn Fn(&mut Variables)| {
+        let mut sim = Sim::new();
+        let mut vars = Variables::with_start_values();
+        sim.set_inputs(&mut vars);
+        set(&mut vars);
+        let mut model = EkfModel::new(&vars);
+        model.initialize(&mut vars, 0.0, &mut Logger::null()).unwrap();
+        vars
+    };
+    let trim = init(&|_| {});
+    let x = Plant::new(Airframe::default()).trim_vertical_climb(3.0).unwrap().state;
+    assert!((trim.thrust - x[idx::THRUST]).abs() < 1e-9 && trim.elevator == 0.0);
+    let off_trim = |v: &mut Variables| {
+        v.thrust_cmd = 40.0;
+        v.elevator_cmd = 0.3;
+        v.aileron_cmd = -0.2;
+        v.rudder_cmd = 0.1;
+        v.flap_collective_cmd = 0.25;
+        v.flap_differential_cmd = -0.15;
+        v.vertical_flap_cmd = 0.05;
+    };
+    let moved = init(&off_trim);
+    assert_eq!(moved.thrust_cmd, 40.0, "the commands were set");
+    let outputs: Vec<_> = <Variables as VariableStore>::VARIABLES
+        .iter()
+        .filter(|s| s.causality == fmi2_export::Causality::Output && s.value_type == fmi2_export::ValueType::Real)
+        .collect();
+    assert!(outputs.len() > 30);
+    for s in &outputs {
+        let (a, b) = (
+            trim.get_real(s.value_reference).unwrap(),
+            moved.get_real(s.value_reference).unwrap(),
+        );
+        assert_eq!(
+            a.to_bits(),
+            b.to_bits(),
+            "{} changed with the commands: {a} -> {b}",
+            s.name
+        );
+    }
+    // The parameters set the actuators' start, each within its limits.
+    let started = init(&|v| {
+        off_trim(v);
+        v.init_thrust = 70.0;
+        v.init_elevator = 0.1;
+    });
+    assert_eq!((started.thrust, started.elevator, started.aileron), (70.0, 0.1, 0.0));
+    let limited = init(&|v| {
+        v.init_thrust = 500.0;
+        v.init_elevator = -1.0;
+    });
+    assert_eq!(limited.thrust, 150.0);
+    assert_eq!(limited.elevator, -Airframe::default().deflection_limit);
+}

@@ -27,3 +27,5 @@ controller_fmu::flight_controller_binding!(Lqr, LqrController, "LQR", |vars| Lqr
 pub type LqrModel = controller_fmu::UnitFmu<Lqr>;
 
 fmi2_export::export_fmu!(LqrModel);
+// The same model as an FMI 3.0 FMU (fmi3* symbols; dist/fmi3/<id>.fmu).
+fmi3_export::export_fmu3!(LqrModel);

@@ -361,3 +361,5 @@ impl FmuModel for PlantModel {
 }
 
 fmi2_export::export_fmu!(PlantModel);
+// The same model as an FMI 3.0 FMU (fmi3* symbols; dist/fmi3/<id>.fmu).
+fmi3_export::export_fmu3!(PlantModel);

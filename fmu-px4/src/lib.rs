@@ -26,6 +26,8 @@ controller_fmu::flight_controller_binding!(Px4, Px4Controller, "PX4", |vars| Px4
 pub type Px4Model = controller_fmu::UnitFmu<Px4>;
 
 fmi2_export::export_fmu!(Px4Model);
+// The same model as an FMI 3.0 FMU (fmi3* symbols; dist/fmi3/<id>.fmu).
+fmi3_export::export_fmu3!(Px4Model);
 
 #[cfg(test)]
 mod tests {

@@ -122,3 +122,5 @@ impl Binding for SensorsBinding {
 pub type SensorsModel = controller_fmu::UnitFmu<SensorsBinding>;
 
 fmi2_export::export_fmu!(SensorsModel);
+// The same model as an FMI 3.0 FMU (fmi3* symbols; dist/fmi3/<id>.fmu).
+fmi3_export::export_fmu3!(SensorsModel);

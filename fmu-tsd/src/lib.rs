@@ -26,6 +26,8 @@ controller_fmu::flight_controller_binding!(Tsd, TsdController, "TSD", |vars| Tsd
 pub type TsdModel = controller_fmu::UnitFmu<Tsd>;
 
 fmi2_export::export_fmu!(TsdModel);
+// The same model as an FMI 3.0 FMU (fmi3* symbols; dist/fmi3/<id>.fmu).
+fmi3_export::export_fmu3!(TsdModel);
 
 #[cfg(test)]
 mod tests {

@@ -56,6 +56,8 @@ impl Default for Tuning {
             init_std_accel_bias: 0.05,
             init_std_pos_no_gps: 50.0,
             init_std_vel_no_gps: 5.0,
+            init_thrust: 88.37602057800001,
+            init_elevator: 0.0,
             pitot_min_airspeed: 1.0,
             sigma_sideslip: 0.1,
             sideslip_min_airspeed: 10.0,

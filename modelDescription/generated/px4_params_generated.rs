@@ -13,7 +13,7 @@ impl Default for Px4Params {
             MPC_Z_VEL_I_ACC: 2.0,
             MPC_Z_VEL_D_ACC: 0.0,
             MPC_XY_VEL_MAX: 12.0,
-            MPC_Z_VEL_MAX_UP: 6.0,
+            MPC_Z_VEL_MAX_UP: -1.0,
             MPC_Z_VEL_MAX_DN: 3.0,
             MPC_TILTMAX_AIR: 0.7853981633974483,
             MPC_THR_HOVER: -1.0,

@@ -76,24 +76,30 @@ fn write_all(w: &mut W, model: &Model) -> Result<()> {
             model_exchange(w, model)?;
         }
         co_simulation(w, model)?;
-        unit_definitions(w, model)?;
-        log_categories(w)?;
-        let e = &model.default_experiment;
-        let (start, stop, step) = (fmt_f64(e.start_time), fmt_f64(e.stop_time), fmt_f64(e.step_size));
-        empty(
-            w,
-            "DefaultExperiment",
-            [
-                ("startTime", start.as_str()),
-                ("stopTime", stop.as_str()),
-                ("stepSize", step.as_str()),
-            ],
-        )?;
+        units_categories_experiment(w, model)?;
         element(w, "ModelVariables", [], |w| {
             model.variables.iter().try_for_each(|v| scalar_variable(w, model, v))
         })?;
         model_structure(w, model)
     })
+}
+
+/// UnitDefinitions, LogCategories and DefaultExperiment, which FMI 2.0 and FMI 3.0 write
+/// alike, between the interface elements and ModelVariables.
+pub fn units_categories_experiment(w: &mut W, model: &Model) -> Result<()> {
+    unit_definitions(w, model)?;
+    log_categories(w)?;
+    let e = &model.default_experiment;
+    let (start, stop, step) = (fmt_f64(e.start_time), fmt_f64(e.stop_time), fmt_f64(e.step_size));
+    empty(
+        w,
+        "DefaultExperiment",
+        [
+            ("startTime", start.as_str()),
+            ("stopTime", stop.as_str()),
+            ("stepSize", step.as_str()),
+        ],
+    )
 }
 
 /// `<ModelExchange>`: the same binary (same modelIdentifier) serves both interfaces,
@@ -203,37 +209,46 @@ fn scalar_variable(w: &mut W, model: &Model, v: &Variable) -> Result<()> {
             VarType::Boolean => "Boolean",
             VarType::String => "String",
         };
-        let mut attrs: Vec<(&str, String)> = Vec::new();
-        if let Some(u) = &d.unit {
-            attrs.push(("unit", u.clone()));
-        }
-        if let Some(du) = &v.display_unit {
-            attrs.push(("displayUnit", du.clone()));
-        }
-        let number = |x: f64| match d.var_type {
-            VarType::Integer => format!("{}", x as i64),
-            _ => fmt_f64(x),
-        };
-        if let Some(lo) = d.min {
-            attrs.push(("min", number(lo)));
-        }
-        if let Some(hi) = d.max {
-            attrs.push(("max", number(hi)));
-        }
-        if let Some(x) = d.nominal {
-            attrs.push(("nominal", fmt_f64(x)));
-        }
-        match &d.start {
-            Some(Start::Number(x)) => attrs.push(("start", number(*x))),
-            Some(Start::Bool(b)) => attrs.push(("start", b.to_string())),
-            Some(Start::Text(s)) => attrs.push(("start", s.clone())),
-            None => {}
-        }
+        let mut attrs = value_attributes(v, true);
         if let Some(state) = &d.derivative_of {
             attrs.push(("derivative", index_of(model, state).to_string()));
         }
         empty(w, tag, attrs.iter().map(|(k, v)| (*k, v.as_str())))
     })
+}
+
+/// The attributes of a variable's type element, in schema order: `unit`, `displayUnit`,
+/// `min`, `max`, `nominal`, `start` (a String's start only with `string_start`: FMI 3.0
+/// writes it as a child element). Shared by the FMI 2.0 and FMI 3.0 writers.
+pub fn value_attributes(v: &Variable, string_start: bool) -> Vec<(&'static str, String)> {
+    let d = &v.decl;
+    let mut attrs: Vec<(&'static str, String)> = Vec::new();
+    if let Some(u) = &d.unit {
+        attrs.push(("unit", u.clone()));
+    }
+    if let Some(du) = &v.display_unit {
+        attrs.push(("displayUnit", du.clone()));
+    }
+    let number = |x: f64| match d.var_type {
+        VarType::Integer => format!("{}", x as i64),
+        _ => fmt_f64(x),
+    };
+    if let Some(lo) = d.min {
+        attrs.push(("min", number(lo)));
+    }
+    if let Some(hi) = d.max {
+        attrs.push(("max", number(hi)));
+    }
+    if let Some(x) = d.nominal {
+        attrs.push(("nominal", fmt_f64(x)));
+    }
+    match &d.start {
+        Some(Start::Number(x)) => attrs.push(("start", number(*x))),
+        Some(Start::Bool(b)) => attrs.push(("start", b.to_string())),
+        Some(Start::Text(s)) if string_start => attrs.push(("start", s.clone())),
+        _ => {}
+    }
+    attrs
 }
 
 /// 1-based index of a variable in ModelVariables.

@@ -23,8 +23,7 @@
 #include <string.h>
 
 #include "fmi2Functions.h"
-
-#define MAX_VARS 256
+#include "master_common.h"
 
 typedef struct {
     void *lib;
@@ -40,11 +39,6 @@ typedef struct {
     fmi2FreeInstanceTYPE *free_instance;
 } Unit;
 
-/* A list of value-reference pairs (src:dst) or single references. */
-typedef struct {
-    size_t n;
-    fmi2ValueReference src[MAX_VARS], dst[MAX_VARS];
-} Links;
 
 static void logger(fmi2ComponentEnvironment env, fmi2String name, fmi2Status status, fmi2String category,
                    fmi2String message, ...) {
@@ -57,21 +51,8 @@ static void logger(fmi2ComponentEnvironment env, fmi2String name, fmi2Status sta
     va_end(args);
 }
 
-static void *symbol(void *lib, const char *name) {
-    void *f = dlsym(lib, name);
-    if (!f) {
-        fprintf(stderr, "missing symbol %s\n", name);
-        exit(1);
-    }
-    return f;
-}
-
 static void load(Unit *u, const char *path) {
-    u->lib = dlopen(path, RTLD_NOW | RTLD_LOCAL);
-    if (!u->lib) {
-        fprintf(stderr, "dlopen %s: %s\n", path, dlerror());
-        exit(1);
-    }
+    u->lib = open_library(path);
     u->instantiate = (fmi2InstantiateTYPE *)symbol(u->lib, "fmi2Instantiate");
     u->setup_experiment = (fmi2SetupExperimentTYPE *)symbol(u->lib, "fmi2SetupExperiment");
     u->enter_init = (fmi2EnterInitializationModeTYPE *)symbol(u->lib, "fmi2EnterInitializationMode");
@@ -81,33 +62,6 @@ static void load(Unit *u, const char *path) {
     u->do_step = (fmi2DoStepTYPE *)symbol(u->lib, "fmi2DoStep");
     u->terminate = (fmi2TerminateTYPE *)symbol(u->lib, "fmi2Terminate");
     u->free_instance = (fmi2FreeInstanceTYPE *)symbol(u->lib, "fmi2FreeInstance");
-}
-
-static void parse(Links *l, const char *text, int pairs) {
-    char *copy = strdup(text), *save = NULL;
-    l->n = 0;
-    for (char *tok = strtok_r(copy, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
-        if (l->n == MAX_VARS) {
-            fprintf(stderr, "more than %d references\n", MAX_VARS);
-            exit(1);
-        }
-        char *end;
-        l->src[l->n] = (fmi2ValueReference)strtoul(tok, &end, 10);
-        l->dst[l->n] = l->src[l->n];
-        if (pairs) {
-            if (*end != ':') {
-                fprintf(stderr, "bad link %s (want src:dst)\n", tok);
-                exit(1);
-            }
-            l->dst[l->n] = (fmi2ValueReference)strtoul(end + 1, &end, 10);
-        }
-        if (*end != '\0') {
-            fprintf(stderr, "bad reference %s\n", tok);
-            exit(1);
-        }
-        l->n++;
-    }
-    free(copy);
 }
 
 static void check(fmi2Status s, const char *what, double t) {

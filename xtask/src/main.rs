@@ -5,6 +5,8 @@
 //!   (modelDescription.xml, binaries/linux64/<id>.so, binaries/win64/<id>.dll,
 //!   documentation/index.html); with the platform aarch64-linux also the separate ARM
 //!   archives `dist/aarch64-linux/<modelIdentifier>.fmu` (see [`Platform::Aarch64Linux`]);
+//!   and the FMI 3.0 archives `dist/fmi3/<modelIdentifier>.fmu` holding every platform's
+//!   library (the same libraries; see [`fmi3`]);
 //! - `ssp`: write the SSP 1.0 closed-loop systems `dist/<controller>.ssp` from the packaged FMUs
 //!   (`dist` writes them too);
 //! - `regen`: rewrite the reviewed copies `modelDescription/generated/<id>.xml`, the
@@ -12,6 +14,7 @@
 //!   parameter defaults `modelDescription/generated/*_generated.rs` and the Python
 //!   declarations `python/tailsim/declarations.json`.
 
+mod fmi3;
 mod ssp;
 
 use clap::{Parser, Subcommand};
@@ -272,7 +275,7 @@ fn dist(only: &[String], out: &Path, platforms: &[Platform]) -> Result<(), Strin
             None => archives.push((folder, vec![platform])),
         }
     }
-    for FmuCrate { id, docs, .. } in selected {
+    for FmuCrate { id, docs, .. } in selected.iter().copied() {
         let model = load(id)?;
         let mut readme = String::new();
         for path in docs {
@@ -299,6 +302,8 @@ fn dist(only: &[String], out: &Path, platforms: &[Platform]) -> Result<(), Strin
             );
         }
     }
+    let ids: Vec<&str> = selected.iter().map(|f| f.id.as_str()).collect();
+    fmi3::write_archives(&root, &out, &ids, platforms)?;
     // The closed-loop systems of whatever FMUs the folder now holds, when its archives
     // were rewritten.
     let has = |id: &str| out.join(format!("{id}.fmu")).exists();

@@ -5,10 +5,13 @@
 //! - `SystemStructure.ssd`: one system with the components `plant` and `controller`
 //!   (`resources/<modelIdentifier>.fmu`), connected by port name (docs/DESIGN.md §2): every controller
 //!   input named like a plant output reads it, every controller output named like a plant input
-//!   drives it. The mission parameters (§3) are an inline parameter set on the controller, the
-//!   plant's initial trim speed is bound to `v_vertical`. Default experiment 0–35 s, with the OSP
-//!   annotation giving libcosim its fixed base step (0.02 s = `sample_time`); tools that do not know
-//!   the annotation ignore it.
+//!   drives it. Each component with parameters has exactly one inline parameter binding (one
+//!   parameter set named after the component): the controller's holds the mission (§3) and its
+//!   design model, the plant's its initial trim speed `v_vertical`. Default experiment 0–35 s.
+//!   The fixed step (0.02 s = `sample_time`) is given twice, in the vendor annotations the
+//!   importers need: OSP's `FixedStepAlgorithm` on the default experiment (libcosim) and
+//!   OpenModelica's `FixedStepMaster` on the system (OMSimulator, which cannot create a system
+//!   without it); tools that do not know an annotation ignore it.
 //! - `resources/tailsitter_plant.fmu`, `resources/<controller>.fmu`: the packaged FMUs, verbatim.
 //! - with `dist/tailsitter_atmosphere.fmu` present, a third component `atmosphere`
 //!   (`resources/tailsitter_atmosphere.fmu`) wired by name too: plant `pos_n/e/d`, `airspeed` →
@@ -20,13 +23,21 @@
 //! connections it needs (a controller reads the subset of plant outputs it declares as inputs):
 //! swapping the controller swaps one component.
 //!
-//! Reader constraints the writer respects (checked by tests/test_ssp.py):
+//! Reader constraints the writer respects (checked by tests/test_ssp.py, tests/test_ssp_omsimulator.py):
 //! - fmpy 0.3.32 validates the SSD against the SSP 1.0 schema and needs a connection for every
 //!   declared input connector, so plant inputs that nothing drives (`wind_*`) and controller inputs
 //!   without a plant output (`ref_offset_*`) are not declared as connectors;
 //! - libcosim reads the SSD with fixed prefixes (`ssd:`, `ssc:`, `ssv:`, `osp:`) and needs a type
 //!   element on every connector; namespace declarations sit on the root element only (libcosim would
-//!   read an `xmlns` attribute on an element it iterates as a child).
+//!   read an `xmlns` attribute on an element it iterates as a child);
+//! - one `ParameterBinding` per component: with several inline bindings OMSimulator applies only
+//!   the last (`Values::importFromSnapshot` keys every inline binding as "inline") and libcosim only
+//!   the first, silently; fmpy reads them all. With `.ssv` files (`source=`) OMSimulator applies
+//!   each, libcosim still only the first;
+//! - OMSimulator (acb56d9d) reads the SSD with fixed prefixes too (`ssd:`, `ssc:`, `oms:`) and looks
+//!   at the first `ssc:Annotation` of the system's `ssd:Annotations` only. Its command line
+//!   replaces the default experiment's stop time by its `--stopTime` flag (default 1 s);
+//!   the library (`oms_importFile`) reads it (docs/OMSIMULATOR.md).
 
 // Rust's shortest round-trip representation, as in modelDescription.xml; a valid xs:double.
 use model_description::fmt_f64 as real;
@@ -113,14 +124,14 @@ fn mission_default(name: &str) -> f64 {
 
 /// The plant's airframe parameters (group `airframe` of `modelDescription/tailsitter_plant.json`)
 /// with their declared values: the controllers' design model (`design_airframe`, the same names),
-/// bound on the controller component as the parameter set `design_model`.
+/// bound on the controller component after the mission.
 ///
 /// **The honest default**: the design model is the *declared nominal* airframe, bound as values
 /// of its own, not connected to the plant's parameters. A user who changes the plant's airframe
 /// (a parameter set on the plant: a heavier aircraft, another C_mα) gets a controller that still
 /// designs on the nominal aircraft — as a real controller would, which never knows the aircraft
 /// it flies. Giving it the true plant (perfect model knowledge, the comparison issue 15 found
-/// flattering to the LQR) takes a deliberate second change: the same values in `design_model`.
+/// flattering to the LQR) takes a deliberate second change: the same values on the controller.
 /// One source: the values come from the plant's declaration, as the controllers' defaults do.
 pub static DESIGN_AIRFRAME: LazyLock<Vec<(&'static str, f64)>> =
     LazyLock::new(|| declared_parameters(&format!("{PLANT}.json"), "airframe", "airframe"));
@@ -144,6 +155,13 @@ const NS_SSD: &str = "http://ssp-standard.org/SSP1/SystemStructureDescription";
 const NS_SSC: &str = "http://ssp-standard.org/SSP1/SystemStructureCommon";
 const NS_SSV: &str = "http://ssp-standard.org/SSP1/SystemStructureParameterValues";
 const NS_OSP: &str = "http://opensimulationplatform.com/SSP/OSPAnnotations";
+/// OMSimulator's annotation namespace, as OMSimulator writes it (`Snapshot.cpp`).
+const NS_OMS: &str = "https://raw.githubusercontent.com/OpenModelica/OMSimulator/master/schema/oms.xsd";
+/// OMSimulator's fixed-step master (`SystemWC::getSolverName`).
+const OMS_FIXED_STEP_MASTER: &str = "oms-ma";
+/// The relative tolerance OMSimulator passes to fmi2SetupExperiment (its `--tolerance` default;
+/// without the attribute the library would pass 0, which the FMUs reject).
+const OMS_RELATIVE_TOLERANCE: &str = "0.0001";
 
 /// One scalar variable of an FMU, as far as the SSD needs it.
 #[derive(Debug, Clone, PartialEq)]
@@ -410,21 +428,22 @@ fn component(w: &mut Xml, name: &str, fmu: &FmuInfo, inputs: &[&str], parameter_
                 })
             })
         })?;
-        let sets: Vec<_> = parameter_sets.iter().filter(|(_, p)| !p.is_empty()).collect();
-        if sets.is_empty() {
+        // One binding, one set: importers that take one binding per component (OMSimulator the
+        // last, libcosim the first) see every parameter.
+        let parameters: Vec<_> = parameter_sets.iter().flat_map(|(_, p)| p.iter().cloned()).collect();
+        if parameters.is_empty() {
             return Ok(());
         }
         element(w, "ssd:ParameterBindings", [], |w| {
-            sets.into_iter().try_for_each(|(set, parameters)| {
-                element(w, "ssd:ParameterBinding", [], |w| {
-                    element(w, "ssd:ParameterValues", [], |w| parameter_set(w, set, parameters))
-                })
+            element(w, "ssd:ParameterBinding", [], |w| {
+                element(w, "ssd:ParameterValues", [], |w| parameter_set(w, name, &parameters))
             })
         })
     })
 }
 
-/// Named parameter sets of a component: (set name, [(name, type element, value)]).
+/// Groups of a component's parameters: (group, [(name, type element, value)]); a component's
+/// groups are written as its one parameter set, in this order.
 type ParamSet = (&'static str, Vec<(&'static str, String, String)>);
 
 /// An inline SSV parameter set named `set`: (name, type element, value).
@@ -458,8 +477,8 @@ fn bindings(
         .collect()
 }
 
-/// The controller's parameter sets: `mission` (the declared mission) and `design_model` (the
-/// plant's declared nominal airframe, [`DESIGN_AIRFRAME`]: the honest default).
+/// The controller's parameters: the declared mission, then the design model (the plant's
+/// declared nominal airframe, [`DESIGN_AIRFRAME`]: the honest default).
 fn controller_sets(controller: &FmuInfo) -> Result<Vec<ParamSet>, String> {
     let mission: Vec<_> = MISSION.iter().map(|(n, v)| (*n, "Real", real(*v))).collect();
     let design: Vec<_> = DESIGN_AIRFRAME.iter().map(|(n, v)| (*n, "Real", real(*v))).collect();
@@ -469,7 +488,7 @@ fn controller_sets(controller: &FmuInfo) -> Result<Vec<ParamSet>, String> {
     ])
 }
 
-/// The plant's parameter set `plant`: it starts in the trimmed vertical climb at the mission's
+/// The plant's parameters: it starts in the trimmed vertical climb at the mission's
 /// climb speed (docs/DESIGN.md §3).
 fn plant_sets(plant: &FmuInfo) -> Result<Vec<ParamSet>, String> {
     let start = [
@@ -480,7 +499,7 @@ fn plant_sets(plant: &FmuInfo) -> Result<Vec<ParamSet>, String> {
 }
 
 /// The atmosphere component, if given: its links by name (plant → atmosphere, atmosphere →
-/// plant) join `links`, and its parameter set `atmosphere` (the declared defaults,
+/// plant) join `links`, and its parameters (the declared defaults,
 /// [`ATMOSPHERE_PARAMS`]: calm) is returned. Every atmosphere input must be a plant output.
 fn add_atmosphere<'a>(
     plant: &FmuInfo,
@@ -649,6 +668,7 @@ fn write_ssd(name: &str, description: &str, elements: &[Element], links: &[Conne
         ("xmlns:ssc", NS_SSC),
         ("xmlns:ssv", NS_SSV),
         ("xmlns:osp", NS_OSP),
+        ("xmlns:oms", NS_OMS),
         ("version", "1.0"),
         ("name", name),
         (
@@ -679,7 +699,8 @@ fn write_ssd(name: &str, description: &str, elements: &[Element], links: &[Conne
                         ];
                         empty(w, "ssd:Connection", ends)
                     })
-                })
+                })?;
+                oms_fixed_step_master(w, &base_step)
             })?;
             if !units.is_empty() {
                 element(w, "ssd:Units", [], |w| {
@@ -703,6 +724,26 @@ fn write_ssd(name: &str, description: &str, elements: &[Element], links: &[Conne
         })
     })
     .map_err(|e| e.to_string())
+}
+
+/// The system's `ssd:Annotations`: OMSimulator's fixed-step master at `step` seconds
+/// (`SystemWC::importFromSSD_SimulationInformation`). Without it OMSimulator (acb56d9d) cannot
+/// type the system and aborts (`[NewSystem] internal error`, then std::logic_error).
+fn oms_fixed_step_master(w: &mut Xml, step: &str) -> XmlResult {
+    element(w, "ssd:Annotations", [], |w| {
+        element(w, "ssc:Annotation", [("type", "org.openmodelica")], |w| {
+            element(w, "oms:Annotations", [], |w| {
+                element(w, "oms:SimulationInformation", [], |w| {
+                    let master = [
+                        ("description", OMS_FIXED_STEP_MASTER),
+                        ("stepSize", step),
+                        ("relativeTolerance", OMS_RELATIVE_TOLERANCE),
+                    ];
+                    empty(w, "oms:FixedStepMaster", master)
+                })
+            })
+        })
+    })
 }
 
 #[cfg(test)]
@@ -781,8 +822,8 @@ mod tests {
         assert!(DESIGN_AIRFRAME.len() > 70, "{}", DESIGN_AIRFRAME.len());
         assert_eq!(DESIGN_AIRFRAME[0], ("mass", 9.0));
         let set = ssd
-            .find(r#"<ssv:ParameterSet version="1.0" name="design_model">"#)
-            .expect("design set");
+            .find(r#"<ssv:ParameterSet version="1.0" name="controller">"#)
+            .expect("controller set");
         let controller_end = ssd
             .find(r#"<ssd:Component name="plant""#)
             .expect("plant after controller");
@@ -807,6 +848,55 @@ mod tests {
         assert!(ssd.contains(r#"<ssv:Integer value="0"/>"#));
         assert!(ssd.contains(r#"<osp:FixedStepAlgorithm baseStepSize="0.02"/>"#));
         assert!(ssd.contains(r#"stopTime="35.0""#));
+    }
+
+    /// The count of non-overlapping `needle`s in `haystack`.
+    fn count(haystack: &str, needle: &str) -> usize {
+        haystack.matches(needle).count()
+    }
+
+    #[test]
+    fn one_parameter_binding_per_component_holding_every_parameter() {
+        let ssd = system_description(&plant(), &controller(), Some(&atmosphere())).unwrap();
+        // controller, plant, atmosphere: one binding and one set each, named after the component
+        assert_eq!(count(&ssd, "<ssd:ParameterBinding>"), 3);
+        assert_eq!(count(&ssd, "<ssv:ParameterSet "), 3);
+        for name in ["controller", "plant", "atmosphere"] {
+            assert!(ssd.contains(&format!(r#"<ssv:ParameterSet version="1.0" name="{name}">"#)));
+        }
+        let controller_set =
+            &ssd[ssd.find(r#"name="controller">"#).unwrap()..ssd.find(r#"<ssd:Component name="plant""#).unwrap()];
+        let n = MISSION.len() + DESIGN_AIRFRAME.len();
+        assert_eq!(count(controller_set, "<ssv:Parameter "), n);
+        // the mission first, then the design model
+        let (t_level, mass) = (
+            controller_set.find(r#""t_level""#).unwrap(),
+            controller_set.find(r#""mass""#).unwrap(),
+        );
+        assert!(t_level < mass);
+        let (sensors, ekf, c) = avionics();
+        let ssd = avionics_system_description(&plant(), &sensors, &ekf, &c, None).unwrap();
+        assert_eq!(count(&ssd, "<ssd:ParameterBinding>"), 2, "controller and plant");
+    }
+
+    #[test]
+    fn openmodelica_fixed_step_master_is_the_systems_first_annotation() {
+        let ssd = system_description(&plant(), &controller(), None).unwrap();
+        let master = r#"<ssd:Annotations>
+      <ssc:Annotation type="org.openmodelica">
+        <oms:Annotations>
+          <oms:SimulationInformation>
+            <oms:FixedStepMaster description="oms-ma" stepSize="0.02" relativeTolerance="0.0001"/>
+          </oms:SimulationInformation>
+        </oms:Annotations>
+      </ssc:Annotation>
+    </ssd:Annotations>
+  </ssd:System>"#;
+        assert!(ssd.contains(master), "{ssd}");
+        assert_eq!(count(&ssd, "<ssc:Annotation "), 2, "OMSimulator's and OSP's");
+        // the namespace is declared on the root only (libcosim reads xmlns attributes on children)
+        assert_eq!(count(&ssd, "xmlns:oms="), 1);
+        assert!(ssd.contains(&format!(r#"xmlns:oms="{NS_OMS}" version="1.0""#)));
     }
 
     fn avionics() -> (FmuInfo, FmuInfo, FmuInfo) {

@@ -1,9 +1,13 @@
 //! Selected cells of the wind envelope with per-phase errors (a development probe):
-//! `wind_cells lqr|tsd default|tl|handover step|turb SPEEDS BEARING_INDICES [TRACE.csv]`,
-//! SPEEDS and BEARING_INDICES comma-separated. With a trace file (one cell) the time history
-//! (t, phase, error, position, reference, θ, heading, wind) is written.
+//! `wind_cells lqr|tsd default|tl|handover step|turb SPEEDS BEARING_INDICES [AXIS…] [TRACE.csv]`,
+//! SPEEDS and BEARING_INDICES comma-separated (or `all`), AXIS any of `perfect`, `avionics`,
+//! `avionics_app_d`, `gauss-seidel`, `jacobi`, `tuned`, `thesis` (default perfect,
+//! Gauss-Seidel, tuned). With a trace file (one cell) the time history (t, phase, error,
+//! position, reference, θ, heading, wind) is written.
 use analysis::controllers::Kind;
-use analysis::wind_envelope::{MissionKind, WindForm, BEARINGS_DEG};
+use analysis::wind_envelope::{
+    fly_job, Axes, Configuration, Job, MissionKind, OrderingKind, StateKind, WindForm, BEARINGS_DEG,
+};
 use rayon::prelude::*;
 
 fn main() {
@@ -25,7 +29,20 @@ fn main() {
     } else {
         a[5].split(',').map(|s| s.parse().unwrap()).collect()
     };
-    let trace = a.get(6).cloned();
+    let mut axes = Axes::default();
+    let mut trace = None;
+    for arg in &a[6..] {
+        match arg.as_str() {
+            "perfect" => axes.state = StateKind::Perfect,
+            "avionics" => axes.state = StateKind::Avionics,
+            "avionics_app_d" => axes.state = StateKind::AvionicsAppD,
+            "gauss-seidel" => axes.ordering = OrderingKind::GaussSeidel,
+            "jacobi" => axes.ordering = OrderingKind::Jacobi,
+            "tuned" => axes.configuration = Configuration::Tuned,
+            "thesis" => axes.configuration = Configuration::Thesis,
+            path => trace = Some(path.to_string()),
+        }
+    }
     let jobs: Vec<(f64, usize)> = speeds
         .iter()
         .flat_map(|&s| bearings.iter().map(move |&b| (s, b)))
@@ -36,7 +53,7 @@ fn main() {
             (
                 s,
                 b,
-                analysis::wind_envelope::fly_cell_phases(kind, mission, form, s, b, trace.as_deref()),
+                fly_job(&Job::new(kind, mission, form, s, b).on(axes), trace.as_deref()),
             )
         })
         .collect();

@@ -67,9 +67,10 @@ enum Cmd {
     /// writes them): one JSON job per line in, one JSON row per line out, in job order.
     CampaignJobs(CampaignJobs),
     /// Wind envelope over whole missions (wind_envelope.json, wind_envelope.csv): every
-    /// controller (LQR and TSD tuned, PX4), steady wind stepping in and turbulent from the start, every
-    /// speed and bearing (`analysis::wind_envelope`).
-    WindEnvelope(WindEnvelopeArgs),
+    /// controller, steady wind stepping in and turbulent from the start, every speed and
+    /// bearing; perfect state or avionics, Gauss-Seidel or Jacobi, tuned or thesis
+    /// configurations (`analysis::wind_envelope`; `--all` the whole grid).
+    WindEnvelope(analysis::wind_envelope::Args),
     /// One native flight of the default mission through the atmosphere, as CSV (for the
     /// comparison with the FMU master: tests/test_master_atmosphere.py).
     WindTrace(WindTraceArgs),
@@ -129,44 +130,6 @@ fn wind_trace(a: &WindTraceArgs) -> Result<(), String> {
     };
     let csv = analysis::wind_envelope::trace_csv(kind, ordering, params, a.stop)?;
     std::fs::write(&a.out, csv).map_err(|e| format!("{}: {e}", a.out.display()))
-}
-
-#[derive(clap::Args, Clone)]
-struct WindEnvelopeArgs {
-    /// Output folder.
-    #[arg(long, default_value = "out/analysis")]
-    out: PathBuf,
-    /// Threads (default: all cores).
-    #[arg(long)]
-    threads: Option<usize>,
-    /// The default mission only (not the take-off-to-landing mission).
-    #[arg(long)]
-    default_only: bool,
-    /// Also the hover-to-transition handover (the default mission with a 20 s first
-    /// vertical phase, `MissionKind::Handover`).
-    #[arg(long)]
-    handover: bool,
-}
-
-fn wind_envelope(a: &WindEnvelopeArgs) -> Result<(), String> {
-    use analysis::wind_envelope::{run, MissionKind};
-    let mut missions = if a.default_only {
-        vec![MissionKind::Default]
-    } else {
-        vec![MissionKind::Default, MissionKind::TakeoffLanding]
-    };
-    if a.handover {
-        missions.push(MissionKind::Handover);
-    }
-    let start = std::time::Instant::now();
-    let cells = run(&a.out, &Kind::ALL, &missions)?;
-    eprintln!(
-        "wrote {}/wind_envelope.json: {} flights in {:.1} s",
-        a.out.display(),
-        cells.len(),
-        start.elapsed().as_secs_f64()
-    );
-    Ok(())
 }
 
 #[derive(clap::Args, Clone)]
@@ -250,10 +213,7 @@ fn main() {
         Cmd::Nonlinear(c) => (c, true, true, false),
         Cmd::Aero(c) => (c, false, false, true),
         Cmd::WindEnvelope(a) => {
-            if let Some(t) = a.threads {
-                let _ = rayon::ThreadPoolBuilder::new().num_threads(t).build_global();
-            }
-            if let Err(e) = wind_envelope(&a) {
+            if let Err(e) = analysis::wind_envelope::main(&a) {
                 eprintln!("wind envelope failed: {e}");
                 std::process::exit(1);
             }

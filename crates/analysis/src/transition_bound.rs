@@ -614,6 +614,17 @@ impl Flown {
 }
 
 /// The default mission with T2 = `t2`.
+/// The profile's limits with the whole α range up to `alpha_max`, full thrust and no push-over
+/// limit: the profile at its fastest (the flight-mission README's settings, with T2 = 0.5 s).
+pub fn fastest_profile_limits(alpha_max: f64) -> ProfileLimits {
+    ProfileLimits {
+        alpha_max,
+        thrust_fraction: 1.0,
+        thrust_floor: 0.1,
+        push_over_fraction: 1.0,
+    }
+}
+
 pub fn mission(t2: f64) -> MissionParams {
     MissionParams {
         t_transition_2: t2,
@@ -731,12 +742,7 @@ mod tests {
         // The profile of the controllers (elevator-only lift slope, lagged α) with T2 = 0.5 s
         // and the whole α range: its rotation to within 5° of vertical.
         let m = mission(0.5);
-        let limits = ProfileLimits {
-            alpha_max: 15f64.to_radians(),
-            thrust_fraction: 1.0,
-            thrust_floor: 0.1,
-            push_over_fraction: 1.0,
-        };
+        let limits = fastest_profile_limits(15f64.to_radians());
         let profile = profile_time(&m, &limits, true);
         assert!(b.time < profile, "bound {} vs profile {profile}", b.time);
         // Elevator-only with the lag is slower than flap mixing commanded directly.
@@ -761,12 +767,7 @@ mod tests {
         assert!((c.switches.t_cut - 0.62).abs() < 0.1, "{c:?}");
         let r = rotation_bound(&model, a, 25.0);
         assert!(c.time > r.time + 1.0, "{c:?} vs {r:?}");
-        let limits = ProfileLimits {
-            alpha_max: a,
-            thrust_fraction: 1.0,
-            thrust_floor: 0.1,
-            push_over_fraction: 1.0,
-        };
+        let limits = fastest_profile_limits(a);
         let profile = profile_time(&mission(0.5), &limits, false);
         assert!(c.time < profile, "bound {} vs profile {profile}", c.time);
     }
@@ -803,12 +804,7 @@ mod tests {
         }
         // The profile's own times with the README's settings (T2 = 0.5 s, T_max, the whole α range).
         for deg in [12.0f64, 15.0] {
-            let limits = ProfileLimits {
-                alpha_max: deg.to_radians(),
-                thrust_fraction: 1.0,
-                thrust_floor: 0.1,
-                push_over_fraction: 1.0,
-            };
+            let limits = fastest_profile_limits(deg.to_radians());
             let m = mission(0.5);
             println!(
                 "profile T2 0.5 α {deg}: γ within 2°: {:.2} s, 5°: {:.2} s; complete (5°, 1 m/s): {:.2} s",

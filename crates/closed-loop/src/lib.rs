@@ -12,6 +12,7 @@ use std::sync::OnceLock;
 use nalgebra::Vector3;
 use tailsitter_physics::{idx, InputVector, Plant, StateVector};
 
+pub mod avionics;
 pub mod wind_source;
 pub use wind_source::{PointWind, WindSource};
 
@@ -271,7 +272,7 @@ pub struct Sample {
     pub t: f64,
     /// Plant state at `t`.
     pub x: StateVector,
-    /// What the controller measured at `t`.
+    /// The plant's outputs at `t` (what the controller measured with perfect state).
     pub measurement: Measurement,
     /// Command the plant flies over [t, t + h).
     pub command: Command,
@@ -516,6 +517,64 @@ pub fn pitch(x: &StateVector) -> f64 {
 /// point (Jacobi). The run stops early, with `failure` set, if the
 /// controller fails or the plant leaves its envelope.
 pub fn fly<C: FlightController>(plant: &Plant, x0: StateVector, controller: &mut C, scenario: &Scenario) -> Trace {
+    fly_with(plant, x0, controller, scenario, &mut Perfect, |_| false)
+}
+
+/// What the controller is handed at each communication point: the plant's outputs
+/// ([`Perfect`]) or an estimate of them ([`avionics::AvionicsSource`]: sensors and estimator).
+pub trait StateSource {
+    /// The controller's measurement at `t` (step `h`); `truth` is the plant's outputs at `t`
+    /// (state `x`, inputs `u`, the wind of the plant outputs `wind`).
+    #[allow(clippy::too_many_arguments)]
+    fn measure(
+        &mut self,
+        t: f64,
+        h: f64,
+        plant: &Plant,
+        x: &StateVector,
+        u: &InputVector,
+        wind: &Vector3<f64>,
+        truth: &Measurement,
+    ) -> Result<Measurement, String>;
+
+    /// After the controller's sample at `t`: the command the plant flies over [t, t + h).
+    fn flown(&mut self, t: f64, h: f64, command: &Command) -> Result<(), String>;
+}
+
+/// The controller measures the plant's outputs (perfect state).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Perfect;
+
+impl StateSource for Perfect {
+    fn measure(
+        &mut self,
+        _t: f64,
+        _h: f64,
+        _plant: &Plant,
+        _x: &StateVector,
+        _u: &InputVector,
+        _wind: &Vector3<f64>,
+        truth: &Measurement,
+    ) -> Result<Measurement, String> {
+        Ok(*truth)
+    }
+
+    fn flown(&mut self, _t: f64, _h: f64, _command: &Command) -> Result<(), String> {
+        Ok(())
+    }
+}
+
+/// [`fly`] with the controller measuring through `state_source`, stopping early (completed) after
+/// the first recorded sample for which `stop` is true. The trace records the truth (the
+/// plant's outputs) as each sample's `measurement`, whatever the controller measured.
+pub fn fly_with<C: FlightController, S: StateSource>(
+    plant: &Plant,
+    x0: StateVector,
+    controller: &mut C,
+    scenario: &Scenario,
+    state_source: &mut S,
+    mut stop: impl FnMut(&Sample) -> bool,
+) -> Trace {
     let h = scenario.comm_step;
     let n = (scenario.stop_time / h).round() as usize;
     let mut trace = Trace {
@@ -547,10 +606,17 @@ pub fn fly<C: FlightController>(plant: &Plant, x0: StateVector, controller: &mut
             }
         };
         let measurement = measure(plant, &x, &u_now, &measured_wind);
+        let measured = match state_source.measure(t, h, plant, &x, &u_now, &measured_wind, &measurement) {
+            Ok(m) => m,
+            Err(e) => {
+                trace.failure = Some(e);
+                break;
+            }
+        };
         if clock.take(t) || held.is_none() {
             let input = ControllerInput {
                 t,
-                measurement,
+                measurement: measured,
                 ref_offset_ned: scenario.ref_offset(t),
             };
             match controller.sample(&input) {
@@ -585,7 +651,11 @@ pub fn fly<C: FlightController>(plant: &Plant, x0: StateVector, controller: &mut
             theta: pitch(&x),
         });
         previous_command = Some(out.command);
-        if k == n {
+        if k == n || stop(trace.samples.last().expect("pushed above")) {
+            break;
+        }
+        if let Err(e) = state_source.flown(t, h, &flown) {
+            trace.failure = Some(e);
             break;
         }
         if let Err(e) = plant.advance(&mut x, &plant_inputs(&flown), &wind, h) {

@@ -46,7 +46,7 @@ pub fn panic_message(payload: &(dyn Any + Send)) -> &str {
 }
 
 /// Run `f`, turning any panic into `fallback`.
-fn guard<T>(fallback: T, f: impl FnOnce() -> T) -> T {
+pub fn guard<T>(fallback: T, f: impl FnOnce() -> T) -> T {
     catch_unwind(AssertUnwindSafe(f)).unwrap_or(fallback)
 }
 
@@ -101,7 +101,9 @@ unsafe fn call<M: FmuModel>(
     })
 }
 
-unsafe fn slice<'a, T>(p: *const T, n: usize, what: &str) -> Fmi2Result<&'a [T]> {
+/// The C array `p[..n]` (empty for `n == 0`); an error for NULL or a misaligned or
+/// oversized array.
+pub unsafe fn slice<'a, T>(p: *const T, n: usize, what: &str) -> Fmi2Result<&'a [T]> {
     if n == 0 {
         return Ok(&[]);
     }
@@ -115,13 +117,15 @@ unsafe fn slice<'a, T>(p: *const T, n: usize, what: &str) -> Fmi2Result<&'a [T]>
     Ok(unsafe { std::slice::from_raw_parts(p, n) })
 }
 
-unsafe fn slice_mut<'a, T>(p: *mut T, n: usize, what: &str) -> Fmi2Result<&'a mut [T]> {
+/// [`slice`] for an output array.
+pub unsafe fn slice_mut<'a, T>(p: *mut T, n: usize, what: &str) -> Fmi2Result<&'a mut [T]> {
     // SAFETY: as `slice`; the caller's output array is exclusively ours during the call.
     let s = unsafe { slice(p.cast_const(), n, what)? };
     Ok(unsafe { std::slice::from_raw_parts_mut(s.as_ptr().cast_mut(), s.len()) })
 }
 
-fn out_ptr<'a, T>(p: *mut T, what: &str) -> Fmi2Result<&'a mut T> {
+/// A non-NULL output argument.
+pub unsafe fn out_ptr<'a, T>(p: *mut T, what: &str) -> Fmi2Result<&'a mut T> {
     if p.is_null() || !p.is_aligned() {
         return Err(Fmi2Error::error(format!("{what} is NULL")));
     }
@@ -129,7 +133,8 @@ fn out_ptr<'a, T>(p: *mut T, what: &str) -> Fmi2Result<&'a mut T> {
     Ok(unsafe { &mut *p })
 }
 
-unsafe fn c_str<'a>(p: *const c_char) -> Option<&'a CStr> {
+/// A C string argument, `None` for NULL.
+pub unsafe fn c_str<'a>(p: *const c_char) -> Option<&'a CStr> {
     // SAFETY: non-NULL strings are NUL-terminated per the C contract.
     (!p.is_null()).then(|| unsafe { CStr::from_ptr(p) })
 }

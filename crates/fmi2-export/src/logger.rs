@@ -1,4 +1,5 @@
-//! Logging through the host's `fmi2CallbackLogger`.
+//! Logging through the host's `fmi2CallbackLogger` (or, for the FMI 3.0 layer built on
+//! this one, its `fmi3LogMessageCallback`: [`LogSink::new_fmi3`]).
 //!
 //! The callback is variadic and hosts treat `message` as a printf format, so
 //! every message is passed as the argument of a constant `"%s"` format, with
@@ -10,7 +11,7 @@
 //! enabled; info/debug messages when `logAll` is enabled. `fmi2Instantiate`'s
 //! `loggingOn` enables all categories; `fmi2SetDebugLogging` changes them.
 
-use fmi_sys::fmi2;
+use fmi_sys::{fmi2, fmi3};
 use std::ffi::{CStr, CString};
 use std::fmt::Display;
 
@@ -37,10 +38,17 @@ pub enum Level {
     Debug,
 }
 
+/// The host's logger function: FMI 2.0 (variadic, printf format) or FMI 3.0 (plain message).
+#[derive(Debug, Clone, Copy)]
+enum Callback {
+    Fmi2(fmi2::fmi2CallbackLogger),
+    Fmi3(fmi3::fmi3LogMessageCallback),
+}
+
 /// The host's logger of one instance plus its category filter.
 #[derive(Debug)]
 pub struct LogSink {
-    callback: fmi2::fmi2CallbackLogger,
+    callback: Callback,
     env: fmi2::fmi2ComponentEnvironment,
     instance_name: CString,
     enabled: [bool; N_CATEGORIES],
@@ -55,7 +63,23 @@ impl LogSink {
         logging_on: bool,
     ) -> Self {
         Self {
-            callback,
+            callback: Callback::Fmi2(callback),
+            env,
+            instance_name: to_cstring(instance_name),
+            enabled: [logging_on; N_CATEGORIES],
+        }
+    }
+
+    /// A sink forwarding to an FMI 3.0 `fmi3LogMessageCallback` (may be `None`: nothing
+    /// is logged). `env` is the host's `instanceEnvironment`.
+    pub fn new_fmi3(
+        callback: fmi3::fmi3LogMessageCallback,
+        env: fmi3::fmi3InstanceEnvironment,
+        instance_name: &str,
+        logging_on: bool,
+    ) -> Self {
+        Self {
+            callback: Callback::Fmi3(callback),
             env,
             instance_name: to_cstring(instance_name),
             enabled: [logging_on; N_CATEGORIES],
@@ -69,7 +93,11 @@ impl LogSink {
 
     /// Whether a message of this level would reach the host.
     pub fn enabled(&self, level: Level) -> bool {
-        self.callback.is_some()
+        let present = match self.callback {
+            Callback::Fmi2(c) => c.is_some(),
+            Callback::Fmi3(c) => c.is_some(),
+        };
+        present
             && match level {
                 Level::Error => true,
                 Level::Warning | Level::Discard => self.enabled[CAT_WARNING] || self.enabled[CAT_ALL],
@@ -102,7 +130,6 @@ impl LogSink {
         if !self.enabled(level) {
             return;
         }
-        let Some(callback) = self.callback else { return };
         let (status, category) = match level {
             Level::Error => (fmi2::fmi2Status_fmi2Error, CATEGORY_CSTRS[CAT_ERROR]),
             Level::Discard => (fmi2::fmi2Status_fmi2Discard, CATEGORY_CSTRS[CAT_WARNING]),
@@ -110,18 +137,27 @@ impl LogSink {
             Level::Info | Level::Debug => (fmi2::fmi2Status_fmi2OK, CATEGORY_CSTRS[CAT_ALL]),
         };
         let text = to_cstring(&message.to_string());
-        // SAFETY: the host supplied `callback`; every pointer passed is a valid
-        // NUL-terminated string that outlives the call; "%s" consumes exactly
-        // the one variadic argument supplied.
-        unsafe {
-            callback(
-                self.env,
-                self.instance_name.as_ptr(),
-                status,
-                category.as_ptr(),
-                c"%s".as_ptr(),
-                text.as_ptr(),
-            );
+        match self.callback {
+            // SAFETY: the host supplied `callback`; every pointer passed is a valid
+            // NUL-terminated string that outlives the call; "%s" consumes exactly
+            // the one variadic argument supplied.
+            Callback::Fmi2(Some(callback)) => unsafe {
+                callback(
+                    self.env,
+                    self.instance_name.as_ptr(),
+                    status,
+                    category.as_ptr(),
+                    c"%s".as_ptr(),
+                    text.as_ptr(),
+                );
+            },
+            // SAFETY: as above; FMI 3.0 passes the message itself (no format) and no
+            // instance name. The FMI 2.0 and 3.0 status codes used here are equal
+            // (OK 0, Warning 1, Discard 2, Error 3).
+            Callback::Fmi3(Some(callback)) => unsafe {
+                callback(self.env, status as fmi3::fmi3Status, category.as_ptr(), text.as_ptr());
+            },
+            Callback::Fmi2(None) | Callback::Fmi3(None) => {}
         }
     }
 }

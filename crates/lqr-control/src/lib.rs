@@ -314,6 +314,7 @@ impl LqrParams {
                 relinearisation_period: self.relinearisation_period,
                 reference_after_back_transition: tuned,
                 reference_in_transition_wind: tuned,
+                reference_in_hover_wind: tuned,
             },
             integrator: IntegratorSwitches {
                 integrator_limit: self.integrator_limit,

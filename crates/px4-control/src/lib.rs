@@ -78,12 +78,14 @@ pub struct Derived {
     pub pitch_offset: f64,
     /// TRIM_PITCH: normalised pitch torque of the level trim's surfaces.
     pub trim_pitch: f64,
-    /// FW_AIRSPD_MIN, VT_ARSP_TRANS (m/s).
+    /// FW_AIRSPD_MIN, VT_ARSP_TRANS (m/s) (the latter FW_AIRSPD_TRIM when derived).
     pub airspeed_min: f64,
     pub transition_airspeed: f64,
     /// FW_T_CLMB_MAX, FW_T_SINK_MIN (m/s).
     pub climb_max: f64,
     pub sink_min: f64,
+    /// MPC_Z_VEL_MAX_UP (m/s).
+    pub climb_rate_max: f64,
     /// VT_F_TRANS_DUR, VT_B_TRANS_DUR (s).
     pub front_duration: f64,
     pub back_duration: f64,
@@ -129,11 +131,20 @@ impl Derived {
             / (airframe.air_density * airframe.wing_area * pm.c_l_alpha * mission.transition_alpha_max))
             .sqrt();
         let airspeed_min = or(p.FW_AIRSPD_MIN, stall_like);
+        // The profile's largest climb rate v sin γ (its pull-up into the second vertical
+        // phase), at least twice v_vertical (the landings' and steps' margin).
+        let profile = guidance::Profile::new(mission, &pm, &guidance::ProfileLimits::of(mission))?;
+        let profile_climb = profile
+            .points()
+            .iter()
+            .map(|q| q.v * q.gamma.sin())
+            .fold(2.0 * mission.v_vertical, f64::max);
         Ok(Self {
             airspeed_min,
-            transition_airspeed: or(p.VT_ARSP_TRANS, airspeed_min),
+            transition_airspeed: or(p.VT_ARSP_TRANS, v_trim),
             climb_max,
             sink_min,
+            climb_rate_max: or(p.MPC_Z_VEL_MAX_UP, profile_climb),
             thr_hover: or(p.MPC_THR_HOVER, climb.thrust / airframe.thrust_max),
             thr_trim: or(p.FW_THR_TRIM, level.thrust / airframe.thrust_max),
             airspeed_trim: v_trim,
@@ -160,6 +171,8 @@ pub struct Internals {
     pub torque: Vector3<f64>,
     /// TECS throttle and pitch setpoint (fixed wing).
     pub tecs: (f64, f64),
+    /// TECS airspeed setpoint (fixed wing) (m/s).
+    pub airspeed_sp: f64,
 }
 
 /// The controller.
@@ -288,7 +301,7 @@ impl Px4Controller {
             vel_i: Vector3::new(p.MPC_XY_VEL_I_ACC, p.MPC_XY_VEL_I_ACC, p.MPC_Z_VEL_I_ACC),
             vel_d: Vector3::new(p.MPC_XY_VEL_D_ACC, p.MPC_XY_VEL_D_ACC, p.MPC_Z_VEL_D_ACC),
             vel_max_xy: p.MPC_XY_VEL_MAX,
-            vel_max_up: p.MPC_Z_VEL_MAX_UP,
+            vel_max_up: self.derived.climb_rate_max,
             vel_max_down: p.MPC_Z_VEL_MAX_DN,
             tilt_max: p.MPC_TILTMAX_AIR,
             thr_hover: self.derived.thr_hover,
@@ -478,6 +491,8 @@ impl Px4Controller {
         let tas = meas.airspeed;
         let tas_rate = meas.specific_force_body.x - g * pitch.sin();
         let tp = self.tecs_params();
+        let tas_sp = self.fw_airspeed_setpoint(meas, r);
+        self.internals.airspeed_sp = tas_sp;
         let out = self.tecs.update(
             &tp,
             -meas.pos_ned.z,
@@ -485,7 +500,7 @@ impl Px4Controller {
             tas,
             tas_rate,
             -r.pos.z,
-            r.airspeed,
+            tas_sp,
             -r.vel.z,
             dt,
         );
@@ -527,6 +542,33 @@ impl Px4Controller {
         self.internals.rate_sp = rate_sp;
         self.internals.tecs = (out.throttle, pitch_sp);
         (torque, out.throttle)
+    }
+
+    /// TECS's airspeed setpoint in fixed-wing flight: the airspeed that gives the ground
+    /// velocity t̂ (|v_ref| + e_s / τ_s) along the reference's tangent t̂ in the measured
+    /// wind, e_s = t̂ · (p_ref − p) the along-track error (README, "What differs from PX4":
+    /// PX4 flies waypoints, not a position over time). τ_s = 2 FW_T_TAS_TC: with TECS's
+    /// first-order speed loop of time constant τ_v the along-track error obeys
+    /// τ_v ë + ė + e/τ_s = 0, damped at ζ = √(τ_s/(4 τ_v)) = 0.71. The correction is at most
+    /// FW_AIRSPD_TRIM − FW_AIRSPD_MIN either way and the setpoint at least FW_AIRSPD_MIN.
+    fn fw_airspeed_setpoint(&self, meas: &Measurement, r: &Reference) -> f64 {
+        let d = &self.derived;
+        let speed = r.vel.norm();
+        if speed < 1.0 {
+            return r.airspeed.max(d.airspeed_min);
+        }
+        let tangent = r.vel / speed;
+        let e_s = tangent.dot(&(r.pos - meas.pos_ned));
+        let tau_s = 2.0 * self.params.FW_T_TAS_TC;
+        let span = (d.airspeed_trim - d.airspeed_min).max(0.0);
+        let ground_sp = tangent * (speed + (e_s / tau_s).clamp(-span, span));
+        // The wind: the ground velocity less the air velocity (body axes turned to earth).
+        let q_b = body_attitude(meas);
+        let (sa, ca) = meas.alpha.sin_cos();
+        let (sb, cb) = meas.beta.sin_cos();
+        let air = q_b * (Vector3::new(ca * cb, sb, sa * cb) * meas.airspeed);
+        let wind = meas.vel_ned - air;
+        (ground_sp - wind).norm().max(d.airspeed_min)
     }
 
     /// A notice when a surface is newly clipped.

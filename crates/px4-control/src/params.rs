@@ -27,7 +27,7 @@ pub struct Px4Params {
     pub MPC_Z_VEL_D_ACC: f64,
     /// Largest horizontal velocity setpoint (PX4 default).
     pub MPC_XY_VEL_MAX: f64,
-    /// Largest climb-rate setpoint. PX4 default 3 m/s; here twice v_vertical so the mission's 3 m/s climb feed-forward is not clipped.
+    /// Largest climb-rate setpoint. PX4 default 3 m/s; derived for this mission when ≤ 0 (README, 'Derived parameters'): the flight-path profile's largest climb rate, at least 2 v_vertical.
     pub MPC_Z_VEL_MAX_UP: f64,
     /// Largest descent-rate setpoint. PX4 default 1.5 m/s; here 3 m/s so the landings' descent rate is not clipped.
     pub MPC_Z_VEL_MAX_DN: f64,
@@ -87,7 +87,7 @@ pub struct Px4Params {
     pub VT_F_TRANS_DUR: f64,
     /// Back transition: pitch ramp duration and time-out; ≤ 0: the mission's t_transition_2 (PX4 default 4 s).
     pub VT_B_TRANS_DUR: f64,
-    /// Front transition: airspeed at which fixed-wing flight may begin (PX4 default 10 m/s, below this airframe's stall speed); ≤ 0: FW_AIRSPD_MIN (PX4: between FW_AIRSPD_MIN and FW_AIRSPD_TRIM).
+    /// Front transition: airspeed at which fixed-wing flight may begin (PX4 default 10 m/s, below this airframe's stall speed; PX4: between FW_AIRSPD_MIN and FW_AIRSPD_TRIM); derived when ≤ 0 (README, 'Derived parameters'): FW_AIRSPD_TRIM, the speed the mission's front transition ends at.
     pub VT_ARSP_TRANS: f64,
     /// Trim airspeed of the airspeed scaling and TECS; derived for this airframe when ≤ 0 (README, 'Derived parameters'): the mission's v_level.
     pub FW_AIRSPD_TRIM: f64,
@@ -276,6 +276,7 @@ impl Px4Params {
                     | "FW_AIRSPD_MIN"
                     | "VT_ARSP_TRANS"
                     | "FW_T_SINK_MIN"
+                    | "MPC_Z_VEL_MAX_UP"
             );
             if !signed && value < 0.0 {
                 return Err(ParamError(format!("{name} = {value}: must be ≥ 0")));

@@ -28,7 +28,7 @@ fn bench(c: &mut Criterion) {
         mag: cbe * params.earth.mag_ned(),
         pitot: x[idx::U],
     };
-    ekf.initialize(&m, &trim.inputs);
+    ekf.initialize(&m);
     let mut k = 0i32;
     c.bench_function("ekf_step_20ms", |b| {
         b.iter(|| {

@@ -32,6 +32,15 @@ impl Actuators {
         }
     }
 
+    /// The state the estimator starts from: thrust `thrust` and elevator `elevator`, the
+    /// other surfaces 0, each within its limits (the steady state of those commands).
+    pub fn initial(a: &Airframe, thrust: f64, elevator: f64) -> Self {
+        let mut u = InputVector::zeros();
+        u[idx::THRUST_CMD] = thrust;
+        u[idx::ELEVATOR_CMD] = elevator;
+        Self::steady(a, &u)
+    }
+
     /// Advance by `h` (s) with the commands `u` held.
     pub fn advance(&mut self, a: &Airframe, u: &InputVector, h: f64) {
         let tc = u[idx::THRUST_CMD].clamp(a.thrust_min, a.thrust_max);

@@ -655,7 +655,7 @@ impl Ekf {
         Ok(())
     }
 
-    /// Initialise from one set of measurements and the commands:
+    /// Initialise from one set of measurements:
     ///
     /// * attitude by TRIAD from accelerometer levelling (in unaccelerated flight the specific
     ///   force is −g: its opposite is "down" in body axes) and the magnetometer (heading),
@@ -664,10 +664,15 @@ impl Ekf {
     /// * position and velocity from the GPS fix when valid (its σ), else the NED origin at
     ///   rest with `init_std_pos_no_gps`, `init_std_vel_no_gps`;
     /// * biases and wind zero with their initial σ;
-    /// * motor and servos at the steady state of the commands (as the plant's trims).
+    /// * motor and servos at `init_thrust`, `init_elevator` (the other surfaces 0): what they
+    ///   hold at the start, the trim the aircraft is released in. Not from the commands: the
+    ///   motor and servos are lags (2.3.16, App. D.5), their state at t₀ does not depend on
+    ///   the command at t₀, which only acts from t₀ on (the first [`Ekf::step`]). So no
+    ///   output at initialisation depends on a command, and a master that initialises the
+    ///   estimator and the controller together has no loop to solve.
     ///
     /// These measurements are not fused again by the next [`Ekf::step`].
-    pub fn initialize(&mut self, m: &Measurements, u: &InputVector) -> InitReport {
+    pub fn initialize(&mut self, m: &Measurements) -> InitReport {
         let p = self.params.clone();
         let g = p.earth.gravity;
         let mut s = FilterState::zeroed();
@@ -758,7 +763,7 @@ impl Ekf {
             // No usable IMU sample: assume the unaccelerated flight of the attitude above.
             s.imu_accel = dcm_earth_to_body(&s.quat) * Vector3::new(0.0, 0.0, -g);
         }
-        s.actuators = Actuators::steady(&p.airframe, u);
+        s.actuators = Actuators::initial(&p.airframe, p.tuning.init_thrust, p.tuning.init_elevator);
         s.out_rates = s.imu_gyro;
         s.out_force = s.imu_accel;
         s.skip_updates = true;
@@ -1515,7 +1520,7 @@ mod tests {
                 pitot: 0.0,
             };
             let mut ekf = Ekf::new(params.clone()).unwrap();
-            let r = ekf.initialize(&m, &InputVector::zeros());
+            let r = ekf.initialize(&m);
             assert!(r.attitude_from_sensors && r.accel_ratio > 1.1, "{r:?}");
             let levelled_tilt = (a.norm() / g).atan();
             assert!(levelled_tilt > 0.38, "the case must be one levelling gets wrong");

@@ -79,7 +79,8 @@ impl Earth {
     }
 }
 
-/// Initial uncertainties of the states not set from a measurement, and behaviour limits.
+/// Initial values and uncertainties of the states not set from a measurement, and
+/// behaviour limits.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Tuning {
     /// Initial wind σ per axis (m/s).
@@ -92,6 +93,14 @@ pub struct Tuning {
     pub init_std_pos_no_gps: f64,
     /// Initial velocity σ per axis without a GPS fix at initialisation (m/s).
     pub init_std_vel_no_gps: f64,
+    /// Thrust state T of the motor model at initialisation (N), clamped to the thrust
+    /// limits: what the motor holds when the estimator starts (the plant's `trim_thrust`).
+    /// A state of the lag (2.3.16), T(t₀) does not depend on the command at t₀.
+    pub init_thrust: f64,
+    /// Elevator deflection of the servo model at initialisation (rad), clamped to the
+    /// deflection limit (the plant's `trim_elevator`); the other surfaces start at 0, as in
+    /// every (symmetric) trim the plant starts in.
+    pub init_elevator: f64,
     /// The pitot is fused only above this reading (m/s): at lower airspeed (hover) the
     /// pressure is too small to resolve.
     pub pitot_min_airspeed: f64,
@@ -271,11 +280,18 @@ impl EstimatorParams {
             ("pitot_min_airspeed", self.tuning.pitot_min_airspeed),
             ("sigma_sideslip", self.tuning.sigma_sideslip),
             ("sideslip_min_airspeed", self.tuning.sideslip_min_airspeed),
+            ("init_thrust", self.tuning.init_thrust),
         ];
         for (name, v) in non_negative {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(format!("{name} = {v} must be finite and >= 0"));
             }
+        }
+        if !self.tuning.init_elevator.is_finite() {
+            return Err(format!(
+                "init_elevator = {} rad must be finite",
+                self.tuning.init_elevator
+            ));
         }
         if !(self.filter.bandwidth.is_finite() && self.filter.bandwidth > 0.0) {
             return Err(format!(

@@ -16,10 +16,9 @@ pub(crate) struct Airflow {
     pub axial_airspeed: f64,
     /// Crossflow V̄ √(1 − cos²α cos²β) (m/s).
     pub crossflow: f64,
-    /// Weight (0–1) of the hover-in-wind design condition.
+    /// Weight (0–1) of the hover-in-wind design condition: the crossflow's, in the take-off
+    /// and landing phases the measured wind's.
     pub hover_wind: f64,
-    /// The same for the loops: 0 in the take-off and landing phases (their own hover design).
-    pub hover_wind_loops: f64,
     /// Weight κ of the wind axes against the reference-path frame.
     pub kappa: f64,
 }
@@ -44,24 +43,28 @@ impl TsdController {
         let crossflow = (meas.airspeed * meas.airspeed - axial_airspeed * axial_airspeed)
             .max(0.0)
             .sqrt();
-        let hover_wind = if dev.hover_wind_design && reference_airspeed <= self.mission.v_vertical + 1.0 {
-            band_weight(crossflow, HOVER_WIND_CROSSFLOW)
-        } else {
+        let hover_wind = if !(dev.hover_wind_design && reference_airspeed <= self.mission.v_vertical + 1.0) {
             0.0
+        } else if ground_phase {
+            // Take-off and landing phases: weighted with the measured wind, not the crossflow
+            // (the approach translates at up to 3 m/s in still air, with its own hover design).
+            let w = guidance::weathervane::air_data_wind(meas);
+            band_weight(w.x.hypot(w.y), HOVER_WIND_CROSSFLOW)
+        } else {
+            band_weight(crossflow, HOVER_WIND_CROSSFLOW)
         };
         // Tuned configuration, hover in wind: the reference-path frame is kept, κ scaled by
         // 1 − hover_wind (README, "Hover in a span-wise wind"): with the nose tilted into a
         // strong wind the air comes along the nose, the axial airspeed passes 4 m/s and the
         // blend turned the loops to wind axes that pointed 50–75° off the vertical; the axial
         // command Σ·i^W then fell to nothing (thrust to 0 N) and the aircraft fell.
-        // Not in the take-off and landing phases (their own hover design; unchanged).
-        let hover_wind_loops = if ground_phase { 0.0 } else { hover_wind };
-        let kappa = self.frame_weight(axial_airspeed) * (1.0 - hover_wind_loops);
+        // Also in the take-off and landing phases, there with the measured wind's weight
+        // (README, "Take-off and landing in wind").
+        let kappa = self.frame_weight(axial_airspeed) * (1.0 - hover_wind);
         Airflow {
             axial_airspeed,
             crossflow,
             hover_wind,
-            hover_wind_loops,
             kappa,
         }
     }

@@ -167,7 +167,9 @@ impl TsdController {
     ///
     /// In the take-off and landing phases (vertical, slow, the air possibly from behind in
     /// the descent, α → π) the loops are designed for hover at the axial airspeed: the
-    /// attached-flow models of (4.2.x) at α ≈ π would reverse the surfaces' sign. Tuned
+    /// attached-flow models of (4.2.x) at α ≈ π would reverse the surfaces' sign; in wind
+    /// (tuned configuration) blended towards the hover-in-wind condition with the measured
+    /// wind's weight (README, "Take-off and landing in wind"). Tuned
     /// configuration, hover (the reference at the vertical speed) in wind: at α = 0 and
     /// HOVER_WIND_DESIGN_SPEED_FACTOR × V̄, blended in with the crossflow (README, "Hover in a
     /// wind step"). At the measured condition (a wind step puts α at ±60° or β at ±65°, V̄ at
@@ -181,7 +183,8 @@ impl TsdController {
         t: f64,
     ) -> Result<LoopDesign, ControlError> {
         let (fc_airspeed, fc_alpha) = if r.ground_phase() {
-            (air.axial_airspeed.max(0.0), 0.0)
+            let hover_wind_speed = meas.airspeed * HOVER_WIND_DESIGN_SPEED_FACTOR;
+            (lerp(air.axial_airspeed.max(0.0), hover_wind_speed, air.hover_wind), 0.0)
         } else {
             (
                 meas.airspeed * lerp(1.0, HOVER_WIND_DESIGN_SPEED_FACTOR, air.hover_wind),
@@ -195,7 +198,7 @@ impl TsdController {
             induced_velocity: meas.induced_velocity,
             axial_airspeed: air.axial_airspeed,
             reference_airspeed: r.reference.airspeed,
-            hover_wind: air.hover_wind_loops,
+            hover_wind: air.hover_wind,
             crossflow: air.crossflow,
         })
         .map_err(|what| Self::err(format!("{what} gains not computable at t = {t} s")))

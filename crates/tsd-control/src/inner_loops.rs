@@ -55,10 +55,14 @@ impl TsdController {
         let (p_ref, da_p) = roll_law(d, roll_error, meas.beta, axes);
         let (g2, g2_dot, r_prime) = directional_gravity(d, axes, g, air.kappa);
         let k_d = d.directional_gains;
-        let weathercock_ff = if dev.weathercock_feedforward && !r.ground_phase() {
-            self.weathercock_feedforward(meas, d, air)
-        } else {
+        // In the take-off and landing phases weighted with the measured wind (README,
+        // "Take-off and landing in wind").
+        let weathercock_ff = if !dev.weathercock_feedforward {
             0.0
+        } else if r.ground_phase() {
+            air.hover_wind * self.weathercock_feedforward(meas, d, air)
+        } else {
+            self.weathercock_feedforward(meas, d, air)
         };
         LoopLaws {
             thrust_p,

@@ -377,7 +377,15 @@ impl SampledUnit for TsdController {
             self.airframe.deflection_limit,
             dev.integrators_as_accelerations,
         );
-        let (command, u_sat) = mixing::allocate(&u, s.d.mixing, dev.roll_differential_flaps, &self.airframe);
+        let (mut command, u_sat) = mixing::allocate(&u, s.d.mixing, dev.roll_differential_flaps, &self.airframe);
+        // Landing in wind (README, "Take-off and landing in wind"): the collective flaps'
+        // direct-force trim.
+        if dev.hover_wind_design {
+            let lim = self.airframe.deflection_limit;
+            let trim =
+                wind_mission::landing_flap_trim(meas, r.reference.phase, &self.weathervane.wind()) * s.air.hover_wind;
+            command.flap_collective = (command.flap_collective + trim).clamp(-lim, lim);
+        }
         if !command.is_finite() {
             return Err(Self::err(format!("non-finite command at t = {} s", input.t)));
         }

@@ -78,7 +78,10 @@ impl TsdController {
         // vector turned about the earth's down axis by ψ_w; zero in still air and in the
         // take-off and landing phases (their own vertical reference).
         let heading = if sigma_ground.is_some() {
-            guidance::HeadingRef::default()
+            // Take-off and landing phases (README, "Take-off and landing in wind"): the belly
+            // or the back into the measured wind.
+            let target = self.wind_mission.ground_target(&self.weathervane);
+            self.weathervane.update_towards(&self.mission, input.t, meas, target)
         } else {
             // Mission logic in wind (README, "Missions in wind"): the heading of the
             // handover, the transitions and level flight.

@@ -33,6 +33,14 @@ pub const LOAD_FILTER_TIME: f64 = 1.0;
 /// Horizontal specific force below which the heading is held (m/s²).
 pub const MIN_HORIZONTAL_FORCE: f64 = 0.5;
 
+/// Collective-flap trim per m/s of wind into the belly in the landing phases (rad s/m):
+/// the slope of the plant's still, upright hover trim (−5.2°, −9.8°, −13.8° of collective
+/// flaps at 1, 2, 3 m/s face-on, `cargo run --release -p analysis --example tsd_wind_bounds`).
+pub const LANDING_FLAP_TRIM_GAIN: f64 = 4.6 * core::f64::consts::PI / 180.0;
+/// Largest collective-flap trim in the landing phases (rad): the trim of the upright hover
+/// is −20° from 5 m/s; the rest of the ±25° is left to the normal loop.
+pub const LANDING_FLAP_TRIM_LIMIT: f64 = 17.0 * core::f64::consts::PI / 180.0;
+
 /// Number of f64 values [`WindMission::save`] writes.
 pub const WIND_MISSION_STATE_LEN: usize = 3;
 
@@ -60,6 +68,31 @@ fn specific_force_earth(m: &Measurement) -> Vector3<f64> {
     let q = &m.quat;
     let r = UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]));
     r * m.specific_force_body
+}
+
+/// Direct-force trim of the collective flaps in the landing phases (approach, descent,
+/// flare) (rad), from the filtered air-data wind `wind` (NED) and the measured attitude
+/// (README, "Take-off and landing in wind"). Nose up, the flaps sit in the propellers'
+/// slip-stream (≈ 23 m/s in hover): a wind into the belly turns the slip-stream's flow over
+/// the wing, whose normal force then needs 30° of tilt at 3 m/s and 41° at 5 m/s to be held
+/// (measured at touchdown), far outside an upright landing. The collective flaps deflected
+/// against the wind cancel that force with the nose vertical (the plant's trim: −13.8° at
+/// 3 m/s, −20° at 5–8 m/s; the elevator trims the moment). The trim is
+/// −[`LANDING_FLAP_TRIM_GAIN`] × (wind into the belly), within ±[`LANDING_FLAP_TRIM_LIMIT`];
+/// 0 in other phases and without a wind estimate.
+pub fn landing_flap_trim(m: &Measurement, phase: Phase, wind: &Vector3<f64>) -> f64 {
+    let landing = matches!(phase, Phase::Approach | Phase::Descent | Phase::Flare);
+    if !(landing && wind.x.is_finite() && wind.y.is_finite()) {
+        return 0.0;
+    }
+    let q = &m.quat;
+    let belly = UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2])) * Vector3::z();
+    let size = belly.xy().norm();
+    if size < 0.5 {
+        return 0.0;
+    }
+    let into_belly = -wind.xy().dot(&belly.xy()) / size;
+    -(LANDING_FLAP_TRIM_GAIN * into_belly).clamp(-LANDING_FLAP_TRIM_LIMIT, LANDING_FLAP_TRIM_LIMIT)
 }
 
 impl WindMission {
@@ -110,13 +143,7 @@ impl WindMission {
                 self.load = [f.x, f.y];
             }
         }
-        let w = wv.wind();
-        let speed = w.x.hypot(w.y);
-        if speed >= p.engage_speed {
-            self.engaged = true;
-        } else if speed.is_nan() || speed < p.release_speed {
-            self.engaged = false;
-        }
+        self.engage(wv);
         if !(self.engaged && Self::in_window(wv, mission, t)) {
             return None;
         }
@@ -127,6 +154,35 @@ impl WindMission {
             return Some((heading, p.max_rate));
         }
         Some((nearer_face(heading, e.atan2(n)), p.max_rate))
+    }
+
+    /// The engagement's hysteresis on the weathervane's filtered air-data wind.
+    fn engage(&mut self, wv: &Weathervane) {
+        let p = wv.params();
+        let w = wv.wind();
+        let speed = w.x.hypot(w.y);
+        if speed >= p.engage_speed {
+            self.engaged = true;
+        } else if speed.is_nan() || speed < p.release_speed {
+            self.engaged = false;
+        }
+    }
+
+    /// The heading target of the take-off and landing phases (README, "Take-off and landing
+    /// in wind"), for [`Weathervane::update_towards`]: engaged, the belly or the back into the
+    /// wind (the weathervane's); released, the heading held. `None` with the weathervane off.
+    pub fn ground_target(&mut self, wv: &Weathervane) -> Option<(f64, f64)> {
+        let p = wv.params();
+        if !p.enabled {
+            return None;
+        }
+        self.engage(wv);
+        let heading = wv.heading();
+        let w = wv.wind();
+        if !(self.engaged && w.x.is_finite() && w.y.is_finite()) {
+            return Some((heading, p.max_rate));
+        }
+        Some((nearer_face(heading, (-w.y).atan2(-w.x)), p.max_rate))
     }
 
     /// Write the state ([`WIND_MISSION_STATE_LEN`] values).
@@ -200,5 +256,54 @@ mod tests {
             "{}",
             target.to_degrees()
         );
+    }
+
+    /// The take-off and landing phases: still air holds the heading exactly (the calm
+    /// flights unchanged); a steady 8 m/s wind from the east turns the belly or the back
+    /// into it (±90°) once the filtered estimate has engaged.
+    #[test]
+    fn ground_heading_holds_in_still_air_and_faces_the_wind() {
+        let mission = MissionParams::default();
+        let mut wv = Weathervane::new(WeathervaneParams::tuned()).unwrap();
+        let mut wm = WindMission::default();
+        let calm = hovering(Vector3::zeros(), Vector3::zeros());
+        for k in 0..100 {
+            let target = wm.ground_target(&wv);
+            assert_eq!(target, Some((0.0, wv.params().max_rate)));
+            wv.update_towards(&mission, k as f64 * mission.sample_time, &calm, target);
+            assert_eq!(wv.heading(), 0.0);
+        }
+        let m = hovering(Vector3::new(0.0, -8.0, 0.0), Vector3::zeros());
+        for k in 0..1500 {
+            let target = wm.ground_target(&wv);
+            wv.update_towards(&mission, k as f64 * mission.sample_time, &m, target);
+        }
+        assert!(wm.engaged());
+        let (target, _) = wm.ground_target(&wv).unwrap();
+        assert!(
+            (target.abs() - core::f64::consts::FRAC_PI_2).abs() < 0.02,
+            "{}",
+            target.to_degrees()
+        );
+        assert!((wv.heading() - target).abs() < 0.02, "{}", wv.heading().to_degrees());
+    }
+
+    /// The collective-flap trim: −4.6° per m/s of wind into the belly, ±17° at most, the
+    /// sign following the face, only in the landing phases.
+    #[test]
+    fn landing_flap_trim_opposes_the_wind_into_the_belly() {
+        let m = hovering(Vector3::zeros(), Vector3::zeros());
+        let from_north = |v: f64| Vector3::new(-v, 0.0, 0.0);
+        let deg = |x: f64| x.to_degrees();
+        let t = landing_flap_trim(&m, Phase::Descent, &from_north(3.0));
+        assert!((deg(t) + 13.8).abs() < 1e-9, "{}", deg(t));
+        let t = landing_flap_trim(&m, Phase::Flare, &from_north(-3.0));
+        assert!((deg(t) - 13.8).abs() < 1e-9, "{}", deg(t));
+        let t = landing_flap_trim(&m, Phase::Approach, &from_north(10.0));
+        assert!((deg(t) + 17.0).abs() < 1e-9, "{}", deg(t));
+        // Along the span: no trim; outside the landing phases or without an estimate: none.
+        assert!(landing_flap_trim(&m, Phase::Descent, &Vector3::new(0.0, 8.0, 0.0)).abs() < 1e-12);
+        assert_eq!(landing_flap_trim(&m, Phase::Vertical2, &from_north(5.0)), 0.0);
+        assert_eq!(landing_flap_trim(&m, Phase::Descent, &Vector3::repeat(f64::NAN)), 0.0);
     }
 }

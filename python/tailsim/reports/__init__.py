@@ -1,7 +1,7 @@
 """The reports: the comparison product (`compare`: missions, step tests, Markdown and
 HTML), the analysis report (`analysis`, with `aero`, `envelope`, `hover`, `takeoff`
-sections and `analysis_plots`), the avionics section (`avionics`) and the Markdown /
-HTML helpers (`markdown`)."""
+sections and `analysis_plots`), the avionics section (`avionics`), the Markdown /
+HTML helpers (`markdown`) and the generated figures of the documentation (`docs`)."""
 
 from __future__ import annotations
 

@@ -10,6 +10,11 @@ Writes PNGs beside the CSVs:
   table_5_1.png                       regenerated Table 5.1 next to the thesis's
   robustness.png, gusts.png           nonlinear robustness ranges (per aerodynamic model) and
                                       largest survived gusts
+
+Every title names the aerodynamic model and the configuration it shows (`setting`): the
+analysis flies `Plant::new` (the thesis's linear aerodynamics, `aero_model` 0, the controllers'
+design model) with the tuned controllers (`configuration` 0); the robustness sweep also the
+global model (`aero_model` 1).
 """
 
 import csv
@@ -23,6 +28,22 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from tailsim.reports import envelope as report_envelope  # noqa: E402
+
+#: The plant's aerodynamic models by `aero_model`.
+AERO_MODELS = {0: "thesis (linear) aerodynamics", 1: "global (post-stall) aerodynamics"}
+#: The configuration of the controllers the analysis flies (crates/analysis: `configuration` 0).
+CONFIGURATION = "tuned controllers (configuration 0)"
+
+
+def aero(model=0) -> str:
+    """`thesis (linear) aerodynamics (aero_model 0)`."""
+    m = int(model)
+    return f"{AERO_MODELS.get(m, 'aerodynamics')} (aero_model {m})"
+
+
+def setting(model=0, controllers: bool = True) -> str:
+    """The aerodynamic model and (for closed loops) the configuration, for a title."""
+    return aero(model) + (f", {CONFIGURATION}" if controllers else ", open loop")
 
 
 def rows(path):
@@ -67,7 +88,7 @@ def main(out):
             (m["re"], m["im"]) for m in json.loads((out / "report.json").read_text())["open_loop"]["thesis_level"]
         ]
         ax.plot([t[0] for t in thesis], [t[1] for t in thesis], "o", mfc="none", label="thesis (level)")
-        splane(ax, "Open-loop modes")
+        splane(ax, f"Open-loop modes\n{setting(controllers=False)}")
         ax.legend(fontsize=7)
         save(fig, out / "open_loop_modes.png", 120)
 
@@ -80,7 +101,7 @@ def main(out):
                     (float(r["re"]), float(r["im"])) for r in cl if r["condition"] == cond and r["controller"] == ctl
                 ]
                 ax.plot([p[0] for p in pts], [p[1] for p in pts], mk, label=ctl)
-            splane(ax, f"Closed-loop poles, {cond} flight")
+            splane(ax, f"Closed-loop poles, {cond} flight\n{setting()}")
             ax.legend(fontsize=7)
             save(fig, out / f"closed_loop_poles_{cond}.png", 120)
 
@@ -107,6 +128,7 @@ def main(out):
                 axs = axs if len(pitch) > 1 else [axs]
                 for ax, p in zip(axs, pitch, strict=False):
                     draw(ax, (ctl, cond, p), f"{ctl} {cond}: {p} (dot = smallest factor)")
+                fig.suptitle(f"Pole loci, {ctl}, {cond} flight: {setting()}", fontsize=10)
                 save(fig, out / f"loci_{ctl}_{cond}_pitch.png", 110)
             ps = [p for p in params if (ctl, cond, p) in loci]
             ncol = 5
@@ -117,6 +139,7 @@ def main(out):
                     draw(axs[i // ncol][i % ncol], (ctl, cond, p), f"{ctl} {cond}: {p}")
                 for j in range(len(ps), nrow * ncol):
                     axs[j // ncol][j % ncol].axis("off")
+                fig.suptitle(f"Pole loci, {ctl}, {cond} flight: {setting()}", fontsize=12)
                 save(fig, out / f"loci_{ctl}_{cond}_all.png", 80)
 
     if (out / "table_5_1.csv").exists():
@@ -143,7 +166,7 @@ def main(out):
         ax.set_xticks(range(len(params)))
         ax.set_xticklabels(params, rotation=60, fontsize=8)
         ax.set_ylabel("RMS pole movement (% of ω_n)")
-        ax.set_title("Table 5.1, level flight: thesis against regenerated")
+        ax.set_title(f"Table 5.1, level flight: thesis against regenerated\n{setting()}")
         ax.legend(fontsize=8)
         save(fig, out / "table_5_1.png", 110)
 
@@ -152,7 +175,6 @@ def main(out):
         params = unique(x["param"] for x in r)
         # One row of panels per aerodynamic model (thesis 0, global 1).
         models = sorted({x.get("aero_model", "0") for x in r})
-        name = {"0": "thesis aero", "1": "global aero"}
         ctls = unique(x["controller"] for x in r)
         fig, axs = plt.subplots(
             len(models), len(ctls), figsize=(6 * len(ctls), 5 * len(models)), sharey=True, squeeze=False
@@ -177,7 +199,9 @@ def main(out):
                 ax.set_yticks(range(len(params)))
                 ax.set_yticklabels(params, fontsize=8)
                 ax.set_xlabel("scale factor (plant only)")
-                ax.set_title(f"{ctl}, {name.get(model, model)}: mission passed (green) / failed (red)", fontsize=9)
+                ax.set_title(
+                    f"{ctl}, {aero(model)}, {CONFIGURATION}:\nmission passed (green) / failed (red)", fontsize=9
+                )
                 ax.axvline(1, color="k", lw=0.5)
         save(fig, out / "robustness.png", 110)
 
@@ -205,6 +229,7 @@ def main(out):
         ax.set_xticks(range(len(cases)))
         ax.set_xticklabels([f"{p}\n{a}" for p, a in cases], fontsize=8)
         ax.set_ylabel("largest survived 1−cos gust (m/s)")
+        ax.set_title(f"Largest survived gust per phase and axis\n{setting()}", fontsize=9)
         ax.legend()
         save(fig, out / "gusts.png", 110)
 

@@ -86,9 +86,18 @@ def section(d: dict) -> list[str]:
     return out
 
 
-def plot(out: str | Path, d: dict) -> Path | None:
-    """`envelope_fastest.png`: α, flight-path angle and altitude error of the fastest
-    transitions of each controller; None if there is nothing to draw."""
+def title(e: dict) -> str:
+    """The plot's title: the α bound, the aerodynamic model and the controllers' configuration
+    (the fastest transitions are the tuned controllers', flown under the Gauss-Seidel master;
+    `crates/analysis/src/envelope_transitions.rs`)."""
+    from .analysis_plots import setting
+
+    bound = shortest(round(e["alpha_bound_deg"], 6))
+    return f"Fastest transitions inside α ≤ {bound}°: {setting(e['aero_model'])}, Gauss-Seidel master"
+
+
+def figure(d: dict):
+    """The figure of `plot` (None if there is nothing to draw)."""
     e = d.get("envelope_transitions")
     if not e or not e.get("fastest"):
         return None
@@ -116,8 +125,19 @@ def plot(out: str | Path, d: dict) -> Path | None:
     for ax in axes:
         ax.grid(alpha=0.3)
     axes[0].legend(fontsize=7)
-    axes[0].set_title("Fastest transitions inside α ≤ 15° (global aerodynamics, Gauss-Seidel)", fontsize=9)
+    axes[0].set_title(title(e), fontsize=9)
     fig.tight_layout()
+    return fig
+
+
+def plot(out: str | Path, d: dict) -> Path | None:
+    """`envelope_fastest.png`: α, flight-path angle and altitude error of the fastest
+    transitions of each controller; None if there is nothing to draw."""
+    fig = figure(d)
+    if fig is None:
+        return None
+    import matplotlib.pyplot as plt
+
     path = Path(out) / "envelope_fastest.png"
     fig.savefig(path, dpi=110)
     plt.close(fig)

@@ -10,9 +10,7 @@ use nalgebra::Vector3;
 use state_estimator::{Ekf, EstimatorParams};
 use std::hint::black_box;
 
-#[path = "../tests/support/chain.rs"]
-mod chain;
-use chain::{measurement, to_estimator, truth};
+use closed_loop::avionics::{measurement_of as measurement, to_estimator, truth};
 use tailsitter_physics::{idx, Airframe, Plant};
 use tsd_control::{TsdController, TsdParams};
 
@@ -26,10 +24,9 @@ fn mission<C: FlightController>(c: &mut C) -> f64 {
     let wind = Vector3::zeros();
     let mut sensors = sensor_model::SensorModel::new(sensor_model::Params::default()).unwrap();
     let mut ekf = Ekf::new(EstimatorParams::default()).unwrap();
-    ekf.initialize(
-        &to_estimator(&sensors.start(&truth(&plant, &x, &u, &wind), 0.0).unwrap()),
-        &u,
-    );
+    ekf.initialize(&to_estimator(
+        &sensors.start(&truth(&plant, &x, &u, &wind), 0.0).unwrap(),
+    ));
     let n = (m.end_time() / H).round() as usize;
     for k in 0..n {
         let t = k as f64 * H;

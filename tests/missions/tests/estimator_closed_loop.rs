@@ -9,8 +9,7 @@ use state_estimator::{Ekf, EstimatorParams, Measurements};
 use tailsitter_physics::{dcm_earth_to_body, idx, Airframe, Plant};
 use tsd_control::{TsdController, TsdParams};
 
-mod support;
-use support::chain::{measurement, to_estimator, truth};
+use closed_loop::avionics::{measurement_of as measurement, to_estimator, truth};
 
 struct Flight {
     /// Max distance of the true position from the reference (m).
@@ -146,7 +145,7 @@ fn fly_chain<C: FlightController>(c: &mut C, seed: u64, chain: Chain) -> Flight 
     let mut ekf = Ekf::new(estimator_params(chain, &sensor_params)).unwrap();
     let wind = Vector3::zeros();
     let m0 = sensors.start(&truth(&plant, &x, &trim.inputs, &wind), 0.0).unwrap();
-    ekf.initialize(&to_estimator(&m0), &trim.inputs);
+    ekf.initialize(&to_estimator(&m0));
     let n = (m.end_time() / H).round() as usize;
     let hs = H / chain.substeps as f64;
     let mut f = Flight {

@@ -4,10 +4,11 @@
 //! margin (`cargo run --release -p missions --example controller_table` prints them side by
 //! side with the LQR and TSD).
 //!
-//! The position error is against the missions' flight-path profile: PX4's fixed-wing
-//! flight holds height and line but not the position along the path, and its back
-//! transition does not fly the profile's climb, so the errors of the level and later
-//! phases are tens of metres by method, not by failure.
+//! The position error is against the missions' flight-path profile: in fixed-wing flight
+//! the airspeed setpoint is corrected from the along-track error, the back transition's
+//! height loop flies the profile's climb (crate README, "What differs from PX4"); what is
+//! left is PX4's front transition, whose thrust holds height with the horizontal axes free
+//! (it ends 6–8 m behind the profile; the level phase inherits that).
 
 use closed_loop::{fly, MissionCheck, Ordering, Scenario, Trace};
 use flight_mission::{MissionParams, Phase, SampledUnit};
@@ -56,17 +57,20 @@ fn assert_default_mission(ordering: Ordering) {
     let mission = MissionParams::default();
     let (trace, check, modes) = run(mission, ordering);
     assert!(trace.completed(), "{:?}", trace.failure);
-    // The criteria: level airspeed within 1 m/s (measured 0.97 / 0.99 m/s: TECS's 5 s speed
-    // time constant from the transition's end at 20 m/s), pitch within 5° (1.9°), upright
-    // at the end (0.2°).
+    // The criteria: level airspeed within 1 m/s (measured GS / Jacobi 0.40 / 0.42 m/s), pitch
+    // within 5° (0.36° / 0.45°), upright at the end (0.00° / 0.07°).
     assert!(check.passed(), "{check}");
-    assert!(check.final_pitch_error < 1f64.to_radians(), "{check}");
+    assert!(check.level_airspeed_error < 0.6, "{check}");
+    assert!(check.level_pitch_error < 1f64.to_radians(), "{check}");
+    assert!(check.final_pitch_error < 0.5f64.to_radians(), "{check}");
     // Vertical flight on the multicopter position controller: on the reference.
     assert!(check.phase_errors[0].max < 0.05, "{check}");
-    // Front transition: the ramp reaches fixed-wing flight within T1 = 5 s (at ≈ 4.1 s).
+    // Front transition: fixed-wing flight once the ramp is over and the airspeed reaches
+    // VT_ARSP_TRANS = v_level, 0.4 s after T1 = 5 s (the profile reaches it at 9.6 s).
     let fw = first(&trace, &modes, VtolMode::FixedWing).expect("fixed-wing flight");
-    assert!(fw > 5.0 + 3.0 && fw < 10.0, "fixed wing at {fw} s");
-    // Back transition: upright (multicopter flight) before T2 = 10 s is over.
+    assert!(fw > 5.0 + 4.5 && fw < 11.0, "fixed wing at {fw} s");
+    // Back transition: on the request at 20 s, upright (multicopter flight) before T2 = 10 s
+    // is over.
     let back = first(&trace, &modes, VtolMode::BackTransition).expect("back transition");
     assert!((back - 20.0).abs() < 0.03, "{back}");
     let mc = trace
@@ -77,11 +81,22 @@ fn assert_default_mission(ordering: Ordering) {
         .map(|(s, _)| s.t)
         .expect("multicopter flight again");
     assert!(mc < 30.0, "multicopter at {mc} s");
-    // Errors against the profile (measured 6.6 m in T1, 21 m level, 77 m T2, 103 m at the
-    // end: the profile's climb through T2 is not flown).
-    assert!(check.phase_errors[1].max < 8.0, "{check}");
-    assert!(check.phase_errors[2].max < 25.0, "{check}");
-    assert!(trace.max_pos_error() < 110.0, "{}", trace.max_pos_error());
+    // Errors against the profile (measured GS / Jacobi: 8.4 / 8.5 m in T1, 9.5 / 9.6 m
+    // level, 11.6 / 11.4 m in T2, 3.8 / 3.9 m in the second vertical phase). Flying the
+    // profile's climb through T2 is what keeps the last two small: holding 6 m/s of climb
+    // at most, they were 77 m and 103 m.
+    assert!(check.phase_errors[1].max < 10.0, "{check}");
+    assert!(check.phase_errors[2].max < 11.0, "{check}");
+    assert!(check.phase_errors[3].max < 13.0, "{check}");
+    assert!(check.phase_errors[4].max < 5.0, "{check}");
+    assert!(trace.max_pos_error() < 13.0, "{}", trace.max_pos_error());
+    // α through the front transition and level flight: that of flight (measured 16.5°).
+    let alpha = trace
+        .window(5.0, 20.0)
+        .filter(|s| s.measurement.airspeed >= 5.0)
+        .map(|s| s.measurement.alpha.abs())
+        .fold(0.0, f64::max);
+    assert!(alpha < 20f64.to_radians(), "{}", alpha.to_degrees());
 }
 
 #[test]
@@ -94,24 +109,24 @@ fn default_mission_jacobi() {
     assert_default_mission(Ordering::Jacobi);
 }
 
-/// The fast mission (T1 = 3 s, T2 = 4 s): PX4's ramps at 30°/s and 22.5°/s. It flies and ends
-/// upright (2.4° / 2.7°), but the level airspeed is 1.32 / 1.39 m/s short of v_level in the
-/// criteria's window (TECS's 5 s time constant): the 1 m/s criterion is not met.
+/// The fast mission (T1 = 3 s, T2 = 4 s): PX4's ramps at 30°/s and 22.5°/s. It meets the
+/// criteria (level airspeed within 0.30 m/s of v_level, pitch 0.2° / 0.35°, upright within
+/// 0.3° / 1.1°); the largest error 9.1 / 9.3 m (level flight).
 #[test]
 fn fast_mission() {
     for ordering in [Ordering::GaussSeidel, Ordering::Jacobi] {
         let mission = MissionParams::fast();
         let (trace, check, modes) = run(mission, ordering);
         assert!(trace.completed(), "{:?}", trace.failure);
-        assert!(check.all_finite);
-        assert!(check.final_pitch_error < 4f64.to_radians(), "{check}");
-        assert!(check.level_pitch_error < 3f64.to_radians(), "{check}");
-        assert!(check.level_airspeed_error < 1.5, "{check}");
-        // Fixed-wing flight 3.3 s after the transition began (the airspeed reaches
-        // VT_ARSP_TRANS after the 3 s ramp's pitch threshold).
+        assert!(check.passed(), "{check}");
+        assert!(check.level_airspeed_error < 0.45, "{check}");
+        assert!(check.final_pitch_error < 2f64.to_radians(), "{check}");
+        // Fixed-wing flight after the 3 s ramp's pitch threshold and VT_ARSP_TRANS.
         let fw = first(&trace, &modes, VtolMode::FixedWing).expect("fixed-wing flight");
         assert!(fw > 7.0 && fw < 9.0, "fixed wing at {fw} s");
-        assert!(trace.max_pos_error() < 32.0, "{}", trace.max_pos_error());
+        assert!(check.phase_errors[1].max < 7.5, "{check}");
+        assert!(check.phase_errors[2].max < 10.5, "{check}");
+        assert!(trace.max_pos_error() < 10.5, "{}", trace.max_pos_error());
     }
 }
 
@@ -133,6 +148,15 @@ fn takeoff_to_landing() {
         let miss = (last.measurement.pos_ned.xy() - nalgebra::Vector2::new(460.0, 0.0)).norm();
         assert!(miss < 0.5, "miss distance {miss} m");
         assert!((last.theta - core::f64::consts::FRAC_PI_2).abs() < 2f64.to_radians());
+        // On the profile as in the default mission, take-off and landing included (measured
+        // 11.6 / 11.4 m).
+        let theta = Plant::new(Airframe::default())
+            .trim_level(mission.v_level)
+            .unwrap()
+            .theta;
+        let check = MissionCheck::of(&trace, &mission, theta);
+        let flight = check.phase_errors.iter().map(|e| e.max).fold(0.0, f64::max);
+        assert!(flight < 13.0, "{flight} m");
     }
 }
 
@@ -161,6 +185,41 @@ fn vertical_position_steps_settle() {
             last_out - 5.0 < bound && final_err < 0.2,
             "{offset}: {} s, {final_err} m",
             last_out - 5.0
+        );
+    }
+}
+
+/// 5 m steps of the reference 5 s into a 40 s level phase, settling within 0.5 m on the
+/// stepped axis. East (L1 on the offset line): 8.7 s. Down (TECS): 21.7 s — TECS's height
+/// loop is first order with FW_T_ALT_TC = 5 s (11.5 s to 10 % at best), and the descent
+/// trades height for speed, overshoots by 0.75 m and comes back on TECS's slow integrators;
+/// it ends within 0.12 m.
+#[test]
+fn level_position_steps_settle() {
+    let mission = MissionParams::preset("step_level").unwrap();
+    let plant = Plant::new(Airframe::default());
+    let x0 = plant.trim_vertical_climb(mission.v_vertical).unwrap().state;
+    let (t_step, t_end) = (15.0, 45.0);
+    for (offset, bound) in [(Vector3::new(0.0, 5.0, 0.0), 10.0), (Vector3::new(0.0, 0.0, 5.0), 24.0)] {
+        let mut ctl = Px4Controller::with_mission(mission).unwrap();
+        let mut s = Scenario::mission(mission);
+        s.stop_time = t_end;
+        s.ref_offset_steps = vec![(t_step, offset)];
+        let trace = fly(&plant, x0, &mut ctl, &s);
+        assert!(trace.completed(), "{:?}", trace.failure);
+        let axis = offset.normalize();
+        let err = |smp: &closed_loop::Sample| (smp.measurement.pos_ned - smp.diagnostics.ref_pos_ned).dot(&axis).abs();
+        let mut last_out = t_step;
+        for smp in trace.window(t_step, t_end + 1.0) {
+            if err(smp) > 0.5 {
+                last_out = smp.t;
+            }
+        }
+        let final_err = err(trace.samples.last().unwrap());
+        assert!(
+            last_out - t_step < bound && final_err < 0.2,
+            "{offset}: {} s, {final_err} m",
+            last_out - t_step
         );
     }
 }

@@ -296,11 +296,11 @@ fn reinitialisation_mid_run_restarts_cleanly() {
     let mut ekf = Ekf::new(params.clone()).unwrap();
     let mut sim = SensorSim::new(&params, 21);
     let m = sim.measure(&ekf, &truth, 0);
-    ekf.initialize(&m, &truth.u[0]);
+    ekf.initialize(&m);
     for k in 0..truth.len() {
         let m = sim.measure(&ekf, &truth, k);
         if k == 400 {
-            let r = ekf.initialize(&m, &truth.u[k]);
+            let r = ekf.initialize(&m);
             assert!(r.from_gps && r.attitude_from_sensors);
             assert!((r.accel_ratio - 1.0).abs() < 0.1, "steady flight: |f| ≈ g");
             assert_eq!(ekf.estimate().rejected_measurements, 0);

@@ -249,7 +249,7 @@ pub fn run_filter(
     let mut sim = SensorSim::new(params, seed);
     let mut m0 = sim.measure(&ekf, truth, 0);
     perturb(0, &mut sim, &mut m0);
-    ekf.initialize(&m0, &truth.u[0]);
+    ekf.initialize(&m0);
     for k in 0..truth.len() {
         let mut m = if k == 0 { m0 } else { sim.measure(&ekf, truth, k) };
         if k > 0 {

@@ -1,0 +1,190 @@
+"""The documentation's figures stay true: every generated block of docs/*.md is the one
+`python -m tailsim.reports.docs --write` produces from the committed result files now, and
+a measured figure typed by hand outside a generated or history block fails the scan."""
+
+from __future__ import annotations
+
+import json
+import pathlib
+import shutil
+
+import pytest
+
+from tailsim.reports import docs, docs_blocks
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+
+
+def copy_docs(tmp_path: pathlib.Path) -> pathlib.Path:
+    shutil.copytree(ROOT / "docs", tmp_path / "docs")
+    return tmp_path
+
+
+def test_generated_blocks_match_the_result_files():
+    stale = docs.regenerate(ROOT, write=False)
+    assert stale == [], f"{stale}: run `python -m tailsim.reports.docs --write`"
+    assert docs.main(["--check"]) == 0
+
+
+def test_every_block_has_a_generator_and_every_generator_a_block():
+    used = {k for p in docs.doc_files() for k in docs.keys_in(p.read_text())}
+    assert used, "no generated block in docs/"
+    assert {k for k in used if not k.startswith("def.")} == set(docs.BLOCKS)
+    for k in used:
+        docs.render(k, docs.Sources())  # resolves (a definition that is not declared raises)
+
+
+def test_a_changed_result_file_or_a_hand_edit_is_found(tmp_path):
+    root = copy_docs(tmp_path)
+    assert docs.regenerate(root, write=False) == []
+    full = json.loads((ROOT / "docs" / docs_blocks.FULL).read_text())
+    full["arms"]["tsd/tuned/perfect"]["p"] = 0.5
+    assert docs.regenerate(root, write=False, override={docs_blocks.FULL: full}) == ["docs/CAMPAIGN.md"]
+    # the reading now says so, and a rewrite makes the check pass again
+    assert docs.regenerate(root, override={docs_blocks.FULL: full}) == ["docs/CAMPAIGN.md"]
+    assert "the tuned LQR completes 79 % and the tuned TSD 50 %" in (root / "docs" / "CAMPAIGN.md").read_text()
+    assert docs.regenerate(root, write=False, override={docs_blocks.FULL: full}) == []
+    # a figure edited by hand inside a block
+    thesis = root / "docs" / "THESIS.md"
+    text = thesis.read_text()
+    body = docs.BLOCK_RE.search(text)
+    thesis.write_text(text[: body.start("body")] + body["body"].replace("0", "9", 1) + text[body.end("body") :])
+    assert docs.regenerate(root, write=False, override={docs_blocks.FULL: full}) == ["docs/THESIS.md"]
+
+
+def test_no_hand_typed_measured_figure_outside_the_blocks():
+    bad = docs.untagged(ROOT)
+    assert bad == [], (
+        "figures typed by hand in docs/ (generate them: tailsim.reports.docs; or label a dated record "
+        "<!-- history: … -->; a definition goes into docs/figures_allowed.json):\n" + "\n".join(bad)
+    )
+
+
+def test_the_allow_list_is_exact():
+    assert docs.slack(ROOT) == [], "remove these entries from docs/figures_allowed.json"
+    kinds = {k for f in json.loads((ROOT / "docs" / "figures_allowed.json").read_text())["files"].values() for k in f}
+    for k in kinds - set(docs.ALLOWED_KINDS):
+        assert k.startswith(docs.CHECKED) and (ROOT / "docs" / k[len(docs.CHECKED) :]).exists(), k
+
+
+def test_quoted_figures_agree_with_the_committed_outputs():
+    """A figure quoted by hand from a committed output (the thesis_switches examples) is one of
+    its numbers, as rounded in the text: after the output is re-run, a changed figure fails."""
+    assert docs.checked_mismatches(ROOT) == []
+    assert docs.matches("8.1 m", [8.06]) and docs.matches("−1.38 g", [-1.3827])
+    assert not docs.matches("5.69 m", [5.70]) and not docs.matches("3.0°", [3.06])
+
+
+def test_a_changed_output_fails_the_quoted_figures(tmp_path):
+    root = copy_docs(tmp_path)
+    p = root / "docs" / "thesis_switches_tsd.txt"
+    assert docs.checked_mismatches(root) == []
+    p.write_text(p.read_text().replace("| 6.74 / 6.74 / 32.2 / no |", "| 6.90 / 6.90 / 32.2 / no |"))
+    assert docs.checked_mismatches(root) == ["docs/THESIS.md: 6.74 m not in thesis_switches_tsd.txt"]
+
+
+def test_a_new_hand_typed_figure_fails(tmp_path):
+    root = copy_docs(tmp_path)
+    assert docs.untagged(root) == []
+    p = root / "docs" / "USAGE.md"
+    p.write_text(p.read_text() + "\nThe TSD now flies the mission within 0.41 m, 12 % better, in 3.5 s.\n")
+    bad = docs.untagged(root)
+    assert [b.split(": ", 1)[1] for b in bad] == ["0.41 m", "12 %", "3.5 s"], bad
+
+
+@pytest.mark.parametrize(
+    ("text", "found"),
+    [
+        ("max error 0.39 m at 12° and 2.3e-14 m", ["0.39 m", "12°", "2.3e-14 m"]),
+        ("(4.2.17), Table 5.1, §4.2.2, App. D.1, D-4.27, O-17, FMI 2.0, glibc 2.17", []),
+        ("`--samples 200` in `c1000`, t_transition_1, two controllers, 5 phases", []),
+        ("<!-- generated:x -->0.787<!-- /generated --> and <!-- history: d -->0.5 s<!-- /history -->", []),
+        ("```\n1.25 m\n```\n    3.5 s indented\n", []),
+        ("787 of 1000 runs", ["787", "1000"]),
+    ],
+)
+def test_the_scan_finds_measured_figures_and_skips_references(text, found):
+    assert [t for _, t in docs.figures(text)] == found
+
+
+def test_definitions_follow_the_declarations():
+    from tailsim import declarations
+    from tailsim.campaign.sampling import CampaignSpec
+
+    m = declarations.MISSION_DEFAULTS
+    assert docs_blocks.definition("def.mission.t_level") == f"{m['t_level']:g} s"
+    assert docs_blocks.definition("def.mission.v_vertical") == f"{m['v_vertical']:g} m/s"
+    assert docs_blocks.definition("def.limits.deflection") == "25°"  # 0.4363… rad, shown in degrees
+    assert docs_blocks.definition("def.campaign.error_limit_m") == f"{CampaignSpec().error_limit_m:g} m"
+    assert docs_blocks.definition("def.campaign.turbulence_max.value") == str(CampaignSpec().turbulence_max)
+    with pytest.raises(KeyError):
+        docs_blocks.definition("def.nowhere.x")
+
+
+def test_result_files_record_their_command():
+    repro = json.loads((ROOT / "docs" / docs_blocks.REPRO).read_text())
+    assert "analysis -- reproduction" in repro["command"]
+    campaign = (ROOT / "docs" / "CAMPAIGN.md").read_text()
+    for name in (docs_blocks.FULL, docs_blocks.RERUN):
+        assert f"tailsim.campaign.section --write docs/{name}" in " ".join(campaign.split()), name
+    trims = json.loads((ROOT / "docs" / "design_trims.json").read_text())
+    assert "--example design_trims -- docs/design_trims.json" in trims["command"]
+    oms = json.loads((ROOT / "docs" / "omsimulator_run.json").read_text())
+    assert oms["command"].startswith("python scripts/omsimulator.py") and oms["commit"] in oms["omsimulator"]
+
+
+def test_history_documents_are_labelled():
+    for rel in docs.HISTORY_FILES:
+        head = (ROOT / rel).read_text().split("\n\n", 2)[1]
+        assert "history" in head.lower() and "not regenerated" in head, head
+
+
+def test_inventory_counts_every_figure():
+    inv = docs.inventory(ROOT)
+    assert set(inv) == {f"docs/{p.name}" for p in docs.doc_files()}
+    assert all(c["untagged"] == 0 for c in inv.values()), inv
+    assert sum(c["generated"] for c in inv.values()) > 0
+    assert inv["docs/PERFORMANCE.md"]["history"] > 0 and inv["docs/PERFORMANCE.md"]["pending"] == 0
+
+
+def test_markers_leave_the_markdown_intact():
+    """A line that starts with an HTML comment is an HTML block to CommonMark (GitHub): the rest of
+    the line would be shown raw. Markers at the start of a line therefore stand alone on it."""
+    import re
+
+    for p in docs.doc_files():
+        for n, line in enumerate(p.read_text().splitlines(), 1):
+            m = re.match(r"<!--.*?-->", line)
+            assert not m or m.end() == len(line.rstrip()), f"{p.name}:{n}: {line[:80]}"
+
+
+def test_the_omsimulator_page_follows_its_run_record(tmp_path):
+    """docs/OMSIMULATOR.md's figures come from docs/omsimulator_run.json (scripts/omsimulator.py):
+    a changed run changes the page, and the avionics paragraph says whether the two masters'
+    initialisations agree from the recorded distances, not from a fixed text."""
+    from tailsim.reports import docs_omsimulator
+
+    run = json.loads((ROOT / "docs" / docs_omsimulator.RUN).read_text())
+    src = docs.Sources(ROOT)
+    assert run["command"] in docs.render("omsim.run.intro", src)
+    assert run["commit"] in docs.render("omsim.run.intro", src)
+    table = docs.render("omsim.run.table", src)
+    assert len([r for r in table.splitlines() if r.startswith("| `")]) == len(run["runs"])
+
+    def with_distance(d: float) -> dict:
+        out = json.loads(json.dumps(run))
+        for r in out["runs"]:
+            if r["ssp"].endswith("_avionics.ssp"):
+                r["max_position_distance_m"] = d
+                r["initial"] = {"controller.thrust_cmd": 88.0, "estimator.thrust": 80.0, "plant.thrust": 88.0}
+        return out
+
+    same = docs.render("omsim.initialisation", docs.Sources(ROOT, {docs_omsimulator.RUN: with_distance(1e-12)}))
+    differ = docs.render("omsim.initialisation", docs.Sources(ROOT, {docs_omsimulator.RUN: with_distance(0.5)}))
+    assert same.startswith("Both masters") and "apart" not in same
+    assert "8.0 N apart" in differ and "0.50 m away" in differ
+    root = copy_docs(tmp_path)
+    assert docs.regenerate(root, write=False) == []
+    moved = json.loads(json.dumps(run))
+    moved["runs"][0]["max_pos_error_m"] += 0.01
+    assert docs.regenerate(root, write=False, override={docs_omsimulator.RUN: moved}) == ["docs/OMSIMULATOR.md"]
