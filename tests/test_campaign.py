@@ -19,6 +19,8 @@ from tailsim.campaign import Store, deterministic, local_cluster, run_campaign
 from tailsim.campaign import runner as R
 from tailsim.campaign.report import bootstrap_mean_ci, spearman, wilson_interval, write_report
 from tailsim.campaign.sampling import (
+    CONFIGURATIONS,
+    CONTROLLERS,
     MISSIONS,
     TABLE_5_1,
     CampaignSpec,
@@ -45,6 +47,9 @@ def short_spec(**kw) -> CampaignSpec:
     # atmosphere's runs have tests of their own).
     kw.setdefault("turbulence_max", 0)
     kw.setdefault("wind_max", 5.0)
+    # The machinery tests fly the two thesis controllers (the arms of both configurations);
+    # the tests of the third arm say `controllers=CONTROLLERS`.
+    kw.setdefault("controllers", ("lqr", "tsd"))
     return CampaignSpec(seed=7, mission_name="short", mission=dict(MISSIONS["short"]), **kw)
 
 
@@ -85,7 +90,7 @@ def test_samples_are_reproducible_subsets_and_log_uniform():
     a, b = CampaignSpec(seed=11, n_samples=5), CampaignSpec(seed=11, n_samples=500)
     assert draw_sample(a, 3) == draw_sample(b, 3)  # sample i depends on (seed, i) only
     assert draw_sample(a, 3) != draw_sample(CampaignSpec(seed=12), 3)
-    assert [j["sample_id"] for j in jobs(a)] == [0, 0, 1, 1, 2, 2, 3, 3, 4, 4]  # paired: both controllers
+    assert [j["sample_id"] for j in jobs(a)] == [i for i in range(5) for _ in CONTROLLERS]  # paired: every controller
     n = 4000
     samples = [draw_sample(b, i) for i in range(n)]
     for p in (TABLE_5_1[0], TABLE_5_1[-1]):
@@ -163,6 +168,8 @@ def test_unknown_axes_are_refused_clearly():
         CampaignSpec(state_sources=("gps",))
     with pytest.raises(ValueError, match="distinct"):
         CampaignSpec(configurations=("tuned", "tuned"))
+    with pytest.raises(ValueError, match="no arm: .*'px4'"):
+        CampaignSpec(controllers=("px4",), configurations=("thesis",))
 
 
 def test_axes_multiply_runs_without_changing_the_draws():
@@ -170,6 +177,16 @@ def test_axes_multiply_runs_without_changing_the_draws():
     four = short_spec(n_samples=2, configurations=("tuned", "thesis"), state_sources=("perfect", "avionics"))
     a, b = jobs(one), jobs(four)
     assert len(a) == 2 * 2 and len(b) == 2 * 2 * 2 * 2
+    # A controller without the thesis's `configuration` (PX4) is an arm of `tuned` only, on the
+    # same samples: 3 tuned + 2 thesis arms per state source.
+    assert "px4" in CONTROLLERS and "px4" in CONFIGURATIONS["tuned"] and "px4" not in CONFIGURATIONS["thesis"]
+    three = short_spec(
+        n_samples=2, controllers=CONTROLLERS, configurations=("tuned", "thesis"), state_sources=("perfect", "avionics")
+    )
+    c = jobs(three)
+    assert len(c) == 2 * (3 + 2) * 2
+    assert {(j["controller"], j["configuration"]) for j in c if j["controller"] == "px4"} == {("px4", "tuned")}
+    b = b + [j for j in c if j["controller"] == "px4"]
     assert len({j["key"] for j in b}) == len(b)
     for j in b:  # every run of a sample sees the sample's draw, whatever its axes
         ref = next(x for x in a if x["sample_id"] == j["sample_id"])
@@ -564,17 +581,25 @@ def test_native_campaign_flies_identical_jobs_to_the_same_rows(serial, tmp_path)
 
     faults = {1: {"c_m_q_a0": 30.0, "c_m_q_a1": 30.0}, 3: {"mass": -1.0}}  # a tumble, an invalid value
     # Samples 0 and 1 of seed 7 draw light and moderate turbulence: their wind is the atmosphere's in both engines.
-    spec = short_spec(n_samples=N + 1, configurations=("tuned", "thesis"), overrides=faults, turbulence_max=2)
+    spec = short_spec(
+        n_samples=N + 1,
+        controllers=CONTROLLERS,
+        configurations=("tuned", "thesis"),
+        overrides=faults,
+        turbulence_max=2,
+    )
     assert [draw_sample(spec, i)["turbulence_intensity"] for i in range(N + 1)] == [1, 2, 0, 0]
     fmpy_rows = run_campaign(spec, tmp_path / "fmpy", DIST, serial=True, progress=False).to_pylist()
     # The release binary when one was built (fast); else the debug one (same numbers, slower).
     profile = "release" if (ROOT / "target" / "release" / "analysis").exists() else "debug"
     native, _ = run_native(spec, DIST, threads=1, workdir=tmp_path / "native", profile=profile)
-    assert len(native) == len(fmpy_rows) == (N + 1) * 2 * 2
+    assert len(native) == len(fmpy_rows) == (N + 1) * (3 + 2)  # PX4: the tuned configuration only
     cmp = compare(fmpy_rows, native)
     assert cmp["runs"] == len(native) and not cmp["outcome_differs"], cmp["outcome_differs"]
     assert not cmp["beyond_tolerance"], cmp["beyond_tolerance"]
     outcome = {r["key"]: (r["completed"], r["failure"]) for r in native}
+    assert outcome["1/px4/tuned/perfect"] == (False, "divergence")
+    assert outcome["3/px4/tuned/perfect"] == (False, "fmi_error")
     for c in ("lqr", "tsd"):
         for cfg in ("tuned", "thesis"):
             assert outcome[f"1/{c}/{cfg}/perfect"] == (False, "divergence")
@@ -633,13 +658,69 @@ def test_comparison_section_is_the_paired_result(serial, tmp_path):
     (tmp_path / "out").mkdir()
     (tmp_path / "a").rename(tmp_path / "out" / "campaign")
     text = "\n".join(S.report_section(tmp_path / "out"))
-    assert "## Comparison: paired Monte-Carlo" in text and "tuned/perfect | RMS position error (m) | 3 |" in text
+    assert "## Comparison: paired Monte-Carlo" in text
+    assert "tuned/perfect | TSD − LQR | RMS position error (m) | 3 |" in text
+
+
+def test_comparison_section_pairs_every_two_controllers(tmp_path):
+    """Three controllers: the summary holds each pair's paired difference (later-declared
+    minus earlier), TSD − LQR under its old key, and the Markdown names each pair."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from tailsim.campaign import section as S
+
+    n, rows = 8, []
+    rms = {"lqr": 1.0, "tsd": 0.5, "px4": 2.0}
+    for i in range(n):
+        for c in ("lqr", "tsd", "px4"):
+            done = not (c == "px4" and i % 2)
+            rows.append(
+                {
+                    "sample_id": i,
+                    "controller": c,
+                    "configuration": "tuned",
+                    "state_source": "perfect",
+                    "completed": done,
+                    "failure": "" if done else "divergence",
+                    "rms_err": rms[c] + 0.1 * i,
+                    "max_err": 2 * rms[c],
+                }
+            )
+    (tmp_path / "c").mkdir()
+    pq.write_table(pa.Table.from_pylist(rows), tmp_path / "c" / "results.parquet")
+    (tmp_path / "c" / "campaign.json").write_text(json.dumps({"spec": short_spec().to_json(), "fmus": {}}))
+    s = S.summarize([tmp_path / "c"])
+    assert set(s["paired"]) == {"tuned/perfect", "tuned/perfect: PX4 − LQR", "tuned/perfect: PX4 − TSD"}
+    p = s["paired"]["tuned/perfect: PX4 − TSD"]
+    assert p["pair"] == ["px4", "tsd"]
+    assert p["completion"]["mean"] == pytest.approx(-0.5) and p["completion"]["n"] == n
+    assert p["rms_err"]["n"] == n // 2 and p["rms_err"]["mean"] == pytest.approx(1.5)
+    assert s["paired"]["tuned/perfect"]["rms_err"]["mean"] == pytest.approx(-0.5)
+    assert s["arms"]["px4/tuned/perfect"]["completed"] == n // 2
+    md = "\n".join(S.markdown(s, "three"))
+    assert "| tuned/perfect | PX4 − LQR | completion | 8 | -0.500 |" in md
+    assert "| tuned/perfect | TSD − LQR | RMS position error (m) | 8 | -0.500 |" in md
+    # Merged into a documented run (`--base`): each arm from the summary with more runs.
+    base = {
+        "spec": s["spec"],
+        "samples": {"lqr/tuned/perfect": 100},
+        "arms": {"lqr/tuned/perfect": {**s["arms"]["lqr/tuned/perfect"], "runs": 100}},
+        "paired": {},
+        "runtime": [{"folder": "old"}],
+    }
+    m = S.merge(base, s)
+    assert m["arms"]["lqr/tuned/perfect"]["runs"] == 100 and m["samples"]["lqr/tuned/perfect"] == 100
+    assert m["arms"]["px4/tuned/perfect"] == s["arms"]["px4/tuned/perfect"]
+    assert m["paired"] == s["paired"] and m["runtime"][0] == {"folder": "old"}
+    with pytest.raises(SystemExit, match="seed"):
+        S.merge({**base, "spec": {**s["spec"], "seed": 99}}, s)
 
 
 def test_report(serial, tmp_path):
     path = write_report(tmp_path, short_spec(), serial)
     text = path.read_text()
-    for needle in ("Wilson", "Paired difference TSD − LQR", "Spearman", "chapter-6"):
+    for needle in ("Wilson", "Paired differences", "| TSD − LQR | completion |", "Spearman", "chapter-6"):
         assert needle in text
     for png in ("completion.png", "distributions.png", "paired.png", "drivers.png"):
         assert (tmp_path / png).stat().st_size > 5000

@@ -109,7 +109,7 @@ def test_an_unexpected_error_is_one_line_and_exit_1_its_traceback_with_debug(tmp
         ("--tau-mass", "inf", "finite"),
         ("--timeout", "0", "> 0"),
         ("--workers", "0", "≥ 1"),
-        ("--controllers", "lqr,pid", "lqr, tsd"),
+        ("--controllers", "lqr,pid", "lqr, px4, tsd"),
         ("--controllers", "lqr,lqr", "repeated"),
         ("--configurations", "fancy", "tuned, thesis"),
         ("--state-sources", "psychic", "perfect, avionics"),

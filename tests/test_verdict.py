@@ -12,6 +12,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
+from tailsim.campaign.report import wilson_interval
 from tailsim.masters import RunResult
 from tailsim.metrics import flown_transitions, phase_starts
 from tailsim.reports import verdict
@@ -108,6 +109,34 @@ def test_wind_envelope_counts_cells_held(tmp_path):
     assert f.better == "x"
     assert "X holds 6/6 cells, held at every bearing up to 4 m/s" in f.by
     assert "Y holds 4/6 cells, held at every bearing up to 2 m/s" in f.by
+
+
+def test_side_by_side_puts_every_controller_in_its_column(tmp_path):
+    """The three-way table: one column per controller, the campaign's completion with its
+    Wilson interval, – for a controller not flown under a condition (no thesis configuration)."""
+    n = 20
+    write_campaign(
+        tmp_path / "campaign",
+        {
+            ("lqr", "tuned", "perfect"): [True] * n,
+            ("tsd", "tuned", "perfect"): [i % 2 == 0 for i in range(n)],
+            ("px4", "tuned", "perfect"): [i % 4 != 0 for i in range(n)],
+            ("lqr", "thesis", "perfect"): [True] * n,
+            ("tsd", "thesis", "perfect"): [i % 2 == 0 for i in range(n)],
+        },
+        {"lqr": 1.0, "tsd": 1.0, "px4": 2.0},
+    )
+    found = verdict.campaign_findings(tmp_path / "campaign")
+    md = verdict.side_by_side(found)
+    assert md[3] == "| condition | LQR | TSD | PX4 | better |"
+    rows = {r.split(" | ")[0].lstrip("| "): r for r in md[5:]}
+    tuned = rows["tuned configuration, uncertain plants, perfect state"]
+    lo, hi = wilson_interval(15, n)
+    assert f"P(complete) 0.750 [{lo:.3f}, {hi:.3f}]" in tuned
+    assert "P(complete) 1.000 [" in tuned and tuned.endswith("| LQR |")
+    thesis = rows["thesis configuration, uncertain plants, perfect state"]
+    assert thesis.split(" | ")[3] == "–"
+    assert md[2] == "" and "\n".join(md) in "\n".join(verdict.markdown(found))
 
 
 def test_collect_reads_one_run_folder_and_prints(tmp_path, capsys):

@@ -61,6 +61,46 @@ impl Analysable for tsd_control::TsdController {
     }
 }
 
+/// Offset of the PX4 loops' states in `Px4Controller::save`, which writes the VTOL mode
+/// logic, then [vel_int(3), MC rate integral(3), MC saturation flags(3), FW rate
+/// integral(3), FW saturation flags(3), TECS throttle and pitch integrators, the previous
+/// body rates(3), the surface saturation mask], then the ground phases: 21 values between.
+fn px4_loops_offset() -> usize {
+    px4_control::STATE_LEN - guidance::GroundPhases::SAVED_LEN - 21
+}
+
+impl Analysable for px4_control::Px4Controller {
+    /// The states of the loops active in the mode of the last sample: in multicopter flight
+    /// and the transitions the velocity integrator (PX4 `PositionControl`) and the MC rate
+    /// integrator (`RateControl`); in fixed-wing flight the FW rate integrator and TECS's
+    /// two integrators. Both modes also carry the previous body rates (the D terms'
+    /// finite-difference angular acceleration): a one-sample delay, a state of the sampled
+    /// map (its eigenvalue near z = 0 maps to a large negative s). Inactive integrators
+    /// are left out (they would add poles at s = 0 that no input reaches).
+    fn dynamic_states(&self) -> Vec<(usize, &'static str)> {
+        let o = px4_loops_offset();
+        let mut v = match self.mode() {
+            px4_control::VtolMode::FixedWing => vec![
+                (o + 9, "I_fw_p"),
+                (o + 10, "I_fw_q"),
+                (o + 11, "I_fw_r"),
+                (o + 15, "I_tecs_thr"),
+                (o + 16, "I_tecs_pitch"),
+            ],
+            _ => vec![
+                (o, "I_vel_n"),
+                (o + 1, "I_vel_e"),
+                (o + 2, "I_vel_d"),
+                (o + 3, "I_mc_x"),
+                (o + 4, "I_mc_y"),
+                (o + 5, "I_mc_z"),
+            ],
+        };
+        v.extend([(o + 17, "p_prev"), (o + 18, "q_prev"), (o + 19, "r_prev")]);
+        v
+    }
+}
+
 /// Names of the 19 minimal plant coordinates of the map.
 pub const PLANT_COORDS: [&str; 19] = [
     "pos_n", "pos_e", "pos_d", "u", "v", "w", "δθx", "δθy", "δθz", "p", "q", "r", "thrust", "δe", "δa", "δr", "δfc",

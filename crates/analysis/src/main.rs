@@ -80,7 +80,7 @@ enum Cmd {
 
 #[derive(clap::Args, Clone)]
 struct WindTraceArgs {
-    /// "lqr" or "tsd".
+    /// "lqr", "tsd" or "px4".
     #[arg(long, default_value = "tsd")]
     controller: String,
     /// "gauss-seidel" or "jacobi".
@@ -110,11 +110,10 @@ struct WindTraceArgs {
 
 fn wind_trace(a: &WindTraceArgs) -> Result<(), String> {
     use closed_loop::Ordering;
-    let kind = match a.controller.as_str() {
-        "lqr" => Kind::Lqr,
-        "tsd" => Kind::Tsd,
-        other => return Err(format!("controller '{other}': lqr or tsd")),
-    };
+    let kind = Kind::ALL
+        .into_iter()
+        .find(|k| k.name().eq_ignore_ascii_case(&a.controller))
+        .ok_or_else(|| format!("controller '{}': lqr, tsd or px4", a.controller))?;
     let ordering = match a.ordering.as_str() {
         "gauss-seidel" => Ordering::GaussSeidel,
         "jacobi" => Ordering::Jacobi,

@@ -19,6 +19,7 @@ use closed_loop::{fly, plant_inputs, MeasuredWind, Sample, Scenario, Trace, Wind
 use flight_mission::{FlightController, MissionParams};
 use lqr_control::{LqrController, LqrParams};
 use nalgebra::Vector3;
+use px4_control::{Px4Controller, Px4Params};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use tailsitter_physics::{AeroModel, Airframe, GlobalAero, Ground, Plant, StateVector};
@@ -55,9 +56,9 @@ pub struct JobWind {
 #[derive(Debug, Clone, Deserialize)]
 pub struct Job {
     pub key: String,
-    /// "lqr" or "tsd".
+    /// "lqr", "tsd" or "px4".
     pub controller: String,
-    /// The controllers' `configuration`: 0 tuned, 1 thesis.
+    /// The controllers' `configuration`: 0 tuned, 1 thesis (PX4 has none: 0 only).
     pub configuration: i32,
     /// Only "perfect" (the avionics chain is flown by the fmpy campaign only).
     pub state_source: String,
@@ -268,6 +269,16 @@ fn fly_job(job: &Job) -> Result<(Plant, Trace), String> {
             let trace = trace_of(&plant, x0, c, &scenario);
             Ok((plant, trace))
         }
+        // PX4's default parameters (its FMU's defaults); it has no thesis configuration.
+        "px4" if job.configuration == 0 => {
+            let c = Px4Controller::new(design, mission, Px4Params::default()).map_err(|e| format!("PX4: {}", e.0))?;
+            let trace = trace_of(&plant, x0, c, &scenario);
+            Ok((plant, trace))
+        }
+        "px4" => Err(format!(
+            "configuration = {}: PX4 has no thesis configuration",
+            job.configuration
+        )),
         other => Err(format!("unknown controller '{other}'")),
     }
 }
@@ -442,6 +453,22 @@ mod tests {
         assert_eq!((p.turbulence_model, p.turbulence_intensity, p.seed), (1, 2, 9));
         assert_eq!((p.wind_profile, p.origin_height), (0, 10.0));
         assert!((Wind::Atmosphere(p).at(0.0) - Vector3::new(-3.0, 4.0, 0.0)).norm() < 1e-12);
+    }
+
+    /// PX4 is an arm like the others: the same short flight completes; it has no thesis
+    /// configuration, so configuration 1 is a failed row saying so.
+    #[test]
+    fn px4_flies_the_same_job_and_refuses_a_thesis_configuration() {
+        let r = run(&job("px4"));
+        assert!(r.completed, "{r:?}");
+        assert_eq!(r.metrics["t_end"], Some(1.0));
+        let mut j = job("px4");
+        j.configuration = 1;
+        let r = run(&j);
+        assert!(
+            !r.completed && r.failure == "fmi_error" && r.detail.contains("no thesis configuration"),
+            "{r:?}"
+        );
     }
 
     #[test]

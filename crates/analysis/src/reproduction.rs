@@ -267,7 +267,7 @@ pub fn run(out: &Path, cfg: &Config, progress: bool) -> std::io::Result<Value> {
     let mut jobs: Vec<(usize, Kind, i32)> = Vec::new();
     for (pi, _) in params.iter().enumerate() {
         for (conf, _) in CONFIGURATIONS {
-            for kind in Kind::ALL {
+            for kind in Kind::THESIS {
                 jobs.push((pi, kind, conf));
             }
         }
@@ -299,7 +299,7 @@ pub fn run(out: &Path, cfg: &Config, progress: bool) -> std::io::Result<Value> {
         e.insert("param".into(), json!(p.id));
         e.insert("name".into(), json!(p.name));
         e.insert("class".into(), json!(p.class));
-        for kind in Kind::ALL {
+        for kind in Kind::THESIS {
             let th = if kind == Kind::Lqr { p.thesis.0 } else { p.thesis.1 };
             let k = kind.name().to_lowercase();
             e.insert(format!("{k}_thesis"), json!(th));
@@ -320,7 +320,7 @@ pub fn run(out: &Path, cfg: &Config, progress: bool) -> std::io::Result<Value> {
     }
     let idx: Vec<usize> = (0..params.len()).collect();
     let mut spear = serde_json::Map::new();
-    for kind in Kind::ALL {
+    for kind in Kind::THESIS {
         for (conf, cname) in CONFIGURATIONS {
             let ours: Vec<f64> = idx.iter().map(|&i| rms(i, kind, conf)).collect();
             let th: Vec<f64> = params
@@ -377,7 +377,7 @@ pub fn run(out: &Path, cfg: &Config, progress: bool) -> std::io::Result<Value> {
         "verdict": verdict(c1_holds * 10 >= thesis_holds * 9, c1_holds * 2 > n_params),
     }));
     let mut tops = serde_json::Map::new();
-    for kind in Kind::ALL {
+    for kind in Kind::THESIS {
         let k = kind.name().to_lowercase();
         tops.insert(format!("{k}_thesis"), json!(top3(kind, None)));
         for (conf, cname) in CONFIGURATIONS {
@@ -433,7 +433,7 @@ pub fn run(out: &Path, cfg: &Config, progress: bool) -> std::io::Result<Value> {
             .collect();
         v.iter().sum::<f64>() / v.len().max(1) as f64
     };
-    let phys_ok = Kind::ALL.iter().all(|k| {
+    let phys_ok = Kind::THESIS.iter().all(|k| {
         class_max(*k, 1, true) < class_max(*k, 1, false) && class_mean(*k, 1, true) < class_mean(*k, 1, false)
     });
     conclusions.push(json!({
@@ -478,7 +478,7 @@ pub fn run(out: &Path, cfg: &Config, progress: bool) -> std::io::Result<Value> {
     };
     let mut missions = serde_json::Map::new();
     for (conf, cname) in CONFIGURATIONS {
-        for kind in Kind::ALL {
+        for kind in Kind::THESIS {
             for (mname, m) in [("default", mission), ("fast", fast)] {
                 missions.insert(
                     format!("{}_{cname}_{mname}", kind.name().to_lowercase()),
@@ -721,7 +721,7 @@ pub fn run(out: &Path, cfg: &Config, progress: bool) -> std::io::Result<Value> {
             sf(0), sf(1), sf(2), sf(3), sf(4), sf(5),
         )
     };
-    for kind in Kind::ALL {
+    for kind in Kind::THESIS {
         for flight in ["level", "vertical"] {
             for axis in ["normal", "lateral"] {
                 let (Some(c1), c0) = (
@@ -856,7 +856,7 @@ mod tests {
     fn table_5_1_configuration_1_finite_for_both() {
         let p = sensitivity::params().into_iter().find(|p| p.id == "Cma").unwrap();
         let mission = MissionParams::default();
-        for kind in Kind::ALL {
+        for kind in Kind::THESIS {
             let r = table_5_1_entry(&p, kind, 1, 4, &mission).expect("nominal point");
             assert!(
                 r.rms_percent.is_finite() && r.rms_percent > 0.0,

@@ -655,6 +655,7 @@ pub fn fly_t2(kind: Kind, model: AeroModel, t2: f64) -> Result<Trace, String> {
             let mut c = TsdController::new(Airframe::default(), m, TsdParams::default()).map_err(|e| e.0)?;
             fly(&plant, x0, &mut c, &scenario)
         }
+        Kind::Px4 => fly(&plant, x0, &mut Kind::Px4.make(&m), &scenario),
     })
 }
 
@@ -857,7 +858,7 @@ mod tests {
     #[ignore]
     fn flown_table() {
         for model in [AeroModel::Thesis, AeroModel::Global] {
-            for kind in Kind::ALL {
+            for kind in Kind::THESIS {
                 for t2 in T2_VALUES {
                     let r = flown(kind, model, t2);
                     println!("{r:?} tracked {}", r.tracked());

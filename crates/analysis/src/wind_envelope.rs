@@ -994,11 +994,12 @@ pub fn main(a: &Args) -> Result<(), String> {
 mod tests {
     use super::*;
 
+    /// Held by the thesis's controllers; PX4 flies it to the end but off the held bound.
     #[test]
     fn calm_cell_of_the_default_mission_holds() {
         for kind in Kind::ALL {
             let c = fly_cell(kind, MissionKind::Default, WindForm::Step, 0.0, 0);
-            assert!(c.completed && c.held, "{c:?}");
+            assert!(c.completed && c.held == kind.in_thesis(), "{c:?}");
         }
     }
 
@@ -1093,12 +1094,13 @@ mod tests {
         }
     }
 
-    /// A calm default mission is held by every tuned controller on every state source and
-    /// ordering (perfect < 3 m, avionics < 5 m from the reference; measured 0.4–0.7 m and
-    /// 2.0–4.4 m).
+    /// A calm default mission is held by the thesis's tuned controllers on every state source
+    /// and ordering (perfect < 3 m, avionics < 5 m from the reference; measured 0.4–0.7 m and
+    /// 2.0–4.4 m). PX4 is not: its back transition leaves the reference's horizontal path
+    /// (11.5 m in calm air), a cell the grid reports as flown but not held.
     #[test]
     fn calm_cell_is_held_on_every_axis_by_the_tuned_controllers() {
-        for kind in Kind::ALL {
+        for kind in Kind::THESIS {
             for state in [StateKind::Perfect, StateKind::Avionics] {
                 for ordering in [OrderingKind::GaussSeidel, OrderingKind::Jacobi] {
                     let job = Job::new(kind, MissionKind::Default, WindForm::Step, 0.0, 0).on(axes(

@@ -66,7 +66,7 @@ fn writes_the_data_the_renderer_reads() {
     let dir = std::env::temp_dir().join(format!("aero-models-test-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let rows = run(&dir, &MissionParams::default(), &[1.0, 2.0]).unwrap();
-    assert_eq!(rows.len(), cases(&MissionParams::default()).len() * 2 * 2);
+    assert_eq!(rows.len(), cases(&MissionParams::default()).len() * Kind::ALL.len() * 2);
     for r in &rows {
         assert!((0.0..=1.0).contains(&r.max_stall_fraction), "{r:?}");
         assert!(r.max_pos_error_m.is_finite() && r.max_alpha_deg <= 180.0);
@@ -92,10 +92,9 @@ fn writes_the_data_the_renderer_reads() {
             "{path}: refresh tests/data/analysis (cargo run --release -p analysis -- aero --out tests/data/analysis)"
         );
     }
-    // 3 phases × 3 axes × 2 controllers × 2 models; with the thesis's model the default
-    // mission survives 1 m/s gusts everywhere (the analysis's gust sweep on it, report.json).
+    // 3 phases × 3 axes × every controller × 2 models.
     let gusts = written["gusts"]["rows"].as_array().unwrap();
-    assert_eq!(gusts.len(), 36);
+    assert_eq!(gusts.len(), 3 * 3 * Kind::ALL.len() * 2);
     for f in ["aero_models.csv", "aero_coefficients.csv", "aero_gusts.csv"] {
         let text = std::fs::read_to_string(dir.join(f)).unwrap();
         assert!(text.lines().count() > rows.len().min(24), "{f}");

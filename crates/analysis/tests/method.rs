@@ -291,9 +291,10 @@ fn tiny_campaign_tables_come_from_runs_and_are_cached() {
     cfg.envelope_hover = false;
     let s = run(&cfg).unwrap();
     assert_eq!(s.cache_hits, 0);
-    // 2 controllers × 2 conditions nominal + 2 controllers × 2 factors sweep.
+    // Table 5.1: the thesis's 2 controllers (PX4 is not in it, and the report says so).
     let sens: Vec<_> = s.sensitivity.iter().filter(|r| r.param == "Cmde").collect();
     assert_eq!(sens.len(), 2);
+    assert!(sens.iter().all(|r| r.controller.in_thesis()));
     for r in &sens {
         let row = r.row.as_ref().expect("nominal point flies");
         assert!(row.rms_percent > 0.0 && row.rms_percent.is_finite());
@@ -324,18 +325,26 @@ fn tiny_campaign_tables_come_from_runs_and_are_cached() {
     }
     let table = std::fs::read_to_string(dir.join("table_5_1.csv")).unwrap();
     assert_eq!(table.lines().filter(|l| l.starts_with("Cmde,")).count(), 2, "{table}");
-    // Robustness: 2 controllers × 2 aerodynamic models (issue 13), factors 1/τ and 1.
-    assert_eq!(s.robustness.len(), 4);
+    assert_eq!(report["sensitivity"]["not_applicable"][0]["controller"], "PX4");
+    // Poles of every controller at both conditions, PX4's among them.
+    let nk = Kind::ALL.len();
+    assert_eq!(s.closed_loop.len(), nk * 2);
+    assert!(s
+        .closed_loop
+        .iter()
+        .any(|(k, _, j)| *k == Kind::Px4 && j.error.is_none() && !j.poles.is_empty()));
+    // Robustness: every controller × 2 aerodynamic models, factors 1/τ and 1.
+    assert_eq!(s.robustness.len(), nk * 2);
     for r in &s.robustness {
         assert_eq!(r.outcomes.len(), 2);
         assert_eq!(r.factors[1], 1.0);
     }
     robustness_on_both_models(&s.robustness);
-    assert_eq!(s.gusts.len(), 2 * 3 * 3);
+    assert_eq!(s.gusts.len(), nk * 3 * 3);
     let rb = report["robustness"]["rows"].as_array().unwrap();
-    assert_eq!(rb.len(), 4);
+    assert_eq!(rb.len(), nk * 2);
     assert!(rb.iter().all(|r| r["param"] == "Cmde" && r["points"] == 2));
-    for ctl in ["LQR", "TSD"] {
+    for ctl in Kind::ALL.map(Kind::name) {
         for model in [0, 1] {
             assert_eq!(
                 rb.iter()
@@ -358,11 +367,11 @@ fn tiny_campaign_tables_come_from_runs_and_are_cached() {
                 .skip(1)
                 .filter(|l| l.split(',').nth(col) == Some(model))
                 .count(),
-            4,
+            nk * 2,
             "{csv}"
         );
     }
-    assert_eq!(report["gusts"]["rows"].as_array().unwrap().len(), 2 * 3 * 3);
+    assert_eq!(report["gusts"]["rows"].as_array().unwrap().len(), nk * 3 * 3);
     let cache_lines = std::fs::read_to_string(dir.join("cache/poles.jsonl"))
         .unwrap()
         .lines()
@@ -372,7 +381,6 @@ fn tiny_campaign_tables_come_from_runs_and_are_cached() {
     let s2 = run(&cfg).unwrap();
     assert_eq!(s2.cache_hits, s2.jobs);
     assert_eq!(std::fs::read_to_string(dir.join("table_5_1.csv")).unwrap(), table);
-    let _ = Kind::ALL;
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -14,7 +14,7 @@ import numpy as np
 
 from .. import controllers
 from ..metrics import PHASES
-from .sampling import TABLE_5_1, CampaignSpec
+from .sampling import ORDER, TABLE_5_1, CampaignSpec
 
 Z95 = 1.959963984540054  # standard normal 97.5 % quantile
 COLORS = controllers.COLORS
@@ -81,6 +81,18 @@ def _columns(table) -> dict[str, np.ndarray]:
 def arms(cols: Mapping[str, np.ndarray]) -> list[tuple[str, str, str]]:
     keys = sorted(set(zip(cols["controller"], cols["configuration"], cols["state_source"], strict=False)))
     return [tuple(map(str, k)) for k in keys]
+
+
+def controller_pairs(A) -> list[tuple[tuple[str, str, str], tuple[str, str, str]]]:
+    """(earlier, later) arms of every two controllers of one configuration and state source,
+    in the reports' order (`sampling.ORDER`): (LQR, TSD), (LQR, PX4), (TSD, PX4)."""
+    order = {k: i for i, k in enumerate(ORDER)}
+
+    def rank(a) -> int:
+        return order.get(a[0], len(order))
+
+    pairs = [(b, a) for a in A for b in A if b[1:] == a[1:] and rank(b) < rank(a)]
+    return sorted(pairs, key=lambda p: (p[0][1:], rank(p[0]), rank(p[1])))
 
 
 def arm_label(arm: tuple[str, str, str], single: bool) -> str:
@@ -215,7 +227,8 @@ def write_report(out: str | pathlib.Path, spec: CampaignSpec | None = None, tabl
     lab = {a: arm_label(a, single) for a in A}
     color = {a: COLORS.get(a[0], "gray") for a in A}
     n_samples = len(set(cols["sample_id"].tolist())) if table.num_rows else 0
-    md: list[str] = ["# Monte-Carlo campaign: LQR and TSD on uncertain plants", ""]
+    ctrls = list(dict.fromkeys(a[0] for a in A))
+    md: list[str] = [f"# Monte-Carlo campaign: {', '.join(c.upper() for c in ctrls)} on uncertain plants", ""]
     if spec is not None:
         md += [
             f"{n_samples} samples (seed {spec.seed}), mission '{spec.mission_name}' "
@@ -357,22 +370,19 @@ def write_report(out: str | pathlib.Path, spec: CampaignSpec | None = None, tabl
     plt.close(fig)
     md += ["![distributions](distributions.png)", ""]
 
-    # 3. paired differences
-    pairs = []
-    for a in A:
-        if a[0] == "tsd":
-            b = ("lqr", a[1], a[2])
-            if b in A:
-                pairs.append((b, a))
+    # 3. paired differences: every two controllers of one configuration and state source,
+    # the later-declared minus the earlier (TSD − LQR, PX4 − LQR, PX4 − TSD).
+    pairs = controller_pairs(A)
     diff_summary: dict[str, tuple[float, float, float, int]] = {}
     if pairs:
         md += [
-            "## Paired difference TSD − LQR",
+            "## Paired differences",
             "",
-            "On the same samples. Completion: difference of the completion indicators; errors: samples that both "
-            "completed. Mean with a 95 % percentile-bootstrap interval (4000 resamples of the samples), median.",
+            "On the same samples, each pair of controllers of one configuration and state source. Completion: "
+            "difference of the completion indicators; errors: samples that both completed. Mean with a 95 % "
+            "percentile-bootstrap interval (4000 resamples of the samples), median.",
             "",
-            "| pair | quantity | samples | mean TSD − LQR | 95 % bootstrap interval | median |",
+            "| pair | quantity | samples | mean difference | 95 % bootstrap interval | median |",
             "|---|---|---|---|---|---|",
         ]
         fig, axes = plt.subplots(1, len(pairs), figsize=(6 * len(pairs), 4), squeeze=False)
@@ -381,7 +391,10 @@ def write_report(out: str | pathlib.Path, spec: CampaignSpec | None = None, tabl
             ids, cb, ca = paired(cols, b, a, "completed")
             d = ca.astype(float) - cb.astype(float)
             lo, hi = bootstrap_mean_ci(d)
-            diff_summary["completed"] = (float(d.mean()) if d.size else float("nan"), lo, hi, d.size)
+            # The thesis paragraph reads the TSD − LQR pair.
+            thesis_pair = (b[0], a[0]) == ("lqr", "tsd")
+            if thesis_pair:
+                diff_summary["completed"] = (float(d.mean()) if d.size else float("nan"), lo, hi, d.size)
             md.append(
                 f"| {name} | completion | {d.size} | {_fmt(d.mean() if d.size else np.nan, 3)} | [{_fmt(lo, 3)}, "
                 f"{_fmt(hi, 3)}] | — |"
@@ -392,7 +405,8 @@ def write_report(out: str | pathlib.Path, spec: CampaignSpec | None = None, tabl
                 dd = (va - vb)[both]
                 dd = dd[np.isfinite(dd)]
                 lo, hi = bootstrap_mean_ci(dd)
-                diff_summary[m] = (float(dd.mean()) if dd.size else float("nan"), lo, hi, dd.size)
+                if thesis_pair:
+                    diff_summary[m] = (float(dd.mean()) if dd.size else float("nan"), lo, hi, dd.size)
                 md.append(
                     f"| {name} | {title} | {dd.size} | {_fmt(dd.mean() if dd.size else np.nan, 3)} | "
                     f"[{_fmt(lo, 3)}, {_fmt(hi, 3)}] | {_fmt(np.median(dd) if dd.size else np.nan, 3)} |"
@@ -407,7 +421,7 @@ def write_report(out: str | pathlib.Path, spec: CampaignSpec | None = None, tabl
                 ax.axvspan(lo, hi, color="orange", alpha=0.3, label=f"95 % CI [{lo:.2f}, {hi:.2f}]")
                 ax.axvline(0, color="k", ls=":")
                 ax.legend(fontsize=8)
-            ax.set(xlabel="RMS position error, TSD − LQR [m]", ylabel="samples", title=f"paired difference ({name})")
+            ax.set(xlabel=f"RMS position error, {name} [m]", ylabel="samples", title=f"paired difference ({name})")
             ax.grid(True, alpha=0.3)
         fig.tight_layout()
         fig.savefig(out / "paired.png", dpi=110)

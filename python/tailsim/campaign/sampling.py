@@ -80,14 +80,21 @@ assert len(TABLE_5_1) == 25
 #: controller flies on: `perfect` = the plant's outputs; `avionics` = the estimate of
 #: `tailsitter_ekf` fed by `tailsitter_sensors` (tailsim.masters.avionics, Gauss-Seidel), the
 #: sensors seeded with the sample's `noise_seed`.
-#: The campaign's controller arms: the declared controllers with a `configuration` parameter
-#: (the configuration axes set it, and the native campaign's controllers, crates/analysis
-#: `Kind`, are those); a controller without one (`tailsitter_px4`) is not an arm yet.
-CONTROLLERS = tuple(k for k in controllers.KEYS if "configuration" in declarations.VARIABLES[controllers.NAMES[k]])
+#: The campaign's controllers: every declared controller. A configuration applies to the
+#: controllers it lists: `tuned` (each controller's defaults) to all of them, `thesis` to
+#: those with the thesis's `configuration` parameter; a controller without one
+#: (`tailsitter_px4`, PX4's parameters) is an arm of the `tuned` configuration only, flown
+#: on the same paired samples.
+CONTROLLERS = controllers.KEYS
 CONFIGURATIONS: dict[str, dict[str, dict[str, int]]] = {
     "tuned": {k: {} for k in CONTROLLERS},
-    "thesis": {k: {"configuration": 1} for k in CONTROLLERS},
+    "thesis": {
+        k: {"configuration": 1} for k in CONTROLLERS if "configuration" in declarations.VARIABLES[controllers.NAMES[k]]
+    },
 }
+#: The order the reports list controllers in: the thesis's (those with its `configuration`)
+#: first, each group in declaration order (LQR, TSD, then PX4).
+ORDER = tuple(sorted(CONTROLLERS, key=lambda k: k not in CONFIGURATIONS["thesis"]))
 #: The controller FMUs' `configuration` value of each configuration (the native campaign's input).
 CONFIGURATION_INDEX = {"tuned": 0, "thesis": 1}
 STATE_SOURCES = ("perfect", "avionics", "avionics_app_d")
@@ -162,6 +169,11 @@ class CampaignSpec:
         ):
             if not axis or len(set(axis)) != len(axis):
                 raise ValueError(f"{name} = {axis!r}: expected distinct values, at least one")
+        if not arms(self):
+            raise ValueError(
+                f"no arm: none of the controllers {self.controllers!r} has a configuration of "
+                f"{self.configurations!r} ({', '.join(f'{k}: {tuple(v)}' for k, v in CONFIGURATIONS.items())})"
+            )
         if self.aero_model not in (0, 1):
             raise ValueError(f"aero_model = {self.aero_model!r}: expected 0 (thesis) or 1 (global)")
         if not (self.tau_aero >= 1.0 and self.tau_mass >= 1.0):
@@ -302,22 +314,33 @@ def run_key(sample_id: int, controller: str, configuration: str, state_source: s
     return f"{sample_id}/{controller}/{configuration}/{state_source}"
 
 
+def arms(spec: CampaignSpec) -> list[tuple[str, str, str]]:
+    """The campaign's arms (controller, configuration, state source): every controller in
+    every configuration that applies to it (`CONFIGURATIONS`), every state source."""
+    return [
+        (c, cfg, src)
+        for c in spec.controllers
+        for cfg in spec.configurations
+        if c in CONFIGURATIONS[cfg]
+        for src in spec.state_sources
+    ]
+
+
 def jobs(spec: CampaignSpec, sample_ids=None) -> list[dict[str, Any]]:
-    """Every run of the campaign: sample × controller × configuration × state source."""
+    """Every run of the campaign: sample × arm (`arms`), every arm on the same draw."""
     out = []
+    arms_ = arms(spec)
     for i in range(spec.n_samples) if sample_ids is None else sample_ids:
         s = draw_sample(spec, i)
-        for c in spec.controllers:
-            for cfg in spec.configurations:
-                for src in spec.state_sources:
-                    out.append(
-                        {
-                            "key": run_key(i, c, cfg, src),
-                            "controller": c,
-                            "configuration": cfg,
-                            "state_source": src,
-                            "overrides": json.dumps(dict(spec.overrides.get(i, {})), sort_keys=True),
-                            **s,
-                        }
-                    )
+        for c, cfg, src in arms_:
+            out.append(
+                {
+                    "key": run_key(i, c, cfg, src),
+                    "controller": c,
+                    "configuration": cfg,
+                    "state_source": src,
+                    "overrides": json.dumps(dict(spec.overrides.get(i, {})), sort_keys=True),
+                    **s,
+                }
+            )
     return out

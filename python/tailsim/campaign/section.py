@@ -3,9 +3,10 @@
 The controllers are compared on the same random plants, winds and gusts (paired
 samples, `tailsim.campaign`), not on one nominal mission: completion probability of
 each arm (controller × configuration × state source) with its 95 % Wilson interval,
-and the paired differences TSD − LQR on the same samples with 95 % percentile-bootstrap
-intervals — completion (all samples), RMS and max position error (samples both
-completed).
+and the paired differences of every two controllers of one configuration and state source
+(TSD − LQR, PX4 − LQR, PX4 − TSD: the later minus the earlier in `sampling.ORDER`) on the same samples
+with 95 % percentile-bootstrap intervals — completion (all samples), RMS and max position
+error (samples both completed).
 
 Two sources, both shown when present:
 
@@ -32,7 +33,7 @@ from typing import Any
 import numpy as np
 
 from .. import cli
-from .report import _arm_mask, arms, bootstrap_mean_ci, paired, wilson_interval
+from .report import _arm_mask, arms, bootstrap_mean_ci, controller_pairs, paired, wilson_interval
 from .sampling import CampaignSpec
 
 ROOT = pathlib.Path(__file__).resolve().parents[3]
@@ -106,19 +107,46 @@ def summarize(folders: Iterable[str | pathlib.Path]) -> dict[str, Any]:
             "failures": reasons,
             "median_completed": med,
         }
-    for a in A:
-        if a[0] != "tsd" or ("lqr", a[1], a[2]) not in A:
-            continue
-        b = ("lqr", a[1], a[2])
+    for b, a in controller_pairs(A):
         _, cb, ca = paired(cols, b, a, "completed")
         d = ca.astype(float) - cb.astype(float)
-        res = {"completion": _ci(d)}
+        res = {"pair": [a[0], b[0]], "completion": _ci(d)}
         both = (cb > 0) & (ca > 0)
         for q in ("rms_err", "max_err"):
             _, vb, va = paired(cols, b, a, q)
             dd = (va - vb)[both]
             res[q] = _ci(dd[np.isfinite(dd)])
-        out["paired"][f"{a[1]}/{a[2]}"] = res
+        out["paired"][pair_key(b, a)] = res
+    return out
+
+
+def pair_key(b, a) -> str:
+    """The summary's key of the paired difference a − b: `configuration/state source` for
+    TSD − LQR (as every summary before the third controller wrote it), else with the pair."""
+    group = f"{a[1]}/{a[2]}"
+    return group if (b[0], a[0]) == ("lqr", "tsd") else f"{group}: {a[0].upper()} − {b[0].upper()}"
+
+
+def merge(base: Mapping[str, Any], new: Mapping[str, Any]) -> dict[str, Any]:
+    """Two summaries of one sample space as one: each arm and each paired difference from the
+    summary that measured it on more samples (the base on a tie), the runtimes of both. For
+    adding arms to a documented run without its folders (`--base`)."""
+    # As JSON (a summary read from a file has lists where a fresh one has tuples).
+    norm = json.loads(json.dumps([base["spec"], new["spec"]]))
+    bad = [k for k in SAMPLE_SPACE if norm[0].get(k) != norm[1].get(k)]
+    if bad:
+        raise SystemExit(f"summaries of different sample spaces cannot be merged ({', '.join(bad)} differ)")
+    out = {"spec": dict(base["spec"]), "samples": {}, "arms": {}, "paired": {}, "runtime": []}
+    for k in dict.fromkeys([*base["arms"], *new["arms"]]):
+        b, n = base["arms"].get(k), new["arms"].get(k)
+        src = base if n is None or (b is not None and b["runs"] >= n["runs"]) else new
+        out["arms"][k] = src["arms"][k]
+        out["samples"][k] = src["samples"][k]
+    for k in dict.fromkeys([*base["paired"], *new["paired"]]):
+        b, n = base["paired"].get(k), new["paired"].get(k)
+        better_b = n is None or (b is not None and b["completion"]["n"] >= n["completion"]["n"])
+        out["paired"][k] = b if better_b else n
+    out["runtime"] = [*base["runtime"], *new["runtime"]]
     return out
 
 
@@ -137,7 +165,7 @@ def _f(x: float, nd: int = 3) -> str:
 
 
 def markdown(summary: Mapping[str, Any], title: str) -> list[str]:
-    """Markdown of a summary: completion per arm, paired TSD − LQR, runtime."""
+    """Markdown of a summary: completion per arm, the paired differences, runtime."""
     s = summary["spec"]
     n_samples = max(summary["samples"].values()) if summary["samples"] else 0
     md = [
@@ -165,13 +193,15 @@ def markdown(summary: Mapping[str, Any], title: str) -> list[str]:
     if summary["paired"]:
         md += [
             "",
-            "Paired difference TSD − LQR on the same samples (completion: all paired samples, +1 = only the TSD "
+            "Paired differences A − B on the same samples (completion: all paired samples, +1 = only A "
             "completed; errors: samples both completed), mean with a 95 % percentile-bootstrap interval, median:",
             "",
-            "| configuration/state source | quantity | samples | mean TSD − LQR | 95 % interval | median |",
-            "|---|---|---|---|---|---|",
+            "| configuration/state source | A − B | quantity | samples | mean A − B | 95 % interval | median |",
+            "|---|---|---|---|---|---|---|",
         ]
-        for pair, res in summary["paired"].items():
+        for key, res in summary["paired"].items():
+            a, b = res.get("pair", ["tsd", "lqr"])
+            group, name = key.split(":")[0], f"{a.upper()} − {b.upper()}"
             for q, label in (
                 ("completion", "completion"),
                 ("rms_err", "RMS position error (m)"),
@@ -179,8 +209,8 @@ def markdown(summary: Mapping[str, Any], title: str) -> list[str]:
             ):
                 r = res[q]
                 md.append(
-                    f"| {pair} | {label} | {r['n']} | {_f(r['mean'])} | [{_f(r['ci95'][0])}, {_f(r['ci95'][1])}] | "
-                    f"{_f(r['median'])} |"
+                    f"| {group} | {name} | {label} | {r['n']} | {_f(r['mean'])} | "
+                    f"[{_f(r['ci95'][0])}, {_f(r['ci95'][1])}] | {_f(r['median'])} |"
                 )
     rt = [r for r in summary["runtime"] if r.get("runs_done_now")]
     if rt:
@@ -233,7 +263,14 @@ def main(argv: list[str] | None = None) -> int:
     ap = cli.Parser(prog="python -m tailsim.campaign.section", description=__doc__.split("\n\n")[0])
     ap.add_argument("folders", nargs="+", help="campaign folders of one sample space (rows merged, paired by sample)")
     ap.add_argument("--write", help="write the summary JSON here (e.g. docs/campaign_full_run.json)")
+    ap.add_argument(
+        "--base",
+        help="a summary JSON of the same sample space to merge with (each arm and paired difference from the "
+        "summary with more samples), e.g. docs/campaign_full_run.json when adding a controller",
+    )
     a = ap.parse_args(argv)
+    if a.base and not pathlib.Path(a.base).is_file():
+        ap.error(f"argument --base: {a.base!r} is not a file")
     for f in a.folders:
         for name in ("campaign.json", "results.parquet"):
             if not (pathlib.Path(f) / name).is_file():
@@ -243,6 +280,8 @@ def main(argv: list[str] | None = None) -> int:
 
     def run() -> int:
         s = summarize(a.folders)
+        if a.base:
+            s = merge(json.loads(pathlib.Path(a.base).read_text()), s)
         if a.write:
             pathlib.Path(a.write).write_text(json.dumps(s, indent=1) + "\n")
         print("\n".join(markdown(s, "Paired Monte-Carlo")))

@@ -159,12 +159,16 @@ def table_5_1(d: dict) -> list[str]:
         "thesis's column is level flight.",
         "",
     ]
-    cells = [[f"{k} thesis", *(f"{k} ours ({c})" for c in d["conditions"])] for k in d["controllers"]]
+    # The thesis's controllers only: a controller outside the thesis is named with the reason.
+    ctrls = [k for k in d["controllers"] if all(k in p["thesis_percent"] for p in d["params"])]
+    for na in s.get("not_applicable", []):
+        out += [f"Not for {na['controller']}: {na['reason']}.", ""]
+    cells = [[f"{k} thesis", *(f"{k} ours ({c})" for c in d["conditions"])] for k in ctrls]
     out += table_head(["parameter", *(c for per_controller in cells for c in per_controller)])
     rows = {(r["param"], r["controller"], r["condition"]): r for r in s["rows"]}
     for p in d["params"]:
         line = f"| {p['name']} |"
-        for k in d["controllers"]:
+        for k in ctrls:
             line += f" {p['thesis_percent'][k]:.1f}% |"
             for c in d["conditions"]:
                 row = rows.get((p["id"], k, c), {}).get("row")

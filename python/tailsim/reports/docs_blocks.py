@@ -237,7 +237,9 @@ def _full_reading(src: Sources) -> str:
         + ", ".join(f"{label(k)} {_p3(_arm(s, f'{k}/tuned/avionics')['p'])}" for k in av)
         + f" on the first {n_av} samples): the avionics' remaining cost is mostly the estimator's rate and "
         "specific-force lag (crates/state-estimator/README.md). The thesis configurations ("
-        + ", ".join(f"{label(k)} {_p3(_arm(s, f'{k}/thesis/perfect')['p'])}" for k in ks)
+        + ", ".join(
+            f"{label(k)} {_p3(_arm(s, f'{k}/thesis/perfect')['p'])}" for k in ks if f"{k}/thesis/perfect" in s["arms"]
+        )
         + ") are worse for both (the thesis TSD's wind-axes frame is linearly unstable in the "
         f"{definition('def.mission.v_vertical')} climb, crates/tsd-control/README.md)."
     )

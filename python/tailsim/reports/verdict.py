@@ -54,6 +54,8 @@ class Finding:
     short: str = ""
     """The condition in a few words, for the one-sentence summary."""
     detail: list[str] = field(default_factory=list)
+    cells: dict[str, str] = field(default_factory=dict)
+    """Each controller's figure under the condition (its key → Markdown), for the side-by-side table."""
 
 
 def label(key: str) -> str:
@@ -163,6 +165,10 @@ def campaign_findings(folder: str | pathlib.Path) -> list[Finding]:
                 by=f"completed: {per}; paired: " + "; ".join(diffs),
                 source=source,
                 short=f"{config} configuration, uncertain plants, {state} state",
+                cells={
+                    a[0]: f"P(complete) {_f(stats[a][1] / max(stats[a][0], 1), 3)} {_interval(stats[a][2], 3)}"
+                    for a in members
+                },
             )
         )
     if found:
@@ -218,6 +224,10 @@ def nominal_findings(path: str | pathlib.Path) -> list[Finding]:
                 by="; ".join(cells) + " (one run each, no interval)",
                 source=str(path),
                 short=f"nominal {mission} mission",
+                cells={
+                    k: (f"completed, largest error {_f(worst(runs[k]))} m" if runs[k]["completed"] else "not completed")
+                    for k in ranked
+                },
             )
         )
     return found
@@ -252,6 +262,7 @@ def wind_findings(path: str | pathlib.Path) -> list[Finding]:
                 + " (a grid, no interval)",
                 source=str(path),
                 short=f"wind envelope, {mission} mission, {wind} wind",
+                cells={k: f"{count[k]}/{len(held[k])} cells held, {_reach(held[k])}" for k in ranked},
             )
         )
     return found
@@ -309,11 +320,42 @@ def markdown(findings: list[Finding], heading: str = "## Verdict") -> list[str]:
     ]
     for f in findings:
         md.append(f"| {f.condition} | {label(f.better) if f.better else 'not separated'} | {f.by} |")
+    md += side_by_side(findings)
     for f in findings:
         for d in f.detail:
             md += ["", d]
     sources = sorted({f.source for f in findings})
     md += ["", "Read from this run's " + ", ".join(f"`{s}`" for s in sources) + "."]
+    return md
+
+
+def _ordered(keys) -> list[str]:
+    """Distinct controller keys in the reports' order (`tailsim.campaign.sampling.ORDER`: the
+    thesis's controllers first), unknown keys after them as they come."""
+    from ..campaign.sampling import ORDER
+
+    order = {k: i for i, k in enumerate(ORDER)}
+    seen = list(dict.fromkeys(keys))
+    return sorted(seen, key=lambda k: (order.get(k, len(order)), seen.index(k)))
+
+
+def side_by_side(findings: list[Finding]) -> list[str]:
+    """The controllers side by side: one column per controller, one row per condition (the
+    campaign's completion with its 95 % Wilson interval, the wind envelope's cells held, the
+    nominal missions' largest error); – where a controller was not flown under it."""
+    ctrls = _ordered(k for f in findings for k in f.cells)
+    if len(ctrls) < 2:
+        return []
+    md = [
+        "",
+        "Side by side:",
+        "",
+        "| condition | " + " | ".join(label(k) for k in ctrls) + " | better |",
+        "|---|" + "---|" * (len(ctrls) + 1),
+    ]
+    for f in findings:
+        cells = " | ".join(f.cells.get(k, "–") for k in ctrls)
+        md.append(f"| {f.short or f.condition} | {cells} | {label(f.better) if f.better else 'not separated'} |")
     return md
 
 
@@ -339,21 +381,28 @@ def headline_table(summary: Mapping[str, Any]) -> list[str]:
     summary (`tailsim.campaign.section.summarize`, e.g. `docs/campaign_full_run.json`).
     Better: the controller whose completion interval lies above every other's."""
     arms_ = {tuple(k.split("/")): v for k, v in summary["arms"].items()}
-    ctrls = list(dict.fromkeys(a[0] for a in arms_))
+    ctrls = _ordered(a[0] for a in arms_)
     groups = sorted({a[1:] for a in arms_}, key=lambda g: (g[1] != "perfect", g[0] != "tuned", g))
-    header = ["configuration, state", "samples", *(f"{label(k)}: P(complete) [95 %], median RMS error" for k in ctrls)]
+    header = [
+        "configuration, state",
+        "samples",
+        *(f"{label(k)}: P(complete) [95 %], median RMS error" for k in ctrls),
+    ]
     header.append("better")
     md = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     for g in groups:
         cells, present = [], [k for k in ctrls if (k, *g) in arms_]
+        n = max(arms_[(k, *g)]["runs"] for k in present)
         for k in ctrls:
             r = arms_.get((k, *g))
-            cells.append(
-                f"{_f(r['p'], 3)} {_interval(r['wilson95'], 3)}, {_f(r['median_completed']['rms_err'])} m" if r else "–"
-            )
+            if r is None:
+                cells.append("–")
+                continue
+            err = f"{_f(r['median_completed']['rms_err'])} m" if r["completed"] else "no run completed"
+            fewer = f" ({r['runs']} samples)" if r["runs"] != n else ""
+            cells.append(f"{_f(r['p'], 3)} {_interval(r['wilson95'], 3)}, {err}{fewer}")
         top = max(present, key=lambda k: arms_[(k, *g)]["p"])
         sep = all(arms_[(top, *g)]["wilson95"][0] > arms_[(k, *g)]["wilson95"][1] for k in present if k != top)
-        n = max(arms_[(k, *g)]["runs"] for k in present)
         md.append(f"| {g[0]}, {g[1]} | {n} | " + " | ".join(cells) + f" | {label(top) if sep else 'not separated'} |")
     s = summary["spec"]
     md += [
