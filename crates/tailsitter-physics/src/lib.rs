@@ -37,7 +37,9 @@ pub use attitude::{
 pub use error::PhysicsError;
 pub use global_aero::{AeroDiagnostics, AeroModel, AeroRegime, GlobalAero};
 pub use ground::{ContactState, Ground};
-pub use plant::{dp5, Envelope, Integrator, Outputs, Plant, Trim, DEFAULT_INTEGRATION_STEP, MAX_SUBSTEPS};
+pub use plant::{
+    dp5, Envelope, Integrator, Outputs, Plant, Trim, DEFAULT_INTEGRATION_STEP, MAX_CHECKED_SUBSTEPS, MAX_SUBSTEPS,
+};
 pub use site::Site;
 
 use nalgebra::SVector;

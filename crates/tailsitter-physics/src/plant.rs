@@ -53,6 +53,13 @@ pub const DEFAULT_INTEGRATION_STEP: f64 = 0.02 / 3.0;
 /// their own `max_halvings`.
 pub const CONTACT_HALVINGS: u32 = 20;
 
+/// Most substeps one checked internal step ([`Integrator::Dp5Checked`]) makes before it
+/// stops refining and accepts the rest at the level it has reached (climbing back to the
+/// step's own grid): a bound on the work of one `fmi2DoStep`. Touchdowns and lift-offs take
+/// a few hundred; an error estimate that never meets the tolerance (a non-finite one, or a
+/// contact that keeps the estimate up) would otherwise take 2²⁰ substeps per internal step.
+pub const MAX_CHECKED_SUBSTEPS: u64 = 8192;
+
 /// Fixed-step explicit Runge–Kutta method of [`Plant::advance`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Integrator {
@@ -505,6 +512,7 @@ impl Plant {
         let depth = max_halvings.max(CONTACT_HALVINGS);
         let total = 1u64 << depth;
         let (mut done, mut level) = (0u64, 0u32);
+        let mut substeps = 0u64;
         let (mut y, mut k) = (*s, *k1);
         while done < total {
             let h = dt / (1u64 << level) as f64;
@@ -523,7 +531,10 @@ impl Plant {
             } else {
                 depth
             };
-            if estimate <= tolerance || level >= deepest {
+            substeps += 1;
+            // A non-finite estimate is accepted as it is: the state check after the internal
+            // step reports it, and refining cannot make it finite.
+            if estimate <= tolerance || level >= deepest || !estimate.is_finite() || substeps >= MAX_CHECKED_SUBSTEPS {
                 y = y_new;
                 k = k_new;
                 done += total >> level;

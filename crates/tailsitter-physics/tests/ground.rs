@@ -241,3 +241,35 @@ fn a_hard_touchdown_is_integrated_to_the_fine_step() {
     assert!(worst_pos < 1e-7, "position off the fine step by {worst_pos:e} m");
     assert!(worst_rate < 1e-6, "rates off the fine step by {worst_rate:e} rad/s");
 }
+
+/// The work of one communication step is bounded: with a tolerance the error estimate never
+/// meets (0), a checked step resting on the gear would refine every internal step to the
+/// contact depth (2²⁰ substeps, ≈ 2·10⁷ evaluations per 20 ms: a host blocked for minutes
+/// over a whole flight, as one campaign run was). Now it stops refining after
+/// `MAX_CHECKED_SUBSTEPS` and the step still ends on the ground, finite.
+#[test]
+fn a_checked_step_on_the_ground_has_bounded_work() {
+    use tailsitter_physics::{Integrator, MAX_CHECKED_SUBSTEPS};
+    let mut plant = Plant::new(Airframe::default());
+    plant.ground = Ground::default();
+    plant.integrator = Integrator::Dp5Checked {
+        tolerance: 0.0,
+        max_halvings: 4,
+    };
+    let mut x = plant.resting_on_ground(0.0, 0.0, 0.0);
+    x[W] = -0.5;
+    let u = InputVector::zeros();
+    let mut evals = 0u64;
+    plant
+        .advance_counting(&mut x, &u, &Vector3::zeros(), 0.02, &mut evals)
+        .expect("the step on the ground succeeds");
+    // Three internal steps at the default step, each at most MAX_CHECKED_SUBSTEPS substeps
+    // plus the climb back to its grid (≤ 2·20), 7 evaluations each.
+    let bound = 3 * (MAX_CHECKED_SUBSTEPS + 40) * 7 + 3;
+    assert!(evals <= bound, "{evals} evaluations > {bound}");
+    assert!(
+        evals > 3 * MAX_CHECKED_SUBSTEPS,
+        "the refinement ran: {evals} evaluations"
+    );
+    assert!(x.iter().all(|v| v.is_finite()));
+}
