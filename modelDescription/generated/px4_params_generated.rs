@@ -19,7 +19,7 @@ impl Default for Px4Params {
             MPC_THR_HOVER: -1.0,
             MPC_THR_MIN: 0.12,
             MPC_THR_MAX: 1.0,
-            MC_ROLL_P: 6.5,
+            MC_ROLL_P: 4.0,
             MC_PITCH_P: 6.5,
             MC_YAW_P: 2.8,
             MC_YAW_WEIGHT: 0.4,

@@ -208,15 +208,18 @@ mod tests {
         assert!(worst < 1.0 - 1e-4, "max |z| = {worst}");
     }
 
-    /// In the climb the linearisation and the nonlinear flight agree on the stability of the
-    /// least stable pole: if |z| > 1, a small kick in the body rate r (about the belly axis,
-    /// PX4's multicopter roll axis on a tail-sitter) grows over 2 s to 4 s, else it decays.
+    /// In the climb every pole lies in the left half plane with a margin (with PX4's
+    /// default MC_ROLL_P = 6.5 the roll-rate loop about the belly axis, no faster than the
+    /// attitude loop, gave a growing pair at s = +0.37 ± 7.4j), and the nonlinear flight
+    /// agrees: a kick in the body rate r (about the belly axis, PX4's multicopter roll axis
+    /// on a tail-sitter) has decayed to a small fraction over 2 s to 4 s.
     #[test]
-    fn px4_climb_poles_agree_with_a_kicked_nonlinear_flight() {
+    fn px4_climb_poles_are_stable_and_a_kicked_flight_decays() {
         let mission = MissionParams::default();
         let plant = Plant::new(Airframe::default());
         let p = poles_at(&plant, Kind::Px4.make(&mission), &mission, Condition::Vertical).unwrap();
-        let worst = p.discrete.iter().map(|e| e.value.norm()).fold(0.0, f64::max);
+        let worst_re = p.poles.iter().map(|s| s.re).fold(f64::MIN, f64::max);
+        assert!(worst_re < -0.1, "largest real part {worst_re}");
         let kick = 1e-3;
         let mut x = plant.trim_vertical_climb(mission.v_vertical).unwrap().state;
         x[tailsitter_physics::idx::R] += kick;
@@ -230,6 +233,6 @@ mod tests {
             .filter(|s| s.t >= 2.0)
             .map(|s| s.x[tailsitter_physics::idx::R].abs())
             .fold(0.0, f64::max);
-        assert_eq!(worst > 1.0, late > kick, "max |z| = {worst}, late |r| = {late}");
+        assert!(late < 0.1 * kick, "late |r| = {late}");
     }
 }

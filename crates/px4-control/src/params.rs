@@ -39,7 +39,7 @@ pub struct Px4Params {
     pub MPC_THR_MIN: f64,
     /// Largest collective thrust in multicopter flight, fraction of T_max (PX4 default).
     pub MPC_THR_MAX: f64,
-    /// Multicopter roll attitude gain (PX4 default); multicopter axes (README, 'Frames').
+    /// Multicopter roll attitude gain, below PX4's default 6.5 for this airframe's slow roll-rate loop (README, 'Roll-axis tuning'); multicopter axes (README, 'Frames').
     pub MC_ROLL_P: f64,
     /// Multicopter pitch attitude gain (PX4 default).
     pub MC_PITCH_P: f64,
