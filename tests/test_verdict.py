@@ -207,3 +207,17 @@ def test_cli_prints_the_verdict_of_a_run_folder(tmp_path, capsys):
         "- uncertain plants in wind and gusts (30 samples), tuned configuration, perfect state: ONE."
     )
     assert "`" not in "\n".join(lines) and "**" not in "\n".join(lines)
+
+
+def test_the_headline_caption_names_the_turbulence_and_the_completion_criterion():
+    spec = {"tau_aero": 1.5, "tau_mass": 1.1, "wind_max": 10.0, "gust_max": 5.0, "aero_model": 1}
+    plain = verdict._conditions_text(spec)
+    assert "turbulence" not in plain and "completed" not in plain
+    text = verdict._conditions_text({**spec, "turbulence_max": 2, "error_limit_m": 5.0})
+    assert "Dryden turbulence up to moderate" in text
+    assert "within 5 m of the controller's reference" in text
+    # the documented full run records both, and the README's caption says them
+    root = verdict.ROOT
+    full = json.loads((root / "docs" / "campaign_full_run.json").read_text())
+    assert full["spec"]["error_limit_m"] == 5.0 and full["spec"]["turbulence_max"] == 2
+    assert "completed = flown to the end within 5 m" in (root / "README.md").read_text()

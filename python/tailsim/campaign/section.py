@@ -81,7 +81,13 @@ def summarize(folders: Iterable[str | pathlib.Path]) -> dict[str, Any]:
     cols = {k: np.asarray(v) for k, v in table.to_pydict().items()}
     A = arms(cols)
     out: dict[str, Any] = {
-        "spec": {k: specs[0].to_json()[k] for k in SAMPLE_SPACE},
+        "spec": {
+            **{k: specs[0].to_json()[k] for k in SAMPLE_SPACE},
+            # What a run must do to count as completed, and the strongest turbulence flown
+            # (the avionics arms fly without the atmosphere): the readings name both.
+            "turbulence_max": max(sp.to_json()["turbulence_max"] for sp in specs),
+            "error_limit_m": max(sp.to_json()["error_limit_m"] for sp in specs),
+        },
         "samples": {f"{a[0]}/{a[1]}/{a[2]}": int(_arm_mask(cols, a).sum()) for a in A},
         "arms": {},
         "paired": {},

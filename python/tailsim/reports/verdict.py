@@ -93,8 +93,24 @@ def _conditions_text(spec: Mapping[str, Any]) -> str:
     return (
         f"Table 5.1 factors within τ = {spec['tau_aero']:g} (aero) / {spec['tau_mass']:g} (mass, inertia), "
         f"steady wind ≤ {spec['wind_max']:g} m/s and a 1 − cos gust ≤ {spec['gust_max']:g} m/s, "
-        f"{aero} aerodynamics"
+        f"{aero} aerodynamics{_turbulence_and_criterion(spec)}"
     )
+
+
+#: Dryden turbulence intensities of the campaign's `--turbulence-max` (0 none … 3 severe).
+TURBULENCE = ("none", "light", "moderate", "severe")
+
+
+def _turbulence_and_criterion(spec: Mapping[str, Any]) -> str:
+    """', Dryden turbulence up to …; completed = flown to the end within … m' where recorded."""
+    text = ""
+    t = spec.get("turbulence_max")
+    if t:
+        text += f", Dryden turbulence up to {TURBULENCE[int(t)]} (perfect-state runs)"
+    e = spec.get("error_limit_m")
+    if e is not None and math.isfinite(e) and e < 1e6:
+        text += f"; completed = flown to the end within {e:g} m of the controller's reference"
+    return text
 
 
 def campaign_findings(folder: str | pathlib.Path) -> list[Finding]:
