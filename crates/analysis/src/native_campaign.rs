@@ -344,9 +344,14 @@ pub fn metrics(plant: &Plant, samples: &[Sample]) -> BTreeMap<String, Option<f64
 
 /// CPU time of the calling thread (s) (`CLOCK_THREAD_CPUTIME_ID`, as Python's `time.thread_time`).
 fn cpu_time() -> f64 {
+    clock_seconds(libc::CLOCK_THREAD_CPUTIME_ID)
+}
+
+/// The reading of a POSIX CPU-time clock (s); NaN if the clock cannot be read.
+pub(crate) fn clock_seconds(clock: libc::clockid_t) -> f64 {
     let mut ts = libc::timespec { tv_sec: 0, tv_nsec: 0 };
     // SAFETY: clock_gettime writes one timespec into `ts`, which outlives the call.
-    let rc = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+    let rc = unsafe { libc::clock_gettime(clock, &mut ts) };
     if rc == 0 {
         ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
     } else {

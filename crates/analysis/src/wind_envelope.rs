@@ -780,14 +780,7 @@ pub fn run(out: &Path, grid: &Grid, no_cache: bool) -> Result<Vec<Cell>, String>
 
 /// CPU time of this process, every thread (s) (`CLOCK_PROCESS_CPUTIME_ID`).
 fn process_cpu_time() -> f64 {
-    let mut ts = libc::timespec { tv_sec: 0, tv_nsec: 0 };
-    // SAFETY: clock_gettime writes one timespec into `ts`, which outlives the call.
-    let rc = unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut ts) };
-    if rc == 0 {
-        ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
-    } else {
-        f64::NAN
-    }
+    crate::native_campaign::clock_seconds(libc::CLOCK_PROCESS_CPUTIME_ID)
 }
 
 impl MissionKind {
