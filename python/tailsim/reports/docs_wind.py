@@ -117,13 +117,15 @@ def dumps(summary: Mapping[str, Any]) -> str:
 
 
 def head_commit() -> str | None:
-    """The checkout's commit (`+dirty` with uncommitted changes), or None outside git."""
+    """The checkout's commit (`+dirty` with uncommitted changes to the sources the flights
+    depend on: crates, FMUs, declarations), or None outside git."""
 
     def git(*args: str) -> str:
         return subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=True, check=True).stdout.strip()
 
     try:
-        rev, dirty = git("rev-parse", "--short", "HEAD"), git("status", "--porcelain", "--", "crates")
+        rev = git("rev-parse", "--short", "HEAD")
+        dirty = git("status", "--porcelain", "--", "crates", "fmu-*", "modelDescription", ":(exclude)*.md")
     except (OSError, subprocess.CalledProcessError):
         return None
     return rev + ("+dirty" if dirty else "")
@@ -186,7 +188,10 @@ def reach(rows: Sequence[Mapping[str, Any]]) -> float | None:
 def reach_text(rows: Sequence[Mapping[str, Any]]) -> str:
     s = reach(rows)
     held, n = sum(r["held"] for r in rows), sum(r["cells"] for r in rows)
-    where = "not at every bearing even in calm air" if s is None else f"every bearing up to {s:g} m/s"
+    if s is None:
+        where = "not at every bearing even in calm air"
+    else:
+        where = "every bearing in calm air only" if s == 0 else f"every bearing up to {s:g} m/s"
     return f"{where} ({held}/{n} held)"
 
 
@@ -319,17 +324,25 @@ def _tsd(src: Sources) -> str:
 
 @block("wind.readme", WIND)
 def _readme(src: Sources) -> str:
-    """The README's wind sentence: per tuned controller, up to which speed every bearing of the
-    default mission and of take-off to landing is held (step wind, turbulent)."""
+    """The README's wind sentence: per tuned controller (perfect state, Gauss-Seidel), the
+    highest steady wind held from every bearing in the default mission / from take-off to
+    landing, with the wind stepping in, then with moderate turbulence."""
     w = src.json(WIND)
+
+    def reach_of(k: str, mission: str, wind: str) -> str | None:
+        rows = rows_of(w, k, MAIN_AXIS, mission, wind)
+        if not rows:
+            return None
+        s = reach(rows)
+        return "none" if s is None else f"{s:g} m/s"
+
     parts = []
     for k in controllers(w):
         forms = []
-        for mission in ("default", "takeoff_landing"):
-            for wind in _present(w, "wind", WINDS):
-                rows = rows_of(w, k, MAIN_AXIS, mission, wind)
-                if rows:
-                    s = reach(rows)
-                    forms.append(f"{'–' if s is None else f'{s:g}'}")
-        parts.append(f"{k} {' / '.join(forms)} m/s")
+        for wind in _present(w, "wind", WINDS):
+            pair = [reach_of(k, m, wind) for m in ("default", "takeoff_landing")]
+            if any(pair):
+                text = " / ".join(x or "–" for x in pair)
+                forms.append(text if wind == "step" else f"{WINDS.get(wind, wind)}: {text}")
+        parts.append(f"{k} {forms[0]}" + (f" ({', '.join(forms[1:])})" if len(forms) > 1 else ""))
     return "; ".join(parts)
