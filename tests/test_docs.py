@@ -220,7 +220,9 @@ def test_a_hand_typed_figure_in_a_crate_readme_fails(tmp_path):
     p.write_text(p.read_text() + "\nThe fast mission now rotates in 1.71 s with 0.38 m of error.\n")
     assert [b.split(": ", 1)[1] for b in docs.untagged(root)] == ["1.71 s", "0.38 m"]
     # a dated record is not a hand-typed figure, and neither is one inside a generated block
-    p.write_text(p.read_text().replace("The fast mission now", "<!-- history: 2026-11-27, a note -->The fast mission now"))
+    p.write_text(
+        p.read_text().replace("The fast mission now", "<!-- history: 2026-11-27, a note -->The fast mission now")
+    )
     p.write_text(p.read_text().replace("of error.", "of error.<!-- /history -->"))
     assert docs.untagged(root) == []
 
