@@ -219,7 +219,7 @@ def test_a_hand_typed_figure_in_a_crate_readme_fails(tmp_path):
     p = root / rel
     p.write_text(p.read_text() + "\nThe fast mission now rotates in 1.71 s with 0.38 m of error.\n")
     assert [b.split(": ", 1)[1] for b in docs.untagged(root)] == ["1.71 s", "0.38 m"]
-    # a dated record is not a hand-typed figure, and neither is one inside a generated block
+    # a dated record is not a hand-typed figure
     p.write_text(
         p.read_text().replace("The fast mission now", "<!-- history: 2026-11-27, a note -->The fast mission now")
     )
@@ -350,3 +350,37 @@ def test_a_stale_wind_envelope_block_is_found(tmp_path):
     text = p.read_text()
     p.write_text(text[: body.start("body")] + body["body"].replace("/8", "/9", 1) + text[body.end("body") :])
     assert docs.regenerate(root, write=False, override={docs_wind.WIND: w}) == ["crates/tsd-control/README.md"]
+
+
+# --- labelling a document for the scan ------------------------------------------------------------------------------
+
+
+def test_labelling_records_and_definitions(tmp_path):
+    """`docs_label` wraps measured lines in dated records that keep the Markdown intact (marker
+    lines around a paragraph, inline markers in a list item) and allow-lists what is left."""
+    from tailsim.reports import docs_label
+
+    text = "# x\n\nMeasured: 1.23 m\nin 4.5 s.\n\n* **Item** — flew 6.7 m\n  and 8.9 s.\n\nA limit of 25°.\n"
+    para = docs_label.record_lines(text, 3, 4, "a test", "2026-11-27")
+    assert para.split("\n")[2:6] == [
+        "<!-- history: 2026-11-27, a test -->",
+        "Measured: 1.23 m",
+        "in 4.5 s.",
+        "<!-- /history -->",
+    ]
+    item = docs_label.record_lines(para, 8, 9, "a test", "2026-11-27")
+    assert "* **Item** — <!-- history: 2026-11-27, a test -->flew 6.7 m" in item
+    assert "  and 8.9 s.<!-- /history -->" in item
+    assert [t for _, t in docs.figures(item)] == ["25°"]
+    inline = docs_label.record_text(text, "flew 6.7 m", "a test", "2026-11-27")
+    assert [t for _, t in docs.figures(inline)] == ["1.23 m", "4.5 s", "8.9 s", "25°"]
+    with pytest.raises(ValueError):
+        docs_label.record_text(text, "m", "a test", "2026-11-27")
+    with pytest.raises(ValueError):
+        docs_label.record_lines(text, 3, 4, "no --> inside", "2026-11-27")
+    # the definitions left, allow-listed: the scan then passes on the document
+    root = copy_docs(tmp_path)
+    (root / "NOTE.md").write_text(item)
+    assert docs_label.refused(root, "NOTE.md") == [(11, "25°")]
+    assert docs_label.add_definitions(root, "NOTE.md") == ["25°"]
+    assert docs_label.refused(root, "NOTE.md") == []

@@ -204,6 +204,7 @@ def _run(src: Sources) -> str:
     run = w["run"]
     n = sum(r["cells"] for r in w["rows"])
     speeds = ", ".join(f"{s:g}" for s in w["speeds"])
+    rate = f", {run['flown'] / run['cpu_time_s']:.1f} flights per CPU-second" if run.get("cpu_time_s") else ""
     return (
         f"{n} flights: wind speeds {speeds} m/s from {len(w['bearings_deg'])} bearings "
         f"({', '.join(f'{b:g}°' for b in w['bearings_deg'])}; clockwise from north, the mission's heading), "
@@ -212,7 +213,7 @@ def _run(src: Sources) -> str:
         f"{w['held_max_error']:g} m of the controller's own reference (perfect state; "
         f"{w['held_max_error_avionics']:g} m with avionics). Flown by `{w['command'].split(';')[0]}` "
         f"(commit {w['commit']}; {run['flown']} flights flown, {run['from_cache']} from the cache, "
-        f"{run['wall_time_s']:.0f} s on {run['threads']} thread(s))."
+        f"{run['wall_time_s']:.0f} s on {run['threads']} thread(s){rate})."
     )
 
 
