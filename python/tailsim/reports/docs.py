@@ -18,7 +18,9 @@ A figure a reader meets in the documentation is one of these kinds:
   versions, identifiers and code are not figures (`strip_lines`).
 
 Generated blocks are rewritten in every document of `BLOCK_GLOBS` (docs/*.md, README.md, the
-crates' and FMUs' READMEs); the scan reads `SCAN_GLOBS` except `SCAN_LATER`.
+crates' and FMUs' READMEs); the scan reads `SCAN_GLOBS` except `SCAN_LATER` (to switch it on
+for one of those: remove it there, then label what `python -m tailsim.reports.docs_label FILE`
+lists: measured figures into generated blocks or dated records, definitions allow-listed).
 `python -m tailsim.reports.docs --write` rewrites every generated block (and the tables the
 verdict generates in README.md and docs/CAMPAIGN.md, `tailsim.reports.verdict --docs`);
 `--check` only compares (exit 1 when a block is stale); `--inventory` counts the figures by

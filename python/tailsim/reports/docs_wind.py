@@ -39,7 +39,7 @@ STATUS = {
     "L": "lost: farther than the lost distance from the reference, stopped",
     "N": "did not land by the stop time",
     "T": "landed beyond the error limit from the target",
-    "F": "stopped by an error (plant, controller or estimator)",
+    "F": "stopped by an error of the plant, controller or estimator",
 }
 MISSIONS = {"default": "default mission", "takeoff_landing": "take-off to landing", "handover": "handover"}
 WINDS = {"step": "step", "turbulent": "turbulent"}
@@ -175,24 +175,22 @@ def cell_text(r: Mapping[str, Any]) -> str:
 
 
 def reach(rows: Sequence[Mapping[str, Any]]) -> float | None:
-    """The largest speed up to which every cell (every bearing, every lower speed) is held;
-    None if not even the calm one."""
+    """The largest speed up to which every cell (every bearing, every lower speed, every row at
+    that speed) is held; None if not even the calm one."""
     best = None
-    for r in sorted(rows, key=lambda r: r["speed"]):
-        if r["held"] != r["cells"]:
+    for speed in sorted({r["speed"] for r in rows}):
+        if any(r["held"] != r["cells"] for r in rows if r["speed"] == speed):
             break
-        best = r["speed"]
+        best = speed
     return best
 
 
 def reach_text(rows: Sequence[Mapping[str, Any]]) -> str:
+    """The highest speed held from every bearing (`none`: not even in calm air) and the cells
+    held of those flown, e.g. `3 m/s (19/40)`."""
     s = reach(rows)
     held, n = sum(r["held"] for r in rows), sum(r["cells"] for r in rows)
-    if s is None:
-        where = "not at every bearing even in calm air"
-    else:
-        where = "every bearing in calm air only" if s == 0 else f"every bearing up to {s:g} m/s"
-    return f"{where} ({held}/{n} held)"
+    return f"{'none' if s is None else f'{s:g} m/s'} ({held}/{n})"
 
 
 # --- the blocks ---------------------------------------------------------------------------------------------------
@@ -246,9 +244,11 @@ def envelope_table(w: Mapping[str, Any], controller: str, axis=MAIN_AXIS) -> lis
 
 
 def _legend(w: Mapping[str, Any]) -> str:
+    codes = ", ".join(f"{s} {w['status'][s].split(':')[0]}" for s in "LNTF")
     return (
-        "Each cell: held of the bearings, the smallest–largest of the completed cells' largest distance to the "
-        "reference; cells not completed: " + ", ".join(f"{s} {w['status'][s].split(':')[0]}" for s in "LNTF") + "."
+        "Each speed: cells held of the bearings, the smallest–largest of the completed cells' largest distance to "
+        f"the reference, the cells not completed ({codes}). Held: the highest wind held from every bearing at it "
+        "and every lower speed (none: not even in calm air), and the cells held of those flown."
     )
 
 
@@ -302,14 +302,20 @@ def _controller_block(w: Mapping[str, Any], controller: str) -> str:
         "",
         _legend(w),
         "",
-        "Every bearing held, per state source and ordering (all missions and wind forms):",
+        "Per state source and ordering, the highest wind held from every bearing (cells held):",
         "",
     ]
     for axis in dict.fromkeys(_axis(r) for r in w["rows"] if r["controller"] == controller):
         c, s, o = axis
         if c != "tuned":
             continue
-        md.append(f"- {STATES.get(s, s)}, {ORDERINGS.get(o, o)}: {reach_text(rows_of(w, controller, axis))}")
+        cells = [
+            f"{MISSIONS.get(m, m)}, {WINDS.get(f, f)} {reach_text(rows)}"
+            for m in _present(w, "mission", MISSIONS)
+            for f in _present(w, "wind", WINDS)
+            if (rows := rows_of(w, controller, axis, m, f))
+        ]
+        md.append(f"- {STATES.get(s, s)}, {ORDERINGS.get(o, o)}: " + "; ".join(cells))
     return "\n".join(md)
 
 
