@@ -231,7 +231,7 @@ def test_scanned_readmes_carry_no_issue_numbers():
     import re
 
     for p in (p for p in docs.scanned_files() if p.name == "README.md"):
-        found = re.findall(r"\bissues? \d+", p.read_text(), flags=re.I)
+        found = re.findall(r"\bissues?\s*#?\d+", p.read_text(), flags=re.I)
         assert not found, f"{docs.rel_of(p)}: {found} (a README states the design and its results; history goes to git)"
 
 
