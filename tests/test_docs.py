@@ -157,7 +157,8 @@ def test_markers_leave_the_markdown_intact():
 
     for p in sorted(set(docs.doc_files()) | set(docs.scanned_files())):
         for n, line in enumerate(p.read_text().splitlines(), 1):
-            m = re.match(r"<!--.*?-->", line)
+            # also inside a list item: its content must not start with a marker either
+            m = re.match(r"\s*(?:[*-] |\d+\. )?<!--.*?-->", line)
             assert not m or m.end() == len(line.rstrip()), f"{docs.rel_of(p)}:{n}: {line[:80]}"
 
 
@@ -370,13 +371,19 @@ def test_labelling_records_and_definitions(tmp_path):
         "<!-- /history -->",
     ]
     item = docs_label.record_lines(para, 8, 9, "a test", "2026-11-27")
-    assert "* **Item** — <!-- history: 2026-11-27, a test -->flew 6.7 m" in item
+    assert "* **Item** — flew <!-- history: 2026-11-27, a test -->6.7 m" in item
     assert "  and 8.9 s.<!-- /history -->" in item
     assert [t for _, t in docs.figures(item)] == ["25°"]
     inline = docs_label.record_text(text, "flew 6.7 m", "a test", "2026-11-27")
     assert [t for _, t in docs.figures(inline)] == ["1.23 m", "4.5 s", "8.9 s", "25°"]
     with pytest.raises(ValueError):
         docs_label.record_text(text, "m", "a test", "2026-11-27")
+    # a text at a line's start: the opening marker ends the line before (never starts a line)
+    cont = docs_label.record_text(text, "in 4.5 s.", "a test", "2026-11-27")
+    assert "Measured: 1.23 m<!-- history: 2026-11-27, a test -->\nin 4.5 s.<!-- /history -->" in cont
+    for starts in ("Measured: 1.23 m", "**Item** — flew"):
+        with pytest.raises(ValueError):
+            docs_label.record_text(text, starts, "a test", "2026-11-27")
     with pytest.raises(ValueError):
         docs_label.record_lines(text, 3, 4, "no --> inside", "2026-11-27")
     # the definitions left, allow-listed: the scan then passes on the document

@@ -63,11 +63,14 @@ def record_lines(text: str, first: int, last: int, how: str, date: str) -> str:
     if not 1 <= first <= last <= len(lines):
         raise ValueError(f"lines {first}-{last} outside the file's 1-{len(lines)}")
     begin, end = opening(date, how), "<!-- /history -->"
-    item = _ITEM.match(lines[first - 1]) or lines[first - 1].startswith((" ", "\t"))
-    if item:
-        prefix = _ITEM.match(lines[first - 1])
-        cut = prefix.end() if prefix else len(lines[first - 1]) - len(lines[first - 1].lstrip())
-        lines[first - 1] = lines[first - 1][:cut] + begin + lines[first - 1][cut:]
+    line = lines[first - 1]
+    if _ITEM.match(line) or line.startswith((" ", "\t")):
+        # inline, after the item's first word: a line whose content starts with a comment is an
+        # HTML block to CommonMark (the rest of it shown raw)
+        start = _ITEM.match(line).end() if _ITEM.match(line) else len(line) - len(line.lstrip())
+        word = line.find(" ", start + 1)
+        cut = len(line) if word < 0 else word + 1
+        lines[first - 1] = line[:cut] + begin + line[cut:]
         lines[last - 1] += end
     else:
         lines[first - 1 : last] = [begin, *lines[first - 1 : last], end]
@@ -78,8 +81,15 @@ def record_text(text: str, exact: str, how: str, date: str) -> str:
     """`text` with the (unique) `exact` text in an inline history record."""
     if text.count(exact) != 1:
         raise ValueError(f"{exact[:60]!r} occurs {text.count(exact)} times (must be once)")
-    i = text.index(exact)
-    return text[:i] + opening(date, how) + exact + "<!-- /history -->" + text[i + len(exact) :]
+    i = j = text.index(exact)
+    line_start = text.rfind("\n", 0, i) + 1
+    if not text[line_start:i].strip():  # at a line's start: the opening ends the line before
+        j = line_start - 1
+        if j < 0 or text[text.rfind("\n", 0, j) + 1 : j].strip() == "":
+            raise ValueError(f"{exact[:60]!r} starts a paragraph: record its lines (--record) instead")
+    elif re.fullmatch(r"\s*(?:[*-] |\d+\. )", text[line_start:i]):
+        raise ValueError(f"{exact[:60]!r} starts a list item: record its lines (--record) instead")
+    return text[:j] + opening(date, how) + text[j:i] + exact + "<!-- /history -->" + text[i + len(exact) :]
 
 
 def refused(root: pathlib.Path, rel: str) -> list[tuple[int, str]]:
