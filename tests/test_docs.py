@@ -319,6 +319,12 @@ def test_the_wind_envelope_summary_of_a_synthetic_file():
     )
     axes = docs.render("wind.axes", src)
     assert "| LQR | tuned | avionics | Gauss-Seidel | none (0/1) | – |" in axes
+    # a cell that names no axis (a file of one grid) is on the main one
+    bare = {
+        k: v for k, v in synthetic_envelope()["cells"][0].items() if k not in ("configuration", "state", "ordering")
+    }
+    one = docs_wind.summarize({**synthetic_envelope(), "cells": [bare]})["rows"]
+    assert [tuple(r[k] for k in ("configuration", "state", "ordering")) for r in one] == [docs_wind.MAIN_AXIS]
     # every row at a speed counts: a calm turbulent row not held means none
     calm = [
         {"speed": 0.0, "held": 8, "cells": 8},

@@ -49,6 +49,8 @@ ORDERINGS = {"gauss-seidel": "Gauss-Seidel", "jacobi": "Jacobi"}
 MAIN_AXIS = ("tuned", "perfect", "gauss-seidel")
 _AXIS_KEYS = ("configuration", "state", "ordering")
 _ROW_KEYS = ("controller", *_AXIS_KEYS, "mission", "wind", "speed")
+#: The axis of a cell that names none (a file of one grid: tuned, perfect state, Gauss-Seidel).
+_DEFAULT_AXIS = dict(zip(_AXIS_KEYS, MAIN_AXIS, strict=True))
 
 
 # --- the summary ---------------------------------------------------------------------------------------------------
@@ -78,7 +80,7 @@ def summarize(full: Mapping[str, Any], command: str = COMMAND, commit: str | Non
     """The compact summary of the analysis's `wind_envelope.json` (`full`)."""
     rows: dict[tuple, list[Mapping[str, Any]]] = {}
     for c in full["cells"]:
-        rows.setdefault(tuple(c[k] for k in _ROW_KEYS), []).append(c)
+        rows.setdefault(tuple(c.get(k, _DEFAULT_AXIS.get(k)) for k in _ROW_KEYS), []).append(c)
     out_rows = []
     for key, cells in rows.items():
         cells = sorted(cells, key=lambda c: c["bearing_deg"])
