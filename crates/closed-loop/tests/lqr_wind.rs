@@ -31,9 +31,8 @@ fn hover(speed: f64, bearing_deg: f64) -> Trace {
 }
 
 /// In an 8 and a 10 m/s wind from the four quartering bearings the 5 s first vertical
-/// phase holds within 3.5 m of the reference (measured 1.54–3.45 m at 8 m/s, 1.31–2.51 m
-/// at 10 m/s, the reference drifting downwind from 0.5 s on) and the 3-2-1 pitch stays above
-/// 20° (lowest measured 38.2°). Before, the
+/// phase holds within 3.5 m of the reference (measured 2.19–2.63 m at 8 m/s, 3.03–3.27 m
+/// at 10 m/s) and the 3-2-1 pitch stays above 20° (lowest measured 26.6°). Before, the
 /// gains went back to the measured state once the tilt into the wind had brought α and β
 /// below 30° — the weathervane, whose return window (6.5 s) is longer than the phase, never
 /// engaged — the thrust fell to zero and the pitch through level (−3.9° at 8 m/s from 45°)
