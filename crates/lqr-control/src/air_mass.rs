@@ -7,9 +7,8 @@
 //! still-air trim (V_t, α_t, β = 0, attitude, thrust, surfaces) is then an exact trim in the
 //! steady wind, and the gains linearised about it are the still-air ones. r rises
 //! (smoothstep) over [`AIR_MASS_RAMP`] s ending [`AIR_MASS_RAMP_END`] s into the first
-//! transition (the hover lets go of the ground position and drifts, upright, while it
-//! pitches over) or, in a hover long enough, where the weathervane starts to return the
-//! heading to the mission's. The take-off and landing phases hold the ground (r = 0); the approach
+//! transition: the hover lets go of the ground position and drifts, upright, while it
+//! pitches over. The take-off and landing phases hold the ground (r = 0); the approach
 //! starts from the drifted reference with its drift velocity.
 
 use flight_mission::Phase;
@@ -38,26 +37,11 @@ impl LqrController {
         if !(tuned && self.wind_integral) || self.ground_active {
             return 0.0;
         }
-        let end = self.air_mass_ramp_end();
+        let end = self.mission.t_vertical_1 + AIR_MASS_RAMP_END;
         match self.mission.phase_at(t).0 {
             Phase::Vertical1 | Phase::TransitionToLevel => smoothstep(1.0 - (end - t) / AIR_MASS_RAMP),
             Phase::Level | Phase::TransitionToVertical | Phase::Vertical2 => 1.0,
             _ => 0.0,
-        }
-    }
-
-    /// Mission time at which the air-mass weight reaches 1: where the first vertical phase
-    /// holds the whole ramp before the weathervane's return window, at the start of that
-    /// window (the heading then returns to the mission's in the air mass, with no wind
-    /// across the span); otherwise [`AIR_MASS_RAMP_END`] s into the first transition.
-    fn air_mass_ramp_end(&self) -> f64 {
-        let t1 = self.mission.t_vertical_1;
-        let vane = self.weathervane.params();
-        let window = vane.return_window();
-        if vane.enabled && t1 - window >= AIR_MASS_RAMP {
-            t1 - window
-        } else {
-            t1 + AIR_MASS_RAMP_END
         }
     }
 
