@@ -1,26 +1,21 @@
 //! The wing-borne part of the mission flown in the air mass (tuned configuration, README
-//! "Mission in wind"): in a steady wind the transitions, the level leg and the last vertical
-//! phase keep the still-air trajectory **relative to the air** and the reference position
-//! drifts with the estimated wind, p_ref = origin + p_t + D, Ḋ = r ŵ_d (ŵ_d: the horizontal
-//! wind estimate less a headwind along the track, which the wind trim carries in the pitch
-//! plane). With r = 1 the reference air velocity is the table's own, v_g − ŵ_d = v_t: the
-//! still-air trim (V_t, α_t, β = 0, attitude, thrust, surfaces) is then an exact trim in the
-//! steady wind, and the gains linearised about it are the still-air ones. r rises
-//! (smoothstep) over [`AIR_MASS_RAMP`] s ending [`AIR_MASS_RAMP_END`] s into the first
-//! transition: the hover lets go of the ground position and drifts, upright, while it
-//! pitches over. The take-off and landing phases hold the ground (r = 0); the approach
-//! starts from the drifted reference with its drift velocity.
+//! "Mission in wind"): in a steady wind the transitions and the level leg keep the still-air
+//! trajectory **relative to the air** and the reference position drifts with the estimated
+//! wind, p_ref = origin + p_t + D, Ḋ = r ŵ. With r = 1 the reference air velocity is the
+//! table's own, v_g − ŵ = v_t: the still-air trim (V_t, α_t, β = 0, attitude, thrust,
+//! surfaces) is then an exact trim in the steady wind, and the gains scheduled on it are the
+//! still-air ones. r ramps from 0 to 1 over the last [`AIR_MASS_RAMP_IN`] s of the first
+//! vertical phase (the hover lets go of the ground position and drifts, upright, before the
+//! pitch-over) and back to 0 over the first [`AIR_MASS_RAMP_OUT`] s of the last vertical
+//! phase (the hover then holds the drifted position against the wind, as in the first).
 
 use flight_mission::Phase;
 use nalgebra::Vector3;
 
 use crate::LqrController;
 
-/// Time over which the air-mass weight r rises (smoothstep) from 0 to 1 (s).
-pub const AIR_MASS_RAMP: f64 = 7.0;
-/// Time into the first transition at which r reaches 1 (s): the ramp starts
-/// [`AIR_MASS_RAMP`] − this before the transition.
-pub const AIR_MASS_RAMP_END: f64 = 2.5;
+/// Time over which the air-mass weight r rises from 0 to 1 before the first transition (s).
+pub const AIR_MASS_RAMP_IN: f64 = 2.0;
 
 /// 3x² − 2x³ on [0, 1].
 fn smoothstep(x: f64) -> f64 {
@@ -37,10 +32,13 @@ impl LqrController {
         if !(tuned && self.wind_integral) || self.ground_active {
             return 0.0;
         }
-        let end = self.mission.t_vertical_1 + AIR_MASS_RAMP_END;
-        match self.mission.phase_at(t).0 {
-            Phase::Vertical1 | Phase::TransitionToLevel => smoothstep(1.0 - (end - t) / AIR_MASS_RAMP),
-            Phase::Level | Phase::TransitionToVertical | Phase::Vertical2 => 1.0,
+        let (phase, tau) = self.mission.phase_at(t);
+        match phase {
+            Phase::Vertical1 => {
+                let left = self.mission.t_vertical_1 - tau;
+                smoothstep(1.0 - left / AIR_MASS_RAMP_IN)
+            }
+            Phase::TransitionToLevel | Phase::Level | Phase::TransitionToVertical | Phase::Vertical2 => 1.0,
             _ => 0.0,
         }
     }
