@@ -14,7 +14,6 @@
 //!
 //! See README.md for the equations and the design choices.
 
-mod air_mass;
 mod command;
 mod error_state;
 mod gain;
@@ -281,10 +280,6 @@ pub struct LqrController {
     warm_len: usize,
     /// Recompute every accepted warm solve cold and record the difference (tests).
     verify_warm: bool,
-    /// Air-mass drift D of the reference position (N, E, h) (m) (`air_mass`).
-    drift: Vector3<f64>,
-    /// The air-mass weight r of the current sample (recomputed every sample, not saved).
-    air_mass_r: f64,
 }
 
 /// Names of the commands, for [`Notice::Saturated`].
@@ -412,8 +407,6 @@ impl LqrController {
             warm_hist: [SMatrix::zeros(); 2],
             warm_len: 0,
             verify_warm: false,
-            drift: Vector3::zeros(),
-            air_mass_r: 0.0,
         };
         c.initial_gains()?;
         Ok(c)
@@ -679,9 +672,6 @@ impl SampledUnit for LqrController {
             out(*v);
         }
         out(f64::from(u8::from(self.wind_integral)));
-        for v in self.drift.iter() {
-            out(*v);
-        }
     }
 
     /// Restore what [`Self::save`] wrote; `None` from `next` = truncated state.
@@ -736,7 +726,6 @@ impl SampledUnit for LqrController {
             }
         }
         self.wind_integral = take()? != 0.0;
-        self.drift = Vector3::new(take()?, take()?, take()?);
         Ok(())
     }
 

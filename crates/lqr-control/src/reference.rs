@@ -67,18 +67,17 @@ impl LqrController {
         sw: &ReferenceSwitches,
     ) -> ControlFlow<ControllerOutput, (Vector3<f64>, Option<VerticalReference>)> {
         let m = &input.measurement;
-        let (trajectory, lqr_origin, drift) = (&self.trajectory, self.origin, self.drift);
-        let drift_vel = self.drift_velocity();
+        let (trajectory, lqr_origin) = (&self.trajectory, self.origin);
         let mode = self.ground.step(input.t, m, |tm| {
             let p = trajectory.at(tm);
             let o = lqr_origin.unwrap_or(measured_neh);
             let off = &input.ref_offset_ned;
             let (sg, cg) = p.gamma.sin_cos();
             let (sp, cp) = p.euler_321.z.sin_cos();
-            let pos = o + p.pos_neh + drift + Vector3::new(off.x, off.y, -off.z);
+            let pos = o + p.pos_neh + Vector3::new(off.x, off.y, -off.z);
             (
                 Vector3::new(pos.x, pos.y, -pos.z),
-                p.v * Vector3::new(cg * cp, cg * sp, -sg) + drift_vel,
+                p.v * Vector3::new(cg * cp, cg * sp, -sg),
             )
         });
         let (offset, ground_ref) = match mode {
@@ -136,7 +135,6 @@ impl LqrController {
         sw: &ReferenceSwitches,
     ) -> Reference {
         let m = &input.measurement;
-        self.update_air_mass_drift(t, sw.hover_in_wind && sw.wind_compensation);
         let (point, pos_neh) = self.trajectory_point(input, t, measured_neh, offset, ground.as_ref(), sw);
         let in_wind = ground.is_none() && sw.hover_in_wind && self.hover_in_wind(t, m);
         self.update_hover_shift(measured_neh, pos_neh, in_wind);
@@ -201,7 +199,7 @@ impl LqrController {
         let origin = *self.origin.get_or_insert(measured_neh);
         let ref_neh = match ground {
             Some(v) => Vector3::new(v.pos.x + off.x, v.pos.y + off.y, -(v.pos.z + off.z)),
-            None => origin + reference.pos_neh + self.drift + Vector3::new(off.x, off.y, -off.z),
+            None => origin + reference.pos_neh + Vector3::new(off.x, off.y, -off.z),
         };
         (reference, ref_neh)
     }
@@ -295,20 +293,19 @@ impl LqrController {
     /// fails.
     fn trimmed(&self, p: &TrajPoint, sw: &ReferenceSwitches) -> Option<TrajPoint> {
         let h = self.mission.sample_time;
-        let wind = self.reference_wind(&self.wind);
-        let w_next = self.reference_wind(&(self.wind + h * self.wind_rate));
+        let w_next = self.wind + h * self.wind_rate;
         let lift = (p.v / self.mission.v_level).powi(2).min(1.0);
         let (w0, w1) = WIND_TRIM_RAMP;
         let weight = |w: &Vector3<f64>| {
             let x = ((w.norm() - w0) / (w1 - w0)).clamp(0.0, 1.0);
             lift * x * x * (3.0 - 2.0 * x)
         };
-        let (k, k_next) = (weight(&wind), weight(&w_next));
+        let (k, k_next) = (weight(&self.wind), weight(&w_next));
         if !sw.wind_compensation || !(k > 0.0 || k_next > 0.0) {
             return None;
         }
         let s_lat = self.lateral_wind_weight(p);
-        let z = self.wind_trim(p, &wind, s_lat)?;
+        let z = self.wind_trim(p, &self.wind, s_lat)?;
         let z_next = self.wind_trim(p, &w_next, s_lat)?;
         let rate = (k_next * z_next.x - k * z.x) / h;
         let mut q = *p;
@@ -393,9 +390,8 @@ impl LqrController {
         let c = model::dcm_of_quat(&p.quat());
         let (sa, ca) = p.alpha.sin_cos();
         let v_g = c.transpose() * (p.v * Vector3::new(ca, 0.0, sa));
-        let wind = self.reference_wind(&self.wind);
-        let full = c * (v_g - wind);
-        let v_b = Vector3::new(full.x, (c * (v_g - s_lat * wind)).y, full.z);
+        let full = c * (v_g - self.wind);
+        let v_b = Vector3::new(full.x, (c * (v_g - s_lat * self.wind)).y, full.z);
         let v = v_b.norm();
         if !(v.is_finite() && v >= MIN_AIRSPEED) {
             return plain;
