@@ -16,6 +16,10 @@ use crate::reference::Reference;
 use crate::weights::Weights;
 use crate::{Gain, LqrController, LqrParams, HOVER_WIND_AIR_ANGLE};
 
+/// Largest tailwind component along the track, in climb speeds V_V, for which the front
+/// transition in wind is linearised about the reference (README, "Mission in wind").
+pub const TRANSITION_TAILWIND_REFERENCE: f64 = 2.0;
+
 /// Size of the augmented ZOH exponential: states + integrator + inputs.
 const NM: usize = NA + NU;
 
@@ -404,7 +408,8 @@ impl LqrController {
     /// measured at 8 m/s), and the measured state, swinging through those angles, is no
     /// valid point for the model's linearisation (README, "Mission in wind"); the reference
     /// carries the wind-consistent air data instead. In a tailwind the measured state is
-    /// the better point (about the reference a 10 m/s tailwind was lost, 361 m).
+    /// the better point (about the reference a 10 m/s tailwind was lost, 361 m), unless the
+    /// tailwind is weak ([`Self::tailwind_within_reference_range`]).
     fn transition_in_wind(&self, t: f64) -> bool {
         if !(self.wind_integral && self.mission.phase_at(t).0 == Phase::TransitionToLevel) {
             return false;
@@ -412,7 +417,18 @@ impl LqrController {
         let w = self.weathervane.wind();
         let (s, c) = self.trajectory.at(t).euler_321.z.sin_cos();
         let (along, across) = (w.x * c + w.y * s, (w.y * c - w.x * s).abs());
-        w.xy().norm() > self.mission.v_vertical && along < across
+        w.xy().norm() > self.mission.v_vertical && (along < across || self.tailwind_within_reference_range(along))
+    }
+
+    /// A tailwind component along the track `along` (m/s) of at most
+    /// [`TRANSITION_TAILWIND_REFERENCE`] climb speeds: the front transition's gains are then
+    /// computed about the reference too (README, "Mission in wind"). At 5 m/s from behind the
+    /// transition's measured air angles pass through the same wind-dominated range as across
+    /// the track (the handover's tailwind 3.05 → 2.95 m, its quartering tailwinds 19.5 →
+    /// 7.0 m); from 8 m/s the measured state is the better point (about the reference the
+    /// handover's 10 m/s tailwind was lost).
+    fn tailwind_within_reference_range(&self, along: f64) -> bool {
+        along <= TRANSITION_TAILWIND_REFERENCE * self.mission.v_vertical
     }
 
     /// The first vertical phase with the weathervane's wind estimate (4 s filter) at or above
