@@ -409,7 +409,7 @@ impl LqrController {
     /// valid point for the model's linearisation (README, "Mission in wind"); the reference
     /// carries the wind-consistent air data instead. In a tailwind the measured state is
     /// the better point (about the reference a 10 m/s tailwind was lost, 361 m), unless the
-    /// tailwind is weak ([`Self::tailwind_within_reference_range`]).
+    /// tailwind is weak ([`Self::weak_tailwind`]).
     fn transition_in_wind(&self, t: f64) -> bool {
         if !(self.wind_integral && self.mission.phase_at(t).0 == Phase::TransitionToLevel) {
             return false;
@@ -417,17 +417,22 @@ impl LqrController {
         let w = self.weathervane.wind();
         let (s, c) = self.trajectory.at(t).euler_321.z.sin_cos();
         let (along, across) = (w.x * c + w.y * s, (w.y * c - w.x * s).abs());
-        w.xy().norm() > self.mission.v_vertical && (along < across || self.tailwind_within_reference_range(along))
+        w.xy().norm() > self.mission.v_vertical && (along < across || self.weak_tailwind(c, s))
     }
 
-    /// A tailwind component along the track `along` (m/s) of at most
+    /// A tailwind component along the track (`cos_track`, `sin_track`: its heading) of at most
     /// [`TRANSITION_TAILWIND_REFERENCE`] climb speeds: the front transition's gains are then
     /// computed about the reference too (README, "Mission in wind"). At 5 m/s from behind the
     /// transition's measured air angles pass through the same wind-dominated range as across
     /// the track (the handover's tailwind 3.05 → 2.95 m, its quartering tailwinds 19.5 →
     /// 7.0 m); from 8 m/s the measured state is the better point (about the reference the
     /// handover's 10 m/s tailwind was lost).
-    fn tailwind_within_reference_range(&self, along: f64) -> bool {
+    ///
+    /// The tailwind is read from the controller's own estimate (0.3 s filter), which has
+    /// settled before the transition: on the weathervane's 4 s estimate a building 8 m/s
+    /// tailwind passes through the range early in the transition.
+    fn weak_tailwind(&self, cos_track: f64, sin_track: f64) -> bool {
+        let along = self.wind.x * cos_track + self.wind.y * sin_track;
         along <= TRANSITION_TAILWIND_REFERENCE * self.mission.v_vertical
     }
 
