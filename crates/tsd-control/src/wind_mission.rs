@@ -41,6 +41,13 @@ pub const LANDING_FLAP_TRIM_GAIN: f64 = 4.6 * core::f64::consts::PI / 180.0;
 /// is −20° from 5 m/s; the rest of the ±25° is left to the normal loop.
 pub const LANDING_FLAP_TRIM_LIMIT: f64 = 17.0 * core::f64::consts::PI / 180.0;
 
+/// Engage speed of the take-off and landing phases' heading (m/s): below the weathervane's
+/// (3 m/s). Its estimate (a 4 s filter) reaches a steady 3 m/s wind only asymptotically, so a
+/// 3 m/s wind engaged it from some bearings and not from others; not engaged, a quartering
+/// 3 m/s wind met the belly and the span together and the aircraft touched down 12° from the
+/// vertical. Still air is unaffected (the estimate is 0).
+pub const GROUND_ENGAGE_SPEED: f64 = 2.0;
+
 /// Number of f64 values [`WindMission::save`] writes.
 pub const WIND_MISSION_STATE_LEN: usize = 3;
 
@@ -158,10 +165,16 @@ impl WindMission {
 
     /// The engagement's hysteresis on the weathervane's filtered air-data wind.
     fn engage(&mut self, wv: &Weathervane) {
+        self.engage_at(wv, wv.params().engage_speed);
+    }
+
+    /// [`Self::engage`] at the engage speed `engage_speed` (m/s) (the release speed the
+    /// weathervane's).
+    fn engage_at(&mut self, wv: &Weathervane, engage_speed: f64) {
         let p = wv.params();
         let w = wv.wind();
         let speed = w.x.hypot(w.y);
-        if speed >= p.engage_speed {
+        if speed >= engage_speed {
             self.engaged = true;
         } else if speed.is_nan() || speed < p.release_speed {
             self.engaged = false;
@@ -169,14 +182,15 @@ impl WindMission {
     }
 
     /// The heading target of the take-off and landing phases (README, "Take-off and landing
-    /// in wind"), for [`Weathervane::update_towards`]: engaged, the belly or the back into the
-    /// wind (the weathervane's); released, the heading held. `None` with the weathervane off.
+    /// in wind"), for [`Weathervane::update_towards`]: engaged (at [`GROUND_ENGAGE_SPEED`]),
+    /// the belly or the back into the wind (the weathervane's); released, the heading held.
+    /// `None` with the weathervane off.
     pub fn ground_target(&mut self, wv: &Weathervane) -> Option<(f64, f64)> {
         let p = wv.params();
         if !p.enabled {
             return None;
         }
-        self.engage(wv);
+        self.engage_at(wv, p.engage_speed.min(GROUND_ENGAGE_SPEED).max(p.release_speed));
         let heading = wv.heading();
         let w = wv.wind();
         if !(self.engaged && w.x.is_finite() && w.y.is_finite()) {
@@ -286,6 +300,35 @@ mod tests {
             target.to_degrees()
         );
         assert!((wv.heading() - target).abs() < 0.02, "{}", wv.heading().to_degrees());
+    }
+
+    /// The take-off and landing heading engages at [`GROUND_ENGAGE_SPEED`], below the
+    /// weathervane's engage speed: a steady 2.5 m/s wind from the north-east turns the belly
+    /// or the back into it; 1.5 m/s does not (the heading is held).
+    #[test]
+    fn ground_heading_engages_below_the_weathervanes_engage_speed() {
+        let mission = MissionParams::default();
+        let fly = |speed: f64| {
+            let mut wv = Weathervane::new(WeathervaneParams::tuned()).unwrap();
+            let mut wm = WindMission::default();
+            let d = core::f64::consts::FRAC_1_SQRT_2 * speed;
+            let m = hovering(Vector3::new(-d, -d, 0.0), Vector3::zeros());
+            for k in 0..2000 {
+                let target = wm.ground_target(&wv);
+                wv.update_towards(&mission, k as f64 * mission.sample_time, &m, target);
+            }
+            assert!(wv.params().engage_speed > 2.5);
+            (wm.engaged(), wv.heading())
+        };
+        let (engaged, heading) = fly(2.5);
+        assert!(engaged);
+        let off = (heading - core::f64::consts::FRAC_PI_4).rem_euclid(core::f64::consts::PI);
+        assert!(
+            off < 0.02 || off > core::f64::consts::PI - 0.02,
+            "{}",
+            heading.to_degrees()
+        );
+        assert_eq!(fly(1.5), (false, 0.0));
     }
 
     /// The collective-flap trim: −4.6° per m/s of wind into the belly, ±17° at most, the
