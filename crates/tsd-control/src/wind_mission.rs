@@ -41,6 +41,15 @@ pub const LANDING_FLAP_TRIM_GAIN: f64 = 4.6 * core::f64::consts::PI / 180.0;
 /// is −20° from 5 m/s; the rest of the ±25° is left to the normal loop.
 pub const LANDING_FLAP_TRIM_LIMIT: f64 = 17.0 * core::f64::consts::PI / 180.0;
 
+/// Collective flap per radian of lean towards the belly in the landing phases, per m/s of
+/// the wind estimate (rad/rad per m/s), within [`LANDING_LEAN_GAIN_RANGE`]: the flaps' direct
+/// force takes the wind load off the tilt (README, "Take-off and landing in wind").
+pub const LANDING_LEAN_GAIN_PER_WIND: f64 = 0.3;
+/// Range of the lean gain (rad/rad): 1.2 up to 4 m/s, 1.8 from 6 m/s. Measured margins: 2.2
+/// lost every 3 m/s cell and 1.8 one (the lean loop through the flaps' pitching moment
+/// oscillates); 1.2 at 8 m/s touched down at 0.42–0.48 m/s.
+pub const LANDING_LEAN_GAIN_RANGE: (f64, f64) = (1.2, 1.8);
+
 /// Engage speed of the take-off and landing phases' heading (m/s): below the weathervane's
 /// (3 m/s). Its estimate (a 4 s filter) reaches a steady 3 m/s wind only asymptotically, so a
 /// 3 m/s wind engaged it from some bearings and not from others; not engaged, a quartering
@@ -77,29 +86,46 @@ fn specific_force_earth(m: &Measurement) -> Vector3<f64> {
     r * m.specific_force_body
 }
 
-/// Direct-force trim of the collective flaps in the landing phases (approach, descent,
+/// Direct-force command of the collective flaps in the landing phases (approach, descent,
 /// flare) (rad), from the filtered air-data wind `wind` (NED) and the measured attitude
-/// (README, "Take-off and landing in wind"). Nose up, the flaps sit in the propellers'
-/// slip-stream (≈ 23 m/s in hover): a wind into the belly turns the slip-stream's flow over
-/// the wing, whose normal force then needs 30° of tilt at 3 m/s and 41° at 5 m/s to be held
-/// (measured at touchdown), far outside an upright landing. The collective flaps deflected
-/// against the wind cancel that force with the nose vertical (the plant's trim: −13.8° at
-/// 3 m/s, −20° at 5–8 m/s; the elevator trims the moment). The trim is
-/// −[`LANDING_FLAP_TRIM_GAIN`] × (wind into the belly), within ±[`LANDING_FLAP_TRIM_LIMIT`];
-/// 0 in other phases and without a wind estimate.
+/// (README, "Take-off and landing in wind"); the controller weights it with the measured
+/// wind (0 in still air). Nose up, the flaps sit in the propellers' slip-stream (≈ 23 m/s in
+/// hover): a wind into the belly turns the slip-stream's flow over the wing, whose normal
+/// force then needs 30° of tilt at 3 m/s and 41° at 5 m/s to be held (measured at
+/// touchdown), far outside an upright landing. The collective flaps deflected against the
+/// wind cancel that force with the nose vertical (the plant's trim: −13.8° at 3 m/s, −20° at
+/// 5–8 m/s; the elevator trims the moment). Two parts:
+///
+/// * the trim −[`LANDING_FLAP_TRIM_GAIN`] × (wind into the belly), within
+///   ±[`LANDING_FLAP_TRIM_LIMIT`];
+/// * the lean feedback −k_λ sin λ, λ the lean of the nose towards the belly's horizontal
+///   direction, k_λ = [`LANDING_LEAN_GAIN_PER_WIND`] |ŵ_h| within
+///   [`LANDING_LEAN_GAIN_RANGE`]. The TSD's normal loop regulates the normal specific force,
+///   not the attitude: leaning into the wind and deflecting the flaps make the same force, and
+///   with the trim alone the aircraft hung 20–23° into 5 m/s; with larger fixed trims the
+///   attitude swung ±50° at a steady position. The lean feedback makes the flaps carry the
+///   load the lean would carry, so the position loop levels the nose.
+///
+/// 0 in other phases, without a wind estimate, or with the belly axis within 30° of the
+/// vertical.
 pub fn landing_flap_trim(m: &Measurement, phase: Phase, wind: &Vector3<f64>) -> f64 {
     let landing = matches!(phase, Phase::Approach | Phase::Descent | Phase::Flare);
     if !(landing && wind.x.is_finite() && wind.y.is_finite()) {
         return 0.0;
     }
     let q = &m.quat;
-    let belly = UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2])) * Vector3::z();
+    let r = UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]));
+    let (nose, belly) = (r * Vector3::x(), r * Vector3::z());
     let size = belly.xy().norm();
     if size < 0.5 {
         return 0.0;
     }
     let into_belly = -wind.xy().dot(&belly.xy()) / size;
-    -(LANDING_FLAP_TRIM_GAIN * into_belly).clamp(-LANDING_FLAP_TRIM_LIMIT, LANDING_FLAP_TRIM_LIMIT)
+    let trim = -(LANDING_FLAP_TRIM_GAIN * into_belly).clamp(-LANDING_FLAP_TRIM_LIMIT, LANDING_FLAP_TRIM_LIMIT);
+    let (lo, hi) = LANDING_LEAN_GAIN_RANGE;
+    let gain = (LANDING_LEAN_GAIN_PER_WIND * wind.xy().norm()).clamp(lo, hi);
+    let sin_lean = nose.xy().dot(&belly.xy()) / size;
+    trim - gain * sin_lean
 }
 
 impl WindMission {
@@ -331,8 +357,8 @@ mod tests {
         assert_eq!(fly(1.5), (false, 0.0));
     }
 
-    /// The collective-flap trim: −4.6° per m/s of wind into the belly, ±17° at most, the
-    /// sign following the face, only in the landing phases.
+    /// The collective-flap command: −4.6° per m/s of wind into the belly, ±17° at most, the
+    /// sign following the face, and the lean feedback; only in the landing phases.
     #[test]
     fn landing_flap_trim_opposes_the_wind_into_the_belly() {
         let m = hovering(Vector3::zeros(), Vector3::zeros());
@@ -344,6 +370,24 @@ mod tests {
         assert!((deg(t) - 13.8).abs() < 1e-9, "{}", deg(t));
         let t = landing_flap_trim(&m, Phase::Approach, &from_north(10.0));
         assert!((deg(t) + 17.0).abs() < 1e-9, "{}", deg(t));
+        // Leaning 6° towards the belly in 5 m/s: 1.5 × sin 6° more flap towards the belly;
+        // in 2 m/s (gain 1.2) and 10 m/s (1.8) the gain's range.
+        let tilted = |deg: f64| {
+            let r = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), (90.0 - deg).to_radians());
+            Measurement::still_in_air(&r, &Vector3::zeros())
+        };
+        for (v, gain) in [(5.0, 1.5), (2.0, 1.2), (10.0, 1.8)] {
+            let t = landing_flap_trim(&tilted(6.0), Phase::Descent, &from_north(v));
+            let trim = -(4.6 * v).min(17.0).to_radians();
+            assert!(
+                (t - (trim - gain * 6f64.to_radians().sin())).abs() < 1e-12,
+                "{v}: {}",
+                deg(t)
+            );
+        }
+        // Leaning towards the back: the other way.
+        let t = landing_flap_trim(&tilted(-6.0), Phase::Descent, &Vector3::zeros());
+        assert!((t - 1.2 * 6f64.to_radians().sin()).abs() < 1e-12, "{}", deg(t));
         // Along the span: no trim; outside the landing phases or without an estimate: none.
         assert!(landing_flap_trim(&m, Phase::Descent, &Vector3::new(0.0, 8.0, 0.0)).abs() < 1e-12);
         assert_eq!(landing_flap_trim(&m, Phase::Vertical2, &from_north(5.0)), 0.0);
