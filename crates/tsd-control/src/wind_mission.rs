@@ -45,9 +45,9 @@ pub const LANDING_FLAP_TRIM_LIMIT: f64 = 17.0 * core::f64::consts::PI / 180.0;
 /// the wind estimate (rad/rad per m/s), within [`LANDING_LEAN_GAIN_RANGE`]: the flaps' direct
 /// force takes the wind load off the tilt (README, "Take-off and landing in wind").
 pub const LANDING_LEAN_GAIN_PER_WIND: f64 = 0.3;
-/// Range of the lean gain (rad/rad): 1.2 up to 4 m/s, 1.8 from 6 m/s. Measured margins: 2.2
-/// lost every 3 m/s cell and 1.8 one (the lean loop through the flaps' pitching moment
-/// oscillates); 1.2 at 8 m/s touched down at 0.42–0.48 m/s.
+/// Range of the lean gain (rad/rad): 1.2 up to 4 m/s, 1.8 from 6 m/s. Measured with fixed
+/// gains: 2.5 lost every 3 m/s take-off → landing cell and 1.5 one (the lean loop through the
+/// flaps' pitching moment oscillates); 1.2 at 8 m/s tipped 4 of 8 over after the thrust cut.
 pub const LANDING_LEAN_GAIN_RANGE: (f64, f64) = (1.2, 1.8);
 
 /// Engage speed of the take-off and landing phases' heading (m/s): below the weathervane's
