@@ -54,20 +54,25 @@ pub const LANDING_LEAN_GAIN_RANGE: (f64, f64) = (1.2, 1.8);
 /// (3 m/s). Its estimate (a 4 s filter) reaches a steady 3 m/s wind only asymptotically, so a
 /// 3 m/s wind engaged it from some bearings and not from others; not engaged, a quartering
 /// 3 m/s wind met the belly and the span together and the aircraft touched down 12° from the
-/// vertical. Still air is unaffected (the estimate is 0).
+/// vertical. The landing phases only, with their own hysteresis: in the take-off, or through
+/// the mission logic's flag, the lower speed turned the heading before the mission (3 m/s
+/// cells under Jacobi lost in T2). Still air is unaffected (the estimate is 0).
 pub const GROUND_ENGAGE_SPEED: f64 = 2.0;
 
 /// Number of f64 values [`WindMission::save`] writes.
-pub const WIND_MISSION_STATE_LEN: usize = 3;
+pub const WIND_MISSION_STATE_LEN: usize = 4;
 
 /// State of the mission logic in wind: the low-passed horizontal wind load and whether the
-/// logic is engaged.
+/// logic and the take-off and landing heading are engaged.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct WindMission {
     /// Low-passed horizontal (measured − reference) specific force, N and E (m/s²); NaN
     /// before the first sample.
     load: [f64; 2],
     engaged: bool,
+    /// Whether the landing phases' heading is engaged: its own hysteresis, so that its lower
+    /// engage speed does not reach the take-off or the mission's logic.
+    ground_engaged: bool,
 }
 
 impl Default for WindMission {
@@ -75,6 +80,7 @@ impl Default for WindMission {
         Self {
             load: [f64::NAN; 2],
             engaged: false,
+            ground_engaged: false,
         }
     }
 }
@@ -191,35 +197,54 @@ impl WindMission {
 
     /// The engagement's hysteresis on the weathervane's filtered air-data wind.
     fn engage(&mut self, wv: &Weathervane) {
-        self.engage_at(wv, wv.params().engage_speed);
+        self.engaged = Self::hysteresis(self.engaged, wv, wv.params().engage_speed);
     }
 
-    /// [`Self::engage`] at the engage speed `engage_speed` (m/s) (the release speed the
-    /// weathervane's).
-    fn engage_at(&mut self, wv: &Weathervane, engage_speed: f64) {
-        let p = wv.params();
+    /// Engaged after a sample with the weathervane's filtered air-data wind, engaged before
+    /// `engaged`: at or above `engage_speed` (m/s) engaged, below the weathervane's release
+    /// speed (or without an estimate) released, else as before.
+    fn hysteresis(engaged: bool, wv: &Weathervane, engage_speed: f64) -> bool {
         let w = wv.wind();
         let speed = w.x.hypot(w.y);
         if speed >= engage_speed {
-            self.engaged = true;
-        } else if speed.is_nan() || speed < p.release_speed {
-            self.engaged = false;
+            true
+        } else if speed.is_nan() || speed < wv.params().release_speed {
+            false
+        } else {
+            engaged
         }
     }
 
+    /// Whether the landing phases' heading is engaged (its own hysteresis, from
+    /// [`GROUND_ENGAGE_SPEED`]).
+    pub fn ground_engaged(&self) -> bool {
+        self.ground_engaged
+    }
+
     /// The heading target of the take-off and landing phases (README, "Take-off and landing
-    /// in wind"), for [`Weathervane::update_towards`]: engaged (at [`GROUND_ENGAGE_SPEED`]),
-    /// the belly or the back into the wind (the weathervane's); released, the heading held.
-    /// `None` with the weathervane off.
-    pub fn ground_target(&mut self, wv: &Weathervane) -> Option<(f64, f64)> {
+    /// in wind"), for [`Weathervane::update_towards`]: engaged, the belly or the back into the
+    /// wind (the weathervane's); released, the heading held. `phase`: in the take-off engaged
+    /// with the mission logic's hysteresis, in the landing phases (approach, descent, flare)
+    /// with its own from [`GROUND_ENGAGE_SPEED`]. `None` with the weathervane off.
+    pub fn ground_target(&mut self, wv: &Weathervane, phase: Phase) -> Option<(f64, f64)> {
         let p = wv.params();
         if !p.enabled {
             return None;
         }
-        self.engage_at(wv, p.engage_speed.min(GROUND_ENGAGE_SPEED).max(p.release_speed));
+        let engaged = if matches!(phase, Phase::Approach | Phase::Descent | Phase::Flare) {
+            self.ground_engaged = Self::hysteresis(
+                self.ground_engaged,
+                wv,
+                p.engage_speed.min(GROUND_ENGAGE_SPEED).max(p.release_speed),
+            );
+            self.ground_engaged
+        } else {
+            self.engage(wv);
+            self.engaged
+        };
         let heading = wv.heading();
         let w = wv.wind();
-        if !(self.engaged && w.x.is_finite() && w.y.is_finite()) {
+        if !(engaged && w.x.is_finite() && w.y.is_finite()) {
             return Some((heading, p.max_rate));
         }
         Some((nearer_face(heading, (-w.y).atan2(-w.x)), p.max_rate))
@@ -230,12 +255,14 @@ impl WindMission {
         out(self.load[0]);
         out(self.load[1]);
         out(if self.engaged { 1.0 } else { 0.0 });
+        out(if self.ground_engaged { 1.0 } else { 0.0 });
     }
 
     /// Restore what [`Self::save`] wrote (`v`: [`WIND_MISSION_STATE_LEN`] values).
     pub fn restore(&mut self, v: &[f64]) {
         self.load = [v[0], v[1]];
         self.engaged = v[2] != 0.0;
+        self.ground_engaged = v[3] != 0.0;
     }
 }
 
@@ -308,18 +335,18 @@ mod tests {
         let mut wm = WindMission::default();
         let calm = hovering(Vector3::zeros(), Vector3::zeros());
         for k in 0..100 {
-            let target = wm.ground_target(&wv);
+            let target = wm.ground_target(&wv, Phase::Descent);
             assert_eq!(target, Some((0.0, wv.params().max_rate)));
             wv.update_towards(&mission, k as f64 * mission.sample_time, &calm, target);
             assert_eq!(wv.heading(), 0.0);
         }
         let m = hovering(Vector3::new(0.0, -8.0, 0.0), Vector3::zeros());
         for k in 0..1500 {
-            let target = wm.ground_target(&wv);
+            let target = wm.ground_target(&wv, Phase::Descent);
             wv.update_towards(&mission, k as f64 * mission.sample_time, &m, target);
         }
-        assert!(wm.engaged());
-        let (target, _) = wm.ground_target(&wv).unwrap();
+        assert!(wm.ground_engaged() && !wm.engaged());
+        let (target, _) = wm.ground_target(&wv, Phase::Descent).unwrap();
         assert!(
             (target.abs() - core::f64::consts::FRAC_PI_2).abs() < 0.02,
             "{}",
@@ -328,30 +355,32 @@ mod tests {
         assert!((wv.heading() - target).abs() < 0.02, "{}", wv.heading().to_degrees());
     }
 
-    /// The take-off and landing heading engages at [`GROUND_ENGAGE_SPEED`], below the
+    /// The landing phases' heading engages at [`GROUND_ENGAGE_SPEED`], below the
     /// weathervane's engage speed: a steady 2.5 m/s wind from the north-east turns the belly
-    /// or the back into it; 1.5 m/s does not (the heading is held).
+    /// or the back into it in the descent; 1.5 m/s does not (the heading is held), nor does
+    /// 2.5 m/s in the take-off (the weathervane's engage speed there).
     #[test]
-    fn ground_heading_engages_below_the_weathervanes_engage_speed() {
+    fn landing_heading_engages_below_the_weathervanes_engage_speed() {
         let mission = MissionParams::default();
-        let fly = |speed: f64| {
+        let fly = |speed: f64, phase: Phase| {
             let mut wv = Weathervane::new(WeathervaneParams::tuned()).unwrap();
             let mut wm = WindMission::default();
             let d = core::f64::consts::FRAC_1_SQRT_2 * speed;
             let m = hovering(Vector3::new(-d, -d, 0.0), Vector3::zeros());
             for k in 0..2000 {
-                let target = wm.ground_target(&wv);
+                let target = wm.ground_target(&wv, phase);
                 wv.update_towards(&mission, k as f64 * mission.sample_time, &m, target);
             }
             assert!(wv.params().engage_speed > 2.5);
-            (wm.engaged(), wv.heading())
+            (wm.ground_engaged() || wm.engaged(), wv.heading())
         };
-        let (engaged, heading) = fly(2.5);
+        let (engaged, heading) = fly(2.5, Phase::Descent);
         assert!(engaged);
         // Belly or back towards 45°: within 0.02 rad of 45° modulo 180°.
         let off = (heading - core::f64::consts::FRAC_PI_4).rem_euclid(core::f64::consts::PI);
         assert!(off.min(core::f64::consts::PI - off) < 0.02, "{}", heading.to_degrees());
-        assert_eq!(fly(1.5), (false, 0.0));
+        assert_eq!(fly(1.5, Phase::Descent), (false, 0.0));
+        assert_eq!(fly(2.5, Phase::TakeOff), (false, 0.0));
     }
 
     /// The collective-flap command: −4.6° per m/s of wind into the belly, ±17° at most, the
