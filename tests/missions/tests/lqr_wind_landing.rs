@@ -11,53 +11,30 @@
 //! `cargo test --release -p missions --test lqr_wind_landing -- --nocapture` prints the numbers.
 
 use analysis::controllers::Kind;
-use analysis::takeoff_landing::{self, Flight};
-use analysis::wind_envelope::{plant, wind, WindForm, BEARINGS_DEG};
-use closed_loop::{fly, Ordering, Scenario};
-use flight_mission::Phase;
-
-/// The largest distance to the own reference and the landing's figures of one cell.
-fn cell(speed: f64, bearing_index: usize) -> (f64, Flight) {
-    let plant = plant();
-    let mission = takeoff_landing::mission();
-    let x0 = plant.resting_on_ground(0.0, 0.0, 0.0);
-    let mut scenario = Scenario::mission(mission);
-    scenario.stop_time = takeoff_landing::stop_time(&mission);
-    scenario.wind = wind(WindForm::Step, speed, bearing_index, plant.ground.height);
-    let mut c = Kind::Lqr.make(&mission);
-    let mut trace = fly(&plant, x0, &mut c, &scenario);
-    if let Some(k) = trace.samples.iter().position(|s| s.diagnostics.phase == Phase::Landed) {
-        let t_end = trace.samples[k].t + takeoff_landing::AFTER_LANDING;
-        trace.samples.retain(|s| s.t <= t_end + 1e-9);
-    }
-    let f = takeoff_landing::evaluate(&plant, Kind::Lqr, Ordering::GaussSeidel, &mission, &trace);
-    let max = trace.samples.iter().map(|s| s.pos_error()).fold(0.0, f64::max);
-    println!(
-        "{speed} m/s from {}°: max error {max:.2} m, landed {:?}, miss {:.2} m, touchdown {:.2} m/s, tilt {:.1}° / {:.1}° at the end, every landing criterion {}",
-        BEARINGS_DEG[bearing_index],
-        f.landed_time,
-        f.miss_final,
-        f.touchdown_speed,
-        f.tilt_touchdown_deg,
-        f.tilt_final_deg,
-        f.passed
-    );
-    (max, f)
-}
+use analysis::wind_envelope::{fly_cell, MissionKind, WindForm, BEARINGS_DEG};
 
 /// 3 m/s headwind (from the north, into the belly) and across the track (from the east, the
-/// weathervane turning the belly into it): every landing criterion — on the target, slow,
-/// upright, staying down (measured: largest error 3.24 / 3.06 m, miss 0.38 / 0.38 m,
-/// touchdown 0.15 / 0.12 m/s, tilt 2.6° / 3.4° at touchdown, 0.2° at the end).
+/// weathervane turning the belly into it): every landing criterion of
+/// `analysis::takeoff_landing` — on the target, slow, upright, staying down (measured:
+/// largest error 3.24 / 3.06 m, miss 0.38 / 0.38 m, touchdown 0.15 / 0.12 m/s, tilt 2.6° /
+/// 3.4° at touchdown, 0.2° at the end).
 #[test]
 fn lands_upright_on_the_target_in_3_m_s_head_and_cross_winds() {
     for bearing_index in [0, 2] {
-        let (max, f) = cell(3.0, bearing_index);
-        assert!(max < 3.5, "{}°: {max}", BEARINGS_DEG[bearing_index]);
+        let c = fly_cell(
+            Kind::Lqr,
+            MissionKind::TakeoffLanding,
+            WindForm::Step,
+            3.0,
+            bearing_index,
+        );
+        let bearing = BEARINGS_DEG[bearing_index];
+        println!("3 m/s from {bearing}°: {c:?}");
+        assert!(c.completed && c.max_error < 3.5, "{bearing}°: {c:?}");
+        assert_eq!(c.landing_passed, Some(true), "{bearing}°: {c:?}");
         assert!(
-            f.passed && f.miss_final < 0.5 && f.touchdown_speed < 0.3 && f.tilt_touchdown_deg < 10.0,
-            "{}°: {f:?}",
-            BEARINGS_DEG[bearing_index]
+            c.landing_distance.is_some_and(|d| d < 0.5) && c.touchdown_speed.is_some_and(|v| v < 0.3),
+            "{bearing}°: {c:?}"
         );
     }
 }
