@@ -343,7 +343,7 @@ impl LqrController {
         (x, xt): (&X, &X),
         sw: &GainScheduleSwitches,
     ) -> Option<Notice> {
-        let due = t + 1e-9 >= self.next_relinearisation;
+        let due = t + 1e-9 >= self.next_relinearisation && !self.holds_flare_gains(r);
         if self.have_gain && rep == self.rep && !due {
             return None;
         }
@@ -399,6 +399,17 @@ impl LqrController {
             x_lin[ix::BETA] = 0.0;
         }
         x_lin
+    }
+
+    /// The flare in wind keeps the gains of the end of the descent (README, "Take-off and
+    /// landing"): its reference air data, those of `DCM_t (v_ref − ŵ)`, swing from α ≈ 130° to
+    /// 90° as the sink stops, and the gains relinearised about them in the 1 s flare cut the
+    /// thrust the flare needs (touchdown 0.54–0.81 m/s at 3 m/s with them, 0.09–0.37 m/s
+    /// held). A structural relinearisation (`next_relinearisation` = −∞) still runs.
+    fn holds_flare_gains(&self, r: &Reference) -> bool {
+        self.ground_in_wind()
+            && r.ground.is_some_and(|v| v.phase == Phase::Flare)
+            && self.next_relinearisation.is_finite()
     }
 
     /// The front transition in a steady wind (the position integrators latched) whose

@@ -66,6 +66,14 @@ pub const WIND_TRIM_RAMP: (f64, f64) = (0.5, 1.5);
 /// wind"); in still air they stay inert (the still-air flights bit-identical).
 pub const WIND_INTEGRAL_SPEED: f64 = 1.5;
 
+/// Collective-flap trim of the descent and flare in wind per m/s of wind into the belly
+/// (rad s/m) (README, "Take-off and landing"): the slope of the plant's upright hover trim up
+/// to 3 m/s (−5.2°, −9.8°, −13.8° at 1, 2, 3 m/s face-on).
+pub const LANDING_FLAP_GAIN: f64 = 4.6 * std::f64::consts::PI / 180.0;
+/// Largest collective-flap trim of the descent and flare (rad); the rest of the ±25° is left
+/// to the feedback.
+pub const LANDING_FLAP_LIMIT: f64 = 17.0 * std::f64::consts::PI / 180.0;
+
 /// Time constant τ_s of the integral action on the horizontal position in wind (s).
 pub const HOVER_SHIFT_TIME: f64 = 3.0;
 /// Bound on that integral's shift of the regulated position (m).
@@ -272,6 +280,9 @@ pub struct LqrController {
     /// Whether the weathervane's wind estimate has reached [`WIND_INTEGRAL_SPEED`] (latched): the position
     /// integrators are then on in the mission phases (README, "Mission in wind").
     wind_integral: bool,
+    /// Whether the horizontal position integrators are on in the descent and flare in wind
+    /// (README, "Take-off and landing"; [`Self::update_landing_integral`]).
+    landing_integral: bool,
     /// The last DARE solution of the 14-state design, in the Euler set `rep` (warm start).
     warm_p: Option<SMatrix<f64, NR, NR>>,
     /// The two solutions before `warm_p` (same Euler set, consecutive), for extrapolation.
@@ -403,6 +414,7 @@ impl LqrController {
             ground: GroundPhases::new(mission, airframe.mass * airframe.gravity),
             ground_active: false,
             wind_integral: false,
+            landing_integral: false,
             warm_p: None,
             warm_hist: [SMatrix::zeros(); 2],
             warm_len: 0,
@@ -468,7 +480,10 @@ impl LqrController {
     /// translation of the approach); all three in the mission phases once the wind estimate
     /// has latched [`WIND_INTEGRAL_SPEED`].
     fn position_integral_on(&self, j: usize) -> bool {
-        self.params.position_integral != 0 || self.ground_active && j == 2 || self.wind_integral && !self.ground_active
+        self.params.position_integral != 0
+            || self.ground_active && j == 2
+            || self.wind_integral && !self.ground_active
+            || self.landing_integral
     }
 
     /// With `on`, every accepted warm-started gain is recomputed cold and the largest relative
@@ -672,6 +687,7 @@ impl SampledUnit for LqrController {
             out(*v);
         }
         out(f64::from(u8::from(self.wind_integral)));
+        out(f64::from(u8::from(self.landing_integral)));
     }
 
     /// Restore what [`Self::save`] wrote; `None` from `next` = truncated state.
@@ -726,6 +742,7 @@ impl SampledUnit for LqrController {
             }
         }
         self.wind_integral = take()? != 0.0;
+        self.landing_integral = take()? != 0.0;
         Ok(())
     }
 

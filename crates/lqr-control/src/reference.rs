@@ -13,8 +13,8 @@ use tailsitter_physics::Surfaces;
 use crate::model;
 use crate::trajectory::TrajPoint;
 use crate::{
-    LqrController, HOVER_SHIFT_LIMIT, HOVER_SHIFT_TIME, MAX_WIND_ESTIMATE, MIN_AIRSPEED, WIND_INTEGRAL_SPEED,
-    WIND_TRIM_MAX_PITCH, WIND_TRIM_RAMP,
+    LqrController, HOVER_SHIFT_LIMIT, HOVER_SHIFT_TIME, LANDING_FLAP_GAIN, LANDING_FLAP_LIMIT, MAX_WIND_ESTIMATE,
+    MIN_AIRSPEED, WIND_INTEGRAL_SPEED, WIND_TRIM_MAX_PITCH, WIND_TRIM_RAMP,
 };
 
 /// Switches of the reference stage (from [`crate::LqrParams::effective`]).
@@ -101,7 +101,21 @@ impl LqrController {
                 self.pos_integrator = Vector3::zeros();
             }
         }
+        self.update_landing_integral(ground_ref.as_ref());
         ControlFlow::Continue((offset, ground_ref))
+    }
+
+    /// The horizontal position integrators ∫ΔN, ∫ΔE of the descent and flare in wind (README,
+    /// "Take-off and landing"): on from the start of the descent once the wind has latched the
+    /// mission's integrators ([`Self::ground_in_wind`]), so the collective-flap trim
+    /// ([`Self::landing_flaps`]) leaves no steady offset from the target; switching
+    /// relinearises at once (the gain's integrator columns change). In still air never on.
+    fn update_landing_integral(&mut self, ground: Option<&VerticalReference>) {
+        let on = self.ground_in_wind() && ground.is_some_and(|v| matches!(v.phase, Phase::Descent | Phase::Flare));
+        if on != self.landing_integral {
+            self.landing_integral = on;
+            self.next_relinearisation = f64::NEG_INFINITY;
+        }
     }
 
     /// The output on the gear: the ground phases' thrust, surfaces neutral.
@@ -152,7 +166,7 @@ impl LqrController {
         }
         let trimmed = match ground {
             None => self.trimmed(&point, sw).unwrap_or(point),
-            Some(_) => point,
+            Some(v) => self.landing_flaps(&point, v.phase),
         };
         Reference {
             point: trimmed,
@@ -397,6 +411,28 @@ impl LqrController {
             return plain;
         }
         Vector3::new(v, v_b.z.atan2(v_b.x), (v_b.y / v).clamp(-1.0, 1.0).asin())
+    }
+
+    /// The landing reference with the collective flaps trimmed against the wind into the belly
+    /// (README, "Take-off and landing"): in the descent and the flare in wind
+    /// ([`Self::ground_in_wind`]) δfc_t −= [`LANDING_FLAP_GAIN`] × (the weathervane's 4 s wind
+    /// estimate into the reference belly), within ±[`LANDING_FLAP_LIMIT`]; elsewhere the point
+    /// unchanged. Upright, the wing and flaps sit in the propellers' slip-stream and a wind
+    /// into the belly turns that flow: holding the target, the aircraft leaned 28–40° into
+    /// 3–8 m/s and tipped over on the gear. The flaps deflected against the wind carry that
+    /// force with the nose vertical (the plant's upright hover trim, `examples/hover_lean.rs`).
+    fn landing_flaps(&self, p: &TrajPoint, phase: Phase) -> TrajPoint {
+        let w = self.weathervane.wind();
+        if !(matches!(phase, Phase::Descent | Phase::Flare) && self.ground_in_wind() && w.iter().all(|v| v.is_finite()))
+        {
+            return *p;
+        }
+        // The belly (body z) in earth axes: the third row of DCM^BE.
+        let belly = model::dcm_of_quat(&p.quat()).row(2).transpose();
+        let into_belly = -w.xy().dot(&belly.xy());
+        let mut q = *p;
+        q.u[4] -= (LANDING_FLAP_GAIN * into_belly).clamp(-LANDING_FLAP_LIMIT, LANDING_FLAP_LIMIT);
+        q
     }
 
     /// The reference point of a take-off / landing reference (guidance::ground): the

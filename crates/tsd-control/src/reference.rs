@@ -80,7 +80,7 @@ impl TsdController {
         let heading = if sigma_ground.is_some() {
             // Take-off and landing phases (README, "Take-off and landing in wind"): the belly
             // or the back into the measured wind.
-            let target = self.wind_mission.ground_target(&self.weathervane);
+            let target = self.wind_mission.ground_target(&self.weathervane, reference.phase);
             self.weathervane.update_towards(&self.mission, input.t, meas, target)
         } else {
             // Mission logic in wind (README, "Missions in wind"): the heading of the

@@ -2,11 +2,12 @@
 //! steady wind stepping in at 2 s, the cells of the wind envelope (`analysis::wind_envelope`:
 //! global aerodynamics, the ground 10 m below the origin, Gauss-Seidel, perfect state).
 //!
-//! Before the take-off and landing phases flew in wind (tsd-control README, "Take-off and
-//! landing in wind": the belly into the measured wind, the hover-in-wind design, the
-//! collective flaps' direct-force trim) every cell from 5 m/s was lost in the descent: 5 m/s
-//! from the north 3.8 m off its reference, 8 m/s from the south 256 m; at 3 m/s the aircraft
-//! touched down leaning 30° into the wind.
+//! The take-off and landing phases in wind (tsd-control README, "Take-off and landing in
+//! wind"): the belly into the measured wind (engaged from 2 m/s), the hover-in-wind design,
+//! the collective flaps' direct force (trim and lean feedback). Without them every cell from
+//! 5 m/s was lost in the descent and at 3 m/s the aircraft touched down leaning 30° into the
+//! wind; without the lean feedback it touched down leaning 20–23° into 5 m/s, and without the
+//! lower engage speed 12° in a quartering 3 m/s wind.
 //!
 //! `cargo test --release -p missions --test tsd_wind_landing -- --nocapture` prints the numbers.
 
@@ -45,25 +46,32 @@ fn cell(speed: f64, bearing_index: usize) -> (f64, Flight) {
     (max, f)
 }
 
-/// 3 m/s across the track (from the east): every landing criterion, upright (measured: 1.56 m
-/// largest error, 0.10 m miss, 0.11 m/s, tilt 7.9° at touchdown).
+/// 3 m/s across the track (from the east) and quartering (from the north-east): every
+/// landing criterion, upright (measured: largest error 1.44 / 1.91 m, miss 0.07 / 0.06 m,
+/// 0.14 m/s, tilt 3.5° / 3.2° at touchdown).
 #[test]
-fn lands_upright_on_the_target_in_a_3_m_s_crosswind() {
-    let (max, f) = cell(3.0, 2);
-    assert!(max < 2.0, "{max}");
-    assert!(f.passed && f.tilt_touchdown_deg < 9.0 && f.miss_final < 0.2, "{f:?}");
+fn lands_upright_on_the_target_in_a_3_m_s_crosswind_and_quartering_wind() {
+    for bearing_index in [2, 1] {
+        let (max, f) = cell(3.0, bearing_index);
+        assert!(max < 2.5, "{}°: {max}", BEARINGS_DEG[bearing_index]);
+        assert!(
+            f.passed && f.tilt_touchdown_deg < 5.0 && f.miss_final < 0.2,
+            "{}°: {f:?}",
+            BEARINGS_DEG[bearing_index]
+        );
+    }
 }
 
-/// 5 m/s headwind and 8 m/s tailwind: held (< 3 m from the own reference), on the target
-/// (< 1 m) at < 0.5 m/s (measured 1.65 / 1.34 m, 0.20 / 0.39 m, 0.10 / 0.38 m/s); not upright
-/// (touchdown tilt 20° and 2.5°, the first above the 10° criterion).
+/// 5 m/s headwind and 8 m/s tailwind: held (< 3 m from the own reference) and every landing
+/// criterion, upright (measured: largest error 1.65 / 1.56 m, miss 0.06 / 0.17 m, 0.13 /
+/// 0.10 m/s, tilt 6.2° / 6.6° at touchdown, 0.5° / 1.2° 5 s later).
 #[test]
-fn lands_on_the_target_in_a_5_m_s_headwind_and_an_8_m_s_tailwind() {
+fn lands_upright_on_the_target_in_a_5_m_s_headwind_and_an_8_m_s_tailwind() {
     for (speed, bearing_index) in [(5.0, 0), (8.0, 4)] {
         let (max, f) = cell(speed, bearing_index);
         assert!(max < 2.0, "{speed} m/s: {max}");
         assert!(
-            f.landed_time.is_some() && f.miss_final < 0.6 && f.touchdown_speed < 0.5,
+            f.passed && f.miss_final < 0.3 && f.touchdown_speed < 0.3 && f.tilt_touchdown_deg < 8.0,
             "{speed} m/s: {f:?}"
         );
     }

@@ -1,0 +1,40 @@
+//! The tuned LQR's take-off-to-landing mission (`analysis::takeoff_landing::mission`) in a
+//! steady 3 m/s wind stepping in at 2 s, cells of the wind envelope (`analysis::wind_envelope`:
+//! global aerodynamics, the ground 10 m below the origin, Gauss-Seidel, perfect state).
+//!
+//! The landing in wind (lqr-control README, "Take-off and landing"): the collective flaps
+//! trimmed against the wind into the belly in the descent and flare, the horizontal position
+//! integrators on there, and the flare flown on the descent's last gains. Without them the
+//! aircraft held the target by leaning 28–40° into the wind and tipped over on the gear
+//! (3 m/s from the north: 30.8° lean in the descent, every landing failed).
+//!
+//! `cargo test --release -p missions --test lqr_wind_landing -- --nocapture` prints the numbers.
+
+use analysis::controllers::Kind;
+use analysis::wind_envelope::{fly_cell, MissionKind, WindForm, BEARINGS_DEG};
+
+/// 3 m/s headwind (from the north, into the belly) and across the track (from the east, the
+/// weathervane turning the belly into it): every landing criterion of
+/// `analysis::takeoff_landing` — on the target, slow, upright, staying down (measured:
+/// largest error 3.24 / 3.06 m, miss 0.38 / 0.38 m, touchdown 0.15 / 0.12 m/s, tilt 2.6° /
+/// 3.4° at touchdown, 0.2° at the end).
+#[test]
+fn lands_upright_on_the_target_in_3_m_s_head_and_cross_winds() {
+    for bearing_index in [0, 2] {
+        let c = fly_cell(
+            Kind::Lqr,
+            MissionKind::TakeoffLanding,
+            WindForm::Step,
+            3.0,
+            bearing_index,
+        );
+        let bearing = BEARINGS_DEG[bearing_index];
+        println!("3 m/s from {bearing}°: {c:?}");
+        assert!(c.completed && c.max_error < 3.5, "{bearing}°: {c:?}");
+        assert_eq!(c.landing_passed, Some(true), "{bearing}°: {c:?}");
+        assert!(
+            c.landing_distance.is_some_and(|d| d < 0.5) && c.touchdown_speed.is_some_and(|v| v < 0.3),
+            "{bearing}°: {c:?}"
+        );
+    }
+}
