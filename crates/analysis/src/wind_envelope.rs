@@ -30,7 +30,10 @@
 //! true position to the controller's own reference over the flight (on the gear the
 //! reference is the measured position; with the tuned estimator, whose positions are
 //! relative to the start, the true position relative to the start), the landing distance from the target at rest and
-//! the touchdown speed. **Held** = completed and the largest distance below the error limit
+//! the touchdown speed; in the default and handover missions also the largest distance of
+//! the true position from the reference the same controller flies in still air
+//! ([`calm_reference`]), the mission's path, whatever wind logic does to the controller's own
+//! reference. **Held** = completed and both distances below the error limit
 //! ([`error_limit`]: [`HELD_MAX_ERROR`] with perfect state, [`HELD_MAX_ERROR_AVIONICS`] with
 //! avionics). Writes `wind_envelope.json` and `wind_envelope.csv` into the output folder
 //! (schema: crates/analysis/README.md); `tailsim.reports.wind_envelope` renders them. Cells
@@ -70,7 +73,7 @@ pub const LOST_ERROR: f64 = 50.0;
 pub const TURBULENCE_INTENSITY: i32 = 2;
 
 /// The missions.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "snake_case")]
 #[value(rename_all = "snake_case")]
 pub enum MissionKind {
@@ -121,7 +124,7 @@ impl WindForm {
 }
 
 /// What the controller measures.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "snake_case")]
 #[value(rename_all = "snake_case")]
 pub enum StateKind {
@@ -134,7 +137,7 @@ pub enum StateKind {
 }
 
 /// The master's ordering of the units within a step.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "kebab-case")]
 #[value(rename_all = "kebab-case")]
 pub enum OrderingKind {
@@ -155,7 +158,7 @@ impl OrderingKind {
 }
 
 /// The controllers' `configuration`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "snake_case")]
 #[value(rename_all = "snake_case")]
 pub enum Configuration {
@@ -226,7 +229,18 @@ pub struct Cell {
     pub landing_distance: Option<f64>,
     pub touchdown_speed: Option<f64>,
     pub landing_passed: Option<bool>,
-    /// Completed and `max_error` below the error limit of its state ([`error_limit`]).
+    /// Default and handover missions: largest |true position − the still-air reference| (m),
+    /// the reference the same controller flies in calm air at the same time ([`calm_reference`]):
+    /// the distance from the mission's path, whatever the controller does to its own reference
+    /// in wind. None for the landing mission (its reference follows the flight's events).
+    #[serde(default)]
+    pub mission_error: Option<f64>,
+    /// The same, of the controller's own reference: how far wind logic moved it (m).
+    #[serde(default)]
+    pub reference_drift: Option<f64>,
+    /// Completed, and `max_error` and `mission_error` below the error limit of its state
+    /// ([`error_limit`]): a controller that moves its own reference with the wind holds a cell
+    /// only on the mission's path.
     pub held: bool,
     /// Wall time of the run (s).
     pub wall_time_s: f64,
@@ -501,6 +515,8 @@ pub fn fly_job(job: &Job, history: Option<&str>) -> (Cell, [f64; closed_loop::N_
         landing_distance: None,
         touchdown_speed: None,
         landing_passed: None,
+        mission_error: None,
+        reference_drift: None,
         held: false,
         wall_time_s: 0.0,
     };
@@ -525,6 +541,11 @@ pub fn fly_job(job: &Job, history: Option<&str>) -> (Cell, [f64; closed_loop::N_
                 cell.completed = trace.completed();
                 cell.failure = trace.failure.clone();
                 cell.max_error = max_error(&trace);
+                if let Some(calm) = calm_reference(job) {
+                    let (mission_error, drift) = path_errors(&trace, &calm);
+                    cell.mission_error = Some(mission_error);
+                    cell.reference_drift = Some(drift);
+                }
             }
         },
         MissionKind::TakeoffLanding => {
@@ -565,9 +586,78 @@ pub fn fly_job(job: &Job, history: Option<&str>) -> (Cell, [f64; closed_loop::N_
             cell.landing_passed = Some(flight.passed);
         }
     }
-    cell.held = cell.completed && cell.max_error < limit;
+    cell.held = cell.completed && cell.max_error < limit && cell.mission_error.is_none_or(|e| e < limit);
     cell.wall_time_s = start.elapsed().as_secs_f64();
     (cell, phases)
+}
+
+/// Reference positions (NED, m) at a flight's samples.
+pub type CalmPath = std::sync::Arc<Vec<Vector3<f64>>>;
+
+/// The still-air reference of `job`'s controller, configuration, mission, state source and
+/// ordering: its reference position at every sample of the calm flight (the same steps as
+/// the cell's), flown once per process and kept. None for the landing mission or a calm
+/// flight that failed.
+pub fn calm_reference(job: &Job) -> Option<CalmPath> {
+    use std::collections::HashMap;
+    use std::sync::{Arc, Mutex, OnceLock};
+    type Key = (Kind, MissionKind, StateKind, OrderingKind, Configuration);
+    static CALM: OnceLock<Mutex<HashMap<Key, Option<CalmPath>>>> = OnceLock::new();
+    if job.mission == MissionKind::TakeoffLanding {
+        return None;
+    }
+    let key = (
+        job.kind,
+        job.mission,
+        job.axes.state,
+        job.axes.ordering,
+        job.axes.configuration,
+    );
+    let memo = CALM.get_or_init(|| Mutex::new(HashMap::new()));
+    if let Some(hit) = memo.lock().ok()?.get(&key) {
+        return hit.clone();
+    }
+    let plant = plant();
+    let mission = job.mission.mission();
+    let mut scenario = Scenario::mission(mission);
+    scenario.ordering = job.axes.ordering.ordering();
+    let calm = (|| {
+        let mut c = job
+            .kind
+            .make_configured(&mission, job.axes.configuration.index())
+            .ok()?;
+        let (x0, u0) = trimmed_climb(&plant, mission.v_vertical).ok()?;
+        let trace = fly_on(&plant, x0, &u0, &mut c, &scenario, job.axes.state, seed(0), |_| false);
+        trace.failure.is_none().then(|| {
+            Arc::new(
+                trace
+                    .samples
+                    .iter()
+                    .map(|s| s.diagnostics.ref_pos_ned)
+                    .collect::<Vec<_>>(),
+            )
+        })
+    })();
+    memo.lock().ok()?.insert(key, calm.clone());
+    calm
+}
+
+/// Largest |true position − calm reference| and |own reference − calm reference| of
+/// `trace` against the still-air reference `calm` sample by sample (m; NaN if not finite).
+pub fn path_errors(trace: &Trace, calm: &[Vector3<f64>]) -> (f64, f64) {
+    let (mut path, mut drift): (f64, f64) = (0.0, 0.0);
+    for (s, r) in trace.samples.iter().zip(calm) {
+        let (e, d) = (
+            (s.measurement.pos_ned - r).norm(),
+            (s.diagnostics.ref_pos_ned - r).norm(),
+        );
+        if !(e.is_finite() && d.is_finite()) {
+            return (f64::NAN, f64::NAN);
+        }
+        path = path.max(e);
+        drift = drift.max(d);
+    }
+    (path, drift)
 }
 
 /// Which axes and cells a run flies.
@@ -751,11 +841,11 @@ pub fn run(out: &Path, grid: &Grid, no_cache: bool) -> Result<Vec<Cell>, String>
     let text = serde_json::to_string_pretty(&value).map_err(|e| e.to_string())?;
     std::fs::write(&json_path, text).map_err(|e| format!("{}: {e}", json_path.display()))?;
     let mut csv = String::from(
-        "controller,configuration,state,ordering,mission,wind,speed,bearing_deg,completed,held,max_error,landing_distance,touchdown_speed,landing_passed,failure\n",
+        "controller,configuration,state,ordering,mission,wind,speed,bearing_deg,completed,held,max_error,mission_error,reference_drift,landing_distance,touchdown_speed,landing_passed,failure\n",
     );
     for c in &cells {
         csv.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\"\n",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\"\n",
             c.controller,
             c.configuration.name(),
             c.state.name(),
@@ -767,6 +857,8 @@ pub fn run(out: &Path, grid: &Grid, no_cache: bool) -> Result<Vec<Cell>, String>
             c.completed,
             c.held,
             c.max_error,
+            csv_field(c.mission_error),
+            csv_field(c.reference_drift),
             csv_field(c.landing_distance),
             csv_field(c.touchdown_speed),
             c.landing_passed.map_or_else(String::new, |p| p.to_string()),
@@ -994,6 +1086,46 @@ mod tests {
             let c = fly_cell(kind, MissionKind::Default, WindForm::Step, 0.0, 0);
             assert!(c.completed && c.held == kind.in_thesis(), "{c:?}");
         }
+    }
+
+    /// In calm air the mission's path is the controller's own reference: the calm cell's
+    /// reference drift is exactly zero and its mission error its largest error.
+    #[test]
+    fn calm_cell_flies_on_the_still_air_reference() {
+        for kind in [Kind::Lqr, Kind::Tsd] {
+            let c = fly_cell(kind, MissionKind::Default, WindForm::Step, 0.0, 3);
+            assert_eq!(c.reference_drift, Some(0.0), "{c:?}");
+            assert_eq!(c.mission_error, Some(c.max_error), "{c:?}");
+        }
+        let tl = fly_cell(Kind::Tsd, MissionKind::TakeoffLanding, WindForm::Step, 0.0, 0);
+        assert_eq!((tl.mission_error, tl.reference_drift), (None, None));
+    }
+
+    /// A reference moved 4 m with the wind and the aircraft 1 m short of it: 3 m off the
+    /// mission's path, 4 m of drift.
+    #[test]
+    fn path_errors_measure_from_the_still_air_reference() {
+        let calm = [Vector3::zeros(), Vector3::new(10.0, 0.0, 0.0)];
+        let plant = plant();
+        let mission = MissionKind::Default.mission();
+        let (x0, u0) = trimmed_climb(&plant, mission.v_vertical).unwrap();
+        let mut c = Kind::Tsd.make_configured(&mission, 0).unwrap();
+        let scenario = Scenario::mission(mission);
+        let mut trace = fly_on(&plant, x0, &u0, &mut c, &scenario, StateKind::Perfect, 1, |s| {
+            s.t > 0.01
+        });
+        assert_eq!(trace.samples.len(), 2);
+        for (i, (s, r)) in trace.samples.iter_mut().zip(&calm).enumerate() {
+            s.diagnostics.ref_pos_ned = r + Vector3::new(0.0, 4.0 * i as f64, 0.0);
+            s.measurement.pos_ned = r + Vector3::new(0.0, 3.0 * i as f64, 0.0);
+        }
+        let (path, drift) = path_errors(&trace, &calm);
+        assert!(
+            (path - 3.0).abs() < 1e-12 && (drift - 4.0).abs() < 1e-12,
+            "{path} {drift}"
+        );
+        trace.samples[0].measurement.pos_ned.x = f64::NAN;
+        assert!(path_errors(&trace, &calm).0.is_nan());
     }
 
     /// The tuned LQR's mission logic in wind (lqr-control README, "Mission in wind"): the

@@ -1,12 +1,13 @@
-"""The figures of the documentation (`docs/*.md`), generated from committed result files.
+"""The figures of the documentation (`docs/*.md`, the crates' and FMUs' READMEs), generated
+from committed result files.
 
-A figure a reader meets in `docs/` is one of these kinds:
+A figure a reader meets in the documentation is one of these kinds:
 
 * **generated**: it sits in a marked block, `<!-- generated:KEY -->…<!-- /generated -->`
   (a whole table or paragraph on lines of its own, or a few words inside a sentence), whose
-  content `BLOCKS[KEY]` writes (generators in `docs_blocks` and `docs_transition`) from a
-  committed result file under `docs/` (each records the command that produced it) or from
-  the declarations (`python/tailsim/declarations.json`, the campaign's `CampaignSpec`
+  content `BLOCKS[KEY]` writes (generators in `docs_blocks`, `docs_transition`, `docs_wind`, …)
+  from a committed result file under `docs/` (each records the command that produced it) or
+  from the declarations (`python/tailsim/declarations.json`, the campaign's `CampaignSpec`
   defaults: keys `def.<scope>.<name>`, so a definition cannot drift either);
 * **history**: a dated measurement kept as a record, inside
   `<!-- history: DATE, how -->…<!-- /history -->` (and `docs/PERFORMANCE.md`, the dated
@@ -16,11 +17,16 @@ A figure a reader meets in `docs/` is one of these kinds:
   (measured figures not yet generated). References (equations, tables, §, register ids),
   versions, identifiers and code are not figures (`strip_lines`).
 
+Generated blocks are rewritten in every document of `BLOCK_GLOBS` (docs/*.md, README.md, the
+crates' and FMUs' READMEs); the scan reads `SCAN_GLOBS` except `SCAN_LATER` (to switch it on
+for one of those: remove it there, then label what `python -m tailsim.reports.docs_label FILE`
+lists: measured figures into generated blocks or dated records, definitions allow-listed).
 `python -m tailsim.reports.docs --write` rewrites every generated block (and the tables the
 verdict generates in README.md and docs/CAMPAIGN.md, `tailsim.reports.verdict --docs`);
 `--check` only compares (exit 1 when a block is stale); `--inventory` counts the figures by
 kind. After new result files (a campaign summarised into `docs/*.json`, an analysis run:
-`--reproduction out/analysis/reproduction.json`), re-run this one command.
+`--reproduction out/analysis/reproduction.json`, the wind envelope:
+`--wind-envelope out/analysis/wind_envelope.json`, `docs_wind.COMMAND`), re-run this one command.
 `tests/test_docs.py` fails on a stale block, on a figure outside any block that the
 allow-list does not hold, and on an allow-list entry no figure uses.
 """
@@ -40,6 +46,12 @@ from .. import cli
 
 ROOT = pathlib.Path(__file__).resolve().parents[3]
 DOCS_DIR = "docs"
+#: The documents whose generated blocks `--write` rewrites (globs under the checkout).
+BLOCK_GLOBS = ("docs/*.md", "README.md", "crates/*/README.md", "fmu-*/README.md")
+#: The documents the scan for hand-typed figures reads (globs under the checkout), and those
+#: of them it leaves out for now (their figures not yet labelled; remove a file here to scan it).
+SCAN_GLOBS = ("README.md", "docs/*.md", "crates/*/README.md", "fmu-*/README.md")
+SCAN_LATER = ("crates/lqr-control/README.md", "crates/tsd-control/README.md")
 #: Dated history documents: every figure in them is a record, none is generated.
 HISTORY_FILES = ("docs/PERFORMANCE.md",)
 
@@ -118,13 +130,34 @@ def interval(ci, nd: int = 3, signed: bool = False) -> str:
 
 # --- the blocks are registered by the modules below ------------------------------------------------------------
 
-from . import docs_blocks, docs_omsimulator, docs_thesis, docs_transition, docs_trims  # noqa: E402,F401  (register BLOCKS)
+from . import (  # noqa: E402,F401  (register BLOCKS)
+    docs_blocks,
+    docs_omsimulator,
+    docs_thesis,
+    docs_transition,
+    docs_trims,
+    docs_wind,
+)
 
 # --- regeneration ------------------------------------------------------------------------------------------------
 
 
+def _glob(root: pathlib.Path, globs: tuple[str, ...]) -> list[pathlib.Path]:
+    return sorted({p for g in globs for p in root.glob(g)})
+
+
 def doc_files(root: pathlib.Path = ROOT) -> list[pathlib.Path]:
-    return sorted((root / DOCS_DIR).glob("*.md"))
+    """The documents with generated blocks (`BLOCK_GLOBS`)."""
+    return _glob(root, BLOCK_GLOBS)
+
+
+def scanned_files(root: pathlib.Path = ROOT) -> list[pathlib.Path]:
+    """The documents the scan for hand-typed figures reads (`SCAN_GLOBS` but `SCAN_LATER`)."""
+    return [p for p in _glob(root, SCAN_GLOBS) if rel_of(p, root) not in SCAN_LATER]
+
+
+def rel_of(path: pathlib.Path, root: pathlib.Path = ROOT) -> str:
+    return path.relative_to(root).as_posix()
 
 
 def render(key: str, src: Sources) -> str:
@@ -150,15 +183,15 @@ def keys_in(text: str) -> list[str]:
 
 
 def regenerate(root: pathlib.Path = ROOT, write: bool = True, override: Mapping[str, Any] | None = None) -> list[str]:
-    """Rewrite the generated blocks of every `docs/*.md` under `root`; the files that were stale
-    (relative to `root`)."""
+    """Rewrite the generated blocks of every document (`doc_files`) under `root`; the files that
+    were stale (relative to `root`)."""
     src = Sources(root, override)
     stale = []
     for path in doc_files(root):
         old = path.read_text()
-        new = regenerate_text(old, src, path.name)
+        new = regenerate_text(old, src, rel_of(path, root))
         if new != old:
-            stale.append(str(path.relative_to(root)))
+            stale.append(rel_of(path, root))
             if write:
                 path.write_text(new)
     return stale
@@ -281,12 +314,12 @@ def checked_mismatches(root: pathlib.Path = ROOT) -> list[str]:
 
 
 def untagged(root: pathlib.Path = ROOT) -> list[str]:
-    """Figures of `docs/*.md` outside generated and history blocks and not allowed:
-    `file:line: figure` each (a figure allowed n times may appear n times)."""
+    """Figures of the scanned documents (`scanned_files`) outside generated and history blocks
+    and not allowed: `file:line: figure` each (a figure allowed n times may appear n times)."""
     allowed = load_allowed(root)
     bad = []
-    for path in doc_files(root):
-        rel = f"{DOCS_DIR}/{path.name}"
+    for path in scanned_files(root):
+        rel = rel_of(path, root)
         if rel not in HISTORY_FILES:
             bad += untagged_in(rel, figures(path.read_text()), allowed.get(rel, {}))
     return bad
@@ -312,8 +345,8 @@ def inventory(root: pathlib.Path = ROOT) -> dict[str, dict[str, int]]:
     pending) and untagged."""
     allowed = load_allowed(root)
     out = {}
-    for path in doc_files(root):
-        rel = f"{DOCS_DIR}/{path.name}"
+    for path in scanned_files(root):
+        rel = rel_of(path, root)
         text = path.read_text()
         gen = sum(len(figures(m["body"])) for m in BLOCK_RE.finditer(text))
         gen += sum(len(figures(m[0].split("-->", 1)[1])) for m in VERDICT_RE.finditer(text))
@@ -350,7 +383,7 @@ def untagged_in(rel: str, prose: list[tuple[int, str]], allowed: Mapping[str, li
 def main(argv: list[str] | None = None) -> int:
     ap = cli.Parser(prog="python -m tailsim.reports.docs", description=__doc__.split("\n\n")[0])
     mode = ap.add_mutually_exclusive_group(required=True)
-    mode.add_argument("--write", action="store_true", help="rewrite every generated block of docs/*.md and the README")
+    mode.add_argument("--write", action="store_true", help="rewrite every generated block of docs/*.md and the READMEs")
     mode.add_argument("--check", action="store_true", help="only compare (exit 1 when a block is stale)")
     ap.add_argument(
         "--reproduction",
@@ -358,7 +391,13 @@ def main(argv: list[str] | None = None) -> int:
         help="with --write: first take docs/reproduction.json from this reproduction.json "
         "(`cargo run --release -p analysis -- reproduction --out out/analysis`)",
     )
-    mode.add_argument("--inventory", action="store_true", help="count the figures of docs/*.md by kind")
+    ap.add_argument(
+        "--wind-envelope",
+        metavar="FILE",
+        help="with --write: first summarise this wind_envelope.json into docs/wind_envelope.json "
+        "(`cargo run --release -p analysis -- wind-envelope --all --threads 1 --out out/analysis`)",
+    )
+    mode.add_argument("--inventory", action="store_true", help="count the figures of the scanned documents by kind")
     a = ap.parse_args(argv)
 
     def run() -> int:
@@ -383,6 +422,12 @@ def main(argv: list[str] | None = None) -> int:
             )
             taken = docs_blocks.take_reproduction(full, cmd)
             (ROOT / DOCS_DIR / "reproduction.json").write_text(json.dumps(taken, indent=1, sort_keys=True) + "\n")
+        if a.wind_envelope:
+            if not a.write:
+                ap.error("argument --wind-envelope: only with --write")
+            full = json.loads(pathlib.Path(a.wind_envelope).read_text())
+            summary = docs_wind.summarize(full, docs_wind.COMMAND, docs_wind.head_commit())
+            (ROOT / DOCS_DIR / docs_wind.WIND).write_text(docs_wind.dumps(summary))
         stale = regenerate(write=a.write) + verdict.regenerate(write=a.write)
         for file in stale:
             print(f"{file}: {'rewritten' if a.write else 'stale'}", file=sys.stderr)

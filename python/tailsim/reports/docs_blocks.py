@@ -416,3 +416,23 @@ def take_reproduction(full: Mapping[str, Any], command: str) -> dict[str, Any]:
         "table_5_1_median_ratio": ratios,
         "open_loop_modes": full["open_loop_modes"],
     }
+
+
+def _sig3(x: float) -> str:
+    """Three significant digits, trailing zeros kept, Unicode minus."""
+    return f"{x:#.3g}".rstrip(".").replace("-", "−")
+
+
+def _pole(re_: float, im: float, fmt) -> str:
+    sign = "+" if re_ > 0 else ""
+    return f"{sign}{fmt(re_)}" + (f" ± {fmt(abs(im))}i" if im else "")
+
+
+@block("physics.open_loop_modes", REPRO)
+def _physics_modes(src: Sources) -> str:
+    """crates/tailsitter-physics/README.md: the open-loop modes at the level trim beside the thesis's."""
+    rows = ["| mode | this model | thesis (Tables 3.2/3.3) |", "|---|---|---|"]
+    for m in src.json(REPRO)["open_loop_modes"]:
+        thesis = _pole(*m["thesis"], lambda x: f"{x:g}".replace("-", "−"))
+        rows.append(f"| {m['mode']} | {_pole(*m['ours'], _sig3)} | {thesis} |")
+    return "\n".join(rows)

@@ -42,3 +42,16 @@ def _climb_trim(src: Sources) -> str:
 @block("transition.t_climb", TRIMS)
 def _t_climb(src: Sources) -> str:
     return f"{src.json(TRIMS)['point_mass_t_climb']:.1f} N"
+
+
+@block("physics.trims", TRIMS)
+def _physics_trims(src: Sources) -> str:
+    """crates/tailsitter-physics/README.md: the level and climb trims of the default airframe."""
+    t = src.json(TRIMS)
+    lv, cl = t["plant"]["thesis"]["level"], t["plant"]["thesis"]["climb"]
+    return "| condition | result |\n|---|---|\n" + _minus(
+        f"| level {t['v_level']:g} m/s | α = θ = {lv['alpha_deg']:.3f}°, δe = {lv['elevator_deg']:.3f}°, "
+        f"T = {lv['thrust']:.3f} N, w = {lv['induced_velocity']:.3f} m/s |\n"
+        f"| vertical climb {t['v_vertical']:g} m/s | T = {cl['thrust']:.3f} N (= m g + q̄S C_D0), "
+        f"w = {cl['induced_velocity']:.3f} m/s, δe = {abs(cl['elevator_deg']):.0f}, θ = {cl['theta_deg']:.0f}° |"
+    )
