@@ -214,6 +214,19 @@ impl WindMission {
         Some((nearer_face(heading, (-w.y).atan2(-w.x)), p.max_rate))
     }
 
+    /// The heading target of the take-off climb (README, "Missions in wind"):
+    /// [`Self::ground_target`] with the face chosen against the track ([`track_face`]), so
+    /// the first vertical phase starts on the front transition's face instead of turning it
+    /// round (from the back into a crosswind: 180° in the 5 s before the transition).
+    pub fn takeoff_target(&mut self, wv: &Weathervane) -> Option<(f64, f64)> {
+        let (target, rate) = self.ground_target(wv)?;
+        let w = wv.wind();
+        if !(self.engaged && w.x.is_finite() && w.y.is_finite()) {
+            return Some((target, rate));
+        }
+        Some((track_face(wv.heading(), (-w.y).atan2(-w.x)), rate))
+    }
+
     /// Write the state ([`WIND_MISSION_STATE_LEN`] values).
     pub fn save(&self, out: &mut impl FnMut(f64)) {
         out(self.wind[0]);
@@ -362,6 +375,20 @@ mod tests {
             target.to_degrees()
         );
         assert!((wv.heading() - target).abs() < 0.02, "{}", wv.heading().to_degrees());
+    }
+
+    /// The take-off climb in 8 m/s from the west: the ground phases' nearer face is the back
+    /// (+90°), the take-off's the belly (−90°), the face the front transition needs.
+    #[test]
+    fn takeoff_faces_the_wind_with_the_transitions_face() {
+        let w = Vector3::new(0.0, 8.0, 0.0);
+        let wv = weathervane_at(0.0, w);
+        let mut wm = WindMission::default();
+        let (ground, _) = wm.ground_target(&wv).unwrap();
+        let (takeoff, rate) = wm.takeoff_target(&wv).unwrap();
+        assert!((ground.to_degrees() - 90.0).abs() < 1e-9, "{}", ground.to_degrees());
+        assert!((takeoff.to_degrees() + 90.0).abs() < 1e-9, "{}", takeoff.to_degrees());
+        assert_eq!(rate, wv.params().max_rate);
     }
 
     /// The collective-flap trim: −4.6° per m/s of wind into the belly, ±17° at most, the
