@@ -1192,8 +1192,10 @@ mod tests {
     /// Representative held cells of the tuned TSD over the default mission: a 10 m/s head-,
     /// tail- and quartering (45°) wind stepping in, a 3 m/s crosswind, and an 8 m/s headwind
     /// with moderate turbulence, each within the held limit with the largest error measured
-    /// (0.6, 0.5, 2.2, 1.8, 1.1 m) plus 0.5 m; an 8 m/s quartering headwind (45°) and a 10 m/s
-    /// quartering tailwind (135°) within 2.7 m and the held limit (measured 2.2 and 2.7 m).
+    /// (0.6, 0.5, 2.2, 1.8, 1.1 m) plus 0.5 m; an 8 m/s quartering headwind (45°) within 2.7 m
+    /// (measured 2.2 m) and an 8 m/s crosswind (90°) stepping in 3 s before the transition
+    /// within 2.5 m (measured 2.0 m). (The 10 m/s quartering tailwinds, 135° and 225°, are not
+    /// held: tsd-control README, "Missions in wind".)
     #[test]
     fn tuned_tsd_holds_representative_wind_cells_of_the_default_mission() {
         for (form, speed, bearing, bound) in [
@@ -1202,9 +1204,9 @@ mod tests {
             (WindForm::Step, 10.0, 1, 2.7),
             (WindForm::Step, 3.0, 2, 2.3),
             (WindForm::Turbulent, 8.0, 0, 1.6),
-            // Held by the mission logic in wind (without it 12.3 and 456 m, lost).
+            // Held by the mission logic in wind (without it 12.3 m, and lost at 9.7 s).
             (WindForm::Step, 8.0, 1, 2.7),
-            (WindForm::Step, 10.0, 3, 3.0),
+            (WindForm::Step, 8.0, 2, 2.5),
         ] {
             let c = fly_cell(Kind::Tsd, MissionKind::Default, form, speed, bearing);
             assert!(c.held && c.max_error < bound, "{c:?}");

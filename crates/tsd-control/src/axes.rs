@@ -5,7 +5,7 @@
 //! direction cosines e_i3 (4.2.17) and the stability-axis rates.
 
 use crate::deviations::Deviations;
-use crate::{band_weight, TsdController, HOVER_WIND_CROSSFLOW};
+use crate::{band_weight, TsdController, HOVER_LOW_AIRSPEED_ALPHA, HOVER_WIND_CROSSFLOW};
 use flight_mission::Measurement;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
@@ -19,6 +19,9 @@ pub(crate) struct Airflow {
     /// Weight (0–1) of the hover-in-wind design condition: the crossflow's, in the take-off
     /// and landing phases the measured wind's.
     pub hover_wind: f64,
+    /// Weight (0–1) of the measured α in the loop design: in hover below
+    /// [`HOVER_LOW_AIRSPEED_ALPHA`] the design is at α = 0.
+    pub alpha_weight: f64,
     /// Weight κ of the wind axes against the reference-path frame.
     pub kappa: f64,
 }
@@ -43,7 +46,13 @@ impl TsdController {
         let crossflow = (meas.airspeed * meas.airspeed - axial_airspeed * axial_airspeed)
             .max(0.0)
             .sqrt();
-        let hover_wind = if !(dev.hover_wind_design && reference_airspeed <= self.mission.v_vertical + 1.0) {
+        let hover = dev.hover_wind_design && reference_airspeed <= self.mission.v_vertical + 1.0;
+        let alpha_weight = if hover && !ground_phase {
+            band_weight(meas.airspeed, HOVER_LOW_AIRSPEED_ALPHA)
+        } else {
+            1.0
+        };
+        let hover_wind = if !hover {
             0.0
         } else if ground_phase {
             // Take-off and landing phases: weighted with the measured wind, not the crossflow
@@ -65,6 +74,7 @@ impl TsdController {
             axial_airspeed,
             crossflow,
             hover_wind,
+            alpha_weight,
             kappa,
         }
     }

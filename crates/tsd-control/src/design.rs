@@ -175,6 +175,8 @@ impl TsdController {
     /// wind step"). At the measured condition (a wind step puts α at ±60° or β at ±65°, V̄ at
     /// 5–10 m/s) the elevator and flaps went into a bang-bang pitch limit cycle
     /// (q ≈ ±8 rad/s) that the Jacobi master's extra sample turned into a tumble from 5 m/s on.
+    /// In hover below `HOVER_LOW_AIRSPEED_ALPHA` also at α = 0 (the air data of a near-still
+    /// air flow are no flight condition).
     pub(crate) fn scheduled_design(
         &self,
         meas: &Measurement,
@@ -188,7 +190,7 @@ impl TsdController {
         } else {
             (
                 meas.airspeed * lerp(1.0, HOVER_WIND_DESIGN_SPEED_FACTOR, air.hover_wind),
-                meas.alpha * (1.0 - air.hover_wind),
+                meas.alpha * (1.0 - air.hover_wind) * air.alpha_weight,
             )
         };
         self.design(&FlightCondition {

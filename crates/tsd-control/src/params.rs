@@ -22,6 +22,15 @@ pub const HOVER_WIND_DESIGN_SPEED_FACTOR: f64 = 1.3;
 /// the calm missions unchanged), fully at the second.
 pub const HOVER_WIND_CROSSFLOW: (f64, f64) = (1.0, 3.0);
 
+/// Airspeed band (m/s) over which the measured α enters the loop design in hover (tuned
+/// configuration, the reference at the vertical speed, not the take-off and landing phases):
+/// none at the first value, fully from the second (the still-air climb's 3 m/s, the calm
+/// missions unchanged). Below 2 m/s the air data are no flight condition — a gust along the
+/// nose of the climb leaves 1 m/s at α ≈ ±80–90° — and the coefficients and mixing ratios
+/// designed there put the rudder, vertical flaps and ailerons into a bang-bang cycle that
+/// tumbled the aircraft (README, "Missions in wind").
+pub const HOVER_LOW_AIRSPEED_ALPHA: (f64, f64) = (2.0, 3.0);
+
 /// Tuned configuration: the normal loop's steady-state feed-forward of the reference's normal
 /// acceleration ([`crate::gains::normal_steady_state`]) is blended in as the reference airspeed rises from
 /// v_vertical to v_vertical + this (m/s): none in the hover (the hover-in-wind design and the

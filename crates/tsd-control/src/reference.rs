@@ -80,7 +80,12 @@ impl TsdController {
         let heading = if sigma_ground.is_some() {
             // Take-off and landing phases (README, "Take-off and landing in wind"): the belly
             // or the back into the measured wind.
-            let target = self.wind_mission.ground_target(&self.weathervane, reference.phase);
+            // The take-off climb on the front transition's face (README, "Missions in wind").
+            let target = if reference.phase == Phase::TakeOff {
+                self.wind_mission.takeoff_target(&self.weathervane)
+            } else {
+                self.wind_mission.ground_target(&self.weathervane, reference.phase)
+            };
             self.weathervane.update_towards(&self.mission, input.t, meas, target)
         } else {
             // Mission logic in wind (README, "Missions in wind"): the heading of the

@@ -7,31 +7,48 @@
 //! the wing and of the surfaces in the slip-stream, pitch); along the span it has only the
 //! weak rudder and vertical flaps. Unbanked, its plane of symmetry is the vertical plane of
 //! bearing ψ_w in hover (belly towards ψ_w) as in level flight (nose towards ψ_w), so the
-//! heading chooses which horizontal forces are made in the strong plane. The target is the
-//! bearing of the horizontal specific force the flight needs, belly or back towards it
-//! (whichever is nearer): the reference's own Σ^RE (4.3.35–4.3.36) — the push-over's
-//! acceleration and the pull-up's deceleration, along the track — plus the wind load, the
-//! low-passed difference between the measured horizontal specific force and Σ^RE. In hover
-//! in a crosswind the load dominates and the belly faces the wind, as the weathervane turns
-//! it, so the handover from the weathervane is continuous; as the front transition
-//! accelerates along the track the target turns towards the track; in level flight the
-//! heading does not act (γ = 0 makes the prescribed normal vector vertical, and the
-//! computed one of (4.3.29–4.3.30) takes over); the back transition's deceleration turns
-//! it back towards the track.
+//! heading chooses which way the air meets it. The target is the bearing of the horizontal
+//! air-relative velocity previewed by [`AIR_PREVIEW_TIME`], v_h − ŵ_h + τ Σ^RE_h (ŵ the
+//! weathervane's filtered air-data wind, Σ^RE (4.3.35–4.3.36) the reference's specific
+//! acceleration): the plane of symmetry along the air flow (small sideslip). In hover it is
+//! the wind's bearing (belly or back into the wind, as the weathervane); through the front
+//! transition it turns with the growing airspeed along the track towards the level flight's
+//! crab; in level flight the heading does not act (γ = 0 makes the prescribed normal vector
+//! vertical, and the computed one of (4.3.29–4.3.30) takes over); in the back transition it
+//! turns back towards the wind.
 //!
-//! Engaged with the weathervane (its filtered air-data wind at or above its engage speed,
-//! released below its release speed), at its rate limit: in still air the logic is idle
-//! and the calm mission is flown exactly as without it.
+//! **Face.** The front transition pitches the nose over towards the belly, so the belly must
+//! face the track's side when it starts: the face is chosen against the track
+//! ([`track_face`]) — the belly towards the air flow within 90° + [`BELLY_MARGIN`] of the
+//! track (a crosswind, a headwind), the back beyond (a tailwind), with a hysteresis band of
+//! ±[`FACE_HYSTERESIS`] — not the nearer face of the weathervane, which could leave the back
+//! towards a crosswind and turn the transition's heading away from the track.
+//!
+//! Engaged from the whole first vertical phase through the transitions and level flight
+//! into the last vertical phase's `settle_time`, when the wind estimate engages: the
+//! weathervane's 4 s estimate or this logic's own [`ENGAGE_FILTER_TIME`] one at or above the
+//! engage speed (a wind stepping in 3 s before the transition is turned into at once),
+//! released with the weathervane's below its release speed; the heading turns at up to
+//! [`WINDOW_RATE`]. In still air the logic is idle and the calm mission is flown exactly as
+//! without it.
 
 use flight_mission::{Measurement, MissionParams, Phase};
-use guidance::weathervane::nearer_face;
+use guidance::weathervane::{air_data_wind, nearer_face, wrap_pi};
 use guidance::Weathervane;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
-/// Time constant of the low-passed wind load (s).
-pub const LOAD_FILTER_TIME: f64 = 1.0;
-/// Horizontal specific force below which the heading is held (m/s²).
-pub const MIN_HORIZONTAL_FORCE: f64 = 0.5;
+/// Preview τ of the air-relative velocity by the reference's acceleration (s).
+pub const AIR_PREVIEW_TIME: f64 = 1.0;
+/// Time constant of the engagement's own air-data wind estimate (s).
+pub const ENGAGE_FILTER_TIME: f64 = 1.0;
+/// How far behind the beam the belly may face the air flow (rad).
+pub const BELLY_MARGIN: f64 = 20.0 * core::f64::consts::PI / 180.0;
+/// Half-width of the band around 90° + [`BELLY_MARGIN`] in which the nearer face is kept (rad).
+pub const FACE_HYSTERESIS: f64 = 10.0 * core::f64::consts::PI / 180.0;
+/// Largest heading rate of the mission logic (rad/s): a 90° turn in 3 s.
+pub const WINDOW_RATE: f64 = 30.0 * core::f64::consts::PI / 180.0;
+/// Previewed horizontal air-relative speed below which the heading is held (m/s).
+pub const MIN_AIR_SPEED: f64 = 1.0;
 
 /// Collective-flap trim per m/s of wind into the belly in the landing phases (rad s/m):
 /// the slope of the plant's still, upright hover trim (−5.2°, −9.8°, −13.8° of collective
@@ -64,13 +81,13 @@ pub const GROUND_ENGAGE_SPEED: f64 = 2.0;
 /// Number of f64 values [`WindMission::save`] writes.
 pub const WIND_MISSION_STATE_LEN: usize = 4;
 
-/// State of the mission logic in wind: the low-passed horizontal wind load and whether the
-/// logic and the take-off and landing heading are engaged.
+/// State of the mission logic in wind: its own filtered horizontal air-data wind (for the
+/// engagement) and whether the logic and the landing phases' heading are engaged.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct WindMission {
-    /// Low-passed horizontal (measured − reference) specific force, N and E (m/s²); NaN
-    /// before the first sample.
-    load: [f64; 2],
+    /// Air-data wind low-passed over [`ENGAGE_FILTER_TIME`], N and E (m/s); NaN before the
+    /// first sample.
+    wind: [f64; 2],
     engaged: bool,
     /// Whether the landing phases' heading is engaged: its own hysteresis, so that its lower
     /// engage speed does not reach the take-off or the mission's logic.
@@ -80,18 +97,27 @@ pub struct WindMission {
 impl Default for WindMission {
     fn default() -> Self {
         Self {
-            load: [f64::NAN; 2],
+            wind: [f64::NAN; 2],
             engaged: false,
             ground_engaged: false,
         }
     }
 }
 
-/// The measured specific force in earth axes (NED) (m/s²).
-fn specific_force_earth(m: &Measurement) -> Vector3<f64> {
-    let q = &m.quat;
-    let r = UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]));
-    r * m.specific_force_body
+/// The heading nearest `heading` that puts the belly or the back towards `bearing` (rad),
+/// the face chosen against the track (the mission's heading, 0): the belly when `bearing`
+/// is within 90° + [`BELLY_MARGIN`] − [`FACE_HYSTERESIS`] of the track, the back beyond
+/// 90° + [`BELLY_MARGIN`] + [`FACE_HYSTERESIS`], in between the face nearer `heading`.
+pub fn track_face(heading: f64, bearing: f64) -> f64 {
+    use core::f64::consts::{FRAC_PI_2, PI};
+    let off = wrap_pi(bearing).abs();
+    if off <= FRAC_PI_2 + BELLY_MARGIN - FACE_HYSTERESIS {
+        heading + wrap_pi(bearing - heading)
+    } else if off >= FRAC_PI_2 + BELLY_MARGIN + FACE_HYSTERESIS {
+        heading + wrap_pi(bearing + PI - heading)
+    } else {
+        nearer_face(heading, bearing)
+    }
 }
 
 /// Direct-force command of the collective flaps in the landing phases (approach, descent,
@@ -137,17 +163,15 @@ pub fn landing_flap_trim(m: &Measurement, phase: Phase, wind: &Vector3<f64>) -> 
 }
 
 impl WindMission {
-    /// Whether the phase at mission time `t` is flown with this heading: the last
-    /// `return_window` of the first vertical phase (where the weathervane alone would return
-    /// to the mission's heading), the transitions and level flight, and the last vertical
-    /// phase until the weathervane follows the wind again.
+    /// Whether the phase at mission time `t` is flown with this heading: the first vertical
+    /// phase (so the face is the transition's from the start), the transitions and level
+    /// flight, and the last vertical phase until the weathervane follows the wind again.
     pub fn in_window(wv: &Weathervane, mission: &MissionParams, t: f64) -> bool {
         let p = wv.params();
         let (phase, tau) = mission.phase_at(t);
         p.enabled
             && match phase {
-                Phase::Vertical1 => mission.t_vertical_1 - tau <= p.return_window(),
-                Phase::TransitionToLevel | Phase::Level | Phase::TransitionToVertical => true,
+                Phase::Vertical1 | Phase::TransitionToLevel | Phase::Level | Phase::TransitionToVertical => true,
                 Phase::Vertical2 => tau < p.settle_time,
                 _ => false,
             }
@@ -170,31 +194,36 @@ impl WindMission {
         m: &Measurement,
         sigma_ref: &Vector3<f64>,
     ) -> Option<(f64, f64)> {
-        let p = wv.params();
-        if !p.enabled {
+        if !wv.params().enabled {
             return None;
         }
-        let f = specific_force_earth(m) - sigma_ref;
-        if f.x.is_finite() && f.y.is_finite() {
-            if self.load[0].is_finite() && self.load[1].is_finite() {
-                let k = 1.0 - (-mission.sample_time / LOAD_FILTER_TIME).exp();
-                self.load[0] += k * (f.x - self.load[0]);
-                self.load[1] += k * (f.y - self.load[1]);
+        let raw = air_data_wind(m);
+        if raw.x.is_finite() && raw.y.is_finite() {
+            if self.wind[0].is_finite() && self.wind[1].is_finite() {
+                let k = 1.0 - (-mission.sample_time / ENGAGE_FILTER_TIME).exp();
+                self.wind[0] += k * (raw.x - self.wind[0]);
+                self.wind[1] += k * (raw.y - self.wind[1]);
             } else {
-                self.load = [f.x, f.y];
+                self.wind = [raw.x, raw.y];
             }
         }
         self.engage(wv);
+        if self.wind[0].hypot(self.wind[1]) >= wv.params().engage_speed {
+            self.engaged = true;
+        }
         if !(self.engaged && Self::in_window(wv, mission, t)) {
             return None;
         }
-        let (n, e) = (sigma_ref.x + self.load[0], sigma_ref.y + self.load[1]);
+        // The previewed horizontal air-relative velocity v − ŵ + τ Σ^RE.
+        let w = wv.wind();
+        let n = m.vel_ned.x - w.x + AIR_PREVIEW_TIME * sigma_ref.x;
+        let e = m.vel_ned.y - w.y + AIR_PREVIEW_TIME * sigma_ref.y;
         let heading = wv.heading();
         let size = n.hypot(e);
-        if size.is_nan() || size < MIN_HORIZONTAL_FORCE {
-            return Some((heading, p.max_rate));
+        if size.is_nan() || size < MIN_AIR_SPEED {
+            return Some((heading, WINDOW_RATE));
         }
-        Some((nearer_face(heading, e.atan2(n)), p.max_rate))
+        Some((track_face(heading, e.atan2(n)), WINDOW_RATE))
     }
 
     /// The engagement's hysteresis on the weathervane's filtered air-data wind.
@@ -252,17 +281,30 @@ impl WindMission {
         Some((nearer_face(heading, (-w.y).atan2(-w.x)), p.max_rate))
     }
 
+    /// The heading target of the take-off climb (README, "Missions in wind"):
+    /// [`Self::ground_target`] with the face chosen against the track ([`track_face`]), so
+    /// the first vertical phase starts on the front transition's face instead of turning it
+    /// round (from the back into a crosswind: 180° in the 5 s before the transition).
+    pub fn takeoff_target(&mut self, wv: &Weathervane) -> Option<(f64, f64)> {
+        let (target, rate) = self.ground_target(wv, Phase::TakeOff)?;
+        let w = wv.wind();
+        if !(self.engaged && w.x.is_finite() && w.y.is_finite()) {
+            return Some((target, rate));
+        }
+        Some((track_face(wv.heading(), (-w.y).atan2(-w.x)), rate))
+    }
+
     /// Write the state ([`WIND_MISSION_STATE_LEN`] values).
     pub fn save(&self, out: &mut impl FnMut(f64)) {
-        out(self.load[0]);
-        out(self.load[1]);
+        out(self.wind[0]);
+        out(self.wind[1]);
         out(if self.engaged { 1.0 } else { 0.0 });
         out(if self.ground_engaged { 1.0 } else { 0.0 });
     }
 
     /// Restore what [`Self::save`] wrote (`v`: [`WIND_MISSION_STATE_LEN`] values).
     pub fn restore(&mut self, v: &[f64]) {
-        self.load = [v[0], v[1]];
+        self.wind = [v[0], v[1]];
         self.engaged = v[2] != 0.0;
         self.ground_engaged = v[3] != 0.0;
     }
@@ -276,55 +318,102 @@ mod tests {
     /// Nose up, belly north, hovering still in the horizontal wind `w` (NED) while making
     /// the horizontal specific force `f_h` (NED, m/s²) against it.
     fn hovering(w: Vector3<f64>, f_h: Vector3<f64>) -> Measurement {
+        moving(w, Vector3::zeros(), f_h)
+    }
+
+    /// As [`hovering`], moving at the velocity `v` (NED).
+    fn moving(w: Vector3<f64>, v: Vector3<f64>, f_h: Vector3<f64>) -> Measurement {
         let r = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), core::f64::consts::FRAC_PI_2);
         Measurement {
             specific_force_body: r.inverse() * (f_h - Vector3::new(0.0, 0.0, 9.81)),
-            ..Measurement::still_in_air(&r, &(r.inverse() * (-w)))
+            vel_ned: v,
+            ..Measurement::still_in_air(&r, &(r.inverse() * (v - w)))
         }
     }
 
-    /// Still air: idle everywhere. A crosswind from the east held by a force towards the
-    /// east: in the first vertical phase's return window the belly turns east (90°); in the
-    /// front transition the reference's acceleration north turns it towards the track.
+    /// A weathervane at `heading` (rad) with the filtered wind `w` (NED) settled.
+    fn weathervane_at(heading: f64, w: Vector3<f64>) -> Weathervane {
+        let mut wv = Weathervane::new(WeathervaneParams::tuned()).unwrap();
+        let v = [w.x, w.y, w.z, heading, 1.0];
+        let mut it = v.into_iter();
+        wv.restore(&mut || it.next()).unwrap();
+        wv
+    }
+
+    /// Still air: idle everywhere. Engaged by its own 1 s estimate half a second after an
+    /// 8 m/s step (the weathervane's 4 s estimate needs 1.9 s).
     #[test]
-    fn idle_in_still_air_and_the_belly_towards_the_needed_force_in_wind() {
+    fn idle_in_still_air_and_engaged_soon_after_a_wind_step() {
         let mission = MissionParams::default();
-        let s = mission.phase_starts();
         let g = Vector3::new(0.0, 0.0, -9.81);
         let mut wv = Weathervane::new(WeathervaneParams::tuned()).unwrap();
         let mut wm = WindMission::default();
         for k in 0..200 {
             let t = k as f64 * mission.sample_time;
-            assert_eq!(
-                wm.target(&wv, &mission, t, &hovering(Vector3::zeros(), Vector3::zeros()), &g),
-                None
-            );
+            let m = hovering(Vector3::zeros(), Vector3::zeros());
+            assert_eq!(wm.target(&wv, &mission, t, &m, &g), None);
+            wv.update_towards(&mission, t, &m, None);
         }
-        // 8 m/s from the east, 5 m/s² of horizontal force towards the east.
-        let m = hovering(Vector3::new(0.0, -8.0, 0.0), Vector3::new(0.0, 5.0, 0.0));
-        let mut last = None;
-        for k in 0..((s[1] - 0.1) / mission.sample_time) as usize {
-            let t = k as f64 * mission.sample_time;
-            last = wm.target(&wv, &mission, t, &m, &g);
-            wv.update_towards(&mission, t, &m, last);
+        let m = hovering(Vector3::new(0.0, -8.0, 0.0), Vector3::zeros());
+        let mut engaged_after = None;
+        for k in 0..100 {
+            let t = 4.0 + k as f64 * mission.sample_time;
+            let target = wm.target(&wv, &mission, t, &m, &g);
+            wv.update_towards(&mission, t, &m, target);
+            if target.is_some() && engaged_after.is_none() {
+                engaged_after = Some(k as f64 * mission.sample_time);
+            }
         }
-        assert!(wm.engaged() && WindMission::in_window(&wv, &mission, s[1] - 0.1));
-        let (target, rate) = last.unwrap();
-        assert!(
-            (target - core::f64::consts::FRAC_PI_2).abs() < 0.05,
-            "{}",
-            target.to_degrees()
-        );
-        assert_eq!(rate, wv.params().max_rate);
-        // In T1 with 5 m/s² along the track the bearing of (5, 5) is 45°.
+        let after = engaged_after.unwrap();
+        assert!((0.4..0.55).contains(&after), "{after}");
+        assert!(!wv.engaged());
+    }
+
+    /// The face against the track: an 8 m/s wind from the east is faced with the belly
+    /// (+90°) even from the back face (−90°: the weathervane's nearer face would stay); from
+    /// the west with the belly (−90°); a tailwind from the south with the back (0°); one from
+    /// 135° with the back (−45°). In the front transition, 10 m/s along the track and
+    /// 5 m/s² of Σ^RE with the east wind: the bearing of (15, 8), 28°.
+    #[test]
+    fn belly_towards_the_air_flow_on_the_tracks_side() {
+        let mission = MissionParams::default();
+        let s = mission.phase_starts();
+        let g = Vector3::new(0.0, 0.0, -9.81);
+        let deg = |x: f64| x.to_degrees();
+        let case = |from_deg: f64, heading_deg: f64| {
+            let b = from_deg.to_radians();
+            let w = -8.0 * Vector3::new(b.cos(), b.sin(), 0.0);
+            let wv = weathervane_at(heading_deg.to_radians(), w);
+            let mut wm = WindMission::default();
+            let (target, rate) = wm
+                .target(&wv, &mission, 1.0, &hovering(w, Vector3::zeros()), &g)
+                .unwrap();
+            assert_eq!(rate, WINDOW_RATE);
+            deg(target)
+        };
+        for (from, heading, expected) in [
+            (90.0, -90.0, 90.0),
+            (90.0, 0.0, 90.0),
+            (270.0, 90.0, -90.0),
+            (180.0, 0.0, 0.0),
+            (135.0, 0.0, -45.0),
+            (225.0, 0.0, 45.0),
+        ] {
+            let t = case(from, heading);
+            let off = wrap_pi((t - expected).to_radians());
+            assert!(off.abs() < 1e-8, "from {from}°, heading {heading}°: {t}°");
+        }
+        // Inside the hysteresis band (115° from the track) the nearer face is kept.
+        assert!((case(115.0, 90.0) - 115.0).abs() < 1e-6);
+        assert!((case(115.0, 0.0) + 65.0).abs() < 1e-6);
+        // Front transition.
+        let w = Vector3::new(0.0, -8.0, 0.0);
+        let wv = weathervane_at(core::f64::consts::FRAC_PI_2, w);
+        let mut wm = WindMission::default();
+        let m = moving(w, Vector3::new(10.0, 0.0, -2.0), Vector3::zeros());
         let sigma = Vector3::new(5.0, 0.0, -9.81);
-        let m = hovering(Vector3::new(0.0, -8.0, 0.0), Vector3::new(5.0, 5.0, 0.0));
-        let (target, _) = wm.target(&wv, &mission, s[1] + 0.5, &m, &sigma).unwrap();
-        assert!(
-            (target - core::f64::consts::FRAC_PI_4).abs() < 0.05,
-            "{}",
-            target.to_degrees()
-        );
+        let (target, _) = wm.target(&wv, &mission, s[1] + 1.0, &m, &sigma).unwrap();
+        assert!((deg(target) - deg(8f64.atan2(15.0))).abs() < 1e-6, "{}", deg(target));
     }
 
     /// The take-off and landing phases: still air holds the heading exactly (the calm
@@ -355,6 +444,20 @@ mod tests {
             target.to_degrees()
         );
         assert!((wv.heading() - target).abs() < 0.02, "{}", wv.heading().to_degrees());
+    }
+
+    /// The take-off climb in 8 m/s from the west: the ground phases' nearer face is the back
+    /// (+90°), the take-off's the belly (−90°), the face the front transition needs.
+    #[test]
+    fn takeoff_faces_the_wind_with_the_transitions_face() {
+        let w = Vector3::new(0.0, 8.0, 0.0);
+        let wv = weathervane_at(0.0, w);
+        let mut wm = WindMission::default();
+        let (ground, _) = wm.ground_target(&wv, Phase::TakeOff).unwrap();
+        let (takeoff, rate) = wm.takeoff_target(&wv).unwrap();
+        assert!((ground.to_degrees() - 90.0).abs() < 1e-9, "{}", ground.to_degrees());
+        assert!((takeoff.to_degrees() + 90.0).abs() < 1e-9, "{}", takeoff.to_degrees());
+        assert_eq!(rate, wv.params().max_rate);
     }
 
     /// The landing phases' heading engages at [`GROUND_ENGAGE_SPEED`], below the
