@@ -5,9 +5,9 @@
 //! was cut 0.76 m above the ground in the sensor-noise seed of bearing index 0 (touchdown
 //! at 3.5 m/s; index 7: 2.3 m/s).
 use analysis::controllers::Kind;
-use analysis::takeoff_landing::{self, AFTER_LANDING};
+use analysis::takeoff_landing;
 use analysis::wind_envelope::{fly_on, plant, seed, StateKind};
-use closed_loop::{Ordering, Sample, Scenario, Wind};
+use closed_loop::{Ordering, Scenario, Wind};
 use flight_mission::Phase;
 use tailsitter_physics::{idx, InputVector};
 
@@ -22,13 +22,7 @@ fn tsd_with_avionics_lands_on_its_gear() {
         scenario.wind = Wind::Calm;
         scenario.ordering = Ordering::GaussSeidel;
         let mut c = Kind::Tsd.make_configured(&mission, 0).unwrap();
-        let mut landed: Option<f64> = None;
-        let stop = |s: &Sample| {
-            if landed.is_none() && s.diagnostics.phase == Phase::Landed {
-                landed = Some(s.t);
-            }
-            landed.is_some_and(|t| s.t >= t + AFTER_LANDING - 1e-9)
-        };
+        let stop = takeoff_landing::after_landing();
         let trace = fly_on(
             &plant,
             x0,
