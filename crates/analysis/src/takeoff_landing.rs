@@ -156,6 +156,18 @@ pub fn tilt(x: &StateVector) -> f64 {
     (-nose.z).clamp(-1.0, 1.0).acos()
 }
 
+/// A stop condition for [`closed_loop::fly_with`]: true from [`AFTER_LANDING`] after the
+/// first sample in [`Phase::Landed`].
+pub fn after_landing() -> impl FnMut(&closed_loop::Sample) -> bool {
+    let mut landed: Option<f64> = None;
+    move |s| {
+        if landed.is_none() && s.diagnostics.phase == Phase::Landed {
+            landed = Some(s.t);
+        }
+        landed.is_some_and(|t| s.t >= t + AFTER_LANDING - 1e-9)
+    }
+}
+
 /// Fly `kind` through `mission` with `ordering`, stopping [`AFTER_LANDING`] after the landing.
 pub fn fly_one(kind: Kind, ordering: Ordering, mission: &MissionParams) -> (Trace, Flight) {
     let (plant, x0) = plant();
