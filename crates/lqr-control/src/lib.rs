@@ -73,6 +73,9 @@ pub const LANDING_FLAP_GAIN: f64 = 4.6 * std::f64::consts::PI / 180.0;
 /// Largest collective-flap trim of the descent and flare (rad); the rest of the ±25° is left
 /// to the feedback.
 pub const LANDING_FLAP_LIMIT: f64 = 17.0 * std::f64::consts::PI / 180.0;
+/// Time over which the collective-flap trim of the descent ramps in from zero (s) (README,
+/// "Take-off and landing").
+pub const LANDING_FLAP_RAMP_TIME: f64 = 12.0;
 
 /// Time constant τ_s of the integral action on the horizontal position in wind (s).
 pub const HOVER_SHIFT_TIME: f64 = 3.0;
@@ -283,6 +286,9 @@ pub struct LqrController {
     /// Whether the horizontal position integrators are on in the descent and flare in wind
     /// (README, "Take-off and landing"; [`Self::update_landing_integral`]).
     landing_integral: bool,
+    /// Fraction (0–1) of the collective-flap trim applied in the descent and flare in wind,
+    /// ramping in over [`LANDING_FLAP_RAMP_TIME`] (`reference::landing_flaps`).
+    landing_flap_ramp: f64,
     /// The last DARE solution of the 14-state design, in the Euler set `rep` (warm start).
     warm_p: Option<SMatrix<f64, NR, NR>>,
     /// The two solutions before `warm_p` (same Euler set, consecutive), for extrapolation.
@@ -415,6 +421,7 @@ impl LqrController {
             ground_active: false,
             wind_integral: false,
             landing_integral: false,
+            landing_flap_ramp: 0.0,
             warm_p: None,
             warm_hist: [SMatrix::zeros(); 2],
             warm_len: 0,
@@ -688,6 +695,7 @@ impl SampledUnit for LqrController {
         }
         out(f64::from(u8::from(self.wind_integral)));
         out(f64::from(u8::from(self.landing_integral)));
+        out(self.landing_flap_ramp);
     }
 
     /// Restore what [`Self::save`] wrote; `None` from `next` = truncated state.
@@ -743,6 +751,7 @@ impl SampledUnit for LqrController {
         }
         self.wind_integral = take()? != 0.0;
         self.landing_integral = take()? != 0.0;
+        self.landing_flap_ramp = take()?;
         Ok(())
     }
 

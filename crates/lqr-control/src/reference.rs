@@ -13,8 +13,8 @@ use tailsitter_physics::Surfaces;
 use crate::model;
 use crate::trajectory::TrajPoint;
 use crate::{
-    LqrController, HOVER_SHIFT_LIMIT, HOVER_SHIFT_TIME, LANDING_FLAP_GAIN, LANDING_FLAP_LIMIT, MAX_WIND_ESTIMATE,
-    MIN_AIRSPEED, WIND_INTEGRAL_SPEED, WIND_TRIM_MAX_PITCH, WIND_TRIM_RAMP,
+    LqrController, HOVER_SHIFT_LIMIT, HOVER_SHIFT_TIME, LANDING_FLAP_GAIN, LANDING_FLAP_LIMIT, LANDING_FLAP_RAMP_TIME,
+    MAX_WIND_ESTIMATE, MIN_AIRSPEED, WIND_INTEGRAL_SPEED, WIND_TRIM_MAX_PITCH, WIND_TRIM_RAMP,
 };
 
 /// Switches of the reference stage (from [`crate::LqrParams::effective`]).
@@ -166,7 +166,10 @@ impl LqrController {
         }
         let trimmed = match ground {
             None => self.trimmed(&point, sw).unwrap_or(point),
-            Some(v) => self.landing_flaps(&point, v.phase),
+            Some(v) => {
+                self.update_landing_flap_ramp(v.phase);
+                self.landing_flaps(&point, v.phase)
+            }
         };
         Reference {
             point: trimmed,
@@ -413,6 +416,16 @@ impl LqrController {
         Vector3::new(v, v_b.z.atan2(v_b.x), (v_b.y / v).clamp(-1.0, 1.0).asin())
     }
 
+    /// Ramp the collective-flap trim in over [`LANDING_FLAP_RAMP_TIME`] from the start of the
+    /// descent in wind; outside the descent and flare in wind back to zero.
+    fn update_landing_flap_ramp(&mut self, phase: Phase) {
+        self.landing_flap_ramp = if matches!(phase, Phase::Descent | Phase::Flare) && self.ground_in_wind() {
+            (self.landing_flap_ramp + self.mission.sample_time / LANDING_FLAP_RAMP_TIME).min(1.0)
+        } else {
+            0.0
+        };
+    }
+
     /// The landing reference with the collective flaps trimmed against the wind into the belly
     /// (README, "Take-off and landing"): in the descent and the flare in wind
     /// ([`Self::ground_in_wind`]) δfc_t −= [`LANDING_FLAP_GAIN`] × (the weathervane's 4 s wind
@@ -431,7 +444,8 @@ impl LqrController {
         let belly = model::dcm_of_quat(&p.quat()).row(2).transpose();
         let into_belly = -w.xy().dot(&belly.xy());
         let mut q = *p;
-        q.u[4] -= (LANDING_FLAP_GAIN * into_belly).clamp(-LANDING_FLAP_LIMIT, LANDING_FLAP_LIMIT);
+        q.u[4] -=
+            self.landing_flap_ramp * (LANDING_FLAP_GAIN * into_belly).clamp(-LANDING_FLAP_LIMIT, LANDING_FLAP_LIMIT);
         q
     }
 
