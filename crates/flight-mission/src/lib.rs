@@ -61,10 +61,7 @@ pub struct MissionParams {
     pub landing_flare_height: f64,
     /// Reference sink rate at touchdown (m/s).
     pub landing_touchdown_rate: f64,
-    /// Touchdown detection (m): in the flare the reference within this of the target height
-    /// (or past it) and not above the CG by more than this, the CG no longer sinking — the gear
-    /// stops the aircraft while its reference sinks on (guidance::ground), not a test of the
-    /// measured height, which an estimated height fails.
+    /// Touchdown detection: height tolerance of the CG over the target (m).
     pub landing_touchdown_tolerance: f64,
 }
 

@@ -35,12 +35,10 @@
 //!   steady sink, thrust ≈ weight: no flare thrust to bounce on) and down to
 //!   [`TOUCHDOWN_OVERSHOOT`] below the target (the reference keeps sinking until the gear
 //!   carries the aircraft).
-//! * [`Phase::Landed`]: latched when, in the flare, the reference has come within
-//!   `landing_touchdown_tolerance` of the target height and is not above the CG by more
-//!   than that (nor below it by more than [`TOUCHDOWN_OVERSHOOT`]), and the CG sinks slower than V_td/2 for [`TOUCHDOWN_DWELL`] (the gear has
-//!   stopped it; [`touchdown_height_reached`]: no test of the measured height against the
-//!   target, which an estimated height fails): thrust command 0 (the controllers clamp it
-//!   to their thrust minimum), surfaces centred, held for good.
+//! * [`Phase::Landed`]: latched when, in the flare, the CG is within
+//!   `landing_touchdown_tolerance` of the target height and sinks slower than V_td/2 for
+//!   [`TOUCHDOWN_DWELL`] (the gear has stopped it): thrust command 0 (the controllers clamp
+//!   it to their thrust minimum), surfaces centred, held for good.
 //!
 //! The reference attitude in the vertical phases here is the mission's vertical one
 //! (nose up, belly north); while descending the air comes from behind, α = π.
@@ -53,12 +51,8 @@ use flight_mission::{Measurement, MissionParams, Phase};
 pub const DESCENT_RAMP_TIME: f64 = 2.0;
 /// Shortest approach (s).
 pub const APPROACH_MIN_TIME: f64 = 4.0;
-/// How far the touchdown reference sinks below the target before it holds (m): farther
-/// than an estimated height can be off (a GPS-only height relative to the start, σ 4 m per
-/// fix: about 1.4 m σ from the fixes on the gear alone, so ≈ 3σ), so that the reference
-/// keeps sinking at V_td until the gear stops the aircraft, wherever the estimate puts the
-/// ground (the hold is reached only if the touchdown is never detected).
-pub const TOUCHDOWN_OVERSHOOT: f64 = 4.5;
+/// How far the touchdown reference sinks below the target before it holds (m).
+pub const TOUCHDOWN_OVERSHOOT: f64 = 0.3;
 /// Time flown at the touchdown rate before the target, after the flare (s).
 pub const FINAL_SEGMENT_TIME: f64 = 1.0;
 /// Time the touchdown condition must hold before the landing is declared (s).
@@ -86,21 +80,6 @@ pub enum GroundMode {
     Vertical(VerticalReference),
     /// Do not fly: command `thrust` (N), surfaces centred ([`Phase::OnGround`], [`Phase::Landed`]).
     Idle { phase: Phase, thrust: f64 },
-}
-
-/// The touchdown's height condition, on the flare's reference (`ref_z`, NED down, m), not
-/// on the measured height (`z`) against the target: the reference has come within
-/// `tolerance` of the target height `target_z` (or passed it) and is neither above the
-/// aircraft by more than `tolerance` nor below it by more than [`TOUCHDOWN_OVERSHOOT`]
-/// (the height error the sinking reference covers). With an estimated height (GPS only, relative to the
-/// start: ≈ 1.4 m σ from the fixes on the gear alone) a test of the measured height
-/// against the target declares the touchdown while the aircraft still flies above the
-/// ground when the estimate is low (the thrust is cut: it falls) and never declares it when
-/// the estimate is high. The reference sinks on below the target until the touchdown: an
-/// aircraft that has stopped sinking (the other condition) with its reference not above it
-/// stands on its gear; one that stops below its reference is catching up with it.
-pub fn touchdown_height_reached(z: f64, ref_z: f64, target_z: f64, tolerance: f64) -> bool {
-    ref_z >= target_z - tolerance && (-tolerance..=TOUCHDOWN_OVERSHOOT).contains(&(ref_z - z))
 }
 
 /// The take-off and landing phase logic of a controller (module docs). Plain state,
@@ -323,7 +302,7 @@ impl GroundPhases {
         let target = origin + Vector3::new(m.landing_target_n, m.landing_target_e, m.landing_target_d);
         let r = self.landing_reference(tm - end, &p0, &v0, &target);
         if r.phase == Phase::Flare {
-            let down = touchdown_height_reached(meas.pos_ned.z, r.pos.z, target.z, m.landing_touchdown_tolerance);
+            let down = meas.pos_ned.z >= target.z - m.landing_touchdown_tolerance;
             let stopped = meas.vel_ned.z < 0.5 * m.landing_touchdown_rate;
             if down && stopped {
                 if self.touch_since.is_nan() {
@@ -583,59 +562,21 @@ mod tests {
         {
             t += 0.02;
         }
-        // The time the reference reaches the target height (20 m down, tolerance 0.02 m).
-        let reference_at = |g: &GroundPhases, t: f64| match g.clone().step(
-            t,
-            &meas(Vector3::zeros(), Vector3::new(0.0, 0.0, 0.3)),
-            mref,
-        ) {
-            GroundMode::Vertical(r) => r.pos.z,
-            other => panic!("{other:?}"),
-        };
-        let mut t_r = t;
-        while reference_at(&g, t_r) < 20.0 - m.landing_touchdown_tolerance {
-            t_r += 0.02;
-        }
         // Sinking through the target height: no touchdown.
         let sinking = meas(Vector3::new(0.0, 0.0, 19.99), Vector3::new(0.0, 0.0, 0.3));
         assert!(matches!(g.step(t, &sinking, mref), GroundMode::Vertical(_)));
-        // Stopped on the target height before the reference got there (an estimated height
-        // below the truth): still flying.
-        let early = meas(Vector3::new(0.0, 0.0, 19.995), Vector3::zeros());
-        for k in 0..10 {
-            assert!(matches!(
-                g.step(t_r - 0.5 + 0.02 * f64::from(k), &early, mref),
-                GroundMode::Vertical(_)
-            ));
-        }
-        // Stopped half a metre below the target with the reference above it (catching up
-        // with it): still flying.
-        let below = meas(Vector3::new(0.0, 0.0, 20.5), Vector3::zeros());
-        for k in 0..10 {
-            assert!(matches!(
-                g.step(t_r + 0.02 * f64::from(k), &below, mref),
-                GroundMode::Vertical(_)
-            ));
-        }
-        // Stopped a metre above the target (an estimated height above the truth) with the
-        // reference sinking past it: landed after the dwell.
-        let high = meas(Vector3::new(0.0, 0.0, 19.0), Vector3::new(0.0, 0.0, 0.01));
-        let mut h = g;
-        let mut t_h = t_r;
-        while reference_at(&h, t_h) < 19.0 - m.landing_touchdown_tolerance {
-            t_h += 0.02;
-        }
-        assert!(matches!(h.step(t_h, &high, mref), GroundMode::Vertical(_)));
+        // Stopped 3 cm above: not down yet.
+        let hover = meas(Vector3::new(0.0, 0.0, 19.97), Vector3::zeros());
+        assert!(matches!(g.step(t + 0.2, &hover, mref), GroundMode::Vertical(_)));
+        // Stopped on the target: landed after the dwell, and stays landed.
+        let down = meas(Vector3::new(0.0, 0.0, 19.995), Vector3::new(0.0, 0.0, 0.01));
+        assert!(matches!(g.step(t + 0.3, &down, mref), GroundMode::Vertical(_)));
         let landed = GroundMode::Idle {
             phase: Phase::Landed,
             thrust: 0.0,
         };
-        assert_eq!(h.step(t_h + TOUCHDOWN_DWELL, &high, mref), landed);
-        // Stopped on the target with the reference there: landed after the dwell, and stays landed.
-        let down = meas(Vector3::new(0.0, 0.0, 19.995), Vector3::new(0.0, 0.0, 0.01));
-        assert!(matches!(g.step(t_r + 0.3, &down, mref), GroundMode::Vertical(_)));
-        assert_eq!(g.step(t_r + 0.3 + TOUCHDOWN_DWELL, &down, mref), landed);
-        assert_eq!(g.step(t_r + 5.0, &sinking, mref), landed);
+        assert_eq!(g.step(t + 0.3 + TOUCHDOWN_DWELL, &down, mref), landed);
+        assert_eq!(g.step(t + 5.0, &sinking, mref), landed);
         // Round trip of the state.
         let mut saved = Vec::new();
         g.save(&mut |x| saved.push(x));
@@ -643,7 +584,7 @@ mod tests {
         let mut fresh = GroundPhases::new(m, 100.0);
         let mut it = saved.into_iter();
         fresh.restore(&mut || it.next()).unwrap();
-        assert_eq!(fresh.step(t_r + 6.0, &sinking, mref), landed);
+        assert_eq!(fresh.step(t + 6.0, &sinking, mref), landed);
         assert!(fresh.approach_start.is_some() && fresh.landed());
     }
 }
