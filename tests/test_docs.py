@@ -314,7 +314,7 @@ def test_the_wind_envelope_summary_of_a_synthetic_file():
     assert "| default mission | step | 2/2, 0.5–0.6 m | 1/2, 1.0 m, 1L | – | 0 m/s (3/4) |" in table
     assert "| take-off to landing | step | 2/2, 0.5–0.6 m | 0/2, 3.4 m | 2/4 | 0 m/s (2/4) |" in table
     assert docs.render("wind.readme", src) == (
-        "held = completed within 3 m of its own reference (perfect state, Gauss-Seidel); "
+        "held = completed within 3 m of its own reference and of its still-air path (perfect state, Gauss-Seidel); "
         "the wind stepping in: LQR 0 m/s / 0 m/s, TSD 0 m/s / 0 m/s"
     )
     axes = docs.render("wind.axes", src)

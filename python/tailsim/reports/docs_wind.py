@@ -210,8 +210,9 @@ def _run(src: Sources) -> str:
         f"({', '.join(f'{b:g}°' for b in w['bearings_deg'])}; clockwise from north, the mission's heading), "
         f"the step wind switching on at {w['step_time']:g} s, the turbulent wind present from t = 0 with Dryden "
         f"turbulence of intensity {w['turbulence_intensity']} (moderate). Held: completed and within "
-        f"{w['held_max_error']:g} m of the controller's own reference (perfect state; "
-        f"{w['held_max_error_avionics']:g} m with avionics). Flown by `{w['command'].split(';')[0]}` "
+        f"{w['held_max_error']:g} m of the controller's own reference and of the reference it flies in still "
+        f"air, the mission's path (perfect state; {w['held_max_error_avionics']:g} m with avionics); the take-off "
+        f"to landing also on its landing criteria where stated. Flown by `{w['command'].split(';')[0]}` "
         f"(commit {w['commit']}; {run['flown']} flights flown, {run['from_cache']} from the cache, "
         f"{run['wall_time_s']:.0f} s on {run['threads']} thread(s){rate})."
     )
@@ -344,7 +345,7 @@ def _readme(src: Sources) -> str:
         return "–" if not rows else "none" if s is None else f"{s:g} m/s"
 
     forms = {"step": "the wind stepping in", "turbulent": "with moderate turbulence"}
-    parts = [f"held = completed within {w['held_max_error']:g} m of its own reference (perfect state, Gauss-Seidel)"]
+    parts = [f"held = completed within {w['held_max_error']:g} m of its own reference and of its still-air path (perfect state, Gauss-Seidel)"]
     for wind in _present(w, "wind", WINDS):
         each = [f"{k} {reach_of(k, 'default', wind)} / {reach_of(k, 'takeoff_landing', wind)}" for k in controllers(w)]
         parts.append(f"{forms.get(wind, wind)}: " + ", ".join(each))
