@@ -345,7 +345,8 @@ def _readme(src: Sources) -> str:
         return "–" if not rows else "none" if s is None else f"{s:g} m/s"
 
     forms = {"step": "the wind stepping in", "turbulent": "with moderate turbulence"}
-    parts = [f"held = completed within {w['held_max_error']:g} m of its own reference and of its still-air path (perfect state, Gauss-Seidel)"]
+    held = f"held = completed within {w['held_max_error']:g} m of its own reference and of its still-air path"
+    parts = [f"{held} (perfect state, Gauss-Seidel)"]
     for wind in _present(w, "wind", WINDS):
         each = [f"{k} {reach_of(k, 'default', wind)} / {reach_of(k, 'takeoff_landing', wind)}" for k in controllers(w)]
         parts.append(f"{forms.get(wind, wind)}: " + ", ".join(each))
