@@ -51,6 +51,15 @@ use flight_mission::{Measurement, MissionParams, Phase};
 pub const DESCENT_RAMP_TIME: f64 = 2.0;
 /// Shortest approach (s).
 pub const APPROACH_MIN_TIME: f64 = 4.0;
+/// Collective-flap trim of the landing phases per m/s of wind into the belly (rad s/m), both
+/// controllers': the slope of the plant's still, upright hover trim (−5.2°, −9.8°, −13.8° of
+/// collective flaps at 1, 2, 3 m/s face-on, `cargo run --release -p analysis --example
+/// tsd_wind_bounds`).
+pub const LANDING_FLAP_TRIM_GAIN: f64 = 4.6 * core::f64::consts::PI / 180.0;
+/// Largest collective-flap trim of the landing phases (rad): the upright hover trim is −20°
+/// from 5 m/s; the rest of the ±25° is left to the feedback.
+pub const LANDING_FLAP_TRIM_LIMIT: f64 = 17.0 * core::f64::consts::PI / 180.0;
+
 /// How far the touchdown reference sinks below the target before it holds (m).
 pub const TOUCHDOWN_OVERSHOOT: f64 = 0.3;
 /// Time flown at the touchdown rate before the target, after the flare (s).

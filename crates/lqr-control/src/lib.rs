@@ -66,13 +66,11 @@ pub const WIND_TRIM_RAMP: (f64, f64) = (0.5, 1.5);
 /// wind"); in still air they stay inert (the still-air flights bit-identical).
 pub const WIND_INTEGRAL_SPEED: f64 = 1.5;
 
-/// Collective-flap trim of the descent and flare in wind per m/s of wind into the belly
-/// (rad s/m) (README, "Take-off and landing"): the slope of the plant's upright hover trim up
-/// to 3 m/s (−5.2°, −9.8°, −13.8° at 1, 2, 3 m/s face-on).
-pub const LANDING_FLAP_GAIN: f64 = 4.6 * std::f64::consts::PI / 180.0;
-/// Largest collective-flap trim of the descent and flare (rad); the rest of the ±25° is left
-/// to the feedback.
-pub const LANDING_FLAP_LIMIT: f64 = 17.0 * std::f64::consts::PI / 180.0;
+/// The collective-flap trim of the descent and flare in wind (README, "Take-off and
+/// landing"): the shared landing trim's slope and limit (guidance::ground).
+pub use guidance::ground::{
+    LANDING_FLAP_TRIM_GAIN as LANDING_FLAP_GAIN, LANDING_FLAP_TRIM_LIMIT as LANDING_FLAP_LIMIT,
+};
 /// Time over which the collective-flap trim of the descent ramps in from zero (s) (README,
 /// "Take-off and landing").
 pub const LANDING_FLAP_RAMP_TIME: f64 = 12.0;

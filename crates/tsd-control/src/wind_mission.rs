@@ -50,13 +50,7 @@ pub const WINDOW_RATE: f64 = 30.0 * core::f64::consts::PI / 180.0;
 /// Previewed horizontal air-relative speed below which the heading is held (m/s).
 pub const MIN_AIR_SPEED: f64 = 1.0;
 
-/// Collective-flap trim per m/s of wind into the belly in the landing phases (rad s/m):
-/// the slope of the plant's still, upright hover trim (−5.2°, −9.8°, −13.8° of collective
-/// flaps at 1, 2, 3 m/s face-on, `cargo run --release -p analysis --example tsd_wind_bounds`).
-pub const LANDING_FLAP_TRIM_GAIN: f64 = 4.6 * core::f64::consts::PI / 180.0;
-/// Largest collective-flap trim in the landing phases (rad): the trim of the upright hover
-/// is −20° from 5 m/s; the rest of the ±25° is left to the normal loop.
-pub const LANDING_FLAP_TRIM_LIMIT: f64 = 17.0 * core::f64::consts::PI / 180.0;
+pub use guidance::ground::{LANDING_FLAP_TRIM_GAIN, LANDING_FLAP_TRIM_LIMIT};
 
 /// Collective flap per radian of lean towards the belly in the landing phases, per m/s of
 /// the wind estimate (rad/rad per m/s), within [`LANDING_LEAN_GAIN_RANGE`]: the flaps' direct
