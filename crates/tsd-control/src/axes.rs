@@ -16,6 +16,8 @@ pub(crate) struct Airflow {
     pub axial_airspeed: f64,
     /// Crossflow V̄ √(1 − cos²α cos²β) (m/s).
     pub crossflow: f64,
+    /// Crossflow of the loop design (m/s): in hover at least the measured horizontal wind.
+    pub design_crossflow: f64,
     /// Weight (0–1) of the hover-in-wind design condition: the crossflow's, in the take-off
     /// and landing phases the measured wind's.
     pub hover_wind: f64,
@@ -52,6 +54,13 @@ impl TsdController {
         } else {
             1.0
         };
+        let wind_speed = if hover && !ground_phase {
+            let w = guidance::weathervane::air_data_wind(meas);
+            w.x.hypot(w.y)
+        } else {
+            0.0
+        };
+        let design_crossflow = crossflow.max(wind_speed.min(HOVER_WIND_CROSSFLOW.1));
         let hover_wind = if !hover {
             0.0
         } else if ground_phase {
@@ -60,7 +69,7 @@ impl TsdController {
             let w = guidance::weathervane::air_data_wind(meas);
             band_weight(w.x.hypot(w.y), HOVER_WIND_CROSSFLOW)
         } else {
-            band_weight(crossflow, HOVER_WIND_CROSSFLOW)
+            band_weight(crossflow.max(wind_speed), HOVER_WIND_CROSSFLOW)
         };
         // Tuned configuration, hover in wind: the reference-path frame is kept, κ scaled by
         // 1 − hover_wind (README, "Hover in a span-wise wind"): with the nose tilted into a
@@ -73,6 +82,7 @@ impl TsdController {
         Airflow {
             axial_airspeed,
             crossflow,
+            design_crossflow,
             hover_wind,
             alpha_weight,
             kappa,

@@ -201,7 +201,7 @@ impl TsdController {
             axial_airspeed: air.axial_airspeed,
             reference_airspeed: r.reference.airspeed,
             hover_wind: air.hover_wind,
-            crossflow: air.crossflow,
+            crossflow: air.design_crossflow,
         })
         .map_err(|what| Self::err(format!("{what} gains not computable at t = {t} s")))
     }
