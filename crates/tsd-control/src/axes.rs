@@ -16,10 +16,11 @@ pub(crate) struct Airflow {
     pub axial_airspeed: f64,
     /// Crossflow V̄ √(1 − cos²α cos²β) (m/s).
     pub crossflow: f64,
-    /// Crossflow of the loop design (m/s): in hover at least the measured horizontal wind.
+    /// Crossflow of the loop design (m/s): in hover (not the take-off and landing phases) at
+    /// least the measured horizontal wind, up to the top of [`HOVER_WIND_CROSSFLOW`].
     pub design_crossflow: f64,
-    /// Weight (0–1) of the hover-in-wind design condition: the crossflow's, in the take-off
-    /// and landing phases the measured wind's.
+    /// Weight (0–1) of the hover-in-wind design condition: the larger of the crossflow's and
+    /// the measured wind's, in the take-off and landing phases the measured wind's.
     pub hover_wind: f64,
     /// Weight (0–1) of the measured α in the loop design: in hover below
     /// [`HOVER_LOW_AIRSPEED_ALPHA`] the design is at α = 0.
@@ -54,6 +55,13 @@ impl TsdController {
         } else {
             1.0
         };
+        // Hover in wind (README, "Missions in wind", hover design): the crossflow follows the
+        // attitude (a 3 m/s wind in the 3 m/s climb leaves 1–3 m/s of it, inside
+        // HOVER_WIND_CROSSFLOW), so a schedule on it alone fed the pitch back into the pitch
+        // loop's gains; under Jacobi the elevator went bang-bang. The design's crossflow is at
+        // least the measured horizontal wind, which the attitude does not move (for the
+        // normal poles' band at most HOVER_WIND_CROSSFLOW.1: uncapped, the slower normal poles
+        // lost the 5–10 m/s tailwinds under Jacobi). Still air: 0.
         let wind_speed = if hover && !ground_phase {
             let w = guidance::weathervane::air_data_wind(meas);
             w.x.hypot(w.y)
