@@ -163,3 +163,55 @@ impl LoopAxes {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::deviations::Deviations;
+    use crate::{TsdController, HOVER_WIND_CROSSFLOW};
+    use flight_mission::{Measurement, MissionParams};
+    use nalgebra::{UnitQuaternion, Vector3};
+
+    /// Climbing at 3 m/s with the nose leaned `lean_deg` towards the north into a wind of
+    /// `wind` m/s from the north: the airflow of the hover's design.
+    fn climb(lean_deg: f64, wind: f64) -> Measurement {
+        let r = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), (90.0 - lean_deg).to_radians());
+        let v = Vector3::new(0.0, 0.0, -3.0);
+        let w = Vector3::new(-wind, 0.0, 0.0);
+        Measurement {
+            vel_ned: v,
+            ..Measurement::still_in_air(&r, &(r.inverse() * (v - w)))
+        }
+    }
+
+    /// A 3 m/s wind in the 3 m/s climb, the nose leaned 24° into it (the Gauss-Seidel trim):
+    /// 1.5 m/s of crossflow, a quarter of the hover-in-wind weight on the crossflow alone; the
+    /// measured wind makes it whole whatever the lean (no gain schedule on the pitch) and
+    /// lifts the normal poles' crossflow to 3 m/s, never above. Still air: none.
+    #[test]
+    fn hover_design_weight_follows_the_measured_wind_not_the_attitude() {
+        let c = TsdController::with_mission(MissionParams::default()).unwrap();
+        let dev = Deviations::of(c.params());
+        let v_ref = c.mission().v_vertical;
+        for lean in [10.0, 24.0, 40.0] {
+            let air = c.airflow(&climb(lean, 3.0), v_ref, false, dev);
+            assert!(
+                air.crossflow < HOVER_WIND_CROSSFLOW.1 - 0.5,
+                "{lean}: {}",
+                air.crossflow
+            );
+            assert!((air.hover_wind - 1.0).abs() < 1e-9, "{lean}: {}", air.hover_wind);
+            assert!(
+                (air.design_crossflow - 3.0).abs() < 1e-9,
+                "{lean}: {}",
+                air.design_crossflow
+            );
+            assert_eq!(air.kappa, 0.0);
+        }
+        let air = c.airflow(&climb(24.0, 3.0), v_ref, false, dev);
+        assert!((air.crossflow - 1.52).abs() < 0.01, "{}", air.crossflow);
+        let air = c.airflow(&climb(24.0, 8.0), v_ref, false, dev);
+        assert_eq!(air.design_crossflow, air.crossflow.max(3.0));
+        let calm = c.airflow(&climb(0.0, 0.0), v_ref, false, dev);
+        assert_eq!((calm.hover_wind, calm.design_crossflow), (0.0, calm.crossflow));
+    }
+}
