@@ -61,8 +61,12 @@ impl TsdController {
         // loop's gains; under Jacobi the elevator went bang-bang. The design's crossflow is at
         // least the measured horizontal wind, which the attitude does not move (for the
         // normal poles' band at most HOVER_WIND_CROSSFLOW.1: uncapped, the slower normal poles
-        // lost the 5–10 m/s tailwinds under Jacobi). Still air: 0.
-        let wind_speed = if hover && !ground_phase {
+        // lost the 5–10 m/s tailwinds under Jacobi), once the mission logic's 1 s air-data
+        // wind reaches the weathervane's release speed (1 m/s; 0.4 s after a 3 m/s step): the
+        // avionics' air-data wind of a single sample in still air is noisy enough to move the
+        // design (a 0 m/s cell under Jacobi 3.2 → 5.9 m). Still air: 0.
+        let windy = self.wind_mission.wind_speed() >= self.weathervane.params().release_speed;
+        let wind_speed = if hover && !ground_phase && windy {
             let w = guidance::weathervane::air_data_wind(meas);
             w.x.hypot(w.y)
         } else {
@@ -186,12 +190,15 @@ mod tests {
     /// A 3 m/s wind in the 3 m/s climb, the nose leaned 24° into it (the Gauss-Seidel trim):
     /// 1.5 m/s of crossflow, a quarter of the hover-in-wind weight on the crossflow alone; the
     /// measured wind makes it whole whatever the lean (no gain schedule on the pitch) and
-    /// lifts the normal poles' crossflow to 3 m/s, never above. Still air: none.
+    /// lifts the normal poles' crossflow to 3 m/s, never above. Not before the mission logic's
+    /// 1 s estimate reaches the release speed (1 m/s); still air: none.
     #[test]
     fn hover_design_weight_follows_the_measured_wind_not_the_attitude() {
-        let c = TsdController::with_mission(MissionParams::default()).unwrap();
+        let mut c = TsdController::with_mission(MissionParams::default()).unwrap();
         let dev = Deviations::of(c.params());
         let v_ref = c.mission().v_vertical;
+        // The logic's estimate: 3 m/s from the north.
+        c.wind_mission.restore(&[-3.0, 0.0, 0.0, 0.0]);
         for lean in [10.0, 24.0, 40.0] {
             let air = c.airflow(&climb(lean, 3.0), v_ref, false, dev);
             assert!(
@@ -211,6 +218,17 @@ mod tests {
         assert!((air.crossflow - 1.52).abs() < 0.01, "{}", air.crossflow);
         let air = c.airflow(&climb(24.0, 8.0), v_ref, false, dev);
         assert_eq!(air.design_crossflow, air.crossflow.max(3.0));
+        // The estimate below 1 m/s (just after the step, or the avionics' noise in still air):
+        // the crossflow's weight alone.
+        c.wind_mission.restore(&[-0.9, 0.0, 0.0, 0.0]);
+        let air = c.airflow(&climb(24.0, 3.0), v_ref, false, dev);
+        assert!(
+            (air.hover_wind - (air.crossflow - 1.0) / 2.0).abs() < 1e-9,
+            "{}",
+            air.hover_wind
+        );
+        assert_eq!(air.design_crossflow, air.crossflow);
+        c.wind_mission.restore(&[0.0, 0.0, 0.0, 0.0]);
         let calm = c.airflow(&climb(0.0, 0.0), v_ref, false, dev);
         assert_eq!((calm.hover_wind, calm.design_crossflow), (0.0, calm.crossflow));
     }

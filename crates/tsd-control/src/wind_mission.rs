@@ -171,6 +171,12 @@ impl WindMission {
             }
     }
 
+    /// Horizontal speed of the logic's own [`ENGAGE_FILTER_TIME`] air-data wind estimate (m/s);
+    /// NaN before its first sample.
+    pub fn wind_speed(&self) -> f64 {
+        self.wind[0].hypot(self.wind[1])
+    }
+
     /// Whether the logic is engaged (the wind estimate's hysteresis).
     pub fn engaged(&self) -> bool {
         self.engaged
