@@ -63,6 +63,14 @@ pub const LANDING_LEAN_GAIN_PER_WIND: f64 = 0.2;
 /// cell in the descent (20.4 m); this schedule holds it.
 pub const LANDING_LEAN_GAIN_RANGE: (f64, f64) = (0.8, 1.6);
 
+/// Vertical flap per radian of lean along the span in the landing phases (rad/rad): the
+/// vertical flaps' direct side force takes the load off the span-wise lean, as the
+/// collective flaps take it off the lean towards the belly ([`landing_vertical_flap`];
+/// README, "Take-off and landing in wind"). Measured (moderate turbulence, 0–5 m/s, 24
+/// cells): 0.5–2.5 keep the span-wise lean of the last 3 s before the touchdown at 7–18°
+/// (11–28° without), 3.5 loses 22 of 24 cells (the loop through the flaps' yawing moment).
+pub const LANDING_SPAN_LEAN_GAIN: f64 = 1.2;
+
 /// Engage speed of the take-off and landing phases' heading (m/s): below the weathervane's
 /// (3 m/s). Its estimate (a 4 s filter) reaches a steady 3 m/s wind only asymptotically, so a
 /// 3 m/s wind engaged it from some bearings and not from others; not engaged, a quartering
@@ -154,6 +162,32 @@ pub fn landing_flap_trim(m: &Measurement, phase: Phase, wind: &Vector3<f64>) -> 
     let gain = (LANDING_LEAN_GAIN_PER_WIND * wind.xy().norm()).clamp(lo, hi);
     let sin_lean = nose.xy().dot(&belly.xy()) / size;
     trim - gain * sin_lean
+}
+
+/// Direct-force command of the vertical flaps in the descent and the flare (rad): +[`LANDING_SPAN_LEAN_GAIN`] sin λ_s, λ_s the lean of the nose along the
+/// body's span (positive towards the right wing); the controller weights it with the
+/// measured wind as [`landing_flap_trim`]. The tail-sitter makes force along its span only
+/// by leaning the thrust that way or with the vertical flaps in the slip-stream (positive
+/// towards the right wing: the plant's upright edge-on hover trim is +9.6° of vertical flap
+/// in 5 m/s from the right, `cargo run --release -p analysis --example tsd_wind_bounds`).
+/// The TSD's lateral loop regulates the force, not the attitude, so a span-wise gust is
+/// met by leaning; this feedback hands that load to the flaps and the position loop levels
+/// the nose (the span-wise counterpart of the lean feedback of [`landing_flap_trim`]).
+///
+/// 0 in other phases (the approach translates along the span, leaning on purpose) or with
+/// the span within 30° of the vertical.
+pub fn landing_vertical_flap(m: &Measurement, phase: Phase) -> f64 {
+    if !matches!(phase, Phase::Descent | Phase::Flare) {
+        return 0.0;
+    }
+    let q = &m.quat;
+    let r = UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]));
+    let (nose, span) = (r * Vector3::x(), r * Vector3::y());
+    let size = span.xy().norm();
+    if size < 0.5 {
+        return 0.0;
+    }
+    LANDING_SPAN_LEAN_GAIN * nose.xy().dot(&span.xy()) / size
 }
 
 impl WindMission {
@@ -517,5 +551,37 @@ mod tests {
         assert!(landing_flap_trim(&m, Phase::Descent, &Vector3::new(0.0, 8.0, 0.0)).abs() < 1e-12);
         assert_eq!(landing_flap_trim(&m, Phase::Vertical2, &from_north(5.0)), 0.0);
         assert_eq!(landing_flap_trim(&m, Phase::Descent, &Vector3::repeat(f64::NAN)), 0.0);
+    }
+
+    /// The vertical flaps' span-wise lean feedback: nose up, belly north, the right wing
+    /// east; leaning 6° east (towards the right wing) deflects the vertical flaps
+    /// +1.2 sin 6° (their side force towards the right wing takes the load), west the other
+    /// way; leaning towards the belly does nothing; only in the descent and the flare.
+    #[test]
+    fn landing_vertical_flap_takes_the_span_wise_lean() {
+        let up = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), core::f64::consts::FRAC_PI_2);
+        let leaning = |axis: Vector3<f64>, deg: f64| {
+            let r = UnitQuaternion::from_axis_angle(&nalgebra::Unit::new_normalize(axis), deg.to_radians()) * up;
+            Measurement::still_in_air(&r, &Vector3::zeros())
+        };
+        // About the north axis by +6°: the nose (up) tips east.
+        let east = leaning(Vector3::x(), 6.0);
+        let q = &east.quat;
+        let r = UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]));
+        assert!((r * Vector3::x()).y > 0.1 && (r * Vector3::y()).y > 0.9);
+        let expected = LANDING_SPAN_LEAN_GAIN * 6f64.to_radians().sin();
+        for phase in [Phase::Descent, Phase::Flare] {
+            assert!((landing_vertical_flap(&east, phase) - expected).abs() < 1e-12);
+            let west = leaning(Vector3::x(), -6.0);
+            assert!((landing_vertical_flap(&west, phase) + expected).abs() < 1e-12);
+            let north = leaning(Vector3::y(), -6.0);
+            let q = &north.quat;
+            let r = UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]));
+            assert!((r * Vector3::x()).x > 0.1);
+            assert!(landing_vertical_flap(&north, phase).abs() < 1e-12);
+        }
+        for phase in [Phase::Approach, Phase::Vertical2, Phase::TakeOff] {
+            assert_eq!(landing_vertical_flap(&east, phase), 0.0);
+        }
     }
 }
