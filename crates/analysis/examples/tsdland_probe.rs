@@ -115,15 +115,6 @@ fn main() {
                 .samples
                 .last()
                 .map_or(f64::NAN, |s| (s.measurement.pos_ned.xy() - own_target).norm());
-            // Largest lean towards the belly and along the span in the last 3 s (deg).
-            let (mut lean_b, mut lean_s) = (0.0f64, 0.0f64);
-            for s in trace.samples.iter().filter(|s| s.t < td && s.t >= td - 3.0) {
-                let q = &s.measurement.quat;
-                let r = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(q[3], q[0], q[1], q[2]));
-                let (nose, belly, span) = (r * nalgebra::Vector3::x(), r * nalgebra::Vector3::z(), r * nalgebra::Vector3::y());
-                lean_b = lean_b.max((nose.xy().dot(&belly.xy()) / belly.xy().norm()).asin().to_degrees().abs());
-                lean_s = lean_s.max((nose.xy().dot(&span.xy()) / span.xy().norm()).asin().to_degrees().abs());
-            }
             // The landing's first contact (not a take-off bounce) and the tilt there.
             let contact = trace.samples.iter().find(|s| {
                 matches!(s.diagnostics.phase, Phase::Flare | Phase::Landed)
@@ -135,6 +126,15 @@ fn main() {
             });
             let td = contact.map_or(td, |s| s.t);
             let tilt_contact = contact.map_or(f64::NAN, |s| tilt(&s.x).to_degrees());
+            // Largest lean towards the belly and along the span in the last 3 s (deg).
+            let (mut lean_b, mut lean_s) = (0.0f64, 0.0f64);
+            for s in trace.samples.iter().filter(|s| s.t < td && s.t >= td - 3.0) {
+                let q = &s.measurement.quat;
+                let r = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(q[3], q[0], q[1], q[2]));
+                let (nose, belly, span) = (r * nalgebra::Vector3::x(), r * nalgebra::Vector3::z(), r * nalgebra::Vector3::y());
+                lean_b = lean_b.max((nose.xy().dot(&belly.xy()) / belly.xy().norm()).asin().to_degrees().abs());
+                lean_s = lean_s.max((nose.xy().dot(&span.xy()) / span.xy().norm()).asin().to_degrees().abs());
+            }
             let late = trace
                 .samples
                 .iter()
