@@ -1,7 +1,7 @@
 //! The tuned TSD's take-off-to-landing mission (`analysis::takeoff_landing::mission`) in
-//! moderate Dryden turbulence and in steady wind, cells of the wind envelope (`analysis::wind_envelope`: global
-//! aerodynamics, the ground 10 m below the origin, perfect state, the turbulence seeded by
-//! the bearing).
+//! moderate Dryden turbulence and in steady wind, cells of the wind envelope
+//! (`analysis::wind_envelope`: global aerodynamics, the ground 10 m below the origin,
+//! perfect state, the turbulence seeded by the bearing).
 //!
 //! The vertical flaps' span-wise lean feedback in the descent and the flare (tsd-control
 //! README, "Take-off and landing in wind"): without it the nose leaned 23–25° along the span
