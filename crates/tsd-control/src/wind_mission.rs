@@ -35,7 +35,7 @@
 use flight_mission::{Measurement, MissionParams, Phase};
 use guidance::weathervane::{air_data_wind, nearer_face, wrap_pi};
 use guidance::Weathervane;
-use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+use nalgebra::{Quaternion, UnitQuaternion, Vector2, Vector3};
 
 /// Preview τ of the air-relative velocity by the reference's acceleration (s).
 pub const AIR_PREVIEW_TIME: f64 = 1.0;
@@ -166,23 +166,29 @@ pub fn landing_flap_trim(m: &Measurement, phase: Phase, wind: &Vector3<f64>, sin
     } else {
         0.5 * (1.0 - (core::f64::consts::PI * x).cos())
     };
-    let q = &m.quat;
-    let r = UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]));
-    let (nose, belly) = (r * Vector3::x(), r * Vector3::z());
-    let size = belly.xy().norm();
-    if size < 0.5 {
+    let Some((belly, size, sin_lean)) = lean_towards(m, &Vector3::z()) else {
         return 0.0;
-    }
-    let into_belly = -wind.xy().dot(&belly.xy()) / size;
+    };
+    let into_belly = -wind.xy().dot(&belly) / size;
     let trim = -(LANDING_FLAP_TRIM_GAIN * into_belly).clamp(-LANDING_FLAP_TRIM_LIMIT, LANDING_FLAP_TRIM_LIMIT);
     let (lo, hi) = LANDING_LEAN_GAIN_RANGE;
     let gain = (LANDING_LEAN_GAIN_PER_WIND * wind.xy().norm()).clamp(lo, hi);
-    let sin_lean = nose.xy().dot(&belly.xy()) / size;
     ramp * (trim - gain * sin_lean)
 }
 
-/// Direct-force command of the vertical flaps in the descent and the flare (rad): +[`LANDING_SPAN_LEAN_GAIN`] sin λ_s, λ_s the lean of the nose along the
-/// body's span (positive towards the right wing); the controller weights it with the
+/// The horizontal part of the body axis `axis` (NED), its length, and the sine of the nose's
+/// lean towards it (the nose's horizontal part along it); `None` with the axis within 30° of
+/// the vertical (length below 0.5).
+fn lean_towards(m: &Measurement, axis: &Vector3<f64>) -> Option<(Vector2<f64>, f64, f64)> {
+    let q = &m.quat;
+    let r = UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]));
+    let (nose, a) = (r * Vector3::x(), (r * axis).xy());
+    let size = a.norm();
+    (size >= 0.5).then(|| (a, size, nose.xy().dot(&a) / size))
+}
+
+/// Direct-force command of the vertical flaps in the descent and the flare (rad):
+/// +[`LANDING_SPAN_LEAN_GAIN`] sin λ_s, λ_s the lean of the nose along the body's span (positive towards the right wing); the controller weights it with the
 /// measured wind as [`landing_flap_trim`]. The tail-sitter makes force along its span only
 /// by leaning the thrust that way or with the vertical flaps in the slip-stream (positive
 /// towards the right wing: the plant's upright edge-on hover trim is +9.6° of vertical flap
@@ -197,14 +203,7 @@ pub fn landing_vertical_flap(m: &Measurement, phase: Phase) -> f64 {
     if !matches!(phase, Phase::Descent | Phase::Flare) {
         return 0.0;
     }
-    let q = &m.quat;
-    let r = UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]));
-    let (nose, span) = (r * Vector3::x(), r * Vector3::y());
-    let size = span.xy().norm();
-    if size < 0.5 {
-        return 0.0;
-    }
-    LANDING_SPAN_LEAN_GAIN * nose.xy().dot(&span.xy()) / size
+    lean_towards(m, &Vector3::y()).map_or(0.0, |(_, _, sin_lean)| LANDING_SPAN_LEAN_GAIN * sin_lean)
 }
 
 impl WindMission {

@@ -37,13 +37,7 @@ fn fly_cell(form: WindForm, ordering: Ordering, speed: f64, bearing_index: usize
     scenario.wind = wind(form, speed, bearing_index, plant.ground.height);
     scenario.ordering = ordering;
     let mut c = Kind::Tsd.make_configured(&mission, 0).unwrap();
-    let mut landed: Option<f64> = None;
-    let stop = |s: &Sample| {
-        if landed.is_none() && s.diagnostics.phase == Phase::Landed {
-            landed = Some(s.t);
-        }
-        landed.is_some_and(|t| s.t >= t + takeoff_landing::AFTER_LANDING - 1e-9)
-    };
+    let stop = takeoff_landing::after_landing();
     let trace = fly_on(
         &plant,
         x0,
