@@ -24,12 +24,19 @@ fn cell(mission: MissionKind, speed: f64, bearing_deg: f64) -> (Cell, Vec<f64>) 
 fn crosswind_back_transition_on_the_ground_path() {
     for (speed, back, last, worst_bound) in [(5.0, 1.5, 2.0, 4.5), (8.0, 2.5, 2.5, 10.0)] {
         let (c, phases) = cell(MissionKind::Default, speed, 90.0);
-        eprintln!("{speed} m/s from 90°: phases {phases:.2?}, largest {:.2} m", c.max_error);
+        eprintln!(
+            "{speed} m/s from 90°: phases {phases:.2?}, largest {:.2} m",
+            c.max_error
+        );
         assert!(c.completed, "{speed} m/s: {:?}", c.failure);
         assert!(phases[3] < back, "{speed} m/s: back transition {} m", phases[3]);
         assert!(phases[4] < last, "{speed} m/s: last vertical phase {} m", phases[4]);
         assert!(c.max_error < worst_bound, "{speed} m/s: {} m", c.max_error);
-        assert!(c.mission_error.is_some_and(|e| e < worst_bound), "{:?}", c.mission_error);
+        assert!(
+            c.mission_error.is_some_and(|e| e < worst_bound),
+            "{:?}",
+            c.mission_error
+        );
     }
 }
 

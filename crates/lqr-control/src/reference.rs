@@ -15,8 +15,8 @@ use tailsitter_physics::Surfaces;
 use crate::model;
 use crate::trajectory::TrajPoint;
 use crate::{
-    LqrController, GROUND_TRIM_MAX_YAW, HOVER_SHIFT_LIMIT, HOVER_SHIFT_TIME, LANDING_FLAP_GAIN, LANDING_FLAP_LIMIT, LANDING_FLAP_RAMP_TIME,
-    MAX_WIND_ESTIMATE, MIN_AIRSPEED, WIND_INTEGRAL_SPEED, WIND_TRIM_MAX_PITCH, WIND_TRIM_RAMP,
+    LqrController, GROUND_TRIM_MAX_YAW, HOVER_SHIFT_LIMIT, HOVER_SHIFT_TIME, LANDING_FLAP_GAIN, LANDING_FLAP_LIMIT,
+    LANDING_FLAP_RAMP_TIME, MAX_WIND_ESTIMATE, MIN_AIRSPEED, WIND_INTEGRAL_SPEED, WIND_TRIM_MAX_PITCH, WIND_TRIM_RAMP,
 };
 
 /// Switches of the reference stage (from [`crate::LqrParams::effective`]).
@@ -619,7 +619,9 @@ mod wind_trim_tests {
             );
             assert!((m - m_still).abs() < 1e-6, "{sign}: {m} vs {m_still}");
             let dtheta = q.euler_321.y - p.euler_321.y;
-            let alpha_air = c.air_reference(&q, &ground_velocity(&p), &c.params.stages().reference).y;
+            let alpha_air = c
+                .air_reference(&q, &ground_velocity(&p), &c.params.stages().reference)
+                .y;
             assert!(
                 sign * dtheta > 0.0 && sign * (alpha_air - p.alpha) > 0.0,
                 "{sign}: δ {dtheta}, α {alpha_air}"
@@ -693,7 +695,10 @@ mod wind_trim_tests {
                 let expect = (-8.0f64).atan2(p.v).to_degrees();
                 assert!((crab - expect).abs() < 2.0, "{t}: crab {crab} vs {expect}");
                 let beta = c.air_reference(&q, &v_g, &sw).z;
-                eprintln!("{t}: crab {crab:.2}° vs {expect:.2}°, β {beta:.4}, φ {:.4}", q.euler_321.x);
+                eprintln!(
+                    "{t}: crab {crab:.2}° vs {expect:.2}°, β {beta:.4}, φ {:.4}",
+                    q.euler_321.x
+                );
                 assert!(beta.abs() < 0.035, "{t}: β {beta}");
                 assert!(q.euler_321.x.abs() < 3f64.to_radians(), "{t}: φ {}", q.euler_321.x);
             }
