@@ -9,7 +9,7 @@ use analysis::wind_envelope::{fly_job, Cell, Job, MissionKind, WindForm, BEARING
 
 /// The LQR's envelope cell in a steady `speed` wind from `bearing_deg` and its largest error
 /// per phase (m).
-fn cell(mission: MissionKind, speed: f64, bearing_deg: f64) -> (Cell, Vec<f64>) {
+fn cell(mission: MissionKind, speed: f64, bearing_deg: f64) -> (Cell, [f64; 11]) {
     let b = BEARINGS_DEG.iter().position(|&d| d == bearing_deg).unwrap();
     fly_job(&Job::new(Kind::Lqr, mission, WindForm::Step, speed, b), None)
 }

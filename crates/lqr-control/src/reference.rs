@@ -7,7 +7,7 @@ use std::ops::ControlFlow;
 
 use flight_mission::{Command, ControllerInput, ControllerOutput, Diagnostics, Measurement, Phase};
 use guidance::{GroundMode, VerticalReference};
-use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
+use nalgebra::{Const, DimMin, Matrix3, SMatrix, SVector, ToTypenum, Vector3};
 use std::f64::consts::TAU;
 use tailsitter_physics::attitude::{euler_321_from_quat, quat_from_dcm};
 use tailsitter_physics::Surfaces;
@@ -408,29 +408,14 @@ impl LqrController {
             SVector::<f64, 6>::new(df.x, df.y, df.z, dm.x, dm.y, dm.z)
         };
         let steps = SVector::<f64, 6>::new(1e-6, 1e-6, 1e-4, 1e-6, 1e-6, 1e-6);
-        let mut z = SVector::<f64, 6>::zeros();
-        for _ in 0..12 {
-            let r = residual(&z);
-            if !r.iter().all(|v| v.is_finite()) {
-                return None;
-            }
-            if r.fixed_rows::<3>(0).norm() < 1e-6 && r.fixed_rows::<3>(3).norm() < 1e-6 {
-                let lim = af.deflection_limit;
-                let in_limits = z[0].abs() <= GROUND_TRIM_MAX_YAW
-                    && z[1].abs() <= WIND_TRIM_MAX_PITCH
-                    && (af.thrust_min..=af.thrust_max).contains(&(p.thrust + z[2]))
-                    && (1..4).all(|j| (p.u[j] + z[2 + j]).abs() <= lim);
-                return in_limits.then_some(z);
-            }
-            let mut jac = SMatrix::<f64, 6, 6>::zeros();
-            for j in 0..6 {
-                let mut zj = z;
-                zj[j] += steps[j];
-                jac.set_column(j, &((residual(&zj) - r) / steps[j]));
-            }
-            z -= jac.lu().solve(&r)?;
-        }
-        None
+        let converged = |r: &SVector<f64, 6>| r.fixed_rows::<3>(0).norm() < 1e-6 && r.fixed_rows::<3>(3).norm() < 1e-6;
+        let z = newton(residual, &steps, 12, converged)?;
+        let lim = af.deflection_limit;
+        let in_limits = z[0].abs() <= GROUND_TRIM_MAX_YAW
+            && z[1].abs() <= WIND_TRIM_MAX_PITCH
+            && (af.thrust_min..=af.thrust_max).contains(&(p.thrust + z[2]))
+            && (1..4).all(|j| (p.u[j] + z[2 + j]).abs() <= lim);
+        in_limits.then_some(z)
     }
 
     /// Lift-borne wind trim of a reference point (README, "Gusts"): the pitch rotation δ, the
@@ -461,27 +446,12 @@ impl LqrController {
             Vector3::new(df.x, df.z, fm.moment_body.y - fm_t.moment_body.y)
         };
         let steps = Vector3::new(1e-6, 1e-4, 1e-6);
-        let mut z = Vector3::zeros();
-        for _ in 0..8 {
-            let r = residual(&z);
-            if !r.iter().all(|v| v.is_finite()) {
-                return None;
-            }
-            if r.xy().norm() < 1e-6 * af.mass * af.gravity && r.z.abs() < 1e-7 {
-                let in_limits = z.x.abs() <= WIND_TRIM_MAX_PITCH
-                    && (af.thrust_min..=af.thrust_max).contains(&(p.thrust + z.y))
-                    && (p.u[1] + z.z).abs() <= af.deflection_limit;
-                return in_limits.then_some(z);
-            }
-            let mut jac = Matrix3::zeros();
-            for j in 0..3 {
-                let mut zj = z;
-                zj[j] += steps[j];
-                jac.set_column(j, &((residual(&zj) - r) / steps[j]));
-            }
-            z -= jac.lu().solve(&r)?;
-        }
-        None
+        let converged = |r: &Vector3<f64>| r.xy().norm() < 1e-6 * af.mass * af.gravity && r.z.abs() < 1e-7;
+        let z = newton(residual, &steps, 8, converged)?;
+        let in_limits = z.x.abs() <= WIND_TRIM_MAX_PITCH
+            && (af.thrust_min..=af.thrust_max).contains(&(p.thrust + z.y))
+            && (p.u[1] + z.z).abs() <= af.deflection_limit;
+        in_limits.then_some(z)
     }
 
     /// Reference (V, α, β): with wind compensation (`sw`), those of the air velocity
@@ -562,6 +532,38 @@ impl LqrController {
         p.u[0] = thrust;
         p
     }
+}
+
+/// Newton's method from zero on `residual` with a forward-difference Jacobian (`steps`), at
+/// most `iterations` steps: the first iterate whose residual is `converged`; None on a
+/// non-finite residual, a singular Jacobian or no convergence.
+fn newton<const N: usize>(
+    residual: impl Fn(&SVector<f64, N>) -> SVector<f64, N>,
+    steps: &SVector<f64, N>,
+    iterations: usize,
+    converged: impl Fn(&SVector<f64, N>) -> bool,
+) -> Option<SVector<f64, N>>
+where
+    Const<N>: DimMin<Const<N>, Output = Const<N>> + ToTypenum,
+{
+    let mut z = SVector::<f64, N>::zeros();
+    for _ in 0..iterations {
+        let r = residual(&z);
+        if !r.iter().all(|v| v.is_finite()) {
+            return None;
+        }
+        if converged(&r) {
+            return Some(z);
+        }
+        let mut jac = SMatrix::<f64, N, N>::zeros();
+        for j in 0..N {
+            let mut zj = z;
+            zj[j] += steps[j];
+            jac.set_column(j, &((residual(&zj) - r) / steps[j]));
+        }
+        z -= jac.lu().solve(&r)?;
+    }
+    None
 }
 
 /// Ground velocity (NED) of a still-air reference point: `DCM_tᵀ V_t (cα_t, 0, sα_t)`.
