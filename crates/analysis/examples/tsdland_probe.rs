@@ -100,6 +100,47 @@ fn main() {
                 }
             }
             let td = f.touchdown_time.unwrap_or(f64::INFINITY);
+            // How far the aircraft moved on the gear before the take-off (the controller's
+            // target is measured from the last sample on the gear, the criteria's from the first).
+            let pad = trace
+                .samples
+                .iter()
+                .take_while(|s| s.t < mission.takeoff_spinup_time)
+                .last()
+                .map_or(nalgebra::Vector3::repeat(f64::NAN), |s| s.measurement.pos_ned);
+            let slid = (pad - trace.samples[0].measurement.pos_ned).xy().norm();
+            // Miss from the controller's own target (the pad measured at the take-off).
+            let own_target = pad.xy() + nalgebra::Vector2::new(mission.landing_target_n, mission.landing_target_e);
+            let own_miss = trace
+                .samples
+                .last()
+                .map_or(f64::NAN, |s| (s.measurement.pos_ned.xy() - own_target).norm());
+            // The landing's first contact (not a take-off bounce) and the tilt there.
+            let contact = trace.samples.iter().find(|s| {
+                matches!(s.diagnostics.phase, Phase::Flare | Phase::Landed)
+                    && plant
+                        .outputs(&s.x, &closed_loop::plant_inputs(&s.command), &s.wind)
+                        .ground
+                        .points
+                        > 0
+            });
+            let td = contact.map_or(td, |s| s.t);
+            let tilt_contact = contact.map_or(f64::NAN, |s| tilt(&s.x).to_degrees());
+            // Largest lean towards the belly and along the span in the last 3 s (deg).
+            let (mut lean_b, mut lean_s) = (0.0f64, 0.0f64);
+            for s in trace.samples.iter().filter(|s| s.t < td && s.t >= td - 3.0) {
+                let q = &s.measurement.quat;
+                let r = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(q[3], q[0], q[1], q[2]));
+                let (nose, belly, span) = (r * nalgebra::Vector3::x(), r * nalgebra::Vector3::z(), r * nalgebra::Vector3::y());
+                lean_b = lean_b.max((nose.xy().dot(&belly.xy()) / belly.xy().norm()).asin().to_degrees().abs());
+                lean_s = lean_s.max((nose.xy().dot(&span.xy()) / span.xy().norm()).asin().to_degrees().abs());
+            }
+            let late = trace
+                .samples
+                .iter()
+                .filter(|s| s.t < td && s.t >= td - 3.0)
+                .map(|s| tilt(&s.x).to_degrees())
+                .fold(0.0, f64::max);
             let last: Vec<&Sample> = trace
                 .samples
                 .iter()
@@ -112,7 +153,7 @@ fn main() {
             (
                 f.passed,
                 format!(
-                    "{speed:>4} {:>5}  held {:5} max {:6.2} ({:6.1} s {:8})  miss {:6.2}  td {:5.2}  tilt td {:5.1} end {:5.1} last10 {:5.1}  δfc {:6.1}  L {} lift {:.2} td@ {:.2} landed@ {:.2} {}",
+                    "{speed:>4} {:>5}  held {:5} max {:6.2} ({:6.1} s {:8})  miss {:6.2}  td {:5.2}  tilt td {:5.1} end {:5.1} last10 {:5.1}  δfc {:6.1}  L {} lift {:.2} td@ {:.2} landed@ {:.2} slid {:.2} gt {:.1} own {:.2} last3 {:.1} contact {:.1} lb {:.0} ls {:.0} {}",
                     BEARINGS_DEG[b],
                     held,
                     max_error,
@@ -128,6 +169,13 @@ fn main() {
                     f.liftoff_time.unwrap_or(f64::NAN),
                     td,
                     f.landed_time.unwrap_or(f64::NAN),
+                    slid,
+                    f.ground_tilt_deg,
+                    own_miss,
+                    late,
+                    tilt_contact,
+                    lean_b,
+                    lean_s,
                     trace.failure.as_deref().unwrap_or("")
                 ),
             )

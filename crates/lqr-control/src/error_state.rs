@@ -30,11 +30,24 @@ pub(crate) fn euler_set(pitch_321: f64, sw: &ErrorStateSwitches) -> EulerRep {
     }
 }
 
+/// The measured α taken to within π of the reference's (x[α] ± 2π): α is an angle, and in
+/// the tail-first flow of a descent or a slowing climb (α ≈ ±π) the measured and reference
+/// air angles sit on either side of the ±π cut, which as numbers differ by ≈ 2π. Without
+/// this the error Δα jumped by 2π as the measured flow crossed the cut (turbulence at the
+/// descent's 2 m/s: the aircraft was lost). Untouched (bit for bit) within π.
+pub(crate) fn unwrap_alpha(x: &mut X, xt: &X) {
+    let d = x[ix::ALPHA] - xt[ix::ALPHA];
+    if d.abs() > core::f64::consts::PI {
+        x[ix::ALPHA] = xt[ix::ALPHA] + wrap_pi(d);
+    }
+}
+
 impl LqrController {
     /// The measured state x (the estimated state of Fig. 3.2) and the trajectory state x_t in
     /// Euler set `rep` (§2.4): x_t at the regulated position `ctrl_neh` with the air-data
     /// reference; in the take-off and landing phases both carry the body air velocity
-    /// ([`Self::hover_air_data`]).
+    /// ([`Self::hover_air_data`]). Where α is an angle, the measured one is taken to within π
+    /// of the reference's ([`unwrap_alpha`]).
     pub(crate) fn state_and_reference(&self, rep: EulerRep, m: &Measurement, r: &Reference) -> (X, X) {
         let mut x = state_of(
             rep, m.airspeed, m.alpha, m.beta, &m.rates, &m.quat, &m.pos_ned, m.thrust,
@@ -55,8 +68,10 @@ impl LqrController {
                 xt[ix::BETA] = (vat.y / va).clamp(-1.0, 1.0).asin();
             } else {
                 self.hover_air_data(m, v, &r.point, &mut x, &mut xt);
+                return (x, xt);
             }
         }
+        unwrap_alpha(&mut x, &xt);
         (x, xt)
     }
 
@@ -113,5 +128,31 @@ impl LqrController {
         xt[ix::V] = vat.x;
         xt[ix::ALPHA] = vat.z / ve;
         xt[ix::BETA] = vat.y / ve;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A measured α just past the ±π cut from the reference's is taken to the reference's
+    /// side (error 0.08 rad, not 2π − 0.08); within π the state is untouched bit for bit.
+    #[test]
+    fn alpha_error_across_the_cut_is_small() {
+        let mut xt = X::zeros();
+        xt[ix::ALPHA] = -3.1;
+        let mut x = X::zeros();
+        x[ix::ALPHA] = 3.1;
+        unwrap_alpha(&mut x, &xt);
+        let d = x[ix::ALPHA] - xt[ix::ALPHA];
+        assert!((d + (core::f64::consts::TAU - 6.2)).abs() < 1e-12, "Δα = {d}");
+        // The flow (sin, cos of α) is unchanged.
+        assert!((x[ix::ALPHA].sin() - 3.1f64.sin()).abs() < 1e-12);
+        for a in [0.0, -2.9, -3.0, -0.1 + 1e-17] {
+            let mut y = X::zeros();
+            y[ix::ALPHA] = a;
+            unwrap_alpha(&mut y, &xt);
+            assert_eq!(y[ix::ALPHA].to_bits(), a.to_bits(), "{a}");
+        }
     }
 }

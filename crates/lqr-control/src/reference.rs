@@ -7,14 +7,16 @@ use std::ops::ControlFlow;
 
 use flight_mission::{Command, ControllerInput, ControllerOutput, Diagnostics, Measurement, Phase};
 use guidance::{GroundMode, VerticalReference};
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{Const, DimMin, Matrix3, SMatrix, SVector, ToTypenum, Vector3};
+use std::f64::consts::TAU;
+use tailsitter_physics::attitude::{euler_321_from_quat, quat_from_dcm};
 use tailsitter_physics::Surfaces;
 
 use crate::model;
 use crate::trajectory::TrajPoint;
 use crate::{
-    LqrController, HOVER_SHIFT_LIMIT, HOVER_SHIFT_TIME, LANDING_FLAP_GAIN, LANDING_FLAP_LIMIT, LANDING_FLAP_RAMP_TIME,
-    MAX_WIND_ESTIMATE, MIN_AIRSPEED, WIND_INTEGRAL_SPEED, WIND_TRIM_MAX_PITCH, WIND_TRIM_RAMP,
+    LqrController, GROUND_TRIM_MAX_YAW, HOVER_SHIFT_LIMIT, HOVER_SHIFT_TIME, LANDING_FLAP_GAIN, LANDING_FLAP_LIMIT,
+    LANDING_FLAP_RAMP_TIME, MAX_WIND_ESTIMATE, MIN_AIRSPEED, WIND_INTEGRAL_SPEED, WIND_TRIM_MAX_PITCH, WIND_TRIM_RAMP,
 };
 
 /// Switches of the reference stage (from [`crate::LqrParams::effective`]).
@@ -176,7 +178,7 @@ impl LqrController {
             ground,
             pos_neh,
             ctrl_neh,
-            air: self.air_reference(&trimmed, sw),
+            air: self.air_reference(&trimmed, &ground_velocity(&point), sw),
             pitch_321: point.euler_321.y,
             in_wind,
         }
@@ -322,6 +324,9 @@ impl LqrController {
             return None;
         }
         let s_lat = self.lateral_wind_weight(p);
+        if let Some(q) = self.ground_path_trimmed(p, (&w_next, k, k_next), s_lat) {
+            return Some(q);
+        }
         let z = self.wind_trim(p, &self.wind, s_lat)?;
         let z_next = self.wind_trim(p, &w_next, s_lat)?;
         let rate = (k_next * z_next.x - k * z.x) / h;
@@ -334,6 +339,83 @@ impl LqrController {
         q.u[0] += k * z.y;
         q.u[1] += k * z.z;
         Some(q)
+    }
+
+    /// The reference point trimmed along its still-air ground path in the estimated wind
+    /// (README, "Mission in wind"): [`Self::ground_path_trim`] at the wind ŵ and at `w_next`
+    /// (one sample on, through the wind filter's rate), weighted by `k`, `k_next`: the
+    /// reference body axes turned by k δψ about body z and k δθ about body y (C = Rᵀ C_t),
+    /// the body rates re-expressed in them plus the rotation's rate, thrust, elevator, aileron
+    /// and rudder changed. The ground velocity stays the still-air path's (the air data are
+    /// read from it, [`Self::air_reference`]). None where the trim fails.
+    fn ground_path_trimmed(
+        &self,
+        p: &TrajPoint,
+        (w_next, k, k_next): (&Vector3<f64>, f64, f64),
+        s_lat: f64,
+    ) -> Option<TrajPoint> {
+        let h = self.mission.sample_time;
+        let z = self.ground_path_trim(p, &self.wind, s_lat)?;
+        let z_next = self.ground_path_trim(p, w_next, s_lat)?;
+        let rate = (z_next * k_next - z * k) / h;
+        let r = body_rotation(k * z[0], k * z[1]);
+        let c = r.transpose() * model::dcm_of_quat(&p.quat());
+        let mut e = euler_321_from_quat(&quat_from_dcm(&c));
+        // ψ of the table is not wrapped: keep the turned heading next to it.
+        e.z += ((p.euler_321.z - e.z) / TAU).round() * TAU;
+        let mut q = *p;
+        q.euler_321 = e;
+        q.rates = r.transpose() * p.rates + Vector3::new(0.0, rate[1], rate[0]);
+        q.thrust += k * z[2];
+        q.u[0] += k * z[2];
+        for j in 0..3 {
+            q.u[1 + j] += k * z[3 + j];
+        }
+        Some(q)
+    }
+
+    /// Trim of a reference point along its still-air ground path in the wind `wind` (NED,
+    /// m/s) (README, "Mission in wind"): the rotation of the reference body axes by δψ about
+    /// body z (in level flight the crab, in vertical flight a lean across the belly) and δθ
+    /// about body y (pitch), the thrust change ΔT and the elevator, aileron and rudder changes
+    /// such that, at the same ground velocity v_g,t (air velocity v_g,t − ŵ, across the body
+    /// weighted by `s_lat` as in [`Self::air_reference`]), the force in earth axes and the
+    /// body moments are the still-air reference's: the same ground-path acceleration
+    /// (2.2.19–2.2.21) and angular acceleration (2.2.22–2.2.24). No rotation about body x (in
+    /// level flight: no bank). Newton's method on the model for control (6 × 6,
+    /// finite-difference Jacobian, ≤ 12 iterations) from the still-air point; None where it
+    /// does not converge or leaves the limits.
+    fn ground_path_trim(&self, p: &TrajPoint, wind: &Vector3<f64>, s_lat: f64) -> Option<SVector<f64, 6>> {
+        let af = &self.airframe;
+        let surfaces = |z: &SVector<f64, 6>| {
+            Surfaces::from_array([p.u[1] + z[3], p.u[2] + z[4], p.u[3] + z[5], p.u[4], p.u[5], p.u[6]])
+        };
+        let c_t = model::dcm_of_quat(&p.quat());
+        let vb_t = model::body_velocity(p.v, p.alpha, 0.0);
+        let fm_t = af.forces_moments(&vb_t, &p.rates, p.thrust, &surfaces(&SVector::zeros()));
+        let f_e = c_t.transpose() * fm_t.force_body;
+        let v_g = c_t.transpose() * vb_t;
+        let (v_a, v_lat) = (v_g - wind, v_g - s_lat * wind);
+        let weight = af.mass * af.gravity;
+        let residual = |z: &SVector<f64, 6>| -> SVector<f64, 6> {
+            let r = body_rotation(z[0], z[1]);
+            let c = r.transpose() * c_t;
+            let mut vb = c * v_a;
+            vb.y = (c * v_lat).y;
+            let fm = af.forces_moments(&vb, &(r.transpose() * p.rates), p.thrust + z[2], &surfaces(z));
+            let df = (c.transpose() * fm.force_body - f_e) / weight;
+            let dm = fm.moment_body - fm_t.moment_body;
+            SVector::<f64, 6>::new(df.x, df.y, df.z, dm.x, dm.y, dm.z)
+        };
+        let steps = SVector::<f64, 6>::new(1e-6, 1e-6, 1e-4, 1e-6, 1e-6, 1e-6);
+        let converged = |r: &SVector<f64, 6>| r.fixed_rows::<3>(0).norm() < 1e-6 && r.fixed_rows::<3>(3).norm() < 1e-6;
+        let z = newton(residual, &steps, 12, converged)?;
+        let lim = af.deflection_limit;
+        let in_limits = z[0].abs() <= GROUND_TRIM_MAX_YAW
+            && z[1].abs() <= WIND_TRIM_MAX_PITCH
+            && (af.thrust_min..=af.thrust_max).contains(&(p.thrust + z[2]))
+            && (1..4).all(|j| (p.u[j] + z[2 + j]).abs() <= lim);
+        in_limits.then_some(z)
     }
 
     /// Lift-borne wind trim of a reference point (README, "Gusts"): the pitch rotation δ, the
@@ -364,27 +446,12 @@ impl LqrController {
             Vector3::new(df.x, df.z, fm.moment_body.y - fm_t.moment_body.y)
         };
         let steps = Vector3::new(1e-6, 1e-4, 1e-6);
-        let mut z = Vector3::zeros();
-        for _ in 0..8 {
-            let r = residual(&z);
-            if !r.iter().all(|v| v.is_finite()) {
-                return None;
-            }
-            if r.xy().norm() < 1e-6 * af.mass * af.gravity && r.z.abs() < 1e-7 {
-                let in_limits = z.x.abs() <= WIND_TRIM_MAX_PITCH
-                    && (af.thrust_min..=af.thrust_max).contains(&(p.thrust + z.y))
-                    && (p.u[1] + z.z).abs() <= af.deflection_limit;
-                return in_limits.then_some(z);
-            }
-            let mut jac = Matrix3::zeros();
-            for j in 0..3 {
-                let mut zj = z;
-                zj[j] += steps[j];
-                jac.set_column(j, &((residual(&zj) - r) / steps[j]));
-            }
-            z -= jac.lu().solve(&r)?;
-        }
-        None
+        let converged = |r: &Vector3<f64>| r.xy().norm() < 1e-6 * af.mass * af.gravity && r.z.abs() < 1e-7;
+        let z = newton(residual, &steps, 8, converged)?;
+        let in_limits = z.x.abs() <= WIND_TRIM_MAX_PITCH
+            && (af.thrust_min..=af.thrust_max).contains(&(p.thrust + z.y))
+            && (p.u[1] + z.z).abs() <= af.deflection_limit;
+        in_limits.then_some(z)
     }
 
     /// Reference (V, α, β): with wind compensation (`sw`), those of the air velocity
@@ -398,15 +465,13 @@ impl LqrController {
     /// gust). The sideways component (β) is weighted by s = max(sin²θ_ref, (V_t/V_L)²):
     /// counted in full, a 5 m/s gust across the path in the slow part of transition 1
     /// (V_t ≈ 10 m/s, β ≈ 27°) left the aircraft 5.8 m off (1.2 m with s = sin²θ_ref).
-    fn air_reference(&self, p: &TrajPoint, sw: &ReferenceSwitches) -> Vector3<f64> {
+    fn air_reference(&self, p: &TrajPoint, v_g: &Vector3<f64>, sw: &ReferenceSwitches) -> Vector3<f64> {
         let plain = Vector3::new(p.v, p.alpha, 0.0);
         if !sw.wind_compensation || !self.wind.iter().all(|v| v.is_finite()) {
             return plain;
         }
         let s_lat = self.lateral_wind_weight(p);
         let c = model::dcm_of_quat(&p.quat());
-        let (sa, ca) = p.alpha.sin_cos();
-        let v_g = c.transpose() * (p.v * Vector3::new(ca, 0.0, sa));
         let full = c * (v_g - self.wind);
         let v_b = Vector3::new(full.x, (c * (v_g - s_lat * self.wind)).y, full.z);
         let v = v_b.norm();
@@ -469,6 +534,51 @@ impl LqrController {
     }
 }
 
+/// Newton's method from zero on `residual` with a forward-difference Jacobian (`steps`), at
+/// most `iterations` steps: the first iterate whose residual is `converged`; None on a
+/// non-finite residual, a singular Jacobian or no convergence.
+fn newton<const N: usize>(
+    residual: impl Fn(&SVector<f64, N>) -> SVector<f64, N>,
+    steps: &SVector<f64, N>,
+    iterations: usize,
+    converged: impl Fn(&SVector<f64, N>) -> bool,
+) -> Option<SVector<f64, N>>
+where
+    Const<N>: DimMin<Const<N>, Output = Const<N>> + ToTypenum,
+{
+    let mut z = SVector::<f64, N>::zeros();
+    for _ in 0..iterations {
+        let r = residual(&z);
+        if !r.iter().all(|v| v.is_finite()) {
+            return None;
+        }
+        if converged(&r) {
+            return Some(z);
+        }
+        let mut jac = SMatrix::<f64, N, N>::zeros();
+        for j in 0..N {
+            let mut zj = z;
+            zj[j] += steps[j];
+            jac.set_column(j, &((residual(&zj) - r) / steps[j]));
+        }
+        z -= jac.lu().solve(&r)?;
+    }
+    None
+}
+
+/// Ground velocity (NED) of a still-air reference point: `DCM_tᵀ V_t (cα_t, 0, sα_t)`.
+fn ground_velocity(p: &TrajPoint) -> Vector3<f64> {
+    model::dcm_of_quat(&p.quat()).transpose() * model::body_velocity(p.v, p.alpha, 0.0)
+}
+
+/// Rotation of the body axes by `yaw` about body z, then `pitch` about body y (the matrix
+/// R with new axes b' = R b): C' = Rᵀ C.
+fn body_rotation(yaw: f64, pitch: f64) -> Matrix3<f64> {
+    (nalgebra::Rotation3::from_axis_angle(&Vector3::z_axis(), yaw)
+        * nalgebra::Rotation3::from_axis_angle(&Vector3::y_axis(), pitch))
+    .into_inner()
+}
+
 #[cfg(test)]
 mod wind_trim_tests {
     use super::*;
@@ -477,9 +587,8 @@ mod wind_trim_tests {
 
     /// Earth-frame force (N) and pitching moment (N m) of the model for control at reference
     /// point `p` in the wind `w`, its ground velocity being that of (V_t, α_t, attitude).
-    fn loads(af: &Airframe, p: &TrajPoint, w: &Vector3<f64>) -> (Vector3<f64>, f64) {
+    fn loads(af: &Airframe, p: &TrajPoint, v_g: &Vector3<f64>, w: &Vector3<f64>) -> (Vector3<f64>, f64) {
         let c = model::dcm_of_quat(&p.quat());
-        let v_g = c.transpose() * model::body_velocity(p.v, p.alpha, 0.0);
         let s = Surfaces::from_array([p.u[1], p.u[2], p.u[3], p.u[4], p.u[5], p.u[6]]);
         let fm = af.forces_moments(&(c * (v_g - w)), &p.rates, p.thrust, &s);
         (c.transpose() * fm.force_body, fm.moment_body.y)
@@ -498,26 +607,29 @@ mod wind_trim_tests {
         let mut c = controller();
         let af = Airframe::default();
         let p = c.trajectory().at(15.0);
-        let (f_still, m_still) = loads(&af, &p, &Vector3::zeros());
+        let v_g = ground_velocity(&p);
+        let (f_still, m_still) = loads(&af, &p, &v_g, &Vector3::zeros());
         for sign in [1.0, -1.0] {
             let w = Vector3::new(5.0 * sign, 0.0, 0.0);
             c.wind = w;
             c.wind_rate = Vector3::zeros();
             let q = c.trimmed(&p, &c.params.stages().reference).expect("trim converges");
-            let (f, m) = loads(&af, &q, &w);
+            let (f, m) = loads(&af, &q, &v_g, &w);
             assert!(
                 (f - f_still).norm() < 1e-5 * af.mass * af.gravity,
                 "{sign}: {f} vs {f_still}"
             );
             assert!((m - m_still).abs() < 1e-6, "{sign}: {m} vs {m_still}");
             let dtheta = q.euler_321.y - p.euler_321.y;
-            let alpha_air = c.air_reference(&q, &c.params.stages().reference).y;
+            let alpha_air = c
+                .air_reference(&q, &ground_velocity(&p), &c.params.stages().reference)
+                .y;
             assert!(
                 sign * dtheta > 0.0 && sign * (alpha_air - p.alpha) > 0.0,
                 "{sign}: δ {dtheta}, α {alpha_air}"
             );
             // Without a wind rate the reference gains no pitch rate.
-            assert_eq!(q.rates, p.rates);
+            assert!((q.rates - p.rates).norm() < 1e-12, "{sign}: {} vs {}", q.rates, p.rates);
         }
     }
 
@@ -544,5 +656,54 @@ mod wind_trim_tests {
         .unwrap();
         t.wind = Vector3::new(5.0, 0.0, 0.0);
         assert!(t.trimmed(&p, &t.params.stages().reference).is_none());
+    }
+
+    /// Along the still-air ground path in an 8 m/s crosswind (from the west) the trim keeps
+    /// the still-air reference's force in earth axes and its body moments at the same ground
+    /// velocity; in level flight it is the crab: the nose turned into the wind by
+    /// atan(8/25) (16.3–16.7° measured against 17.7°), the air nearly along the nose (|β| < 0.035 rad: 1.2–1.7°) and the wings
+    /// level to the pitch's share of the turn about body z (|φ| < 3°); through the back transition it converges at every sampled point.
+    #[test]
+    fn crosswind_trim_along_the_ground_path() {
+        let mut c = controller();
+        let af = Airframe::default();
+        let sw = c.params.stages().reference;
+        let w = Vector3::new(0.0, 8.0, 0.0);
+        c.wind = w;
+        c.wind_rate = Vector3::zeros();
+        for t in [10.0, 15.0, 21.0, 23.0, 25.0, 27.0, 29.0] {
+            let p = c.trajectory().at(t);
+            let q = c.trimmed(&p, &sw).expect("trim converges");
+            let v_g = ground_velocity(&p);
+            let s = Surfaces::from_array([q.u[1], q.u[2], q.u[3], q.u[4], q.u[5], q.u[6]]);
+            let s_t = Surfaces::from_array([p.u[1], p.u[2], p.u[3], p.u[4], p.u[5], p.u[6]]);
+            let (c_q, c_p) = (model::dcm_of_quat(&q.quat()), model::dcm_of_quat(&p.quat()));
+            // The trim's own weighting of the sideways wind (full at these speeds).
+            assert!((c.lateral_wind_weight(&p) - 1.0).abs() < 0.05, "{t}");
+            let fm = af.forces_moments(&(c_q * (v_g - w)), &q.rates, q.thrust, &s);
+            let fm_t = af.forces_moments(&(c_p * v_g), &p.rates, p.thrust, &s_t);
+            let k = (p.v / c.mission.v_level).powi(2).min(1.0);
+            if k > 0.999 {
+                let df = c_q.transpose() * fm.force_body - c_p.transpose() * fm_t.force_body;
+                let dm = fm.moment_body - fm_t.moment_body;
+                let lat = c.lateral_wind_weight(&p);
+                if lat > 0.999 {
+                    assert!(df.norm() < 0.02 * af.mass * af.gravity, "{t}: force {df}");
+                    assert!(dm.norm() < 0.05, "{t}: moment {dm}");
+                }
+            }
+            if (10.0..=21.0).contains(&t) {
+                let crab = (q.euler_321.z - p.euler_321.z).to_degrees();
+                let expect = (-8.0f64).atan2(p.v).to_degrees();
+                assert!((crab - expect).abs() < 2.0, "{t}: crab {crab} vs {expect}");
+                let beta = c.air_reference(&q, &v_g, &sw).z;
+                eprintln!(
+                    "{t}: crab {crab:.2}° vs {expect:.2}°, β {beta:.4}, φ {:.4}",
+                    q.euler_321.x
+                );
+                assert!(beta.abs() < 0.035, "{t}: β {beta}");
+                assert!(q.euler_321.x.abs() < 3f64.to_radians(), "{t}: φ {}", q.euler_321.x);
+            }
+        }
     }
 }

@@ -378,13 +378,16 @@ impl SampledUnit for TsdController {
             dev.integrators_as_accelerations,
         );
         let (mut command, u_sat) = mixing::allocate(&u, s.d.mixing, dev.roll_differential_flaps, &self.airframe);
-        // Landing in wind (README, "Take-off and landing in wind"): the collective flaps'
-        // direct-force trim.
+        // Landing in wind (README, "Take-off and landing in wind"): the collective and
+        // vertical flaps' direct force.
         if dev.hover_wind_design {
             let lim = self.airframe.deflection_limit;
-            let trim =
-                wind_mission::landing_flap_trim(meas, r.reference.phase, &self.weathervane.wind()) * s.air.hover_wind;
+            let since_end = input.t - self.ground.mission_start() - self.mission.end_time();
+            let trim = wind_mission::landing_flap_trim(meas, r.reference.phase, &self.weathervane.wind(), since_end)
+                * s.air.hover_wind;
             command.flap_collective = (command.flap_collective + trim).clamp(-lim, lim);
+            let side = wind_mission::landing_vertical_flap(meas, r.reference.phase) * s.air.hover_wind;
+            command.vertical_flap = (command.vertical_flap + side).clamp(-lim, lim);
         }
         if !command.is_finite() {
             return Err(Self::err(format!("non-finite command at t = {} s", input.t)));

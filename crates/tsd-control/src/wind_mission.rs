@@ -35,7 +35,7 @@
 use flight_mission::{Measurement, MissionParams, Phase};
 use guidance::weathervane::{air_data_wind, nearer_face, wrap_pi};
 use guidance::Weathervane;
-use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+use nalgebra::{Quaternion, UnitQuaternion, Vector2, Vector3};
 
 /// Preview τ of the air-relative velocity by the reference's acceleration (s).
 pub const AIR_PREVIEW_TIME: f64 = 1.0;
@@ -62,6 +62,23 @@ pub const LANDING_LEAN_GAIN_PER_WIND: f64 = 0.2;
 /// Under Jacobi (a sample more of delay) 0.3 /(m/s) within 1.2–1.8 lost the 5 m/s tailwind
 /// cell in the descent (20.4 m); this schedule holds it.
 pub const LANDING_LEAN_GAIN_RANGE: (f64, f64) = (0.8, 1.6);
+
+/// Time over which the collective flaps' landing command ([`landing_flap_trim`]) fades in
+/// from the mission's end, by a cosine (s): the approach (4–6 s) starts with the trim and
+/// the lean feedback partly on and the descent with them fully on, instead of a step of up
+/// to −25° of flap when the last vertical phase ends leaning into the wind (Jacobi, 3 m/s:
+/// 17–25° of lean, the step threw the aircraft to 70° and 10.9–24.8 m off in the approach;
+/// faded over 8 s 2.9–9.3 m; steady wind under Gauss-Seidel, 10 m/s from the north 5.1 →
+/// 1.7 m in the approach).
+pub const LANDING_TRIM_RAMP_TIME: f64 = 8.0;
+
+/// Vertical flap per radian of lean along the span in the landing phases (rad/rad): the
+/// vertical flaps' direct side force takes the load off the span-wise lean, as the
+/// collective flaps take it off the lean towards the belly ([`landing_vertical_flap`];
+/// README, "Take-off and landing in wind"). Measured (moderate turbulence, 0–5 m/s, 24
+/// cells): 0.5–2.5 keep the span-wise lean of the last 3 s before the touchdown at 7–18°
+/// (11–28° without), 3.5 loses 22 of 24 cells (the loop through the flaps' yawing moment).
+pub const LANDING_SPAN_LEAN_GAIN: f64 = 1.2;
 
 /// Engage speed of the take-off and landing phases' heading (m/s): below the weathervane's
 /// (3 m/s). Its estimate (a 4 s filter) reaches a steady 3 m/s wind only asymptotically, so a
@@ -134,26 +151,59 @@ pub fn track_face(heading: f64, bearing: f64) -> f64 {
 ///   attitude swung ±50° at a steady position. The lean feedback makes the flaps carry the
 ///   load the lean would carry, so the position loop levels the nose.
 ///
-/// 0 in other phases, without a wind estimate, or with the belly axis within 30° of the
-/// vertical.
-pub fn landing_flap_trim(m: &Measurement, phase: Phase, wind: &Vector3<f64>) -> f64 {
+/// Faded in over [`LANDING_TRIM_RAMP_TIME`] from the mission's end (`since_mission_end`, s;
+/// NaN: fully on). 0 in other phases, without a wind estimate, or with the belly axis within
+/// 30° of the vertical.
+pub fn landing_flap_trim(m: &Measurement, phase: Phase, wind: &Vector3<f64>, since_mission_end: f64) -> f64 {
     let landing = matches!(phase, Phase::Approach | Phase::Descent | Phase::Flare);
     if !(landing && wind.x.is_finite() && wind.y.is_finite()) {
         return 0.0;
     }
-    let q = &m.quat;
-    let r = UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]));
-    let (nose, belly) = (r * Vector3::x(), r * Vector3::z());
-    let size = belly.xy().norm();
-    if size < 0.5 {
+    // Faded in by a cosine over LANDING_TRIM_RAMP_TIME from the mission's end.
+    let x = (since_mission_end / LANDING_TRIM_RAMP_TIME).clamp(0.0, 1.0);
+    let ramp = if x.is_nan() {
+        1.0
+    } else {
+        0.5 * (1.0 - (core::f64::consts::PI * x).cos())
+    };
+    let Some((belly, size, sin_lean)) = lean_towards(m, &Vector3::z()) else {
         return 0.0;
-    }
-    let into_belly = -wind.xy().dot(&belly.xy()) / size;
+    };
+    let into_belly = -wind.xy().dot(&belly) / size;
     let trim = -(LANDING_FLAP_TRIM_GAIN * into_belly).clamp(-LANDING_FLAP_TRIM_LIMIT, LANDING_FLAP_TRIM_LIMIT);
     let (lo, hi) = LANDING_LEAN_GAIN_RANGE;
     let gain = (LANDING_LEAN_GAIN_PER_WIND * wind.xy().norm()).clamp(lo, hi);
-    let sin_lean = nose.xy().dot(&belly.xy()) / size;
-    trim - gain * sin_lean
+    ramp * (trim - gain * sin_lean)
+}
+
+/// The horizontal part of the body axis `axis` (NED), its length, and the sine of the nose's
+/// lean towards it (the nose's horizontal part along it); `None` with the axis within 30° of
+/// the vertical (length below 0.5).
+fn lean_towards(m: &Measurement, axis: &Vector3<f64>) -> Option<(Vector2<f64>, f64, f64)> {
+    let q = &m.quat;
+    let r = UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]));
+    let (nose, a) = (r * Vector3::x(), (r * axis).xy());
+    let size = a.norm();
+    (size >= 0.5).then(|| (a, size, nose.xy().dot(&a) / size))
+}
+
+/// Direct-force command of the vertical flaps in the descent and the flare (rad):
+/// +[`LANDING_SPAN_LEAN_GAIN`] sin λ_s, λ_s the lean of the nose along the body's span (positive towards the right wing); the controller weights it with the
+/// measured wind as [`landing_flap_trim`]. The tail-sitter makes force along its span only
+/// by leaning the thrust that way or with the vertical flaps in the slip-stream (positive
+/// towards the right wing: the plant's upright edge-on hover trim is +9.6° of vertical flap
+/// in 5 m/s from the right, `cargo run --release -p analysis --example tsd_wind_bounds`).
+/// The TSD's lateral loop regulates the force, not the attitude, so a span-wise gust is
+/// met by leaning; this feedback hands that load to the flaps and the position loop levels
+/// the nose (the span-wise counterpart of the lean feedback of [`landing_flap_trim`]).
+///
+/// 0 in other phases (the approach translates along the span, leaning on purpose) or with
+/// the span within 30° of the vertical.
+pub fn landing_vertical_flap(m: &Measurement, phase: Phase) -> f64 {
+    if !matches!(phase, Phase::Descent | Phase::Flare) {
+        return 0.0;
+    }
+    lean_towards(m, &Vector3::y()).map_or(0.0, |(_, _, sin_lean)| LANDING_SPAN_LEAN_GAIN * sin_lean)
 }
 
 impl WindMission {
@@ -495,11 +545,11 @@ mod tests {
         let m = hovering(Vector3::zeros(), Vector3::zeros());
         let from_north = |v: f64| Vector3::new(-v, 0.0, 0.0);
         let deg = |x: f64| x.to_degrees();
-        let t = landing_flap_trim(&m, Phase::Descent, &from_north(3.0));
+        let t = landing_flap_trim(&m, Phase::Descent, &from_north(3.0), 100.0);
         assert!((deg(t) + 13.8).abs() < 1e-9, "{}", deg(t));
-        let t = landing_flap_trim(&m, Phase::Flare, &from_north(-3.0));
+        let t = landing_flap_trim(&m, Phase::Flare, &from_north(-3.0), 100.0);
         assert!((deg(t) - 13.8).abs() < 1e-9, "{}", deg(t));
-        let t = landing_flap_trim(&m, Phase::Approach, &from_north(10.0));
+        let t = landing_flap_trim(&m, Phase::Approach, &from_north(10.0), 100.0);
         assert!((deg(t) + 17.0).abs() < 1e-9, "{}", deg(t));
         // Leaning 6° towards the belly in 5 m/s: 1.0 × sin 6° more flap towards the belly;
         // in 2 m/s (gain 0.8) and 10 m/s (1.6) the gain's range.
@@ -508,7 +558,7 @@ mod tests {
             Measurement::still_in_air(&r, &Vector3::zeros())
         };
         for (v, gain) in [(5.0, 1.0), (2.0, 0.8), (10.0, 1.6)] {
-            let t = landing_flap_trim(&tilted(6.0), Phase::Descent, &from_north(v));
+            let t = landing_flap_trim(&tilted(6.0), Phase::Descent, &from_north(v), 100.0);
             let trim = -(4.6 * v).min(17.0).to_radians();
             assert!(
                 (t - (trim - gain * 6f64.to_radians().sin())).abs() < 1e-12,
@@ -517,11 +567,54 @@ mod tests {
             );
         }
         // Leaning towards the back: the other way.
-        let t = landing_flap_trim(&tilted(-6.0), Phase::Descent, &Vector3::zeros());
+        let t = landing_flap_trim(&tilted(-6.0), Phase::Descent, &Vector3::zeros(), 100.0);
         assert!((t - 0.8 * 6f64.to_radians().sin()).abs() < 1e-12, "{}", deg(t));
         // Along the span: no trim; outside the landing phases or without an estimate: none.
-        assert!(landing_flap_trim(&m, Phase::Descent, &Vector3::new(0.0, 8.0, 0.0)).abs() < 1e-12);
-        assert_eq!(landing_flap_trim(&m, Phase::Vertical2, &from_north(5.0)), 0.0);
-        assert_eq!(landing_flap_trim(&m, Phase::Descent, &Vector3::repeat(f64::NAN)), 0.0);
+        assert!(landing_flap_trim(&m, Phase::Descent, &Vector3::new(0.0, 8.0, 0.0), 100.0).abs() < 1e-12);
+        assert_eq!(landing_flap_trim(&m, Phase::Vertical2, &from_north(5.0), 100.0), 0.0);
+        assert_eq!(
+            landing_flap_trim(&m, Phase::Descent, &Vector3::repeat(f64::NAN), 100.0),
+            0.0
+        );
+        // Faded in from the mission's end: 0 at its end, half at half the ramp time, whole
+        // from the ramp time; NaN (no mission end known) whole.
+        let full = landing_flap_trim(&m, Phase::Approach, &from_north(3.0), LANDING_TRIM_RAMP_TIME);
+        assert!((deg(full) + 13.8).abs() < 1e-9, "{}", deg(full));
+        assert_eq!(landing_flap_trim(&m, Phase::Approach, &from_north(3.0), 0.0), 0.0);
+        let half = landing_flap_trim(&m, Phase::Approach, &from_north(3.0), 0.5 * LANDING_TRIM_RAMP_TIME);
+        assert!((half - 0.5 * full).abs() < 1e-12, "{}", deg(half));
+        assert_eq!(landing_flap_trim(&m, Phase::Approach, &from_north(3.0), f64::NAN), full);
+    }
+
+    /// The vertical flaps' span-wise lean feedback: nose up, belly north, the right wing
+    /// east; leaning 6° east (towards the right wing) deflects the vertical flaps
+    /// +1.2 sin 6° (their side force towards the right wing takes the load), west the other
+    /// way; leaning towards the belly does nothing; only in the descent and the flare.
+    #[test]
+    fn landing_vertical_flap_takes_the_span_wise_lean() {
+        let up = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), core::f64::consts::FRAC_PI_2);
+        let leaning = |axis: Vector3<f64>, deg: f64| {
+            let r = UnitQuaternion::from_axis_angle(&nalgebra::Unit::new_normalize(axis), deg.to_radians()) * up;
+            Measurement::still_in_air(&r, &Vector3::zeros())
+        };
+        // About the north axis by +6°: the nose (up) tips east.
+        let east = leaning(Vector3::x(), 6.0);
+        let q = &east.quat;
+        let r = UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]));
+        assert!((r * Vector3::x()).y > 0.1 && (r * Vector3::y()).y > 0.9);
+        let expected = LANDING_SPAN_LEAN_GAIN * 6f64.to_radians().sin();
+        for phase in [Phase::Descent, Phase::Flare] {
+            assert!((landing_vertical_flap(&east, phase) - expected).abs() < 1e-12);
+            let west = leaning(Vector3::x(), -6.0);
+            assert!((landing_vertical_flap(&west, phase) + expected).abs() < 1e-12);
+            let north = leaning(Vector3::y(), -6.0);
+            let q = &north.quat;
+            let r = UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]));
+            assert!((r * Vector3::x()).x > 0.1);
+            assert!(landing_vertical_flap(&north, phase).abs() < 1e-12);
+        }
+        for phase in [Phase::Approach, Phase::Vertical2, Phase::TakeOff] {
+            assert_eq!(landing_vertical_flap(&east, phase), 0.0);
+        }
     }
 }
