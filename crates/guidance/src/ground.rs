@@ -32,13 +32,14 @@
 //! * [`Phase::Flare`]: the sink rate falls linearly in time from V_d to the touchdown rate
 //!   V_td over `t_f = 2 (h_f − h_td)/(V_d + V_td)` (covering h_f − h_td), then stays at V_td
 //!   over the last `h_td = V_td ·` [`FINAL_SEGMENT_TIME`] (the gear meets the ground at a
-//!   steady sink, thrust ≈ weight: no flare thrust to bounce on) and down to
-//!   [`TOUCHDOWN_OVERSHOOT`] below the target (the reference keeps sinking until the gear
-//!   carries the aircraft).
-//! * [`Phase::Landed`]: latched when, in the flare, the CG is within
-//!   `landing_touchdown_tolerance` of the target height and sinks slower than V_td/2 for
-//!   [`TOUCHDOWN_DWELL`] (the gear has stopped it): thrust command 0 (the controllers clamp
-//!   it to their thrust minimum), surfaces centred, held for good.
+//!   steady sink, thrust ≈ weight: no flare thrust to bounce on) and on past the target
+//!   until the touchdown is detected, at most [`TOUCHDOWN_SEARCH_DEPTH`] below it (the
+//!   target's height is only as good as the height estimate: with GPS alone σ ≈ 1.4 m).
+//! * [`Phase::Landed`]: latched by the land detector ([`LandDetector`]), which does not use
+//!   the height: ground contact is a commanded sink that does not happen while the thrust is
+//!   below the hover thrust and the accelerometer feels the gear carry the difference; held
+//!   for [`LANDED_TIME`], the thrust command is 0 (the controllers clamp it to their thrust
+//!   minimum), surfaces centred, held for good.
 //!
 //! The reference attitude in the vertical phases here is the mission's vertical one
 //! (nose up, belly north); while descending the air comes from behind, α = π.
@@ -60,12 +61,30 @@ pub const LANDING_FLAP_TRIM_GAIN: f64 = 4.6 * core::f64::consts::PI / 180.0;
 /// from 5 m/s; the rest of the ±25° is left to the feedback.
 pub const LANDING_FLAP_TRIM_LIMIT: f64 = 17.0 * core::f64::consts::PI / 180.0;
 
-/// How far the touchdown reference sinks below the target before it holds (m).
-pub const TOUCHDOWN_OVERSHOOT: f64 = 0.3;
+/// How far the touchdown reference sinks below the target before it holds, if the touchdown
+/// is not detected before (m): three σ of the height relative to the start that GPS alone
+/// gives at the landing (≈ 1.4 m, σ 4 m fixes at 4 Hz), and some.
+pub const TOUCHDOWN_SEARCH_DEPTH: f64 = 5.0;
 /// Time flown at the touchdown rate before the target, after the flare (s).
 pub const FINAL_SEGMENT_TIME: f64 = 1.0;
-/// Time the touchdown condition must hold before the landing is declared (s).
-pub const TOUCHDOWN_DWELL: f64 = 0.04;
+/// Ground contact: largest thrust, in weights (–). The hover thrust is the weight and some
+/// (the slipstream's drag on the wing); on the gear the controllers, whose reference keeps
+/// sinking, take thrust off.
+pub const CONTACT_THRUST: f64 = 0.8;
+/// Ground contact: least share of the weight the gear carries, `f_x/g − T/(m g)` from the
+/// accelerometer's specific force along the thrust axis f_x and the thrust T (–). In the air
+/// it is the aerodynamic force along x (the wing's drag in the slipstream: ≤ 0); a thrust
+/// below the weight in the air shows as a fall (f_x ≈ T/m), not as a reaction.
+pub const CONTACT_REACTION: f64 = 0.1;
+/// Ground contact: largest vertical speed, in touchdown rates V_td (–): the commanded sink
+/// does not happen.
+pub const CONTACT_SINK: f64 = 1.0;
+/// Landed: largest tilt rate |(q, r)| (rad/s) (the gear is not rocking or tipping).
+pub const LANDED_TILT_RATE: f64 = 20.0 * core::f64::consts::PI / 180.0;
+/// Time ground contact (and the tilt rate) must hold before the landing is declared (s).
+pub const LANDED_TIME: f64 = 0.3;
+/// Gravity of the contact test (m/s²): the airframes' g (C.1).
+pub const CONTACT_GRAVITY: f64 = 9.81;
 
 /// A reference for vertical (nose-up) flight, NED, mission origin included.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -102,7 +121,7 @@ pub struct GroundPhases {
     origin: Option<Vector3<f64>>,
     /// Reference position and velocity at the end of the mission (start of the approach).
     approach_start: Option<(Vector3<f64>, Vector3<f64>)>,
-    /// Time since which the touchdown condition holds (NaN: it does not).
+    /// Time since which ground contact holds (NaN: it does not).
     touch_since: f64,
     landed: bool,
 }
@@ -238,7 +257,7 @@ impl GroundPhases {
                 (Phase::Flare, s0 + vd * x - 0.5 * k * x * x, vd - k * x, -k)
             } else {
                 let s = s0 + d_flare + vtd * (x - t_flare);
-                let limit = height + TOUCHDOWN_OVERSHOOT;
+                let limit = height + TOUCHDOWN_SEARCH_DEPTH;
                 if s < limit {
                     (Phase::Flare, s, vtd, 0.0)
                 } else {
@@ -310,25 +329,41 @@ impl GroundPhases {
         });
         let target = origin + Vector3::new(m.landing_target_n, m.landing_target_e, m.landing_target_d);
         let r = self.landing_reference(tm - end, &p0, &v0, &target);
-        if r.phase == Phase::Flare {
-            let down = meas.pos_ned.z >= target.z - m.landing_touchdown_tolerance;
-            let stopped = meas.vel_ned.z < 0.5 * m.landing_touchdown_rate;
-            if down && stopped {
-                if self.touch_since.is_nan() {
-                    self.touch_since = t;
-                }
-                if t - self.touch_since >= TOUCHDOWN_DWELL - 1e-9 {
-                    self.landed = true;
-                    return GroundMode::Idle {
-                        phase: Phase::Landed,
-                        thrust: 0.0,
-                    };
-                }
-            } else {
-                self.touch_since = f64::NAN;
-            }
+        if r.phase == Phase::Flare && self.detect_landing(t, meas) {
+            return GroundMode::Idle {
+                phase: Phase::Landed,
+                thrust: 0.0,
+            };
         }
         GroundMode::Vertical(r)
+    }
+
+    /// Whether the flight meets the ground: a sink is commanded (the flare) but the vertical
+    /// speed stays below [`CONTACT_SINK`] V_td while the thrust is below [`CONTACT_THRUST`]
+    /// weights and the accelerometer shows the gear carrying at least [`CONTACT_REACTION`]
+    /// of the weight (module docs). No height: the estimate's is metres off with GPS alone.
+    pub fn ground_contact(&self, meas: &Measurement) -> bool {
+        let m = &self.mission;
+        let thrust = meas.thrust / self.weight;
+        let reaction = meas.specific_force_body.x / CONTACT_GRAVITY - thrust;
+        meas.vel_ned.z.abs() < CONTACT_SINK * m.landing_touchdown_rate
+            && thrust < CONTACT_THRUST
+            && reaction > CONTACT_REACTION
+    }
+
+    /// The land detector at `t` in the flare: ground contact with the tilt rate below
+    /// [`LANDED_TILT_RATE`] held for [`LANDED_TIME`] latches the landing.
+    fn detect_landing(&mut self, t: f64, meas: &Measurement) -> bool {
+        let still = meas.rates.yz().norm() < LANDED_TILT_RATE;
+        if !(self.ground_contact(meas) && still) {
+            self.touch_since = f64::NAN;
+            return false;
+        }
+        if self.touch_since.is_nan() {
+            self.touch_since = t;
+        }
+        self.landed = t - self.touch_since >= LANDED_TIME - 1e-9;
+        self.landed
     }
 
     /// Append the state ([`Self::SAVED_LEN`] values).
@@ -534,8 +569,8 @@ mod tests {
                 if a.phase == b.phase && r.vel.norm() > 0.0 {
                     assert!(((b.pos - a.pos) / (2.0 * h) - r.vel).norm() < 1e-5, "t = {t}");
                 }
-                // Never climbs back up once descending, never below the overshoot.
-                assert!(r.pos.z <= target.z + TOUCHDOWN_OVERSHOOT + 1e-9);
+                // Never climbs back up once descending, never below the search depth.
+                assert!(r.pos.z <= target.z + TOUCHDOWN_SEARCH_DEPTH + 1e-9);
             }
             if phases.last() != Some(&r.phase) {
                 phases.push(r.phase);
@@ -546,13 +581,25 @@ mod tests {
             phases,
             [Phase::Vertical2, Phase::Approach, Phase::Descent, Phase::Flare]
         );
-        // Ends held just below the target, centred on it.
-        assert!((last.pos - (target + Vector3::new(0.0, 0.0, TOUCHDOWN_OVERSHOOT))).norm() < 1e-9);
+        // Without a touchdown it sinks on past the target at V_td (the target's height is an
+        // estimate) and ends held the search depth below it, centred on it.
+        assert!((last.pos - (target + Vector3::new(0.0, 0.0, TOUCHDOWN_SEARCH_DEPTH))).norm() < 1e-9);
         assert_eq!(last.vel, Vector3::zeros());
     }
 
+    /// A measurement in the flare: sinking at `sink` (m/s) at `height` (m) above the target
+    /// (20 m down), thrust `thrust` and specific force along x `f_x` in weights / g, tilt
+    /// rate `q` (rad/s).
+    fn flare_meas(height: f64, sink: f64, thrust: f64, f_x: f64, q: f64) -> Measurement {
+        let mut m = meas(Vector3::new(0.0, 0.0, 20.0 - height), Vector3::new(0.0, 0.0, sink));
+        m.thrust = thrust * 100.0;
+        m.specific_force_body = Vector3::new(f_x * CONTACT_GRAVITY, 0.0, 0.0);
+        m.rates = Vector3::new(0.0, q, 0.0);
+        m
+    }
+
     #[test]
-    fn touchdown_needs_the_gear_to_stop_the_sink_then_latches() {
+    fn the_land_detector_needs_ground_contact_not_the_height_then_latches() {
         let m = MissionParams {
             landing_descent_rate: 1.0,
             landing_target_d: 20.0,
@@ -565,26 +612,66 @@ mod tests {
         };
         let mut g = GroundPhases::new(m, 100.0);
         let mref = |_| (Vector3::zeros(), Vector3::zeros());
+        let air = meas(Vector3::zeros(), Vector3::zeros());
         // Find the flare.
         let mut t = 1.0;
-        while !matches!(g.clone().step(t, &meas(Vector3::zeros(), Vector3::zeros()), mref), GroundMode::Vertical(r) if r.phase == Phase::Flare)
-        {
+        while !matches!(g.clone().step(t, &air, mref), GroundMode::Vertical(r) if r.phase == Phase::Flare) {
+            // Before the flare even a resting aircraft on the gear is not landed.
+            let resting = flare_meas(0.0, 0.0, 0.5, 1.0, 0.0);
+            assert!(matches!(
+                g.clone().step(t, &resting, mref),
+                GroundMode::Vertical(_) | GroundMode::Mission { .. }
+            ));
             t += 0.02;
         }
-        // Sinking through the target height: no touchdown.
-        let sinking = meas(Vector3::new(0.0, 0.0, 19.99), Vector3::new(0.0, 0.0, 0.3));
-        assert!(matches!(g.step(t, &sinking, mref), GroundMode::Vertical(_)));
-        // Stopped 3 cm above: not down yet.
-        let hover = meas(Vector3::new(0.0, 0.0, 19.97), Vector3::zeros());
-        assert!(matches!(g.step(t + 0.2, &hover, mref), GroundMode::Vertical(_)));
-        // Stopped on the target: landed after the dwell, and stays landed.
-        let down = meas(Vector3::new(0.0, 0.0, 19.995), Vector3::new(0.0, 0.0, 0.01));
-        assert!(matches!(g.step(t + 0.3, &down, mref), GroundMode::Vertical(_)));
+        let flying = |g: &mut GroundPhases, t: f64, x: &Measurement| {
+            for k in 0..50 {
+                assert!(
+                    matches!(g.step(t + 0.02 * f64::from(k), x, mref), GroundMode::Vertical(_)),
+                    "{x:?}"
+                );
+            }
+        };
+        // On the target at the commanded sink, thrust = weight: flying.
+        flying(&mut g, t, &flare_meas(0.0, 0.3, 1.0, 1.0, 0.0));
+        // Thrust well below the weight in the air: it falls (f_x = T/m, no reaction).
+        flying(&mut g, t, &flare_meas(0.5, 0.1, 0.6, 0.6, 0.0));
+        // On the gear (the reaction carries 0.3 W) but still at hover thrust, or sinking at
+        // the commanded rate, or tipping: not landed.
+        flying(&mut g, t, &flare_meas(0.0, 0.0, 0.9, 1.0, 0.0));
+        flying(&mut g, t, &flare_meas(0.0, 0.3, 0.7, 1.0, 0.0));
+        flying(&mut g, t, &flare_meas(0.0, 0.0, 0.7, 1.0, 0.5));
+        // On the gear, thrust off, at rest: landed after LANDED_TIME wherever the estimated
+        // height puts it (1.5 m above or 1.5 m below the target), not before.
         let landed = GroundMode::Idle {
             phase: Phase::Landed,
             thrust: 0.0,
         };
-        assert_eq!(g.step(t + 0.3 + TOUCHDOWN_DWELL, &down, mref), landed);
+        for height in [1.5, -1.5] {
+            let down = flare_meas(height, 0.05, 0.7, 1.0, 0.05);
+            let mut g = g.clone();
+            let t0 = t + 2.0;
+            let mut k = 0;
+            while g.step(t0 + 0.02 * f64::from(k), &down, mref) != landed {
+                k += 1;
+                assert!(k < 100);
+            }
+            assert!((0.02 * f64::from(k) - LANDED_TIME).abs() < 0.011, "{k}");
+            // One sample without contact restarts the count.
+            let mut g2 = g.clone();
+            g2.landed = false;
+            g2.touch_since = f64::NAN;
+            g2.step(t0, &down, mref);
+            g2.step(t0 + 0.1, &flare_meas(height, 0.3, 0.7, 1.0, 0.0), mref);
+            assert!(matches!(
+                g2.step(t0 + LANDED_TIME + 0.01, &down, mref),
+                GroundMode::Vertical(_)
+            ));
+        }
+        let down = flare_meas(0.0, 0.0, 0.7, 1.0, 0.0);
+        g.step(t + 2.0, &down, mref);
+        assert_eq!(g.step(t + 2.0 + LANDED_TIME, &down, mref), landed);
+        let sinking = flare_meas(0.5, 0.3, 1.0, 1.0, 0.0);
         assert_eq!(g.step(t + 5.0, &sinking, mref), landed);
         // Round trip of the state.
         let mut saved = Vec::new();
