@@ -35,11 +35,14 @@
 //!   steady sink, thrust ≈ weight: no flare thrust to bounce on) and on past the target
 //!   until the touchdown is detected, at most [`TOUCHDOWN_SEARCH_DEPTH`] below it (the
 //!   target's height is only as good as the height estimate: with GPS alone σ ≈ 1.4 m).
-//! * [`Phase::Landed`]: latched by the land detector ([`LandDetector`]), which does not use
-//!   the height: ground contact is a commanded sink that does not happen while the thrust is
-//!   below the hover thrust and the accelerometer feels the gear carry the difference; held
-//!   for [`LANDED_TIME`], the thrust command is 0 (the controllers clamp it to their thrust
-//!   minimum), surfaces centred, held for good.
+//! * [`Phase::Landed`]: latched by the land detector, which does not use the height: while a
+//!   sink is commanded (descent, flare), a ground contact — the accelerometer's specific
+//!   force along the thrust axis exceeds the thrust's share, `f_x/g − T/(m g)` >
+//!   [`CONTACT_REACTION`]: the gear carries part of the weight, at the impact or as the
+//!   controller takes thrust off — followed by the sink stopping (|v_d| < [`LANDED_SINK`]
+//!   V_td, tilt rate < [`LANDED_TILT_RATE`], for [`TOUCHDOWN_DWELL`]). Then the thrust
+//!   command is 0 (the controllers clamp it to their thrust minimum), surfaces centred, held
+//!   for good.
 //!
 //! The reference attitude in the vertical phases here is the mission's vertical one
 //! (nose up, belly north); while descending the air comes from behind, α = π.
@@ -67,22 +70,24 @@ pub const LANDING_FLAP_TRIM_LIMIT: f64 = 17.0 * core::f64::consts::PI / 180.0;
 pub const TOUCHDOWN_SEARCH_DEPTH: f64 = 5.0;
 /// Time flown at the touchdown rate before the target, after the flare (s).
 pub const FINAL_SEGMENT_TIME: f64 = 1.0;
-/// Ground contact: largest thrust, in weights (–). The hover thrust is the weight and some
-/// (the slipstream's drag on the wing); on the gear the controllers, whose reference keeps
-/// sinking, take thrust off.
-pub const CONTACT_THRUST: f64 = 0.8;
 /// Ground contact: least share of the weight the gear carries, `f_x/g − T/(m g)` from the
 /// accelerometer's specific force along the thrust axis f_x and the thrust T (–). In the air
-/// it is the aerodynamic force along x (the wing's drag in the slipstream: ≤ 0); a thrust
-/// below the weight in the air shows as a fall (f_x ≈ T/m), not as a reaction.
+/// it is the aerodynamic force along x (the wing's drag in the slipstream: −0.02…−0.05 in the
+/// flare); a thrust below the weight in the air shows as a fall (f_x ≈ T/m), not as a
+/// reaction. At the touchdown the gear's spring stops the sink (0.8 at 0.25 m/s); at rest it
+/// carries what the controller, whose reference keeps sinking, takes off the thrust.
 pub const CONTACT_REACTION: f64 = 0.1;
-/// Ground contact: largest vertical speed, in touchdown rates V_td (–): the commanded sink
-/// does not happen.
-pub const CONTACT_SINK: f64 = 1.0;
-/// Landed: largest tilt rate |(q, r)| (rad/s) (the gear is not rocking or tipping).
-pub const LANDED_TILT_RATE: f64 = 20.0 * core::f64::consts::PI / 180.0;
-/// Time ground contact (and the tilt rate) must hold before the landing is declared (s).
-pub const LANDED_TIME: f64 = 0.3;
+/// How long a ground contact counts for the landing (s): the impact's reaction lasts a few
+/// samples, the sink must have stopped by the end.
+pub const CONTACT_MEMORY: f64 = 0.5;
+/// Largest vertical speed of a landing, in touchdown rates V_td (–): the commanded sink does
+/// not happen.
+pub const LANDED_SINK: f64 = 0.5;
+/// Largest tilt rate |(q, r)| of a landing (rad/s): the gear is not rocking or tipping.
+pub const LANDED_TILT_RATE: f64 = 40.0 * core::f64::consts::PI / 180.0;
+/// Time the sink must have stopped (and the tilt rate be small) after a ground contact
+/// before the landing is declared (s): two samples at 20 ms.
+pub const TOUCHDOWN_DWELL: f64 = 0.04;
 /// Gravity of the contact test (m/s²): the airframes' g (C.1).
 pub const CONTACT_GRAVITY: f64 = 9.81;
 
@@ -121,8 +126,10 @@ pub struct GroundPhases {
     origin: Option<Vector3<f64>>,
     /// Reference position and velocity at the end of the mission (start of the approach).
     approach_start: Option<(Vector3<f64>, Vector3<f64>)>,
-    /// Time since which ground contact holds (NaN: it does not).
+    /// Time since which the landing's conditions hold (NaN: they do not).
     touch_since: f64,
+    /// Time of the last ground contact (NaN: none).
+    contact_at: f64,
     landed: bool,
 }
 
@@ -135,7 +142,7 @@ fn ramp(v: f64, t_r: f64, tau: f64) -> (f64, f64, f64) {
 
 impl GroundPhases {
     /// Number of values [`Self::save`] writes.
-    pub const SAVED_LEN: usize = 13;
+    pub const SAVED_LEN: usize = 14;
 
     /// The phase logic of `mission` for an airframe of weight `weight` (N).
     pub fn new(mission: MissionParams, weight: f64) -> Self {
@@ -145,6 +152,7 @@ impl GroundPhases {
             origin: None,
             approach_start: None,
             touch_since: f64::NAN,
+            contact_at: f64::NAN,
             landed: false,
         }
     }
@@ -329,7 +337,7 @@ impl GroundPhases {
         });
         let target = origin + Vector3::new(m.landing_target_n, m.landing_target_e, m.landing_target_d);
         let r = self.landing_reference(tm - end, &p0, &v0, &target);
-        if r.phase == Phase::Flare && self.detect_landing(t, meas) {
+        if matches!(r.phase, Phase::Descent | Phase::Flare) && self.detect_landing(t, meas) {
             return GroundMode::Idle {
                 phase: Phase::Landed,
                 thrust: 0.0,
@@ -338,31 +346,30 @@ impl GroundPhases {
         GroundMode::Vertical(r)
     }
 
-    /// Whether the flight meets the ground: a sink is commanded (the flare) but the vertical
-    /// speed stays below [`CONTACT_SINK`] V_td while the thrust is below [`CONTACT_THRUST`]
-    /// weights and the accelerometer shows the gear carrying at least [`CONTACT_REACTION`]
+    /// Ground contact: the accelerometer feels the gear carry at least [`CONTACT_REACTION`]
     /// of the weight (module docs). No height: the estimate's is metres off with GPS alone.
     pub fn ground_contact(&self, meas: &Measurement) -> bool {
-        let m = &self.mission;
-        let thrust = meas.thrust / self.weight;
-        let reaction = meas.specific_force_body.x / CONTACT_GRAVITY - thrust;
-        meas.vel_ned.z.abs() < CONTACT_SINK * m.landing_touchdown_rate
-            && thrust < CONTACT_THRUST
-            && reaction > CONTACT_REACTION
+        meas.specific_force_body.x / CONTACT_GRAVITY - meas.thrust / self.weight > CONTACT_REACTION
     }
 
-    /// The land detector at `t` in the flare: ground contact with the tilt rate below
-    /// [`LANDED_TILT_RATE`] held for [`LANDED_TIME`] latches the landing.
+    /// The land detector at `t` while a sink is commanded (descent and flare): a ground
+    /// contact within the last [`CONTACT_MEMORY`], the vertical speed below [`LANDED_SINK`]
+    /// V_td and the tilt rate below [`LANDED_TILT_RATE`] for [`TOUCHDOWN_DWELL`] latch the
+    /// landing.
     fn detect_landing(&mut self, t: f64, meas: &Measurement) -> bool {
-        let still = meas.rates.yz().norm() < LANDED_TILT_RATE;
-        if !(self.ground_contact(meas) && still) {
+        if self.ground_contact(meas) {
+            self.contact_at = t;
+        }
+        let still = meas.vel_ned.z.abs() < LANDED_SINK * self.mission.landing_touchdown_rate
+            && meas.rates.yz().norm() < LANDED_TILT_RATE;
+        if !(still && t - self.contact_at <= CONTACT_MEMORY + 1e-9) {
             self.touch_since = f64::NAN;
             return false;
         }
         if self.touch_since.is_nan() {
             self.touch_since = t;
         }
-        self.landed = t - self.touch_since >= LANDED_TIME - 1e-9;
+        self.landed = t - self.touch_since >= TOUCHDOWN_DWELL - 1e-9;
         self.landed
     }
 
@@ -380,6 +387,7 @@ impl GroundPhases {
         }
         out(self.touch_since);
         out(f64::from(u8::from(self.landed)));
+        out(self.contact_at);
     }
 
     /// Restore what [`Self::save`] wrote; `None` if values are missing.
@@ -392,6 +400,7 @@ impl GroundPhases {
         self.approach_start = (v[4] != 0.0).then(|| (Vector3::new(v[5], v[6], v[7]), Vector3::new(v[8], v[9], v[10])));
         self.touch_since = v[11];
         self.landed = v[12] != 0.0;
+        self.contact_at = v[13];
         Some(())
     }
 }
@@ -613,15 +622,12 @@ mod tests {
         let mut g = GroundPhases::new(m, 100.0);
         let mref = |_| (Vector3::zeros(), Vector3::zeros());
         let air = meas(Vector3::zeros(), Vector3::zeros());
+        // Before the descent even a resting aircraft on the gear is not landed.
+        let resting = flare_meas(0.0, 0.0, 0.5, 1.0, 0.0);
+        assert!(matches!(g.clone().step(1.0, &resting, mref), GroundMode::Vertical(r) if r.phase == Phase::Approach));
         // Find the flare.
         let mut t = 1.0;
         while !matches!(g.clone().step(t, &air, mref), GroundMode::Vertical(r) if r.phase == Phase::Flare) {
-            // Before the flare even a resting aircraft on the gear is not landed.
-            let resting = flare_meas(0.0, 0.0, 0.5, 1.0, 0.0);
-            assert!(matches!(
-                g.clone().step(t, &resting, mref),
-                GroundMode::Vertical(_) | GroundMode::Mission { .. }
-            ));
             t += 0.02;
         }
         let flying = |g: &mut GroundPhases, t: f64, x: &Measurement| {
@@ -632,21 +638,19 @@ mod tests {
                 );
             }
         };
-        // On the target at the commanded sink, thrust = weight: flying.
-        flying(&mut g, t, &flare_meas(0.0, 0.3, 1.0, 1.0, 0.0));
-        // Thrust well below the weight in the air: it falls (f_x = T/m, no reaction).
+        // Holding a height (sink stopped) at hover thrust, or well below it while falling
+        // (f_x = T/m, no reaction), or with the wing's drag (−0.05): flying.
+        flying(&mut g, t, &flare_meas(0.0, 0.0, 1.03, 0.98, 0.0));
         flying(&mut g, t, &flare_meas(0.5, 0.1, 0.6, 0.6, 0.0));
-        // On the gear (the reaction carries 0.3 W) but still at hover thrust, or sinking at
-        // the commanded rate, or tipping: not landed.
-        flying(&mut g, t, &flare_meas(0.0, 0.0, 0.9, 1.0, 0.0));
+        // The gear carries 0.3 W but the aircraft sinks at the commanded rate, or tips: not landed.
         flying(&mut g, t, &flare_meas(0.0, 0.3, 0.7, 1.0, 0.0));
-        flying(&mut g, t, &flare_meas(0.0, 0.0, 0.7, 1.0, 0.5));
-        // On the gear, thrust off, at rest: landed after LANDED_TIME wherever the estimated
-        // height puts it (1.5 m above or 1.5 m below the target), not before.
+        flying(&mut g, t, &flare_meas(0.0, 0.0, 0.7, 1.0, 1.0));
         let landed = GroundMode::Idle {
             phase: Phase::Landed,
             thrust: 0.0,
         };
+        // On the gear at rest, thrust taken off: landed after the dwell wherever the
+        // estimated height puts it (1.5 m above or below the target).
         for height in [1.5, -1.5] {
             let down = flare_meas(height, 0.05, 0.7, 1.0, 0.05);
             let mut g = g.clone();
@@ -656,23 +660,32 @@ mod tests {
                 k += 1;
                 assert!(k < 100);
             }
-            assert!((0.02 * f64::from(k) - LANDED_TIME).abs() < 0.011, "{k}");
-            // One sample without contact restarts the count.
-            let mut g2 = g.clone();
-            g2.landed = false;
-            g2.touch_since = f64::NAN;
-            g2.step(t0, &down, mref);
-            g2.step(t0 + 0.1, &flare_meas(height, 0.3, 0.7, 1.0, 0.0), mref);
-            assert!(matches!(
-                g2.step(t0 + LANDED_TIME + 0.01, &down, mref),
-                GroundMode::Vertical(_)
-            ));
+            assert_eq!(k, 2);
         }
+        // An impact: the gear's spring stops the sink (one sample of reaction), the sink stays
+        // stopped at hover thrust: landed after the dwell, within the contact memory.
+        let t1 = t + 4.0;
+        let mut gi = g.clone();
+        let still = flare_meas(0.0, 0.02, 1.0, 1.0, 0.0);
+        assert!(matches!(
+            gi.step(t1, &flare_meas(0.0, 0.2, 1.0, 1.8, 0.0), mref),
+            GroundMode::Vertical(_)
+        ));
+        assert!(matches!(gi.step(t1 + 0.02, &still, mref), GroundMode::Vertical(_)));
+        assert!(matches!(gi.step(t1 + 0.04, &still, mref), GroundMode::Vertical(_)));
+        assert_eq!(gi.step(t1 + 0.06, &still, mref), landed);
+        // The same impact followed by a still hover past the memory: forgotten.
+        let mut gi = g.clone();
+        gi.step(t1, &flare_meas(0.0, 0.2, 1.0, 1.8, 0.0), mref);
+        gi.step(t1 + 0.02, &flare_meas(0.0, 0.2, 1.0, 1.0, 0.0), mref);
+        flying(&mut gi, t1 + CONTACT_MEMORY + 0.02, &still);
+        // Latched for good.
         let down = flare_meas(0.0, 0.0, 0.7, 1.0, 0.0);
-        g.step(t + 2.0, &down, mref);
-        assert_eq!(g.step(t + 2.0 + LANDED_TIME, &down, mref), landed);
+        g.step(t + 6.0, &down, mref);
+        g.step(t + 6.02, &down, mref);
+        assert_eq!(g.step(t + 6.04, &down, mref), landed);
         let sinking = flare_meas(0.5, 0.3, 1.0, 1.0, 0.0);
-        assert_eq!(g.step(t + 5.0, &sinking, mref), landed);
+        assert_eq!(g.step(t + 7.0, &sinking, mref), landed);
         // Round trip of the state.
         let mut saved = Vec::new();
         g.save(&mut |x| saved.push(x));
