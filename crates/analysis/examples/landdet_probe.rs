@@ -1,7 +1,7 @@
 //! The land detector's inputs around the touchdown of one take-off-to-landing cell (a
 //! development probe): `landdet_probe lqr|tsd SPEED BEARING_INDEX [avionics] [jacobi]`.
 //! Prints, from the flare on, per sample: t, phase, the true CG height above its rest height
-//! at the target and the estimate's, true and measured vertical speed, the measured thrust
+//! at the target, the estimate's and the reference's, true and measured vertical speed, the measured thrust
 //! and the gear's share of the weight (f_x/g − T/W) the detector sees, the tilt rate, the
 //! plant's contact points; then the flight's touchdown figures.
 use analysis::controllers::Kind;
@@ -94,6 +94,8 @@ fn main() {
     let mut c = kind.make_configured(&mission, 0).expect("controller");
     let mut stop = takeoff_landing::after_landing();
     let mut printing = false;
+    // The controller's frame: NED, or relative to the start with the tuned estimator.
+    let frame = if has("avionics") { origin.z } else { 0.0 };
     let trace = fly_with(&plant, x0, &mut c, &scenario, &mut src, |s| {
         let m = last.borrow().unwrap_or(s.measurement);
         printing |= s.diagnostics.phase == Phase::Flare;
@@ -102,11 +104,12 @@ fn main() {
                 .outputs(&s.x, &closed_loop::plant_inputs(&s.command), &s.wind)
                 .ground;
             println!(
-                "{:7.2} {:?} h T{:6.3} E{:6.3} vz T{:6.3} E{:6.3} T/W{:5.2} gear{:6.2} qr{:6.3} pts {} cmd{:6.1}",
+                "{:7.2} {:?} h T{:6.3} E{:6.3} R{:6.3} vz T{:6.3} E{:6.3} T/W{:5.2} gear{:6.2} qr{:6.3} pts {} cmd{:6.1}",
                 s.t,
                 s.diagnostics.phase,
                 target.z - s.x[idx::POS_D],
                 target.z - m.pos_ned.z,
+                target.z - frame - s.diagnostics.ref_pos_ned.z,
                 s.measurement.vel_ned.z,
                 m.vel_ned.z,
                 m.thrust / weight,

@@ -32,9 +32,10 @@
 //! * [`Phase::Flare`]: the sink rate falls linearly in time from V_d to the touchdown rate
 //!   V_td over `t_f = 2 (h_f − h_td)/(V_d + V_td)` (covering h_f − h_td), then stays at V_td
 //!   over the last `h_td = V_td ·` [`FINAL_SEGMENT_TIME`] (the gear meets the ground at a
-//!   steady sink, thrust ≈ weight: no flare thrust to bounce on) and on past the target
-//!   until the touchdown is detected, at most [`TOUCHDOWN_SEARCH_DEPTH`] below it (the
-//!   target's height is only as good as the height estimate: with GPS alone σ ≈ 1.4 m).
+//!   steady sink, thrust ≈ weight: no flare thrust to bounce on), on to
+//!   [`TOUCHDOWN_OVERSHOOT`] below the target and then slower ([`TOUCHDOWN_SEARCH_RATE`])
+//!   until the touchdown is detected, at most [`TOUCHDOWN_SEARCH_DEPTH`] below the target
+//!   (its height is only as good as the height estimate: with GPS alone σ ≈ 1.4 m).
 //! * [`Phase::Landed`]: latched by the land detector, which does not use the height: while a
 //!   sink is commanded (descent, flare), a ground contact — the accelerometer's specific
 //!   force along the thrust axis exceeds the thrust's share, `f_x/g − T/(m g)` >
@@ -68,6 +69,12 @@ pub const LANDING_FLAP_TRIM_LIMIT: f64 = 17.0 * core::f64::consts::PI / 180.0;
 /// is not detected before (m): three σ of the height relative to the start that GPS alone
 /// gives at the landing (≈ 1.4 m, σ 4 m fixes at 4 Hz), and some.
 pub const TOUCHDOWN_SEARCH_DEPTH: f64 = 5.0;
+/// How far the touchdown reference sinks below the target at the touchdown rate before it
+/// slows to [`TOUCHDOWN_SEARCH_RATE`] (m).
+pub const TOUCHDOWN_OVERSHOOT: f64 = 0.3;
+/// Sink rate of the touchdown reference beyond [`TOUCHDOWN_OVERSHOOT`], in touchdown rates
+/// (–): the ground is near, the gear meets it slower.
+pub const TOUCHDOWN_SEARCH_RATE: f64 = 1.0 / 3.0;
 /// Time flown at the touchdown rate before the target, after the flare (s).
 pub const FINAL_SEGMENT_TIME: f64 = 1.0;
 /// Ground contact: least share of the weight the gear carries, `f_x/g − T/(m g)` from the
@@ -131,6 +138,24 @@ pub struct GroundPhases {
     /// Time of the last ground contact (NaN: none).
     contact_at: f64,
     landed: bool,
+}
+
+/// The touchdown reference below the target (m, + down) and its sink rate (m/s), `x` (s)
+/// after it passed `s0` (m) sinking at `vtd` (m/s): at `vtd` to [`TOUCHDOWN_OVERSHOOT`], then
+/// at [`TOUCHDOWN_SEARCH_RATE`] `vtd` to [`TOUCHDOWN_SEARCH_DEPTH`], where it holds.
+fn touchdown_search(s0: f64, vtd: f64, x: f64) -> (f64, f64) {
+    let s = s0 + vtd * x;
+    if s < TOUCHDOWN_OVERSHOOT {
+        return (s, vtd);
+    }
+    let x1 = (TOUCHDOWN_OVERSHOOT - s0).max(0.0) / vtd;
+    let v = TOUCHDOWN_SEARCH_RATE * vtd;
+    let s = s0.max(TOUCHDOWN_OVERSHOOT) + v * (x - x1);
+    if s < TOUCHDOWN_SEARCH_DEPTH {
+        (s, v)
+    } else {
+        (TOUCHDOWN_SEARCH_DEPTH, 0.0)
+    }
 }
 
 /// Cosine ramp from rest to `v` over `t_r`: (distance, speed, acceleration) at τ ∈ [0, t_r].
@@ -264,13 +289,8 @@ impl GroundPhases {
                 let k = (vd - vtd) / t_flare;
                 (Phase::Flare, s0 + vd * x - 0.5 * k * x * x, vd - k * x, -k)
             } else {
-                let s = s0 + d_flare + vtd * (x - t_flare);
-                let limit = height + TOUCHDOWN_SEARCH_DEPTH;
-                if s < limit {
-                    (Phase::Flare, s, vtd, 0.0)
-                } else {
-                    (Phase::Flare, limit, 0.0, 0.0)
-                }
+                let (s, v) = touchdown_search(s0 + d_flare - height, vtd, x - t_flare);
+                (Phase::Flare, height + s, v, 0.0)
             }
         };
         VerticalReference {
@@ -564,9 +584,10 @@ mod tests {
             t += 0.01;
             let r = reference(&mut g, t);
             assert!((r.pos - last.pos).norm() < 0.01 * 3.2 + 1e-9, "position jump at {t}");
-            // (The one velocity step: the hold below the target, reached only if the
-            // touchdown is never detected.)
-            let held = r.vel == Vector3::zeros() && r.phase == Phase::Flare;
+            // (The velocity steps: to the search rate below the target and the hold at the
+            // search depth, reached only if the touchdown is never detected.)
+            let search = (r.vel.z - TOUCHDOWN_SEARCH_RATE * m.landing_touchdown_rate).abs() < 1e-12;
+            let held = (r.vel == Vector3::zeros() || search) && r.phase == Phase::Flare;
             assert!(
                 held || (r.vel - last.vel).norm() < 0.01 * 2.0,
                 "velocity jump at {t}: {:?} {:?}",
