@@ -71,8 +71,9 @@ pub fn stop_time(mission: &MissionParams) -> f64 {
     let climb = 400.0;
     let approach =
         1.5 * (mission.landing_target_n.hypot(mission.landing_target_e) + 50.0) / mission.landing_approach_speed;
-    let search = guidance::ground::TOUCHDOWN_SEARCH_DEPTH
-        / (guidance::ground::TOUCHDOWN_SEARCH_RATE * mission.landing_touchdown_rate);
+    use guidance::ground::{TOUCHDOWN_HOLD_TIME, TOUCHDOWN_SEARCH_DEPTH, TOUCHDOWN_SEARCH_RATE};
+    let search =
+        TOUCHDOWN_HOLD_TIME + TOUCHDOWN_SEARCH_DEPTH / (TOUCHDOWN_SEARCH_RATE * mission.landing_touchdown_rate);
     g.mission_start() + mission.end_time() + approach + climb / mission.landing_descent_rate + search + 20.0
 }
 

@@ -33,8 +33,8 @@
 //!   V_td over `t_f = 2 (h_f − h_td)/(V_d + V_td)` (covering h_f − h_td), then stays at V_td
 //!   over the last `h_td = V_td ·` [`FINAL_SEGMENT_TIME`] (the gear meets the ground at a
 //!   steady sink, thrust ≈ weight: no flare thrust to bounce on), on to
-//!   [`TOUCHDOWN_OVERSHOOT`] below the target and then slower ([`TOUCHDOWN_SEARCH_RATE`])
-//!   until the touchdown is detected, at most [`TOUCHDOWN_SEARCH_DEPTH`] below the target
+//!   [`TOUCHDOWN_OVERSHOOT`] below the target, held there for [`TOUCHDOWN_HOLD_TIME`], then
+//!   slower ([`TOUCHDOWN_SEARCH_RATE`]) until the touchdown is detected, at most [`TOUCHDOWN_SEARCH_DEPTH`] below the target
 //!   (its height is only as good as the height estimate: with GPS alone σ ≈ 1.4 m).
 //! * [`Phase::Landed`]: latched by the land detector, which does not use the height: while a
 //!   sink is commanded (descent, flare), a ground contact — the accelerometer's specific
@@ -72,7 +72,10 @@ pub const TOUCHDOWN_SEARCH_DEPTH: f64 = 5.0;
 /// How far the touchdown reference sinks below the target at the touchdown rate before it
 /// slows to [`TOUCHDOWN_SEARCH_RATE`] (m).
 pub const TOUCHDOWN_OVERSHOOT: f64 = 0.3;
-/// Sink rate of the touchdown reference beyond [`TOUCHDOWN_OVERSHOOT`], in touchdown rates
+/// Time the touchdown reference holds at [`TOUCHDOWN_OVERSHOOT`] before it searches deeper (s):
+/// with a good height measurement the controllers settle onto the gear there.
+pub const TOUCHDOWN_HOLD_TIME: f64 = 10.0;
+/// Sink rate of the touchdown reference after [`TOUCHDOWN_HOLD_TIME`], in touchdown rates
 /// (–): the ground is near, the gear meets it slower.
 pub const TOUCHDOWN_SEARCH_RATE: f64 = 1.0 / 3.0;
 /// Time flown at the touchdown rate before the target, after the flare (s).
@@ -141,16 +144,21 @@ pub struct GroundPhases {
 }
 
 /// The touchdown reference below the target (m, + down) and its sink rate (m/s), `x` (s)
-/// after it passed `s0` (m) sinking at `vtd` (m/s): at `vtd` to [`TOUCHDOWN_OVERSHOOT`], then
-/// at [`TOUCHDOWN_SEARCH_RATE`] `vtd` to [`TOUCHDOWN_SEARCH_DEPTH`], where it holds.
+/// after it passed `s0` (m) sinking at `vtd` (m/s): at `vtd` to [`TOUCHDOWN_OVERSHOOT`], held
+/// there for [`TOUCHDOWN_HOLD_TIME`] (where the ground is when the height is measured well),
+/// then at [`TOUCHDOWN_SEARCH_RATE`] `vtd` to [`TOUCHDOWN_SEARCH_DEPTH`], where it holds.
 fn touchdown_search(s0: f64, vtd: f64, x: f64) -> (f64, f64) {
     let s = s0 + vtd * x;
     if s < TOUCHDOWN_OVERSHOOT {
         return (s, vtd);
     }
-    let x1 = (TOUCHDOWN_OVERSHOOT - s0).max(0.0) / vtd;
+    let x1 = (TOUCHDOWN_OVERSHOOT - s0).max(0.0) / vtd + TOUCHDOWN_HOLD_TIME;
+    let s1 = s0.max(TOUCHDOWN_OVERSHOOT);
+    if x < x1 {
+        return (s1, 0.0);
+    }
     let v = TOUCHDOWN_SEARCH_RATE * vtd;
-    let s = s0.max(TOUCHDOWN_OVERSHOOT) + v * (x - x1);
+    let s = s1 + v * (x - x1);
     if s < TOUCHDOWN_SEARCH_DEPTH {
         (s, v)
     } else {
