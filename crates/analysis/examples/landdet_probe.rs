@@ -1,9 +1,10 @@
 //! The land detector's inputs around the touchdown of one take-off-to-landing cell (a
-//! development probe): `landdet_probe lqr|tsd SPEED BEARING_INDEX [avionics] [jacobi]`.
+//! development probe): `landdet_probe lqr|tsd SPEED BEARING_INDEX [avionics] [jacobi] [quiet]`.
 //! Prints, from the flare on, per sample: t, phase, the true CG height above its rest height
 //! at the target, the estimate's and the reference's, true and measured vertical speed, the measured thrust
 //! and the gear's share of the weight (f_x/g − T/W) the detector sees, the tilt rate, the
-//! plant's contact points; then the flight's touchdown figures.
+//! plant's contact points (`quiet`: none of these); then the largest gear share seen in the
+//! air in the descent and flare and the flight's touchdown figures.
 use analysis::controllers::Kind;
 use analysis::takeoff_landing;
 use analysis::wind_envelope::{plant, seed, wind, WindForm};
@@ -94,15 +95,24 @@ fn main() {
     let mut c = kind.make_configured(&mission, 0).expect("controller");
     let mut stop = takeoff_landing::after_landing();
     let mut printing = false;
+    // Largest gear share the detector saw in the descent and flare before the first contact.
+    let mut air_share = f64::NEG_INFINITY;
+    let mut touched = false;
+    let quiet = has("quiet");
     // The controller's frame: NED, or relative to the start with the tuned estimator.
     let frame = if has("avionics") { origin.z } else { 0.0 };
     let trace = fly_with(&plant, x0, &mut c, &scenario, &mut src, |s| {
         let m = last.borrow().unwrap_or(s.measurement);
         printing |= s.diagnostics.phase == Phase::Flare;
-        if printing {
-            let contact = plant
-                .outputs(&s.x, &closed_loop::plant_inputs(&s.command), &s.wind)
-                .ground;
+        let contact = plant
+            .outputs(&s.x, &closed_loop::plant_inputs(&s.command), &s.wind)
+            .ground;
+        let share = m.specific_force_body.x / CONTACT_GRAVITY - m.thrust / weight;
+        touched |= contact.points > 0 && matches!(s.diagnostics.phase, Phase::Descent | Phase::Flare);
+        if !touched && matches!(s.diagnostics.phase, Phase::Descent | Phase::Flare) {
+            air_share = air_share.max(share);
+        }
+        if printing && !quiet {
             println!(
                 "{:7.2} {:?} h T{:6.3} E{:6.3} R{:6.3} vz T{:6.3} E{:6.3} T/W{:5.2} gear{:6.2} qr{:6.3} pts {} cmd{:6.1}",
                 s.t,
@@ -113,7 +123,7 @@ fn main() {
                 s.measurement.vel_ned.z,
                 m.vel_ned.z,
                 m.thrust / weight,
-                m.specific_force_body.x / CONTACT_GRAVITY - m.thrust / weight,
+                share,
                 m.rates.yz().norm(),
                 contact.points,
                 s.command.thrust,
@@ -123,7 +133,7 @@ fn main() {
     });
     let f = takeoff_landing::evaluate(&plant, kind, ordering, &mission, &trace);
     println!(
-        "touchdown {:?} landed {:?} speed {:.3} miss {:.3}/{:.3} tilt {:.1}/{:.1} bounced {} rebound {:.4} passed {} failure {:?}",
+        "air share max {air_share:.3} touchdown {:?} landed {:?} speed {:.3} miss {:.3}/{:.3} tilt {:.1}/{:.1} bounced {} rebound {:.4} passed {} failure {:?}",
         f.touchdown_time,
         f.landed_time,
         f.touchdown_speed,
