@@ -37,9 +37,10 @@
 //!   slower ([`TOUCHDOWN_SEARCH_RATE`]) until the touchdown is detected, at most [`TOUCHDOWN_SEARCH_DEPTH`] below the target
 //!   (its height is only as good as the height estimate: with GPS alone σ ≈ 1.4 m).
 //! * [`Phase::Landed`]: latched by the land detector, which does not use the height: while a
-//!   sink is commanded (descent, flare), a ground contact — the accelerometer's specific
-//!   force along the thrust axis exceeds the thrust's share, `f_x/g − T/(m g)` >
-//!   [`CONTACT_REACTION`]: the gear carries part of the weight, at the impact or as the
+//!   sink is commanded (descent, flare), a ground contact — the gear's share of the weight
+//!   by the accelerometer, `f_x/g − T/(m g)` (specific force along the thrust axis against
+//!   the thrust), rises above its mean in the air by [`CONTACT_REACTION`] and
+//!   [`CONTACT_SIGMAS`] of its spread: the gear carries weight, at the impact or as the
 //!   controller takes thrust off — followed by the sink stopping (|v_d| < [`LANDED_SINK`]
 //!   V_td, tilt rate < [`LANDED_TILT_RATE`], for [`TOUCHDOWN_DWELL`]). Then the thrust
 //!   command is 0 (the controllers clamp it to their thrust minimum), surfaces centred, held
@@ -80,14 +81,20 @@ pub const TOUCHDOWN_HOLD_TIME: f64 = 10.0;
 pub const TOUCHDOWN_SEARCH_RATE: f64 = 1.0 / 3.0;
 /// Time flown at the touchdown rate before the target, after the flare (s).
 pub const FINAL_SEGMENT_TIME: f64 = 1.0;
-/// Ground contact: least share of the weight the gear carries, `f_x/g − T/(m g)` from the
-/// accelerometer's specific force along the thrust axis f_x and the thrust T (–). In the air
-/// it is the aerodynamic force along x (the wing's drag in the slipstream: −0.02…−0.05 in the
-/// flare); a thrust below the weight in the air shows as a fall (f_x ≈ T/m), not as a
-/// reaction. At the touchdown the gear's spring stops the sink (0.8 at 0.25 m/s on four legs,
-/// 0.09 at 0.09 m/s on one); at rest it
-/// carries what the controller, whose reference keeps sinking, takes off the thrust.
+/// Ground contact: least rise of the gear's share of the weight, `f_x/g − T/(m g)` from the
+/// accelerometer's specific force along the thrust axis f_x and the thrust T, above its mean
+/// in the air (–). In the air the share is the aerodynamic force along x (the wing's drag in
+/// the slipstream: −0.06…−0.02 in the flares) and the estimate's noise; a thrust below the
+/// weight in the air shows as a fall (f_x ≈ T/m), not as a reaction. At the touchdown the
+/// gear's spring stops the sink (+0.8 at 0.25 m/s on four legs, +0.09 for 0.1 s at 0.07 m/s
+/// on one); at rest it carries what the controller, whose reference keeps sinking, takes off
+/// the thrust.
 pub const CONTACT_REACTION: f64 = 0.05;
+/// Ground contact: least rise of the gear's share in standard deviations of its spread in
+/// the air (–): with the avionics chain's noise (σ ≈ 0.01–0.02) the rise must be larger.
+pub const CONTACT_SIGMAS: f64 = 5.0;
+/// Time constant of the gear share's mean and spread in the air (s).
+pub const SHARE_TIME: f64 = 2.0;
 /// How long a ground contact counts for the landing (s): the impact's reaction lasts a few
 /// samples, the sink must have stopped by the end.
 pub const CONTACT_MEMORY: f64 = 0.5;
@@ -141,6 +148,11 @@ pub struct GroundPhases {
     touch_since: f64,
     /// Time of the last ground contact (NaN: none).
     contact_at: f64,
+    /// The gear's share in the air: exponential mean, variance, time of the last sample
+    /// (NaN: none yet).
+    share_mean: f64,
+    share_var: f64,
+    share_t: f64,
     landed: bool,
 }
 
@@ -176,7 +188,7 @@ fn ramp(v: f64, t_r: f64, tau: f64) -> (f64, f64, f64) {
 
 impl GroundPhases {
     /// Number of values [`Self::save`] writes.
-    pub const SAVED_LEN: usize = 14;
+    pub const SAVED_LEN: usize = 17;
 
     /// The phase logic of `mission` for an airframe of weight `weight` (N).
     pub fn new(mission: MissionParams, weight: f64) -> Self {
@@ -187,6 +199,9 @@ impl GroundPhases {
             approach_start: None,
             touch_since: f64::NAN,
             contact_at: f64::NAN,
+            share_mean: f64::NAN,
+            share_var: f64::NAN,
+            share_t: f64::NAN,
             landed: false,
         }
     }
@@ -375,10 +390,37 @@ impl GroundPhases {
         GroundMode::Vertical(r)
     }
 
-    /// Ground contact: the accelerometer feels the gear carry at least [`CONTACT_REACTION`]
-    /// of the weight (module docs). No height: the estimate's is metres off with GPS alone.
+    /// The share of the weight the gear carries by the accelerometer, `f_x/g − T/(m g)` (–).
+    pub fn gear_share(&self, meas: &Measurement) -> f64 {
+        meas.specific_force_body.x / CONTACT_GRAVITY - meas.thrust / self.weight
+    }
+
+    /// Ground contact: the gear's share ([`Self::gear_share`]) above its mean in the air by
+    /// at least [`CONTACT_REACTION`] and [`CONTACT_SIGMAS`] of its spread there (module docs;
+    /// the air's is the wing's drag and the estimate's noise). No height: the estimate's is
+    /// metres off with GPS alone.
     pub fn ground_contact(&self, meas: &Measurement) -> bool {
-        meas.specific_force_body.x / CONTACT_GRAVITY - meas.thrust / self.weight > CONTACT_REACTION
+        let (mean, var) = if self.share_mean.is_nan() {
+            (0.0, 0.0)
+        } else {
+            (self.share_mean, self.share_var)
+        };
+        self.gear_share(meas) - mean > CONTACT_REACTION.max(CONTACT_SIGMAS * var.sqrt())
+    }
+
+    /// Track the gear's share in the air (no contact): exponential mean and variance over
+    /// [`SHARE_TIME`].
+    fn track_share(&mut self, t: f64, meas: &Measurement) {
+        let x = self.gear_share(meas);
+        if self.share_mean.is_nan() {
+            (self.share_mean, self.share_var) = (x, 0.0);
+        } else {
+            let a = ((t - self.share_t) / SHARE_TIME).clamp(0.0, 1.0);
+            let d = x - self.share_mean;
+            self.share_mean += a * d;
+            self.share_var = (1.0 - a) * (self.share_var + a * d * d);
+        }
+        self.share_t = t;
     }
 
     /// The land detector at `t` while a sink is commanded (descent and flare): a ground
@@ -388,6 +430,8 @@ impl GroundPhases {
     fn detect_landing(&mut self, t: f64, meas: &Measurement) -> bool {
         if self.ground_contact(meas) {
             self.contact_at = t;
+        } else {
+            self.track_share(t, meas);
         }
         let still = meas.vel_ned.z.abs() < LANDED_SINK * self.mission.landing_touchdown_rate
             && meas.rates.yz().norm() < LANDED_TILT_RATE;
@@ -417,6 +461,9 @@ impl GroundPhases {
         out(self.touch_since);
         out(f64::from(u8::from(self.landed)));
         out(self.contact_at);
+        out(self.share_mean);
+        out(self.share_var);
+        out(self.share_t);
     }
 
     /// Restore what [`Self::save`] wrote; `None` if values are missing.
@@ -430,6 +477,7 @@ impl GroundPhases {
         self.touch_since = v[11];
         self.landed = v[12] != 0.0;
         self.contact_at = v[13];
+        (self.share_mean, self.share_var, self.share_t) = (v[14], v[15], v[16]);
         Some(())
     }
 }
@@ -660,6 +708,20 @@ mod tests {
         while !matches!(g.clone().step(t, &air, mref), GroundMode::Vertical(r) if r.phase == Phase::Flare) {
             t += 0.02;
         }
+        // In the air: the wing's drag, −0.04 W, and the noise of an estimate (±0.01 W).
+        for k in 0..400 {
+            let noise = 0.01 * if k % 2 == 0 { 1.0 } else { -1.0 };
+            let air = flare_meas(0.0, 0.0, 1.04, 1.0 + noise, 0.0);
+            assert!(matches!(
+                g.step(t + 0.02 * f64::from(k), &air, mref),
+                GroundMode::Vertical(_)
+            ));
+        }
+        t += 8.0;
+        assert!(
+            (g.share_mean + 0.04).abs() < 2e-3 && (g.share_var.sqrt() - 0.01).abs() < 2e-3,
+            "{g:?}"
+        );
         let flying = |g: &mut GroundPhases, t: f64, x: &Measurement| {
             for k in 0..50 {
                 assert!(
@@ -673,15 +735,14 @@ mod tests {
             thrust: 0.0,
         };
         // Holding a height (sink stopped) at hover thrust, or well below it while falling
-        // (f_x = T/m, no reaction), or with the wing's drag (−0.05): flying.
-        flying(&mut g, t, &flare_meas(0.0, 0.0, 1.03, 0.98, 0.0));
-        flying(&mut g, t, &flare_meas(0.5, 0.1, 0.6, 0.6, 0.0));
-        // The estimate's noise in the air (0.03 W; the largest seen in the avionics chain's
-        // flares is 0.01): flying.
-        flying(&mut g, t, &flare_meas(0.0, 0.0, 1.0, 1.03, 0.0));
+        // (f_x = T/m, no reaction): flying.
+        flying(&mut g.clone(), t, &flare_meas(0.0, 0.0, 1.03, 0.98, 0.0));
+        flying(&mut g.clone(), t, &flare_meas(0.5, 0.1, 0.6, 0.6, 0.0));
+        // Noise of 4 σ above the mean: flying.
+        flying(&mut g.clone(), t, &flare_meas(0.0, 0.0, 1.0, 1.0, 0.0));
         // The gear carries 0.3 W but the aircraft sinks at the commanded rate, or tips: not landed.
-        flying(&mut g, t, &flare_meas(0.0, 0.3, 0.7, 1.0, 0.0));
-        flying(&mut g, t, &flare_meas(0.0, 0.0, 0.7, 1.0, 1.0));
+        flying(&mut g.clone(), t, &flare_meas(0.0, 0.3, 0.7, 1.0, 0.0));
+        flying(&mut g.clone(), t, &flare_meas(0.0, 0.0, 0.7, 1.0, 1.0));
         // On the gear at rest, thrust taken off: landed after the dwell wherever the
         // estimated height puts it (1.5 m above or below the target).
         for height in [1.5, -1.5] {
@@ -695,13 +756,13 @@ mod tests {
             }
             assert_eq!(k, 2);
         }
-        // A soft touch on one leg (0.09 m/s: 0.09 W for a few samples), then standing at
-        // hover thrust: landed.
+        // A soft touch on one leg (0.07 m/s: the share rises by 0.09 W, to +0.05, for a few
+        // samples), then standing at hover thrust: landed.
         let mut gi = g.clone();
         let t1 = t + 3.0;
-        gi.step(t1, &flare_meas(0.0, 0.09, 1.03, 1.12, 0.0), mref);
-        gi.step(t1 + 0.02, &flare_meas(0.0, 0.06, 1.03, 1.12, 0.0), mref);
-        assert_eq!(gi.step(t1 + 0.04, &flare_meas(0.0, 0.03, 1.03, 1.0, 0.0), mref), landed);
+        gi.step(t1, &flare_meas(0.0, 0.07, 1.04, 1.09, 0.0), mref);
+        gi.step(t1 + 0.02, &flare_meas(0.0, 0.05, 1.04, 1.09, 0.0), mref);
+        assert_eq!(gi.step(t1 + 0.04, &flare_meas(0.0, 0.03, 1.04, 1.0, 0.0), mref), landed);
         // An impact: the gear's spring stops the sink (one sample of reaction), the sink stays
         // stopped at hover thrust: landed after the dwell, within the contact memory.
         let t1 = t + 4.0;
