@@ -37,7 +37,7 @@
 //!   slower ([`TOUCHDOWN_SEARCH_RATE`]) until the touchdown is detected, at most [`TOUCHDOWN_SEARCH_DEPTH`] below the target
 //!   (its height is only as good as the height estimate: with GPS alone σ ≈ 1.4 m).
 //! * [`Phase::Landed`]: latched by the land detector, which does not use the height: while a
-//!   sink is commanded (descent, flare), a ground contact — the gear's share of the weight
+//!   sink is commanded (the descent at its full rate, the flare), a ground contact — the gear's share of the weight
 //!   by the accelerometer, `f_x/g − T/(m g)` (specific force along the thrust axis against
 //!   the thrust), rises above its mean in the air by [`CONTACT_REACTION`] and
 //!   [`CONTACT_SIGMAS`] of its spread: the gear carries weight, at the impact or as the
@@ -381,7 +381,10 @@ impl GroundPhases {
         });
         let target = origin + Vector3::new(m.landing_target_n, m.landing_target_e, m.landing_target_d);
         let r = self.landing_reference(tm - end, &p0, &v0, &target);
-        if matches!(r.phase, Phase::Descent | Phase::Flare) && self.detect_landing(t, meas) {
+        // A sink is commanded: the flare, or the descent at its full rate (not its ramp from
+        // rest, where the aircraft is still slow in the air).
+        let sinking = r.phase == Phase::Flare || r.phase == Phase::Descent && r.vel.z >= m.landing_descent_rate - 1e-9;
+        if sinking && self.detect_landing(t, meas) {
             return GroundMode::Idle {
                 phase: Phase::Landed,
                 thrust: 0.0,
@@ -423,7 +426,8 @@ impl GroundPhases {
         self.share_t = t;
     }
 
-    /// The land detector at `t` while a sink is commanded (descent and flare): a ground
+    /// The land detector at `t` while a sink is commanded (the descent at its full rate and
+    /// the flare): a ground
     /// contact within the last [`CONTACT_MEMORY`], the vertical speed below [`LANDED_SINK`]
     /// V_td and the tilt rate below [`LANDED_TILT_RATE`] for [`TOUCHDOWN_DWELL`] latch the
     /// landing.
@@ -734,6 +738,14 @@ mod tests {
             phase: Phase::Landed,
             thrust: 0.0,
         };
+        // In the descent's ramp from rest (the aircraft still slow in the air) a rise of the
+        // share (an estimate's accelerometer lagging a thrust change) is no landing.
+        let mut gd = GroundPhases::new(m, 100.0);
+        let mut td = 1.0;
+        while !matches!(gd.clone().step(td, &air, mref), GroundMode::Vertical(r) if r.phase == Phase::Descent) {
+            td += 0.02;
+        }
+        flying(&mut gd, td, &flare_meas(2.0, 0.0, 0.9, 1.0, 0.0));
         // Holding a height (sink stopped) at hover thrust, or well below it while falling
         // (f_x = T/m, no reaction): flying.
         flying(&mut g.clone(), t, &flare_meas(0.0, 0.0, 1.03, 0.98, 0.0));
