@@ -99,8 +99,9 @@ pub const SHARE_TIME: f64 = 2.0;
 /// samples, the sink must have stopped by the end.
 pub const CONTACT_MEMORY: f64 = 0.5;
 /// Largest vertical speed of a landing, in touchdown rates V_td (–): the commanded sink does
-/// not happen.
-pub const LANDED_SINK: f64 = 0.5;
+/// not happen. The estimate's after an impact is 0.2 m/s off with the avionics chain (PX4's
+/// land detector allows 0.25 m/s, widened 2.5 times once it suspects a landing).
+pub const LANDED_SINK: f64 = 1.0;
 /// Largest tilt rate |(q, r)| of a landing (rad/s): the gear is not rocking or tipping.
 pub const LANDED_TILT_RATE: f64 = 40.0 * core::f64::consts::PI / 180.0;
 /// Time the sink must have stopped (and the tilt rate be small) after a ground contact
@@ -752,8 +753,9 @@ mod tests {
         flying(&mut g.clone(), t, &flare_meas(0.5, 0.1, 0.6, 0.6, 0.0));
         // Noise of 4 σ above the mean: flying.
         flying(&mut g.clone(), t, &flare_meas(0.0, 0.0, 1.0, 1.0, 0.0));
-        // The gear carries 0.3 W but the aircraft sinks at the commanded rate, or tips: not landed.
-        flying(&mut g.clone(), t, &flare_meas(0.0, 0.3, 0.7, 1.0, 0.0));
+        // The gear carries 0.3 W but the aircraft sinks faster than the commanded rate, or tips:
+        // not landed.
+        flying(&mut g.clone(), t, &flare_meas(0.0, 0.35, 0.7, 1.0, 0.0));
         flying(&mut g.clone(), t, &flare_meas(0.0, 0.0, 0.7, 1.0, 1.0));
         // On the gear at rest, thrust taken off: landed after the dwell wherever the
         // estimated height puts it (1.5 m above or below the target).
@@ -781,7 +783,7 @@ mod tests {
         let mut gi = g.clone();
         let still = flare_meas(0.0, 0.02, 1.0, 1.0, 0.0);
         assert!(matches!(
-            gi.step(t1, &flare_meas(0.0, 0.2, 1.0, 1.8, 0.0), mref),
+            gi.step(t1, &flare_meas(0.0, 0.4, 1.0, 1.8, 0.0), mref),
             GroundMode::Vertical(_)
         ));
         assert!(matches!(gi.step(t1 + 0.02, &still, mref), GroundMode::Vertical(_)));
@@ -789,8 +791,8 @@ mod tests {
         assert_eq!(gi.step(t1 + 0.06, &still, mref), landed);
         // The same impact followed by a still hover past the memory: forgotten.
         let mut gi = g.clone();
-        gi.step(t1, &flare_meas(0.0, 0.2, 1.0, 1.8, 0.0), mref);
-        gi.step(t1 + 0.02, &flare_meas(0.0, 0.2, 1.0, 1.0, 0.0), mref);
+        gi.step(t1, &flare_meas(0.0, 0.4, 1.0, 1.8, 0.0), mref);
+        gi.step(t1 + 0.02, &flare_meas(0.0, 0.4, 1.0, 1.0, 0.0), mref);
         flying(&mut gi, t1 + CONTACT_MEMORY + 0.02, &still);
         // Latched for good.
         let down = flare_meas(0.0, 0.0, 0.7, 1.0, 0.0);
