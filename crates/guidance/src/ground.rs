@@ -761,7 +761,7 @@ mod tests {
         // estimated height puts it (1.5 m above or below the target).
         for height in [1.5, -1.5] {
             let down = flare_meas(height, 0.05, 0.7, 1.0, 0.05);
-            let mut g = g.clone();
+            let mut g = g;
             let t0 = t + 2.0;
             let mut k = 0;
             while g.step(t0 + 0.02 * f64::from(k), &down, mref) != landed {
@@ -772,7 +772,7 @@ mod tests {
         }
         // A soft touch on one leg (0.07 m/s: the share rises by 0.09 W, to +0.05, for a few
         // samples), then standing at hover thrust: landed.
-        let mut gi = g.clone();
+        let mut gi = g;
         let t1 = t + 3.0;
         gi.step(t1, &flare_meas(0.0, 0.07, 1.04, 1.09, 0.0), mref);
         gi.step(t1 + 0.02, &flare_meas(0.0, 0.05, 1.04, 1.09, 0.0), mref);
@@ -780,7 +780,7 @@ mod tests {
         // An impact: the gear's spring stops the sink (one sample of reaction), the sink stays
         // stopped at hover thrust: landed after the dwell, within the contact memory.
         let t1 = t + 4.0;
-        let mut gi = g.clone();
+        let mut gi = g;
         let still = flare_meas(0.0, 0.02, 1.0, 1.0, 0.0);
         assert!(matches!(
             gi.step(t1, &flare_meas(0.0, 0.4, 1.0, 1.8, 0.0), mref),
@@ -790,7 +790,7 @@ mod tests {
         assert!(matches!(gi.step(t1 + 0.04, &still, mref), GroundMode::Vertical(_)));
         assert_eq!(gi.step(t1 + 0.06, &still, mref), landed);
         // The same impact followed by a still hover past the memory: forgotten.
-        let mut gi = g.clone();
+        let mut gi = g;
         gi.step(t1, &flare_meas(0.0, 0.4, 1.0, 1.8, 0.0), mref);
         gi.step(t1 + 0.02, &flare_meas(0.0, 0.4, 1.0, 1.0, 0.0), mref);
         flying(&mut gi, t1 + CONTACT_MEMORY + 0.02, &still);
