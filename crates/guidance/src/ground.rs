@@ -93,9 +93,6 @@ pub const CONTACT_REACTION: f64 = 0.05;
 /// Ground contact: least rise of the gear's share in standard deviations of its spread in
 /// the air (–): with the avionics chain's noise (σ ≈ 0.01–0.02) the rise must be larger.
 pub const CONTACT_SIGMAS: f64 = 5.0;
-/// Ground contact: the rise that always counts (–), whatever the spread in the air (gusts
-/// move it).
-pub const CONTACT_REACTION_MAX: f64 = 0.1;
 /// Time constant of the gear share's mean and spread in the air (s).
 pub const SHARE_TIME: f64 = 2.0;
 /// How long a ground contact counts for the landing (s): the impact's reaction lasts a few
@@ -403,8 +400,7 @@ impl GroundPhases {
     }
 
     /// Ground contact: the gear's share ([`Self::gear_share`]) above its mean in the air by
-    /// at least [`CONTACT_REACTION`] and [`CONTACT_SIGMAS`] of its spread there, at most
-    /// [`CONTACT_REACTION_MAX`] (module docs;
+    /// at least [`CONTACT_REACTION`] and [`CONTACT_SIGMAS`] of its spread there (module docs;
     /// the air's is the wing's drag and the estimate's noise). No height: the estimate's is
     /// metres off with GPS alone.
     pub fn ground_contact(&self, meas: &Measurement) -> bool {
@@ -413,7 +409,7 @@ impl GroundPhases {
         } else {
             (self.share_mean, self.share_var)
         };
-        self.gear_share(meas) - mean > (CONTACT_SIGMAS * var.sqrt()).clamp(CONTACT_REACTION, CONTACT_REACTION_MAX)
+        self.gear_share(meas) - mean > CONTACT_REACTION.max(CONTACT_SIGMAS * var.sqrt())
     }
 
     /// Track the gear's share in the air (no contact): exponential mean and variance over
