@@ -63,13 +63,18 @@ pub fn plant() -> (Plant, StateVector) {
 }
 
 /// Upper bound of the flight time of `mission` from `x0` (s): take-off, the mission, an
-/// approach over the longest plausible distance and the descent from the mission's peak.
+/// approach over the longest plausible distance, the descent from the mission's peak and the
+/// touchdown reference's search below the target (a touchdown not where the height estimate
+/// puts the ground).
 pub fn stop_time(mission: &MissionParams) -> f64 {
     let g = GroundPhases::new(*mission, 1.0);
     let climb = 400.0;
     let approach =
         1.5 * (mission.landing_target_n.hypot(mission.landing_target_e) + 50.0) / mission.landing_approach_speed;
-    g.mission_start() + mission.end_time() + approach + climb / mission.landing_descent_rate + 20.0
+    use guidance::ground::{TOUCHDOWN_HOLD_TIME, TOUCHDOWN_SEARCH_DEPTH, TOUCHDOWN_SEARCH_RATE};
+    let search =
+        TOUCHDOWN_HOLD_TIME + TOUCHDOWN_SEARCH_DEPTH / (TOUCHDOWN_SEARCH_RATE * mission.landing_touchdown_rate);
+    g.mission_start() + mission.end_time() + approach + climb / mission.landing_descent_rate + search + 20.0
 }
 
 /// Per-phase position errors.

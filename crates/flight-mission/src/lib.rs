@@ -61,7 +61,7 @@ pub struct MissionParams {
     pub landing_flare_height: f64,
     /// Reference sink rate at touchdown (m/s).
     pub landing_touchdown_rate: f64,
-    /// Touchdown detection: height tolerance of the CG over the target (m).
+    /// Not used: the land detector (`guidance::ground`) does not use the height (m).
     pub landing_touchdown_tolerance: f64,
 }
 

@@ -32,13 +32,19 @@
 //! * [`Phase::Flare`]: the sink rate falls linearly in time from V_d to the touchdown rate
 //!   V_td over `t_f = 2 (h_f − h_td)/(V_d + V_td)` (covering h_f − h_td), then stays at V_td
 //!   over the last `h_td = V_td ·` [`FINAL_SEGMENT_TIME`] (the gear meets the ground at a
-//!   steady sink, thrust ≈ weight: no flare thrust to bounce on) and down to
-//!   [`TOUCHDOWN_OVERSHOOT`] below the target (the reference keeps sinking until the gear
-//!   carries the aircraft).
-//! * [`Phase::Landed`]: latched when, in the flare, the CG is within
-//!   `landing_touchdown_tolerance` of the target height and sinks slower than V_td/2 for
-//!   [`TOUCHDOWN_DWELL`] (the gear has stopped it): thrust command 0 (the controllers clamp
-//!   it to their thrust minimum), surfaces centred, held for good.
+//!   steady sink, thrust ≈ weight: no flare thrust to bounce on), on to
+//!   [`TOUCHDOWN_OVERSHOOT`] below the target, held there for [`TOUCHDOWN_HOLD_TIME`], then
+//!   slower ([`TOUCHDOWN_SEARCH_RATE`]) until the touchdown is detected, at most [`TOUCHDOWN_SEARCH_DEPTH`] below the target
+//!   (its height is only as good as the height estimate: with GPS alone σ ≈ 1.4 m).
+//! * [`Phase::Landed`]: latched by the land detector, which does not use the height: while a
+//!   sink is commanded (the descent at its full rate, the flare), a ground contact — the gear's share of the weight
+//!   by the accelerometer, `f_x/g − T/(m g)` (specific force along the thrust axis against
+//!   the thrust), rises above its mean in the air by [`CONTACT_REACTION`] and
+//!   [`CONTACT_SIGMAS`] of its spread: the gear carries weight, at the impact or as the
+//!   controller takes thrust off — followed by the sink stopping (|v_d| < [`LANDED_SINK`]
+//!   V_td, tilt rate < [`LANDED_TILT_RATE`], for [`TOUCHDOWN_DWELL`]). Then the thrust
+//!   command is 0 (the controllers clamp it to their thrust minimum), surfaces centred, held
+//!   for good.
 //!
 //! The reference attitude in the vertical phases here is the mission's vertical one
 //! (nose up, belly north); while descending the air comes from behind, α = π.
@@ -60,12 +66,49 @@ pub const LANDING_FLAP_TRIM_GAIN: f64 = 4.6 * core::f64::consts::PI / 180.0;
 /// from 5 m/s; the rest of the ±25° is left to the feedback.
 pub const LANDING_FLAP_TRIM_LIMIT: f64 = 17.0 * core::f64::consts::PI / 180.0;
 
-/// How far the touchdown reference sinks below the target before it holds (m).
+/// How far the touchdown reference sinks below the target before it holds, if the touchdown
+/// is not detected before (m): three σ of the height relative to the start that GPS alone
+/// gives at the landing (≈ 1.4 m, σ 4 m fixes at 4 Hz), and some.
+pub const TOUCHDOWN_SEARCH_DEPTH: f64 = 5.0;
+/// How far the touchdown reference sinks below the target at the touchdown rate before it
+/// slows to [`TOUCHDOWN_SEARCH_RATE`] (m).
 pub const TOUCHDOWN_OVERSHOOT: f64 = 0.3;
+/// Time the touchdown reference holds at [`TOUCHDOWN_OVERSHOOT`] before it searches deeper (s):
+/// with a good height measurement the controllers settle onto the gear there.
+pub const TOUCHDOWN_HOLD_TIME: f64 = 10.0;
+/// Sink rate of the touchdown reference after [`TOUCHDOWN_HOLD_TIME`], in touchdown rates
+/// (–): the ground is near, the gear meets it slower.
+pub const TOUCHDOWN_SEARCH_RATE: f64 = 1.0 / 3.0;
 /// Time flown at the touchdown rate before the target, after the flare (s).
 pub const FINAL_SEGMENT_TIME: f64 = 1.0;
-/// Time the touchdown condition must hold before the landing is declared (s).
+/// Ground contact: least rise of the gear's share of the weight, `f_x/g − T/(m g)` from the
+/// accelerometer's specific force along the thrust axis f_x and the thrust T, above its mean
+/// in the air (–). In the air the share is the aerodynamic force along x (the wing's drag in
+/// the slipstream: −0.06…−0.02 in the flares) and the estimate's noise; a thrust below the
+/// weight in the air shows as a fall (f_x ≈ T/m), not as a reaction. At the touchdown the
+/// gear's spring stops the sink (+0.8 at 0.25 m/s on four legs, +0.09 for 0.1 s at 0.07 m/s
+/// on one); at rest it carries what the controller, whose reference keeps sinking, takes off
+/// the thrust.
+pub const CONTACT_REACTION: f64 = 0.05;
+/// Ground contact: least rise of the gear's share in standard deviations of its spread in
+/// the air (–): with the avionics chain's noise (σ ≈ 0.01–0.02) the rise must be larger.
+pub const CONTACT_SIGMAS: f64 = 5.0;
+/// Time constant of the gear share's mean and spread in the air (s).
+pub const SHARE_TIME: f64 = 2.0;
+/// How long a ground contact counts for the landing (s): the impact's reaction lasts a few
+/// samples, the sink must have stopped by the end.
+pub const CONTACT_MEMORY: f64 = 0.5;
+/// Largest vertical speed of a landing, in touchdown rates V_td (–): the commanded sink does
+/// not happen. The estimate's after an impact is 0.2 m/s off with the avionics chain (PX4's
+/// land detector allows 0.25 m/s, widened 2.5 times once it suspects a landing).
+pub const LANDED_SINK: f64 = 1.0;
+/// Largest tilt rate |(q, r)| of a landing (rad/s): the gear is not rocking or tipping.
+pub const LANDED_TILT_RATE: f64 = 40.0 * core::f64::consts::PI / 180.0;
+/// Time the sink must have stopped (and the tilt rate be small) after a ground contact
+/// before the landing is declared (s): two samples at 20 ms.
 pub const TOUCHDOWN_DWELL: f64 = 0.04;
+/// Gravity of the contact test (m/s²): the airframes' g (C.1).
+pub const CONTACT_GRAVITY: f64 = 9.81;
 
 /// A reference for vertical (nose-up) flight, NED, mission origin included.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -102,9 +145,39 @@ pub struct GroundPhases {
     origin: Option<Vector3<f64>>,
     /// Reference position and velocity at the end of the mission (start of the approach).
     approach_start: Option<(Vector3<f64>, Vector3<f64>)>,
-    /// Time since which the touchdown condition holds (NaN: it does not).
+    /// Time since which the landing's conditions hold (NaN: they do not).
     touch_since: f64,
+    /// Time of the last ground contact (NaN: none).
+    contact_at: f64,
+    /// The gear's share in the air: exponential mean, variance, time of the last sample
+    /// (NaN: none yet).
+    share_mean: f64,
+    share_var: f64,
+    share_t: f64,
     landed: bool,
+}
+
+/// The touchdown reference below the target (m, + down) and its sink rate (m/s), `x` (s)
+/// after it passed `s0` (m) sinking at `vtd` (m/s): at `vtd` to [`TOUCHDOWN_OVERSHOOT`], held
+/// there for [`TOUCHDOWN_HOLD_TIME`] (where the ground is when the height is measured well),
+/// then at [`TOUCHDOWN_SEARCH_RATE`] `vtd` to [`TOUCHDOWN_SEARCH_DEPTH`], where it holds.
+fn touchdown_search(s0: f64, vtd: f64, x: f64) -> (f64, f64) {
+    let s = s0 + vtd * x;
+    if s < TOUCHDOWN_OVERSHOOT {
+        return (s, vtd);
+    }
+    let x1 = (TOUCHDOWN_OVERSHOOT - s0).max(0.0) / vtd + TOUCHDOWN_HOLD_TIME;
+    let s1 = s0.max(TOUCHDOWN_OVERSHOOT);
+    if x < x1 {
+        return (s1, 0.0);
+    }
+    let v = TOUCHDOWN_SEARCH_RATE * vtd;
+    let s = s1 + v * (x - x1);
+    if s < TOUCHDOWN_SEARCH_DEPTH {
+        (s, v)
+    } else {
+        (TOUCHDOWN_SEARCH_DEPTH, 0.0)
+    }
 }
 
 /// Cosine ramp from rest to `v` over `t_r`: (distance, speed, acceleration) at τ ∈ [0, t_r].
@@ -116,7 +189,7 @@ fn ramp(v: f64, t_r: f64, tau: f64) -> (f64, f64, f64) {
 
 impl GroundPhases {
     /// Number of values [`Self::save`] writes.
-    pub const SAVED_LEN: usize = 13;
+    pub const SAVED_LEN: usize = 17;
 
     /// The phase logic of `mission` for an airframe of weight `weight` (N).
     pub fn new(mission: MissionParams, weight: f64) -> Self {
@@ -126,6 +199,10 @@ impl GroundPhases {
             origin: None,
             approach_start: None,
             touch_since: f64::NAN,
+            contact_at: f64::NAN,
+            share_mean: f64::NAN,
+            share_var: f64::NAN,
+            share_t: f64::NAN,
             landed: false,
         }
     }
@@ -237,13 +314,8 @@ impl GroundPhases {
                 let k = (vd - vtd) / t_flare;
                 (Phase::Flare, s0 + vd * x - 0.5 * k * x * x, vd - k * x, -k)
             } else {
-                let s = s0 + d_flare + vtd * (x - t_flare);
-                let limit = height + TOUCHDOWN_OVERSHOOT;
-                if s < limit {
-                    (Phase::Flare, s, vtd, 0.0)
-                } else {
-                    (Phase::Flare, limit, 0.0, 0.0)
-                }
+                let (s, v) = touchdown_search(s0 + d_flare - height, vtd, x - t_flare);
+                (Phase::Flare, height + s, v, 0.0)
             }
         };
         VerticalReference {
@@ -310,25 +382,73 @@ impl GroundPhases {
         });
         let target = origin + Vector3::new(m.landing_target_n, m.landing_target_e, m.landing_target_d);
         let r = self.landing_reference(tm - end, &p0, &v0, &target);
-        if r.phase == Phase::Flare {
-            let down = meas.pos_ned.z >= target.z - m.landing_touchdown_tolerance;
-            let stopped = meas.vel_ned.z < 0.5 * m.landing_touchdown_rate;
-            if down && stopped {
-                if self.touch_since.is_nan() {
-                    self.touch_since = t;
-                }
-                if t - self.touch_since >= TOUCHDOWN_DWELL - 1e-9 {
-                    self.landed = true;
-                    return GroundMode::Idle {
-                        phase: Phase::Landed,
-                        thrust: 0.0,
-                    };
-                }
-            } else {
-                self.touch_since = f64::NAN;
-            }
+        // A sink is commanded: the flare, or the descent at its full rate (not its ramp from
+        // rest, where the aircraft is still slow in the air).
+        let sinking = r.phase == Phase::Flare || r.phase == Phase::Descent && r.vel.z >= m.landing_descent_rate - 1e-9;
+        if sinking && self.detect_landing(t, meas) {
+            return GroundMode::Idle {
+                phase: Phase::Landed,
+                thrust: 0.0,
+            };
         }
         GroundMode::Vertical(r)
+    }
+
+    /// The share of the weight the gear carries by the accelerometer, `f_x/g − T/(m g)` (–).
+    pub fn gear_share(&self, meas: &Measurement) -> f64 {
+        meas.specific_force_body.x / CONTACT_GRAVITY - meas.thrust / self.weight
+    }
+
+    /// Ground contact: the gear's share ([`Self::gear_share`]) above its mean in the air by
+    /// at least [`CONTACT_REACTION`] and [`CONTACT_SIGMAS`] of its spread there (module docs;
+    /// the air's is the wing's drag and the estimate's noise). No height: the estimate's is
+    /// metres off with GPS alone.
+    pub fn ground_contact(&self, meas: &Measurement) -> bool {
+        let (mean, var) = if self.share_mean.is_nan() {
+            (0.0, 0.0)
+        } else {
+            (self.share_mean, self.share_var)
+        };
+        self.gear_share(meas) - mean > CONTACT_REACTION.max(CONTACT_SIGMAS * var.sqrt())
+    }
+
+    /// Track the gear's share in the air (no contact): exponential mean and variance over
+    /// [`SHARE_TIME`].
+    fn track_share(&mut self, t: f64, meas: &Measurement) {
+        let x = self.gear_share(meas);
+        if self.share_mean.is_nan() {
+            (self.share_mean, self.share_var) = (x, 0.0);
+        } else {
+            let a = ((t - self.share_t) / SHARE_TIME).clamp(0.0, 1.0);
+            let d = x - self.share_mean;
+            self.share_mean += a * d;
+            self.share_var = (1.0 - a) * (self.share_var + a * d * d);
+        }
+        self.share_t = t;
+    }
+
+    /// The land detector at `t` while a sink is commanded (the descent at its full rate and
+    /// the flare): a ground
+    /// contact within the last [`CONTACT_MEMORY`], the vertical speed below [`LANDED_SINK`]
+    /// V_td and the tilt rate below [`LANDED_TILT_RATE`] for [`TOUCHDOWN_DWELL`] latch the
+    /// landing.
+    fn detect_landing(&mut self, t: f64, meas: &Measurement) -> bool {
+        if self.ground_contact(meas) {
+            self.contact_at = t;
+        } else {
+            self.track_share(t, meas);
+        }
+        let still = meas.vel_ned.z.abs() < LANDED_SINK * self.mission.landing_touchdown_rate
+            && meas.rates.yz().norm() < LANDED_TILT_RATE;
+        if !(still && t - self.contact_at <= CONTACT_MEMORY + 1e-9) {
+            self.touch_since = f64::NAN;
+            return false;
+        }
+        if self.touch_since.is_nan() {
+            self.touch_since = t;
+        }
+        self.landed = t - self.touch_since >= TOUCHDOWN_DWELL - 1e-9;
+        self.landed
     }
 
     /// Append the state ([`Self::SAVED_LEN`] values).
@@ -345,6 +465,10 @@ impl GroundPhases {
         }
         out(self.touch_since);
         out(f64::from(u8::from(self.landed)));
+        out(self.contact_at);
+        out(self.share_mean);
+        out(self.share_var);
+        out(self.share_t);
     }
 
     /// Restore what [`Self::save`] wrote; `None` if values are missing.
@@ -357,6 +481,8 @@ impl GroundPhases {
         self.approach_start = (v[4] != 0.0).then(|| (Vector3::new(v[5], v[6], v[7]), Vector3::new(v[8], v[9], v[10])));
         self.touch_since = v[11];
         self.landed = v[12] != 0.0;
+        self.contact_at = v[13];
+        (self.share_mean, self.share_var, self.share_t) = (v[14], v[15], v[16]);
         Some(())
     }
 }
@@ -520,9 +646,10 @@ mod tests {
             t += 0.01;
             let r = reference(&mut g, t);
             assert!((r.pos - last.pos).norm() < 0.01 * 3.2 + 1e-9, "position jump at {t}");
-            // (The one velocity step: the hold below the target, reached only if the
-            // touchdown is never detected.)
-            let held = r.vel == Vector3::zeros() && r.phase == Phase::Flare;
+            // (The velocity steps: to the search rate below the target and the hold at the
+            // search depth, reached only if the touchdown is never detected.)
+            let search = (r.vel.z - TOUCHDOWN_SEARCH_RATE * m.landing_touchdown_rate).abs() < 1e-12;
+            let held = (r.vel == Vector3::zeros() || search) && r.phase == Phase::Flare;
             assert!(
                 held || (r.vel - last.vel).norm() < 0.01 * 2.0,
                 "velocity jump at {t}: {:?} {:?}",
@@ -534,8 +661,8 @@ mod tests {
                 if a.phase == b.phase && r.vel.norm() > 0.0 {
                     assert!(((b.pos - a.pos) / (2.0 * h) - r.vel).norm() < 1e-5, "t = {t}");
                 }
-                // Never climbs back up once descending, never below the overshoot.
-                assert!(r.pos.z <= target.z + TOUCHDOWN_OVERSHOOT + 1e-9);
+                // Never climbs back up once descending, never below the search depth.
+                assert!(r.pos.z <= target.z + TOUCHDOWN_SEARCH_DEPTH + 1e-9);
             }
             if phases.last() != Some(&r.phase) {
                 phases.push(r.phase);
@@ -546,13 +673,25 @@ mod tests {
             phases,
             [Phase::Vertical2, Phase::Approach, Phase::Descent, Phase::Flare]
         );
-        // Ends held just below the target, centred on it.
-        assert!((last.pos - (target + Vector3::new(0.0, 0.0, TOUCHDOWN_OVERSHOOT))).norm() < 1e-9);
+        // Without a touchdown it sinks on past the target at V_td (the target's height is an
+        // estimate) and ends held the search depth below it, centred on it.
+        assert!((last.pos - (target + Vector3::new(0.0, 0.0, TOUCHDOWN_SEARCH_DEPTH))).norm() < 1e-9);
         assert_eq!(last.vel, Vector3::zeros());
     }
 
+    /// A measurement in the flare: sinking at `sink` (m/s) at `height` (m) above the target
+    /// (20 m down), thrust `thrust` and specific force along x `f_x` in weights / g, tilt
+    /// rate `q` (rad/s).
+    fn flare_meas(height: f64, sink: f64, thrust: f64, f_x: f64, q: f64) -> Measurement {
+        let mut m = meas(Vector3::new(0.0, 0.0, 20.0 - height), Vector3::new(0.0, 0.0, sink));
+        m.thrust = thrust * 100.0;
+        m.specific_force_body = Vector3::new(f_x * CONTACT_GRAVITY, 0.0, 0.0);
+        m.rates = Vector3::new(0.0, q, 0.0);
+        m
+    }
+
     #[test]
-    fn touchdown_needs_the_gear_to_stop_the_sink_then_latches() {
+    fn the_land_detector_needs_ground_contact_not_the_height_then_latches() {
         let m = MissionParams {
             landing_descent_rate: 1.0,
             landing_target_d: 20.0,
@@ -565,27 +704,103 @@ mod tests {
         };
         let mut g = GroundPhases::new(m, 100.0);
         let mref = |_| (Vector3::zeros(), Vector3::zeros());
+        let air = meas(Vector3::zeros(), Vector3::zeros());
+        // Before the descent even a resting aircraft on the gear is not landed.
+        let resting = flare_meas(0.0, 0.0, 0.5, 1.0, 0.0);
+        assert!(matches!(g.clone().step(1.0, &resting, mref), GroundMode::Vertical(r) if r.phase == Phase::Approach));
         // Find the flare.
         let mut t = 1.0;
-        while !matches!(g.clone().step(t, &meas(Vector3::zeros(), Vector3::zeros()), mref), GroundMode::Vertical(r) if r.phase == Phase::Flare)
-        {
+        while !matches!(g.clone().step(t, &air, mref), GroundMode::Vertical(r) if r.phase == Phase::Flare) {
             t += 0.02;
         }
-        // Sinking through the target height: no touchdown.
-        let sinking = meas(Vector3::new(0.0, 0.0, 19.99), Vector3::new(0.0, 0.0, 0.3));
-        assert!(matches!(g.step(t, &sinking, mref), GroundMode::Vertical(_)));
-        // Stopped 3 cm above: not down yet.
-        let hover = meas(Vector3::new(0.0, 0.0, 19.97), Vector3::zeros());
-        assert!(matches!(g.step(t + 0.2, &hover, mref), GroundMode::Vertical(_)));
-        // Stopped on the target: landed after the dwell, and stays landed.
-        let down = meas(Vector3::new(0.0, 0.0, 19.995), Vector3::new(0.0, 0.0, 0.01));
-        assert!(matches!(g.step(t + 0.3, &down, mref), GroundMode::Vertical(_)));
+        // In the air: the wing's drag, −0.04 W, and the noise of an estimate (±0.01 W).
+        for k in 0..400 {
+            let noise = 0.01 * if k % 2 == 0 { 1.0 } else { -1.0 };
+            let air = flare_meas(0.0, 0.0, 1.04, 1.0 + noise, 0.0);
+            assert!(matches!(
+                g.step(t + 0.02 * f64::from(k), &air, mref),
+                GroundMode::Vertical(_)
+            ));
+        }
+        t += 8.0;
+        assert!(
+            (g.share_mean + 0.04).abs() < 2e-3 && (g.share_var.sqrt() - 0.01).abs() < 2e-3,
+            "{g:?}"
+        );
+        let flying = |g: &mut GroundPhases, t: f64, x: &Measurement| {
+            for k in 0..50 {
+                assert!(
+                    matches!(g.step(t + 0.02 * f64::from(k), x, mref), GroundMode::Vertical(_)),
+                    "{x:?}"
+                );
+            }
+        };
         let landed = GroundMode::Idle {
             phase: Phase::Landed,
             thrust: 0.0,
         };
-        assert_eq!(g.step(t + 0.3 + TOUCHDOWN_DWELL, &down, mref), landed);
-        assert_eq!(g.step(t + 5.0, &sinking, mref), landed);
+        // In the descent's ramp from rest (the aircraft still slow in the air) a rise of the
+        // share (an estimate's accelerometer lagging a thrust change) is no landing.
+        let mut gd = GroundPhases::new(m, 100.0);
+        let mut td = 1.0;
+        while !matches!(gd.clone().step(td, &air, mref), GroundMode::Vertical(r) if r.phase == Phase::Descent) {
+            td += 0.02;
+        }
+        flying(&mut gd, td, &flare_meas(2.0, 0.0, 0.9, 1.0, 0.0));
+        // Holding a height (sink stopped) at hover thrust, or well below it while falling
+        // (f_x = T/m, no reaction): flying.
+        flying(&mut g.clone(), t, &flare_meas(0.0, 0.0, 1.03, 0.98, 0.0));
+        flying(&mut g.clone(), t, &flare_meas(0.5, 0.1, 0.6, 0.6, 0.0));
+        // Noise of 4 σ above the mean: flying.
+        flying(&mut g.clone(), t, &flare_meas(0.0, 0.0, 1.0, 1.0, 0.0));
+        // The gear carries 0.3 W but the aircraft sinks faster than the commanded rate, or tips:
+        // not landed.
+        flying(&mut g.clone(), t, &flare_meas(0.0, 0.35, 0.7, 1.0, 0.0));
+        flying(&mut g.clone(), t, &flare_meas(0.0, 0.0, 0.7, 1.0, 1.0));
+        // On the gear at rest, thrust taken off: landed after the dwell wherever the
+        // estimated height puts it (1.5 m above or below the target).
+        for height in [1.5, -1.5] {
+            let down = flare_meas(height, 0.05, 0.7, 1.0, 0.05);
+            let mut g = g;
+            let t0 = t + 2.0;
+            let mut k = 0;
+            while g.step(t0 + 0.02 * f64::from(k), &down, mref) != landed {
+                k += 1;
+                assert!(k < 100);
+            }
+            assert_eq!(k, 2);
+        }
+        // A soft touch on one leg (0.07 m/s: the share rises by 0.09 W, to +0.05, for a few
+        // samples), then standing at hover thrust: landed.
+        let mut gi = g;
+        let t1 = t + 3.0;
+        gi.step(t1, &flare_meas(0.0, 0.07, 1.04, 1.09, 0.0), mref);
+        gi.step(t1 + 0.02, &flare_meas(0.0, 0.05, 1.04, 1.09, 0.0), mref);
+        assert_eq!(gi.step(t1 + 0.04, &flare_meas(0.0, 0.03, 1.04, 1.0, 0.0), mref), landed);
+        // An impact: the gear's spring stops the sink (one sample of reaction), the sink stays
+        // stopped at hover thrust: landed after the dwell, within the contact memory.
+        let t1 = t + 4.0;
+        let mut gi = g;
+        let still = flare_meas(0.0, 0.02, 1.0, 1.0, 0.0);
+        assert!(matches!(
+            gi.step(t1, &flare_meas(0.0, 0.4, 1.0, 1.8, 0.0), mref),
+            GroundMode::Vertical(_)
+        ));
+        assert!(matches!(gi.step(t1 + 0.02, &still, mref), GroundMode::Vertical(_)));
+        assert!(matches!(gi.step(t1 + 0.04, &still, mref), GroundMode::Vertical(_)));
+        assert_eq!(gi.step(t1 + 0.06, &still, mref), landed);
+        // The same impact followed by a still hover past the memory: forgotten.
+        let mut gi = g;
+        gi.step(t1, &flare_meas(0.0, 0.4, 1.0, 1.8, 0.0), mref);
+        gi.step(t1 + 0.02, &flare_meas(0.0, 0.4, 1.0, 1.0, 0.0), mref);
+        flying(&mut gi, t1 + CONTACT_MEMORY + 0.02, &still);
+        // Latched for good.
+        let down = flare_meas(0.0, 0.0, 0.7, 1.0, 0.0);
+        g.step(t + 6.0, &down, mref);
+        g.step(t + 6.02, &down, mref);
+        assert_eq!(g.step(t + 6.04, &down, mref), landed);
+        let sinking = flare_meas(0.5, 0.3, 1.0, 1.0, 0.0);
+        assert_eq!(g.step(t + 7.0, &sinking, mref), landed);
         // Round trip of the state.
         let mut saved = Vec::new();
         g.save(&mut |x| saved.push(x));
