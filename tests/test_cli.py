@@ -204,3 +204,42 @@ def test_campaign_section_and_native_refuse_folders_without_a_campaign(tmp_path)
     assert_refused(run("tailsim.campaign.section", empty), empty, "campaign.json")
     assert_refused(run("tailsim.campaign.native", "--campaign", empty), "--campaign", empty, "campaign.json")
     assert_refused(run("tailsim.campaign.native", "--threads", "0"), "--threads", "0", "≥ 1")
+
+
+def _checkout(tmp_path: pathlib.Path, fmu_time: float, source_time: float) -> pathlib.Path:
+    """A minimal source checkout (Cargo.toml, a declaration, a crate source) with dist/m.fmu."""
+    tmp_path.mkdir(parents=True, exist_ok=True)
+    (tmp_path / "Cargo.toml").write_text("[workspace]\n")
+    (tmp_path / "modelDescription").mkdir()
+    decl = tmp_path / "modelDescription" / "m.json"
+    decl.write_text("{}")
+    src = tmp_path / "crates" / "c" / "src" / "lib.rs"
+    src.parent.mkdir(parents=True)
+    src.write_text("")
+    dist = tmp_path / "dist"
+    dist.mkdir()
+    fmu = dist / "m.fmu"
+    with zipfile.ZipFile(fmu, "w") as z:
+        z.writestr("modelDescription.xml", "<fmiModelDescription/>")
+    os.utime(decl, (source_time - 10, source_time - 10))
+    os.utime(src, (source_time, source_time))
+    os.utime(fmu, (fmu_time, fmu_time))
+    return dist
+
+
+def test_an_fmu_older_than_the_sources_is_named_with_the_newest_source(tmp_path, capsys):
+    from tailsim import cli
+
+    t = time.time()
+    dist = _checkout(tmp_path, fmu_time=t - 100, source_time=t)
+    lines = cli.stale_fmus(dist, ["m"], root=tmp_path)
+    assert len(lines) == 1
+    assert "m.fmu is older than crates/c/src/lib.rs" in lines[0] and "cargo xtask dist" in lines[0]
+    # Built after the last change: nothing to say; outside a checkout: nothing to compare.
+    assert cli.stale_fmus(_checkout(tmp_path / "b", fmu_time=t, source_time=t - 100), ["m"], root=tmp_path / "b") == []
+    (tmp_path / "b" / "Cargo.toml").unlink()
+    assert cli.stale_fmus(tmp_path / "b" / "dist", ["m"], root=tmp_path / "b") == []
+    # The CLIs warn on stderr, naming the FMU, and go on.
+    cli.check_fmus(cli.Parser(prog="x"), "--dist", dist, ["m"], root=tmp_path)
+    err = capsys.readouterr().err
+    assert err.startswith("x: warning: ") and "m.fmu is older than crates/c/src/lib.rs" in err

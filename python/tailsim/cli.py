@@ -134,15 +134,64 @@ def fmu_problem(path: pathlib.Path) -> str | None:
     return None
 
 
-def check_fmus(parser: argparse.ArgumentParser, option: str, dist: str | pathlib.Path, models: Iterable[str]) -> None:
-    """`parser.error` unless folder `dist` holds a readable `<model>.fmu` of every model."""
+#: The source checkout the package runs from (None when installed elsewhere).
+SOURCE_ROOT = pathlib.Path(__file__).resolve().parents[2]
+
+#: The files an FMU is built from: their newest change must not postdate the FMU.
+SOURCE_GLOBS = (
+    "crates/*/src/**/*.rs",
+    "fmu-*/src/**/*.rs",
+    "modelDescription/*.json",
+    "modelDescription/fragments/*.json",
+)
+
+
+def newest_source(root: pathlib.Path | None = None) -> pathlib.Path | None:
+    """The most recently modified FMU source file of a source checkout at `root` (default
+    [`SOURCE_ROOT`]; None outside a checkout)."""
+    root = SOURCE_ROOT if root is None else root
+    if not (root / "Cargo.toml").is_file() or not (root / "modelDescription").is_dir():
+        return None
+    files = (f for g in SOURCE_GLOBS for f in root.glob(g) if f.is_file())
+    return max(files, key=lambda f: f.stat().st_mtime, default=None)
+
+
+def stale_fmus(dist: str | pathlib.Path, models: Iterable[str], root: pathlib.Path | None = None) -> list[str]:
+    """One line per `<model>.fmu` in `dist` older than the newest FMU source of the checkout
+    at `root` (default [`SOURCE_ROOT`]; built before a change: its results would be the old
+    code's)."""
+    root = SOURCE_ROOT if root is None else root
+    src = newest_source(root)
+    if src is None:
+        return []
+    t = src.stat().st_mtime
+    out = []
+    for m in models:
+        f = pathlib.Path(dist) / f"{m}.fmu"
+        if f.is_file() and f.stat().st_mtime < t:
+            out.append(f"{f} is older than {src.relative_to(root)}: its results are the previous build's; {BUILD_HINT}")
+    return out
+
+
+def check_fmus(
+    parser: argparse.ArgumentParser,
+    option: str,
+    dist: str | pathlib.Path,
+    models: Iterable[str],
+    root: pathlib.Path | None = None,
+) -> None:
+    """`parser.error` unless folder `dist` holds a readable `<model>.fmu` of every model; a
+    warning on stderr for each FMU older than the checkout's sources (`stale_fmus`)."""
     dist = pathlib.Path(dist)
     if not dist.is_dir():
         parser.error(f"argument {option}: {str(dist)!r} is not a folder of FMUs; {BUILD_HINT}")
+    models = list(models)
     for m in models:
         problem = fmu_problem(dist / f"{m}.fmu")
         if problem:
             parser.error(f"argument {option}: {problem}; {BUILD_HINT}")
+    for line in stale_fmus(dist, models, root):
+        print(f"{parser.prog}: warning: {line}", file=sys.stderr)
 
 
 def check_out(parser: argparse.ArgumentParser, option: str, out: str | pathlib.Path) -> None:
