@@ -40,9 +40,7 @@
 //!   sink is commanded (the descent at its full rate, the flare), a ground contact — the gear's share of the weight
 //!   by the accelerometer, `f_x/g − T/(m g)` (specific force along the thrust axis against
 //!   the thrust), rises above its mean in the air by [`CONTACT_REACTION`] and
-//!   [`CONTACT_SIGMAS`] of its spread (or, near the target, by the smaller of that and
-//!   [`CONTACT_HELD_REACTION`] for [`CONTACT_HOLD_TIME`]: in turbulence the spread hides a
-//!   touch on one leg): the gear carries weight, at the impact or as the
+//!   [`CONTACT_SIGMAS`] of its spread: the gear carries weight, at the impact or as the
 //!   controller takes thrust off — followed by the sink stopping (|v_d| < [`LANDED_SINK`]
 //!   V_td, tilt rate < [`LANDED_TILT_RATE`], for [`TOUCHDOWN_DWELL`]). Then the thrust
 //!   command is 0 (the controllers clamp it to their thrust minimum), surfaces centred, held
@@ -95,21 +93,6 @@ pub const CONTACT_REACTION: f64 = 0.05;
 /// Ground contact: least rise of the gear's share in standard deviations of its spread in
 /// the air (–): with the avionics chain's noise (σ ≈ 0.01–0.02) the rise must be larger.
 pub const CONTACT_SIGMAS: f64 = 5.0;
-/// Ground contact held: a rise of the share by at least [`CONTACT_REACTION`] but no more than
-/// this (–) counts as a contact when it lasts [`CONTACT_HOLD_TIME`], whatever the spread in the
-/// air (in moderate turbulence 5 σ of the spread exceed what a touch on one leg lifts the
-/// share by: the landing came late and the aircraft moved on the gear; a gust's excursion
-/// lasts a sample or two). Above the 0.11–0.12 W the share holds for tenths of a second just
-/// above the ground under a Jacobi master in an 8 m/s wind (0.1 declared landings there).
-pub const CONTACT_HELD_REACTION: f64 = 0.15;
-/// Ground contact held: how long the share must stay [`CONTACT_HELD_REACTION`] up (s): three
-/// samples at 20 ms (a soft touch on one leg lasts 0.1 s).
-pub const CONTACT_HOLD_TIME: f64 = 0.04;
-/// Ground contact held: counted only while the reference is at most this far above the
-/// target (m): [`TOUCHDOWN_SEARCH_DEPTH`], the 3 σ of the height GPS alone gives (the reference
-/// is a plan, not the estimate: the detector stays free of the estimated height). High up, a
-/// sink braked in a steady wind lifts the share by 0.1 W for tenths of a second.
-pub const CONTACT_HELD_HEIGHT: f64 = TOUCHDOWN_SEARCH_DEPTH;
 /// Time constant of the gear share's mean and spread in the air (s).
 pub const SHARE_TIME: f64 = 2.0;
 /// How long a ground contact counts for the landing (s): the impact's reaction lasts a few
@@ -171,8 +154,6 @@ pub struct GroundPhases {
     share_mean: f64,
     share_var: f64,
     share_t: f64,
-    /// Time since which the share is above the held contact's threshold (NaN: it is not).
-    held_since: f64,
     landed: bool,
 }
 
@@ -208,7 +189,7 @@ fn ramp(v: f64, t_r: f64, tau: f64) -> (f64, f64, f64) {
 
 impl GroundPhases {
     /// Number of values [`Self::save`] writes.
-    pub const SAVED_LEN: usize = 18;
+    pub const SAVED_LEN: usize = 17;
 
     /// The phase logic of `mission` for an airframe of weight `weight` (N).
     pub fn new(mission: MissionParams, weight: f64) -> Self {
@@ -222,7 +203,6 @@ impl GroundPhases {
             share_mean: f64::NAN,
             share_var: f64::NAN,
             share_t: f64::NAN,
-            held_since: f64::NAN,
             landed: false,
         }
     }
@@ -405,8 +385,7 @@ impl GroundPhases {
         // A sink is commanded: the flare, or the descent at its full rate (not its ramp from
         // rest, where the aircraft is still slow in the air).
         let sinking = r.phase == Phase::Flare || r.phase == Phase::Descent && r.vel.z >= m.landing_descent_rate - 1e-9;
-        let near = r.pos.z >= target.z - CONTACT_HELD_HEIGHT;
-        if sinking && self.detect_landing(t, meas, near) {
+        if sinking && self.detect_landing(t, meas) {
             return GroundMode::Idle {
                 phase: Phase::Landed,
                 thrust: 0.0,
@@ -425,28 +404,12 @@ impl GroundPhases {
     /// the air's is the wing's drag and the estimate's noise). No height: the estimate's is
     /// metres off with GPS alone.
     pub fn ground_contact(&self, meas: &Measurement) -> bool {
-        self.share_rise(meas) > CONTACT_REACTION.max(CONTACT_SIGMAS * self.share_var.max(0.0).sqrt())
-    }
-
-    /// The gear's share above its mean in the air (–).
-    fn share_rise(&self, meas: &Measurement) -> f64 {
-        self.gear_share(meas) - if self.share_mean.is_nan() { 0.0 } else { self.share_mean }
-    }
-
-    /// Held ground contact at `t`: the share above its mean in the air by the smaller of
-    /// [`CONTACT_HELD_REACTION`] and the single-sample threshold ([`Self::ground_contact`])
-    /// since [`CONTACT_HOLD_TIME`].
-    fn held_contact(&mut self, t: f64, meas: &Measurement) -> bool {
-        let threshold =
-            CONTACT_HELD_REACTION.min(CONTACT_REACTION.max(CONTACT_SIGMAS * self.share_var.max(0.0).sqrt()));
-        if self.share_rise(meas) <= threshold {
-            self.held_since = f64::NAN;
-            return false;
-        }
-        if self.held_since.is_nan() {
-            self.held_since = t;
-        }
-        t - self.held_since >= CONTACT_HOLD_TIME - 1e-9
+        let (mean, var) = if self.share_mean.is_nan() {
+            (0.0, 0.0)
+        } else {
+            (self.share_mean, self.share_var)
+        };
+        self.gear_share(meas) - mean > CONTACT_REACTION.max(CONTACT_SIGMAS * var.sqrt())
     }
 
     /// Track the gear's share in the air (no contact): exponential mean and variance over
@@ -465,14 +428,12 @@ impl GroundPhases {
     }
 
     /// The land detector at `t` while a sink is commanded (the descent at its full rate and
-    /// the flare): a ground contact (a single sample's, [`Self::ground_contact`], or one held,
-    /// [`Self::held_contact`], with the reference `near` the target: within
-    /// [`CONTACT_HELD_HEIGHT`] above it) within the last [`CONTACT_MEMORY`], the vertical speed below [`LANDED_SINK`]
+    /// the flare): a ground
+    /// contact within the last [`CONTACT_MEMORY`], the vertical speed below [`LANDED_SINK`]
     /// V_td and the tilt rate below [`LANDED_TILT_RATE`] for [`TOUCHDOWN_DWELL`] latch the
     /// landing.
-    fn detect_landing(&mut self, t: f64, meas: &Measurement, near: bool) -> bool {
-        let held = self.held_contact(t, meas) && near;
-        if self.ground_contact(meas) || held {
+    fn detect_landing(&mut self, t: f64, meas: &Measurement) -> bool {
+        if self.ground_contact(meas) {
             self.contact_at = t;
         } else {
             self.track_share(t, meas);
@@ -508,7 +469,6 @@ impl GroundPhases {
         out(self.share_mean);
         out(self.share_var);
         out(self.share_t);
-        out(self.held_since);
     }
 
     /// Restore what [`Self::save`] wrote; `None` if values are missing.
@@ -523,7 +483,6 @@ impl GroundPhases {
         self.landed = v[12] != 0.0;
         self.contact_at = v[13];
         (self.share_mean, self.share_var, self.share_t) = (v[14], v[15], v[16]);
-        self.held_since = v[17];
         Some(())
     }
 }
@@ -835,72 +794,6 @@ mod tests {
         gi.step(t1, &flare_meas(0.0, 0.4, 1.0, 1.8, 0.0), mref);
         gi.step(t1 + 0.02, &flare_meas(0.0, 0.4, 1.0, 1.0, 0.0), mref);
         flying(&mut gi, t1 + CONTACT_MEMORY + 0.02, &still);
-        // In turbulence (the share in the air −0.04 ± 0.05 W and gusts: 5 σ > 0.25 W, more than a
-        // touch on one leg), hovering with the sink stopped: gusts lifting the share by 0.2 W
-        // for two samples are no contact; a touch on one leg lifting it by 0.2 W for 0.1 s is.
-        let mut gt = g;
-        let t2 = t + 10.0;
-        let gust = flare_meas(0.0, 0.0, 1.04, 1.2, 0.0);
-        for k in 0..1000 {
-            let noise = 0.05 * if k % 2 == 0 { 1.0 } else { -1.0 };
-            let x = if k >= 400 && k % 25 < 2 {
-                gust
-            } else {
-                flare_meas(0.0, 0.0, 1.04, 1.0 + noise, 0.0)
-            };
-            assert!(
-                matches!(gt.step(t2 + 0.02 * f64::from(k), &x, mref), GroundMode::Vertical(_)),
-                "k = {k}"
-            );
-        }
-        assert!(gt.share_var.sqrt() > 0.05 && !gt.ground_contact(&gust), "{gt:?}");
-        let t3 = t2 + 20.0;
-        let touch = |i: u32| flare_meas(0.0, 0.07 - 0.01 * f64::from(i), 1.04, 1.24 + gt.share_mean, 0.0);
-        let mut g_one_leg = gt;
-        let modes: Vec<_> = (0..5)
-            .map(|i| g_one_leg.step(t3 + 0.02 * f64::from(i), &touch(i), mref))
-            .collect();
-        assert!(
-            modes[..4].iter().all(|m| matches!(m, GroundMode::Vertical(_))),
-            "{modes:?}"
-        );
-        assert_eq!(modes[4], landed);
-        // The same rise held while sinking faster than the commanded rate: not landed.
-        let mut g_sinking = gt;
-        flying(
-            &mut g_sinking,
-            t3,
-            &flare_meas(0.0, 0.35, 1.04, 1.24 + gt.share_mean, 0.0),
-        );
-        // High up in the descent at its full rate (the reference more than
-        // CONTACT_HELD_HEIGHT above the target), after the same turbulence, a sink braked in
-        // the wind lifting the share by 0.18 W for 0.2 s is no held contact.
-        let mut gh = GroundPhases::new(m, 100.0);
-        let mut th = 1.0;
-        while !matches!(gh.clone().step(th, &air, mref), GroundMode::Vertical(r) if r.phase == Phase::Descent && r.vel.z >= 1.0 - 1e-9)
-        {
-            th += 0.02;
-        }
-        for k in 0..200 {
-            let noise = 0.05 * if k % 2 == 0 { 1.0 } else { -1.0 };
-            gh.step(
-                th + 0.02 * f64::from(k),
-                &flare_meas(5.0, 1.0, 1.04, 1.0 + noise, 0.0),
-                mref,
-            );
-        }
-        let th = th + 4.0;
-        let braked = flare_meas(5.0, 0.05, 1.04, 1.22 + gh.share_mean, 0.0);
-        assert!(!gh.ground_contact(&braked), "{gh:?}");
-        for k in 0..10 {
-            match gh.step(th + 0.02 * f64::from(k), &braked, mref) {
-                GroundMode::Vertical(r) => assert!(
-                    r.phase == Phase::Descent && r.pos.z < 20.0 - CONTACT_HELD_HEIGHT,
-                    "{r:?}"
-                ),
-                other => panic!("{other:?}"),
-            }
-        }
         // Latched for good.
         let down = flare_meas(0.0, 0.0, 0.7, 1.0, 0.0);
         g.step(t + 6.0, &down, mref);
