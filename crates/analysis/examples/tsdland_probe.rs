@@ -116,14 +116,7 @@ fn main() {
                 .last()
                 .map_or(f64::NAN, |s| (s.measurement.pos_ned.xy() - own_target).norm());
             // The landing's first contact (not a take-off bounce) and the tilt there.
-            let contact = trace.samples.iter().find(|s| {
-                matches!(s.diagnostics.phase, Phase::Flare | Phase::Landed)
-                    && plant
-                        .outputs(&s.x, &closed_loop::plant_inputs(&s.command), &s.wind)
-                        .ground
-                        .points
-                        > 0
-            });
+            let contact = takeoff_landing::first_landing_contact(&plant, &trace);
             let td = contact.map_or(td, |s| s.t);
             let tilt_contact = contact.map_or(f64::NAN, |s| tilt(&s.x).to_degrees());
             // Largest lean towards the belly and along the span in the last 3 s (deg).

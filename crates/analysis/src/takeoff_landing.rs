@@ -161,6 +161,18 @@ pub fn tilt(x: &StateVector) -> f64 {
     (-nose.z).clamp(-1.0, 1.0).acos()
 }
 
+/// The landing's first ground contact (in the flare or landed, so not a take-off bounce).
+pub fn first_landing_contact<'a>(plant: &Plant, trace: &'a Trace) -> Option<&'a closed_loop::Sample> {
+    trace.samples.iter().find(|s| {
+        matches!(s.diagnostics.phase, Phase::Flare | Phase::Landed)
+            && plant
+                .outputs(&s.x, &closed_loop::plant_inputs(&s.command), &s.wind)
+                .ground
+                .points
+                > 0
+    })
+}
+
 /// A stop condition for [`closed_loop::fly_with`]: true from [`AFTER_LANDING`] after the
 /// first sample in [`Phase::Landed`].
 pub fn after_landing() -> impl FnMut(&closed_loop::Sample) -> bool {

@@ -44,7 +44,7 @@ use std::time::Instant;
 
 use closed_loop::avionics::{Avionics, AvionicsSource};
 use closed_loop::{fly_with, wind_from, Ordering, Perfect, Sample, Scenario, Trace, Wind};
-use flight_mission::{MissionParams, Phase};
+use flight_mission::MissionParams;
 use nalgebra::Vector3;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -552,13 +552,7 @@ pub fn fly_job(job: &Job, history: Option<&str>) -> (Cell, [f64; closed_loop::N_
             let x0 = plant.resting_on_ground(0.0, 0.0, 0.0);
             scenario.stop_time = takeoff_landing::stop_time(&mission);
             // Flown until AFTER_LANDING after the landing (or the stop time).
-            let mut landed: Option<f64> = None;
-            let stop = |s: &Sample| {
-                if landed.is_none() && s.diagnostics.phase == Phase::Landed {
-                    landed = Some(s.t);
-                }
-                landed.is_some_and(|t| s.t >= t + takeoff_landing::AFTER_LANDING - 1e-9)
-            };
+            let stop = takeoff_landing::after_landing();
             let trace = fly_on(
                 &plant,
                 x0,
@@ -1078,6 +1072,7 @@ pub fn main(a: &Args) -> Result<(), String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use flight_mission::Phase;
 
     /// Held by the thesis's controllers; PX4 flies it to the end but off the held bound.
     #[test]

@@ -61,18 +61,7 @@ fn fly_cell(form: WindForm, ordering: Ordering, speed: f64, bearing_index: usize
 /// landing's first ground contact, and the tilt at that contact (deg).
 fn cell(speed: f64, bearing_index: usize) -> (f64, f64) {
     let (plant, trace) = fly_cell(WindForm::Turbulent, Ordering::GaussSeidel, speed, bearing_index);
-    let contact = trace
-        .samples
-        .iter()
-        .find(|s| {
-            matches!(s.diagnostics.phase, Phase::Flare | Phase::Landed)
-                && plant
-                    .outputs(&s.x, &closed_loop::plant_inputs(&s.command), &s.wind)
-                    .ground
-                    .points
-                    > 0
-        })
-        .expect("the landing meets the ground");
+    let contact = takeoff_landing::first_landing_contact(&plant, &trace).expect("the landing meets the ground");
     let lean = trace
         .samples
         .iter()
