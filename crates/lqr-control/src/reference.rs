@@ -16,7 +16,7 @@ use crate::model;
 use crate::trajectory::TrajPoint;
 use crate::{
     LqrController, GROUND_TRIM_MAX_YAW, HOVER_SHIFT_LIMIT, HOVER_SHIFT_TIME, LANDING_FLAP_GAIN, LANDING_FLAP_LIMIT,
-    LANDING_FLAP_RAMP_TIME, MAX_WIND_ESTIMATE, MIN_AIRSPEED, WIND_INTEGRAL_SPEED, WIND_TRIM_MAX_PITCH, WIND_TRIM_RAMP,
+    LANDING_FLAP_RAMP_TIME, MAX_WIND_ESTIMATE, FRONT_TRIM_RAMP_TIME, MIN_AIRSPEED, WIND_INTEGRAL_SPEED, WIND_TRIM_MAX_PITCH, WIND_TRIM_RAMP,
 };
 
 /// Switches of the reference stage (from [`crate::LqrParams::effective`]).
@@ -324,7 +324,13 @@ impl LqrController {
             return None;
         }
         let s_lat = self.lateral_wind_weight(p);
-        if let Some(q) = self.ground_path_trimmed(p, (&w_next, k, k_next), s_lat) {
+        if sw.hover_in_wind && self.wind_integral {
+            if let Some(q) = self.front_transition_trimmed(p, &w_next, s_lat) {
+                return Some(q);
+            }
+        }
+        let plain = |w: &Vector3<f64>| self.ground_path_trim(p, w, s_lat);
+        if let Some(q) = self.ground_path_trimmed(p, (&w_next, k, k_next), plain) {
             return Some(q);
         }
         let z = self.wind_trim(p, &self.wind, s_lat)?;
@@ -352,11 +358,11 @@ impl LqrController {
         &self,
         p: &TrajPoint,
         (w_next, k, k_next): (&Vector3<f64>, f64, f64),
-        s_lat: f64,
+        trim: impl Fn(&Vector3<f64>) -> Option<SVector<f64, 6>>,
     ) -> Option<TrajPoint> {
         let h = self.mission.sample_time;
-        let z = self.ground_path_trim(p, &self.wind, s_lat)?;
-        let z_next = self.ground_path_trim(p, w_next, s_lat)?;
+        let z = trim(&self.wind)?;
+        let z_next = trim(w_next)?;
         let rate = (z_next * k_next - z * k) / h;
         let r = body_rotation(k * z[0], k * z[1]);
         let c = r.transpose() * model::dcm_of_quat(&p.quat());
@@ -374,6 +380,66 @@ impl LqrController {
         Some(q)
     }
 
+    /// The front transition in a steady wind (README, "Mission in wind"): the trim along the
+    /// still-air ground path ([`Self::ground_path_trim_from`]) on the global aerodynamic model,
+    /// weighted by max((V_t/V_L)², smoothstep(τ/[`FRONT_TRIM_RAMP_TIME`])) (τ: time into the
+    /// transition) instead of the lift-borne fraction alone, solved by continuation in the
+    /// wind speed ([`Self::front_trim_continuation`]). None outside the front transition, or
+    /// where no fraction of the wind can be trimmed.
+    fn front_transition_trimmed(&self, p: &TrajPoint, w_next: &Vector3<f64>, s_lat: f64) -> Option<TrajPoint> {
+        let k = self.front_transition_weight(p)?;
+        let s_lat = s_lat.max(k);
+        let (z, lambda) = self.front_trim_continuation(p, &self.wind, s_lat)?;
+        let trim = |w: &Vector3<f64>| {
+            if std::ptr::eq(w, &self.wind) {
+                Some(z)
+            } else {
+                self.ground_path_trim_from(p, &(w * lambda), s_lat, &z, true)
+            }
+        };
+        self.ground_path_trimmed(p, (w_next, k, k), trim)
+    }
+
+    /// Weight of the front transition's trim (None outside the front transition in a steady
+    /// wind): max((V_t/V_L)², smoothstep(τ/[`FRONT_TRIM_RAMP_TIME`])), τ the time into the
+    /// transition, phased in with the estimated wind as [`WIND_TRIM_RAMP`].
+    fn front_transition_weight(&self, p: &TrajPoint) -> Option<f64> {
+        let (phase, tau) = self.mission.phase_at(p.t);
+        if !(self.wind_integral && phase == Phase::TransitionToLevel) {
+            return None;
+        }
+        let smooth = |x: f64| x * x * (3.0 - 2.0 * x);
+        let lift = (p.v / self.mission.v_level).powi(2).min(1.0);
+        let (w0, w1) = WIND_TRIM_RAMP;
+        let x = (tau / FRONT_TRIM_RAMP_TIME).clamp(0.0, 1.0);
+        let y = ((self.wind.norm() - w0) / (w1 - w0)).clamp(0.0, 1.0);
+        Some(lift.max(smooth(x)) * smooth(y))
+    }
+
+    /// Continuation in the wind speed: [`Self::ground_path_trim_from`] on the global model at
+    /// λ ŵ, λ = 1/N … 1, each from the last solution; the trim of the largest λ reached and λ.
+    fn front_trim_continuation(
+        &self,
+        p: &TrajPoint,
+        wind: &Vector3<f64>,
+        s_lat: f64,
+    ) -> Option<(SVector<f64, 6>, f64)> {
+        const N: usize = 4;
+        let mut best = None;
+        let mut z = SVector::<f64, 6>::zeros();
+        for j in 1..=N {
+            let lambda = j as f64 / N as f64;
+            match self.ground_path_trim_from(p, &(wind * lambda), s_lat, &z, true) {
+                Some(zj) => {
+                    z = zj;
+                    best = Some((zj, lambda));
+                }
+                None => break,
+            }
+        }
+        best
+    }
+
     /// Trim of a reference point along its still-air ground path in the wind `wind` (NED,
     /// m/s) (README, "Mission in wind"): the rotation of the reference body axes by δψ about
     /// body z (in level flight the crab, in vertical flight a lean across the belly) and δθ
@@ -386,13 +452,34 @@ impl LqrController {
     /// finite-difference Jacobian, ≤ 12 iterations) from the still-air point; None where it
     /// does not converge or leaves the limits.
     fn ground_path_trim(&self, p: &TrajPoint, wind: &Vector3<f64>, s_lat: f64) -> Option<SVector<f64, 6>> {
+        self.ground_path_trim_from(p, wind, s_lat, &SVector::zeros(), false)
+    }
+
+    /// [`Self::ground_path_trim`] from the start `z0`, on the global aerodynamic model
+    /// (`global`) or the model for control.
+    fn ground_path_trim_from(
+        &self,
+        p: &TrajPoint,
+        wind: &Vector3<f64>,
+        s_lat: f64,
+        z0: &SVector<f64, 6>,
+        global: bool,
+    ) -> Option<SVector<f64, 6>> {
         let af = &self.airframe;
+        let ga = tailsitter_physics::GlobalAero::default();
+        let fmf = |v: &Vector3<f64>, w: &Vector3<f64>, t: f64, s: &Surfaces| {
+            if global {
+                ga.forces_moments(af, v, w, t, s).0
+            } else {
+                af.forces_moments(v, w, t, s)
+            }
+        };
         let surfaces = |z: &SVector<f64, 6>| {
             Surfaces::from_array([p.u[1] + z[3], p.u[2] + z[4], p.u[3] + z[5], p.u[4], p.u[5], p.u[6]])
         };
         let c_t = model::dcm_of_quat(&p.quat());
         let vb_t = model::body_velocity(p.v, p.alpha, 0.0);
-        let fm_t = af.forces_moments(&vb_t, &p.rates, p.thrust, &surfaces(&SVector::zeros()));
+        let fm_t = fmf(&vb_t, &p.rates, p.thrust, &surfaces(&SVector::zeros()));
         let f_e = c_t.transpose() * fm_t.force_body;
         let v_g = c_t.transpose() * vb_t;
         let (v_a, v_lat) = (v_g - wind, v_g - s_lat * wind);
@@ -402,14 +489,14 @@ impl LqrController {
             let c = r.transpose() * c_t;
             let mut vb = c * v_a;
             vb.y = (c * v_lat).y;
-            let fm = af.forces_moments(&vb, &(r.transpose() * p.rates), p.thrust + z[2], &surfaces(z));
+            let fm = fmf(&vb, &(r.transpose() * p.rates), p.thrust + z[2], &surfaces(z));
             let df = (c.transpose() * fm.force_body - f_e) / weight;
             let dm = fm.moment_body - fm_t.moment_body;
             SVector::<f64, 6>::new(df.x, df.y, df.z, dm.x, dm.y, dm.z)
         };
         let steps = SVector::<f64, 6>::new(1e-6, 1e-6, 1e-4, 1e-6, 1e-6, 1e-6);
         let converged = |r: &SVector<f64, 6>| r.fixed_rows::<3>(0).norm() < 1e-6 && r.fixed_rows::<3>(3).norm() < 1e-6;
-        let z = newton(residual, &steps, 12, converged)?;
+        let z = newton_from(*z0, residual, &steps, 12, converged)?;
         let lim = af.deflection_limit;
         let in_limits = z[0].abs() <= GROUND_TRIM_MAX_YAW
             && z[1].abs() <= WIND_TRIM_MAX_PITCH
@@ -470,7 +557,10 @@ impl LqrController {
         if !sw.wind_compensation || !self.wind.iter().all(|v| v.is_finite()) {
             return plain;
         }
-        let s_lat = self.lateral_wind_weight(p);
+        let mut s_lat = self.lateral_wind_weight(p);
+        if sw.hover_in_wind {
+            s_lat = s_lat.max(self.front_transition_weight(p).unwrap_or(0.0));
+        }
         let c = model::dcm_of_quat(&p.quat());
         let full = c * (v_g - self.wind);
         let v_b = Vector3::new(full.x, (c * (v_g - s_lat * self.wind)).y, full.z);
@@ -546,7 +636,21 @@ fn newton<const N: usize>(
 where
     Const<N>: DimMin<Const<N>, Output = Const<N>> + ToTypenum,
 {
-    let mut z = SVector::<f64, N>::zeros();
+    newton_from(SVector::zeros(), residual, steps, iterations, converged)
+}
+
+/// [`newton`] from the start `z0`.
+fn newton_from<const N: usize>(
+    z0: SVector<f64, N>,
+    residual: impl Fn(&SVector<f64, N>) -> SVector<f64, N>,
+    steps: &SVector<f64, N>,
+    iterations: usize,
+    converged: impl Fn(&SVector<f64, N>) -> bool,
+) -> Option<SVector<f64, N>>
+where
+    Const<N>: DimMin<Const<N>, Output = Const<N>> + ToTypenum,
+{
+    let mut z = z0;
     for _ in 0..iterations {
         let r = residual(&z);
         if !r.iter().all(|v| v.is_finite()) {
@@ -703,6 +807,66 @@ mod wind_trim_tests {
                 );
                 assert!(beta.abs() < 0.035, "{t}: β {beta}");
                 assert!(q.euler_321.x.abs() < 3f64.to_radians(), "{t}: φ {}", q.euler_321.x);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod lqrfront2_scan {
+    use super::*;
+    use crate::{LqrParams, MissionParams};
+    use tailsitter_physics::Airframe;
+
+    #[test]
+    #[ignore]
+    fn scan_front_transition() {
+        let mut c = LqrController::new(Airframe::default(), MissionParams::default(), LqrParams::default()).unwrap();
+        let cases: Vec<(f64, f64)> = std::env::var("SCAN")
+            .unwrap_or("5:90,8:90,8:45,8:135,10:135,8:180,10:180".into())
+            .split(',')
+            .map(|x| {
+                let mut it = x.split(':');
+                (it.next().unwrap().parse().unwrap(), it.next().unwrap().parse().unwrap())
+            })
+            .collect();
+        for (speed, bdeg) in cases {
+            let b: f64 = f64::to_radians(bdeg);
+            let w = -speed * Vector3::new(b.cos(), b.sin(), 0.0);
+            c.wind = w;
+            eprintln!("=== {speed} m/s from {bdeg}°");
+            let mut t = 3.0;
+            let mut prev = [SVector::<f64, 6>::zeros(); 2];
+            while t <= 22.0 {
+                let p = c.trajectory().at(t);
+                let s_lat = c.lateral_wind_weight(&p);
+                let mut line = format!("t {t:5.2} V {:5.2} θ {:5.1} T {:5.1}", p.v, p.euler_321.y.to_degrees(), p.thrust);
+                for (k, global) in [false, true].into_iter().enumerate() {
+                    // homotopy in wind speed from the previous solution
+                    let mut z = Some(prev[k]);
+                    for j in 1..=10 {
+                        let lam = j as f64 / 10.0;
+                        z = z.and_then(|z0| c.ground_path_trim_from(&p, &(w * lam), s_lat, &if t == 3.0 { z0 } else { prev[k] }, global));
+                        if t != 3.0 { if j < 10 { continue; } }
+                    }
+                    let z = if t == 3.0 { z } else { c.ground_path_trim_from(&p, &w, s_lat, &prev[k], global) };
+                    let zz = c.ground_path_trim_from(&p, &w, s_lat, &SVector::zeros(), global);
+                    line += &match z {
+                        Some(z) => {
+                            prev[k] = z;
+                            format!(
+                                " | {} y{:6.1} p{:6.1} dT{:6.1} e{:6.1} a{:6.1} r{:6.1}{}",
+                                if global { "G" } else { "L" },
+                                z[0].to_degrees(), z[1].to_degrees(), z[2],
+                                (p.u[1] + z[3]).to_degrees(), (p.u[2] + z[4]).to_degrees(), (p.u[3] + z[5]).to_degrees(),
+                                if zz.is_some() { "" } else { "*" }
+                            )
+                        }
+                        None => format!(" | {} none{}", if global { "G" } else { "L" }, if zz.is_some() { " zero-ok" } else { "" }),
+                    };
+                }
+                eprintln!("{line}");
+                t += if t < 11.0 { 0.25 } else { 2.0 };
             }
         }
     }
