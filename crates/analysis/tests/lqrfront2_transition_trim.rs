@@ -22,7 +22,10 @@ fn cell(mission: MissionKind, speed: f64, bearing_deg: f64) -> (Cell, [f64; 11])
 fn crosswind_front_transition_held() {
     for (speed, bound) in [(5.0, 2.5), (8.0, 1.5)] {
         let (c, phases) = cell(MissionKind::Default, speed, 90.0);
-        eprintln!("{speed} m/s from 90°: phases {phases:.2?}, largest {:.2} m", c.max_error);
+        eprintln!(
+            "{speed} m/s from 90°: phases {phases:.2?}, largest {:.2} m",
+            c.max_error
+        );
         assert!(phases[1] < bound, "{speed} m/s: transition 1 {} m", phases[1]);
         assert!(c.held, "{speed} m/s: {:.2} m, path {:?}", c.max_error, c.mission_error);
     }
@@ -34,13 +37,22 @@ fn crosswind_front_transition_held() {
 #[test]
 fn quartering_wind_front_transition() {
     let (c, phases) = cell(MissionKind::Default, 5.0, 45.0);
-    eprintln!("default 5 m/s from 45°: phases {phases:.2?}, largest {:.2} m", c.max_error);
+    eprintln!(
+        "default 5 m/s from 45°: phases {phases:.2?}, largest {:.2} m",
+        c.max_error
+    );
     assert!(c.held, "{:.2} m, path {:?}", c.max_error, c.mission_error);
     let (c, phases) = cell(MissionKind::Default, 8.0, 45.0);
-    eprintln!("default 8 m/s from 45°: phases {phases:.2?}, largest {:.2} m", c.max_error);
+    eprintln!(
+        "default 8 m/s from 45°: phases {phases:.2?}, largest {:.2} m",
+        c.max_error
+    );
     assert!(c.completed, "{:?}", c.failure);
     assert!(phases[1] < 6.0, "transition 1 {} m", phases[1]);
     let (c, phases) = cell(MissionKind::Handover, 5.0, 45.0);
-    eprintln!("handover 5 m/s from 45°: phases {phases:.2?}, largest {:.2} m", c.max_error);
+    eprintln!(
+        "handover 5 m/s from 45°: phases {phases:.2?}, largest {:.2} m",
+        c.max_error
+    );
     assert!(c.held, "{:.2} m, path {:?}", c.max_error, c.mission_error);
 }
