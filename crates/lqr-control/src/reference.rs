@@ -490,7 +490,7 @@ impl LqrController {
         };
         let steps = SVector::<f64, 6>::new(1e-6, 1e-6, 1e-4, 1e-6, 1e-6, 1e-6);
         let converged = |r: &SVector<f64, 6>| r.fixed_rows::<3>(0).norm() < 1e-6 && r.fixed_rows::<3>(3).norm() < 1e-6;
-        let z = newton_from(*z0, residual, &steps, 12, converged)?;
+        let z = newton(*z0, residual, &steps, 12, converged)?;
         let lim = af.deflection_limit;
         let in_limits = z[0].abs() <= GROUND_TRIM_MAX_YAW
             && z[1].abs() <= WIND_TRIM_MAX_PITCH
@@ -528,7 +528,7 @@ impl LqrController {
         };
         let steps = Vector3::new(1e-6, 1e-4, 1e-6);
         let converged = |r: &Vector3<f64>| r.xy().norm() < 1e-6 * af.mass * af.gravity && r.z.abs() < 1e-7;
-        let z = newton(residual, &steps, 8, converged)?;
+        let z = newton(Vector3::zeros(), residual, &steps, 8, converged)?;
         let in_limits = z.x.abs() <= WIND_TRIM_MAX_PITCH
             && (af.thrust_min..=af.thrust_max).contains(&(p.thrust + z.y))
             && (p.u[1] + z.z).abs() <= af.deflection_limit;
@@ -618,23 +618,10 @@ impl LqrController {
     }
 }
 
-/// Newton's method from zero on `residual` with a forward-difference Jacobian (`steps`), at
+/// Newton's method from `z0` on `residual` with a forward-difference Jacobian (`steps`), at
 /// most `iterations` steps: the first iterate whose residual is `converged`; None on a
 /// non-finite residual, a singular Jacobian or no convergence.
 fn newton<const N: usize>(
-    residual: impl Fn(&SVector<f64, N>) -> SVector<f64, N>,
-    steps: &SVector<f64, N>,
-    iterations: usize,
-    converged: impl Fn(&SVector<f64, N>) -> bool,
-) -> Option<SVector<f64, N>>
-where
-    Const<N>: DimMin<Const<N>, Output = Const<N>> + ToTypenum,
-{
-    newton_from(SVector::zeros(), residual, steps, iterations, converged)
-}
-
-/// [`newton`] from the start `z0`.
-fn newton_from<const N: usize>(
     z0: SVector<f64, N>,
     residual: impl Fn(&SVector<f64, N>) -> SVector<f64, N>,
     steps: &SVector<f64, N>,
