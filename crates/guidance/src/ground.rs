@@ -109,12 +109,14 @@ pub const LANDED_TILT_RATE: f64 = 40.0 * core::f64::consts::PI / 180.0;
 pub const TOUCHDOWN_DWELL: f64 = 0.04;
 /// Gravity of the contact test (m/s²): the airframes' g (C.1).
 pub const CONTACT_GRAVITY: f64 = 9.81;
-/// Share of the thrust reserve `T_max − T̄` (T̄ the mean thrust of the steady descent) the
-/// flare's deceleration may use, with a thrust limit given ([`GroundPhases::with_thrust_limit`])
-/// (–): the rest is the loop's. In a 10 m/s wind the upright hover needs 130 N of the
-/// airframe's 150 N; the flare from 2 m/s over 1.2 m needs 14.7 N more, and the loop's lead
-/// at the flare's start saturated the thrust (touchdowns at 0.57–0.78 m/s).
-pub const FLARE_THRUST_SHARE: f64 = 0.25;
+/// Thrust kept for the loop in a thrust-limited flare, in weights (–): with a thrust limit
+/// given ([`GroundPhases::with_thrust_limit`]) the flare's deceleration may use the thrust
+/// reserve `T_max − T̄` (T̄ the mean thrust of the steady descent) less this. In a 10 m/s
+/// wind the upright hover needs 130 N of the airframe's 150 N; the flare from 2 m/s over
+/// 1.2 m needs 14.7 N more, and the loop's lead at the flare's start saturated the thrust
+/// (touchdowns at 0.57–0.78 m/s). In still air (T̄ ≈ 91 N) the flare needs 1.6 m/s² of the
+/// 4.9 m/s² left: unchanged up to T̄ ≈ 120 N.
+pub const FLARE_LOOP_RESERVE: f64 = 0.17;
 /// Highest flare of a thrust-limited descent (m above the target).
 pub const FLARE_HEIGHT_MAX: f64 = 6.0;
 /// Height above the target at which the reference's flare height is fixed, from the mean
@@ -240,8 +242,8 @@ impl GroundPhases {
     }
 
     /// Height of the flare above the target (m): `landing_flare_height`, raised so that the
-    /// flare's deceleration `(V_d² − V_td²) / (2 (h_f − h_td))` needs at most
-    /// [`FLARE_THRUST_SHARE`] of the thrust reserve over the descent's mean thrust (a wind
+    /// flare's deceleration `(V_d² − V_td²) / (2 (h_f − h_td))` leaves [`FLARE_LOOP_RESERVE`]
+    /// of the thrust reserve over the descent's mean thrust to the loop (a wind
     /// that the hover needs much thrust against), within [`FLARE_HEIGHT_MAX`]. Fixed at
     /// [`FLARE_LATCH_HEIGHT`] above the target.
     pub fn flare_height(&self) -> f64 {
@@ -260,7 +262,7 @@ impl GroundPhases {
             return h_f;
         }
         let (vd, vtd) = (m.landing_descent_rate, m.landing_touchdown_rate);
-        let a_max = FLARE_THRUST_SHARE * (self.thrust_limit - thrust) * CONTACT_GRAVITY / self.weight;
+        let a_max = CONTACT_GRAVITY * ((self.thrust_limit - thrust) / self.weight - FLARE_LOOP_RESERVE);
         let h_td = vtd * FINAL_SEGMENT_TIME;
         let needed = if a_max > 0.0 {
             h_td + (vd * vd - vtd * vtd) / (2.0 * a_max)
