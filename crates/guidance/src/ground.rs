@@ -777,6 +777,66 @@ mod tests {
         assert_eq!(last.vel, Vector3::zeros());
     }
 
+    /// The flare of a thrust-limited airframe: at still air's thrust the mission's flare
+    /// height (the reference identical to one without a limit); at the thrust an upright
+    /// hover needs in a 10 m/s wind (130 N of 150 N, 9 kg) raised so that the flare's
+    /// deceleration leaves [`FLARE_LOOP_RESERVE`] of the weight to the loop; fixed at
+    /// [`FLARE_LATCH_HEIGHT`]; the reference continuous through it.
+    #[test]
+    fn a_thrust_limited_flare_starts_higher_with_less_reserve() {
+        let m = MissionParams {
+            landing_descent_rate: 2.0,
+            landing_target_d: 40.0,
+            t_vertical_1: 0.0,
+            t_transition_1: 0.5,
+            t_level: 0.0,
+            t_transition_2: 0.5,
+            t_vertical_2: 0.0,
+            ..Default::default()
+        };
+        let weight = 9.0 * CONTACT_GRAVITY;
+        let mref = |_| (Vector3::zeros(), Vector3::zeros());
+        // Fly the reference with the thrust `thrust` measured; the last descent sample's height
+        // above the target (the flare height) and the largest step of the reference position.
+        let flare_at = |mut g: GroundPhases, thrust: f64| {
+            let (mut t, mut last, mut h_flare, mut step) = (0.0, None::<VerticalReference>, f64::NAN, 0.0f64);
+            while t < 60.0 {
+                let mut x = meas(Vector3::zeros(), Vector3::zeros());
+                x.thrust = thrust;
+                if let GroundMode::Vertical(r) = g.step(t, &x, mref) {
+                    if let Some(l) = last {
+                        step = step.max((r.pos - l.pos).norm());
+                        if l.phase == Phase::Descent && r.phase == Phase::Flare {
+                            h_flare = m.landing_target_d - l.pos.z;
+                        }
+                    }
+                    last = Some(r);
+                }
+                t += 0.02;
+            }
+            (h_flare, step, g.flare_height())
+        };
+        let plain = flare_at(GroundPhases::new(m, weight), 130.0);
+        let still = flare_at(GroundPhases::new(m, weight).with_thrust_limit(150.0), 91.0);
+        let windy = flare_at(GroundPhases::new(m, weight).with_thrust_limit(150.0), 130.0);
+        assert_eq!(still, plain);
+        assert_eq!(plain.2, m.landing_flare_height);
+        assert!(
+            (plain.0 - m.landing_flare_height).abs() < 2.0 * 0.02 + 1e-9,
+            "{plain:?}"
+        );
+        // a = g ((150 − 130)/W − 0.17) = 0.554 m/s²: h_f = 0.3 + (2² − 0.3²)/(2 a) = 3.83 m.
+        let a = CONTACT_GRAVITY * (20.0 / weight - FLARE_LOOP_RESERVE);
+        let h_f = 0.3 + (4.0 - 0.09) / (2.0 * a);
+        assert!((windy.2 - h_f).abs() < 1e-12 && (h_f - 3.83).abs() < 0.01, "{windy:?}");
+        assert!((windy.0 - h_f).abs() < 2.0 * 0.02 + 1e-9, "{windy:?}");
+        // No jump where the flare height is fixed (0.02 s at 2 m/s).
+        assert!(windy.1 < 0.02 * 2.0 + 1e-9, "{windy:?}");
+        // No reserve at all: the highest flare.
+        let full = flare_at(GroundPhases::new(m, weight).with_thrust_limit(150.0), 150.0);
+        assert_eq!(full.2, FLARE_HEIGHT_MAX);
+    }
+
     /// A measurement in the flare: sinking at `sink` (m/s) at `height` (m) above the target
     /// (20 m down), thrust `thrust` and specific force along x `f_x` in weights / g, tilt
     /// rate `q` (rad/s).
