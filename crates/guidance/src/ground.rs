@@ -29,7 +29,8 @@
 //! * [`Phase::Descent`]: from rest the sink rate ramps by a cosine to V_d over
 //!   [`DESCENT_RAMP_TIME`], then stays at V_d until `landing_flare_height` h_f above the
 //!   target.
-//! * [`Phase::Flare`]: the sink rate falls linearly in time from V_d to the touchdown rate
+//! * [`Phase::Flare`] (from h_f, raised for a thrust-limited airframe:
+//!   [`GroundPhases::flare_height`]): the sink rate falls linearly in time from V_d to the touchdown rate
 //!   V_td over `t_f = 2 (h_f − h_td)/(V_d + V_td)` (covering h_f − h_td), then stays at V_td
 //!   over the last `h_td = V_td ·` [`FINAL_SEGMENT_TIME`] (the gear meets the ground at a
 //!   steady sink, thrust ≈ weight: no flare thrust to bounce on), on to
