@@ -12,31 +12,21 @@
 
 use analysis::controllers::Kind;
 use analysis::takeoff_landing::{self, Flight};
-use analysis::wind_envelope::{fly_on, plant, seed, wind, StateKind, WindForm, BEARINGS_DEG};
-use closed_loop::{Ordering, Scenario};
-use tailsitter_physics::InputVector;
+use analysis::wind_envelope::{StateKind, WindForm, BEARINGS_DEG};
+use closed_loop::Ordering;
 
 /// One cell flown to 5 s after the landing: the largest distance to the own reference up to
 /// the touchdown and the landing's figures.
 fn cell(form: WindForm, speed: f64, bearing_index: usize) -> (f64, Flight) {
-    let plant = plant();
-    let mission = takeoff_landing::mission();
-    let x0 = plant.resting_on_ground(0.0, 0.0, 0.0);
-    let mut scenario = Scenario::mission(mission);
-    scenario.stop_time = takeoff_landing::stop_time(&mission);
-    scenario.wind = wind(form, speed, bearing_index, plant.ground.height);
-    let mut c = Kind::Tsd.make_configured(&mission, 0).unwrap();
-    let stop = takeoff_landing::after_landing();
-    let trace = fly_on(
-        &plant,
-        x0,
-        &InputVector::zeros(),
-        &mut c,
-        &scenario,
+    let (plant, trace) = takeoff_landing::fly_wind_cell(
+        Kind::Tsd,
+        form,
         StateKind::Perfect,
-        seed(bearing_index),
-        stop,
+        Ordering::GaussSeidel,
+        speed,
+        bearing_index,
     );
+    let mission = takeoff_landing::mission();
     let f = takeoff_landing::evaluate(&plant, Kind::Tsd, Ordering::GaussSeidel, &mission, &trace);
     println!(
         "{speed} m/s from {}°: max error {:.2} m, landed {:?}, touchdown {:.2} m/s, miss {:.2} m at touchdown, {:.2} m 5 s later, tilt {:.1}° / {:.1}°, every criterion {}",
