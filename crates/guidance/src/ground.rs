@@ -778,6 +778,21 @@ mod tests {
         assert_eq!(last.vel, Vector3::zeros());
     }
 
+    /// A one-second mission without take-off, then the landing at `descent_rate` (m/s) to
+    /// `target_d` (m) below the origin.
+    fn short_landing(descent_rate: f64, target_d: f64) -> MissionParams {
+        MissionParams {
+            landing_descent_rate: descent_rate,
+            landing_target_d: target_d,
+            t_vertical_1: 0.0,
+            t_transition_1: 0.5,
+            t_level: 0.0,
+            t_transition_2: 0.5,
+            t_vertical_2: 0.0,
+            ..Default::default()
+        }
+    }
+
     /// The flare of a thrust-limited airframe: at still air's thrust the mission's flare
     /// height (the reference identical to one without a limit); at the thrust an upright
     /// hover needs in a 10 m/s wind (130 N of 150 N, 9 kg) raised so that the flare's
@@ -785,16 +800,7 @@ mod tests {
     /// [`FLARE_LATCH_HEIGHT`]; the reference continuous through it.
     #[test]
     fn a_thrust_limited_flare_starts_higher_with_less_reserve() {
-        let m = MissionParams {
-            landing_descent_rate: 2.0,
-            landing_target_d: 40.0,
-            t_vertical_1: 0.0,
-            t_transition_1: 0.5,
-            t_level: 0.0,
-            t_transition_2: 0.5,
-            t_vertical_2: 0.0,
-            ..Default::default()
-        };
+        let m = short_landing(2.0, 40.0);
         let weight = 9.0 * CONTACT_GRAVITY;
         let mref = |_| (Vector3::zeros(), Vector3::zeros());
         // Fly the reference with the thrust `thrust` measured; the last descent sample's height
@@ -851,16 +857,7 @@ mod tests {
 
     #[test]
     fn the_land_detector_needs_ground_contact_not_the_height_then_latches() {
-        let m = MissionParams {
-            landing_descent_rate: 1.0,
-            landing_target_d: 20.0,
-            t_vertical_1: 0.0,
-            t_transition_1: 0.5,
-            t_level: 0.0,
-            t_transition_2: 0.5,
-            t_vertical_2: 0.0,
-            ..Default::default()
-        };
+        let m = short_landing(1.0, 20.0);
         let mut g = GroundPhases::new(m, 100.0);
         let mref = |_| (Vector3::zeros(), Vector3::zeros());
         let air = meas(Vector3::zeros(), Vector3::zeros());

@@ -28,17 +28,15 @@ fn cell(form: WindForm, speed: f64, bearing_index: usize) -> (f64, Flight) {
     );
     let mission = takeoff_landing::mission();
     let f = takeoff_landing::evaluate(&plant, Kind::Tsd, Ordering::GaussSeidel, &mission, &trace);
-    println!(
-        "{speed} m/s from {}°: max error {:.2} m, landed {:?}, touchdown {:.2} m/s, miss {:.2} m at touchdown, {:.2} m 5 s later, tilt {:.1}° / {:.1}°, every criterion {}",
-        BEARINGS_DEG[bearing_index],
-        f.max_pos_error,
-        f.landed_time,
+    let at = BEARINGS_DEG[bearing_index];
+    let (td, miss, tilt) = (
         f.touchdown_speed,
-        f.miss_touchdown,
-        f.miss_final,
-        f.tilt_touchdown_deg,
-        f.tilt_final_deg,
-        f.passed
+        (f.miss_touchdown, f.miss_final),
+        (f.tilt_touchdown_deg, f.tilt_final_deg),
+    );
+    println!(
+        "{speed} m/s from {at}°: max error {:.2} m, landed {:?}, touchdown {td:.2} m/s, miss {miss:.2?} m (touchdown, 5 s later), tilt {tilt:.1?}°, every criterion {}",
+        f.max_pos_error, f.landed_time, f.passed
     );
     (f.max_pos_error, f)
 }
