@@ -199,7 +199,7 @@ impl TsdController {
             trajectory,
             integrators: Integrators::default(),
             initialized: false,
-            ground: GroundPhases::new(mission, airframe.mass * airframe.gravity),
+            ground: GroundPhases::new(mission, airframe.mass * airframe.gravity).with_thrust_limit(airframe.thrust_max),
             saturated: 0,
             internals: Internals::default(),
             weathervane: Weathervane::new(if dev.weathervane {
