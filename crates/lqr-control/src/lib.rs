@@ -82,7 +82,7 @@ pub const LANDING_FLAP_RAMP_TIME: f64 = 12.0;
 pub const LANDING_FLAP_LINEARISED: f64 = 12.0 * core::f64::consts::PI / 180.0;
 /// Collective flap per unit sine of the nose's lean towards the belly in the descent and
 /// flare in wind (rad) (README, "Take-off and landing").
-pub const LANDING_LEAN_GAIN: f64 = 1.0;
+pub const LANDING_LEAN_GAIN: f64 = 0.7;
 
 /// Time constant τ_s of the integral action on the horizontal position in wind (s).
 pub const HOVER_SHIFT_TIME: f64 = 3.0;
