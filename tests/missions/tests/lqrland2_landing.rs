@@ -22,7 +22,13 @@ use analysis::wind_envelope::{fly_cell, MissionKind, WindForm, BEARINGS_DEG};
 #[test]
 fn lands_upright_on_the_target_in_5_m_s_head_and_tail_winds() {
     for bearing_index in [0, 4] {
-        let c = fly_cell(Kind::Lqr, MissionKind::TakeoffLanding, WindForm::Step, 5.0, bearing_index);
+        let c = fly_cell(
+            Kind::Lqr,
+            MissionKind::TakeoffLanding,
+            WindForm::Step,
+            5.0,
+            bearing_index,
+        );
         let bearing = BEARINGS_DEG[bearing_index];
         println!("5 m/s from {bearing}°: {c:?}");
         assert!(c.completed && c.max_error < 3.0, "{bearing}°: {c:?}");
