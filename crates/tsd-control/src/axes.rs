@@ -5,7 +5,7 @@
 //! direction cosines e_i3 (4.2.17) and the stability-axis rates.
 
 use crate::deviations::Deviations;
-use crate::{band_weight, TsdController, HOVER_LOW_AIRSPEED_ALPHA, HOVER_WIND_CROSSFLOW};
+use crate::{band_weight, TsdController, HOVER_LOW_AIRSPEED_ALPHA, HOVER_WIND_CROSSFLOW, PATH_AIR_WIND_BAND};
 use flight_mission::Measurement;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
@@ -99,6 +99,53 @@ impl TsdController {
             alpha_weight,
             kappa,
         }
+    }
+}
+
+impl TsdController {
+    /// The frame weight κ of [`Self::airflow`] (`kappa`) limited, in wind, by the air
+    /// velocity along the reference path (tuned configuration, the mission; README, "Missions
+    /// in wind"): κ_path = the same `wind_frame_speed_low/high` band applied to V̄ (i^W·t̂),
+    /// the measured air velocity along the path's tangent t̂, and κ = min(κ, κ_path), blended
+    /// in with the mission logic's 1 s air-data wind over [`PATH_AIR_WIND_BAND`].
+    ///
+    /// The axial airspeed measures the air along the nose, not along the path. With the wind
+    /// behind the track the nose leans into the air flow (a 10 m/s quartering tailwind: 55°
+    /// from the vertical, 10 m/s of axial airspeed) while the front transition's path climbs
+    /// away from it, so at the end of the hover's design band (the reference at 4 m/s) the
+    /// loops switched at once to wind axes 67–79° from the path (2–4.5 m/s of air along it):
+    /// the axial command Σ·i^W and the normal command Σ·k^W split the path's thrust and lift
+    /// anew (150 N and the collective flaps at their limit within a sample) and the aircraft
+    /// departed (10 m/s from 135°, 225°: lost at 10.7 s). Along the path the air speed is what the
+    /// wing flies on: the loops stay in the path frame (thrust-borne) until it builds, as the
+    /// airspeed-scheduled transitions of PX4 and ArduPilot. Still air (no wind estimate) and
+    /// the take-off and landing phases: `kappa` unchanged.
+    pub(crate) fn path_air_frame_weight(
+        &self,
+        meas: &Measurement,
+        r: &crate::reference::ReferenceSignals,
+        kappa: f64,
+        dev: Deviations,
+    ) -> f64 {
+        if !dev.hover_wind_design || r.ground_phase() {
+            return kappa;
+        }
+        let wind = self.wind_mission.wind_speed();
+        if !wind.is_finite() {
+            return kappa;
+        }
+        let windy = band_weight(wind, PATH_AIR_WIND_BAND);
+        if windy == 0.0 {
+            return kappa;
+        }
+        let q = &meas.quat;
+        let att = UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]));
+        let (sa, ca) = meas.alpha.sin_cos();
+        let (sb, cb) = meas.beta.sin_cos();
+        let along = meas.airspeed * (att * Vector3::new(ca * cb, sb, sa * cb)).dot(&r.reference.tangent());
+        let p = &self.params;
+        let path = band_weight(along, (p.wind_frame_speed_low, p.wind_frame_speed_high));
+        kappa + (kappa.min(path) - kappa) * windy
     }
 }
 
