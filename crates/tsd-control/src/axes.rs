@@ -280,3 +280,74 @@ mod tests {
         assert_eq!((calm.hover_wind, calm.design_crossflow), (0.0, calm.crossflow));
     }
 }
+
+#[cfg(test)]
+mod path_air_tests {
+    use crate::deviations::Deviations;
+    use crate::reference::ReferenceSignals;
+    use crate::{Reference, TsdController, TsdParams};
+    use flight_mission::{Measurement, MissionParams, Phase};
+    use nalgebra::{UnitQuaternion, Vector3};
+    use tailsitter_physics::Airframe;
+
+    /// The reference signals of a path with flight-path angle `gamma` (rad), northbound.
+    fn path(gamma: f64) -> ReferenceSignals {
+        ReferenceSignals {
+            t_mission: 6.0,
+            reference: Reference {
+                phase: Phase::TransitionToLevel,
+                pos: Vector3::zeros(),
+                vel: Vector3::zeros(),
+                specific_accel: Vector3::new(0.0, 0.0, -9.81),
+                airspeed: 5.0,
+                gamma,
+            },
+            ref_pos: Vector3::zeros(),
+            sigma_ground: None,
+            heading: 0.0,
+        }
+    }
+
+    /// The nose level towards the north, held still in a 10 m/s wind from the north: the air
+    /// flows along the nose (10 m/s of axial airspeed). Along a level northbound path the wind
+    /// axes keep the weight they have; up a vertical path (the air across it) the loops keep
+    /// the path frame. No wind estimate (still air), the take-off and landing phases and the
+    /// thesis configuration: unchanged.
+    #[test]
+    fn wind_axes_need_the_air_along_the_path() {
+        let mut c = TsdController::with_mission(MissionParams::default()).unwrap();
+        let dev = Deviations::of(c.params());
+        let m = Measurement::still_in_air(&UnitQuaternion::identity(), &Vector3::new(10.0, 0.0, 0.0));
+        let up = path(core::f64::consts::FRAC_PI_2);
+        let level = path(0.0);
+        // Still air: the logic's estimate 0 (and none before its first sample).
+        c.wind_mission.restore(&[0.0, 0.0, 0.0, 0.0]);
+        assert_eq!(c.path_air_frame_weight(&m, &up, 0.8, dev), 0.8);
+        c.wind_mission.restore(&[f64::NAN, f64::NAN, 0.0, 0.0]);
+        assert_eq!(c.path_air_frame_weight(&m, &up, 0.8, dev), 0.8);
+        // 10 m/s estimated: the air across a vertical path, along a level one.
+        c.wind_mission.restore(&[-10.0, 0.0, 1.0, 0.0]);
+        assert_eq!(c.path_air_frame_weight(&m, &up, 0.8, dev), 0.0);
+        assert_eq!(c.path_air_frame_weight(&m, &level, 0.8, dev), 0.8);
+        // Half-way up (45°): 7.1 m/s along the path, half-way through the 4–10 m/s band.
+        let w = c.path_air_frame_weight(&m, &path(core::f64::consts::FRAC_PI_4), 0.8, dev);
+        assert!((w - (10.0 * 0.5f64.sqrt() - 4.0) / 6.0).abs() < 1e-12, "{w}");
+        // 2 m/s estimated: half the limit.
+        c.wind_mission.restore(&[-2.0, 0.0, 0.0, 0.0]);
+        assert!((c.path_air_frame_weight(&m, &up, 0.8, dev) - 0.4).abs() < 1e-12);
+        // The take-off and landing phases and the thesis configuration.
+        c.wind_mission.restore(&[-10.0, 0.0, 1.0, 0.0]);
+        let ground = ReferenceSignals {
+            sigma_ground: Some(Vector3::new(0.0, 0.0, -9.81)),
+            ..up
+        };
+        assert_eq!(c.path_air_frame_weight(&m, &ground, 0.8, dev), 0.8);
+        let thesis = TsdParams {
+            configuration: 1,
+            ..TsdParams::default()
+        };
+        let mut t = TsdController::new(Airframe::default(), MissionParams::default(), thesis).unwrap();
+        t.wind_mission.restore(&[-10.0, 0.0, 1.0, 0.0]);
+        assert_eq!(t.path_air_frame_weight(&m, &up, 0.8, Deviations::of(t.params())), 0.8);
+    }
+}
