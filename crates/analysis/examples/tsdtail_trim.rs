@@ -43,7 +43,14 @@ fn residual(p: &Plant, psi: f64, v: &Vector3<f64>, sigma: &Vector3<f64>, w: &Vec
     let fm = p.forces_moments(&x, w);
     let m = p.airframe.mass;
     let f = r * fm.force_body - m * sigma;
-    DVector::from_vec(vec![f.x, f.y, f.z, fm.moment_body.x, fm.moment_body.y, fm.moment_body.z])
+    DVector::from_vec(vec![
+        f.x,
+        f.y,
+        f.z,
+        fm.moment_body.x,
+        fm.moment_body.y,
+        fm.moment_body.z,
+    ])
 }
 
 /// Scale of each unknown in the minimum-norm step (rad, N, rad).
@@ -101,7 +108,11 @@ fn main() {
         .collect();
     // Per time: the best (smallest largest-ratio) heading.
     let mut best: Vec<(f64, f64, [f64; N_U])> = vec![(f64::INFINITY, f64::NAN, [0.0; N_U]); times.len()];
-    println!("wind {speed} m/s from {:.0}°; heading: largest T (N), largest |δ| (deg), points within 150 N / 25° of {}", bearing.to_degrees(), times.len());
+    println!(
+        "wind {speed} m/s from {:.0}°; heading: largest T (N), largest |δ| (deg), points within 150 N / 25° of {}",
+        bearing.to_degrees(),
+        times.len()
+    );
     for &psi_deg in &headings {
         let psi = psi_deg.to_radians();
         let mut u = [0.0; N_U];

@@ -19,10 +19,7 @@ use analysis::wind_envelope::{fly_job, Job, MissionKind, WindForm, BEARINGS_DEG}
 /// Largest error (m) to the own and the still-air reference of a steady 10 m/s cell, and the
 /// largest error of the front transition (phase code 1).
 fn fly(mission: MissionKind, bearing_index: usize) -> (f64, f64, f64) {
-    let (cell, phases) = fly_job(
-        &Job::new(Kind::Tsd, mission, WindForm::Step, 10.0, bearing_index),
-        None,
-    );
+    let (cell, phases) = fly_job(&Job::new(Kind::Tsd, mission, WindForm::Step, 10.0, bearing_index), None);
     println!(
         "{mission:?} 10 m/s from {}°: completed {}, max error {:.2} m, to the still-air path {:?} m, T1 {:.2} m",
         BEARINGS_DEG[bearing_index], cell.completed, cell.max_error, cell.mission_error, phases[1]
