@@ -27,15 +27,9 @@ fn residual(p: &Plant, psi: f64, v: &Vector3<f64>, sigma: &Vector3<f64>, w: &Vec
         * UnitQuaternion::from_axis_angle(&Vector3::y_axis(), core::f64::consts::FRAC_PI_2);
     let r = up * UnitQuaternion::from_scaled_axis(Vector3::new(0.0, u[0], u[1]));
     let mut x = StateVector::zeros();
-    let q = r.quaternion();
-    x[idx::Q1] = q.i;
-    x[idx::Q2] = q.j;
-    x[idx::Q3] = q.k;
-    x[idx::Q4] = q.w;
-    let vb = r.inverse() * v;
-    x[idx::U] = vb.x;
-    x[idx::V] = vb.y;
-    x[idx::W] = vb.z;
+    // Quaternion (i, j, k, w) and body velocity.
+    x.fixed_rows_mut::<4>(idx::Q1).copy_from(&r.quaternion().coords);
+    x.fixed_rows_mut::<3>(idx::U).copy_from(&(r.inverse() * v));
     x[idx::THRUST] = u[2];
     for k in 0..6 {
         x[idx::ELEVATOR + k] = u[3 + k];
