@@ -1,6 +1,7 @@
 //! The tuned TSD's take-off-to-landing cells with the landing's figures (a development
 //! probe, flown as the wind envelope flies them, stopping 5 s after the landing):
-//! `tsdland_probe step|turb SPEEDS BEARING_INDICES|all [jacobi] [avionics]`. Per cell: held,
+//! `tsdland_probe step|turb SPEEDS BEARING_INDICES|all [jacobi] [avionics] [lqr]` (`lqr`: the
+//! tuned LQR instead of the TSD). Per cell: held,
 //! largest error to the own reference and its phase, miss at rest, touchdown speed, tilt at
 //! touchdown and at the end, the largest tilt and the mean collective flap over the last
 //! 10 s before the touchdown, and whether every landing criterion is met.
@@ -30,6 +31,11 @@ fn main() {
     } else {
         Ordering::GaussSeidel
     };
+    let kind = if a.iter().any(|s| s == "lqr") {
+        Kind::Lqr
+    } else {
+        Kind::Tsd
+    };
     let state = if a.iter().any(|s| s == "avionics") {
         StateKind::Avionics
     } else {
@@ -49,7 +55,7 @@ fn main() {
             scenario.stop_time = takeoff_landing::stop_time(&mission);
             scenario.wind = wind(form, speed, b, plant.ground.height);
             scenario.ordering = ordering;
-            let mut c = Kind::Tsd.make_configured(&mission, 0).unwrap();
+            let mut c = kind.make_configured(&mission, 0).unwrap();
             let mut landed: Option<f64> = None;
             let stop = |s: &Sample| {
                 if landed.is_none() && s.diagnostics.phase == Phase::Landed {
@@ -58,7 +64,7 @@ fn main() {
                 landed.is_some_and(|t| s.t >= t + takeoff_landing::AFTER_LANDING - 1e-9)
             };
             let trace = fly_on(&plant, x0, &InputVector::zeros(), &mut c, &scenario, state, seed(b), stop);
-            let f = takeoff_landing::evaluate(&plant, Kind::Tsd, ordering, &mission, &trace);
+            let f = takeoff_landing::evaluate(&plant, kind, ordering, &mission, &trace);
             let (mut max_error, mut worst) = (0.0f64, (0.0, Phase::OnGround));
             for s in &trace.samples {
                 if s.pos_error() > max_error {

@@ -185,6 +185,32 @@ pub fn after_landing() -> impl FnMut(&closed_loop::Sample) -> bool {
     }
 }
 
+/// One take-off-to-landing cell of the wind envelope flown as [`crate::wind_envelope`] flies
+/// it (its plant, wind and turbulence seed; `kind` tuned), stopped [`AFTER_LANDING`] after
+/// the landing: the plant and the trace.
+pub fn fly_wind_cell(
+    kind: Kind,
+    form: crate::wind_envelope::WindForm,
+    state: crate::wind_envelope::StateKind,
+    ordering: Ordering,
+    speed: f64,
+    bearing_index: usize,
+) -> (Plant, Trace) {
+    use crate::wind_envelope as env;
+    let plant = env::plant();
+    let m = mission();
+    let x0 = plant.resting_on_ground(0.0, 0.0, 0.0);
+    let mut scenario = Scenario::mission(m);
+    scenario.stop_time = stop_time(&m);
+    scenario.wind = env::wind(form, speed, bearing_index, plant.ground.height);
+    scenario.ordering = ordering;
+    let mut c = kind.make_configured(&m, 0).expect("the tuned controller builds");
+    let u0 = tailsitter_physics::InputVector::zeros();
+    let seed = env::seed(bearing_index);
+    let trace = env::fly_on(&plant, x0, &u0, &mut c, &scenario, state, seed, after_landing());
+    (plant, trace)
+}
+
 /// Fly `kind` through `mission` with `ordering`, stopping [`AFTER_LANDING`] after the landing.
 pub fn fly_one(kind: Kind, ordering: Ordering, mission: &MissionParams) -> (Trace, Flight) {
     let (plant, x0) = plant();

@@ -29,7 +29,8 @@
 //! * [`Phase::Descent`]: from rest the sink rate ramps by a cosine to V_d over
 //!   [`DESCENT_RAMP_TIME`], then stays at V_d until `landing_flare_height` h_f above the
 //!   target.
-//! * [`Phase::Flare`]: the sink rate falls linearly in time from V_d to the touchdown rate
+//! * [`Phase::Flare`] (from h_f, raised for a thrust-limited airframe:
+//!   [`GroundPhases::flare_height`]): the sink rate falls linearly in time from V_d to the touchdown rate
 //!   V_td over `t_f = 2 (h_f − h_td)/(V_d + V_td)` (covering h_f − h_td), then stays at V_td
 //!   over the last `h_td = V_td ·` [`FINAL_SEGMENT_TIME`] (the gear meets the ground at a
 //!   steady sink, thrust ≈ weight: no flare thrust to bounce on), on to
@@ -109,6 +110,22 @@ pub const LANDED_TILT_RATE: f64 = 40.0 * core::f64::consts::PI / 180.0;
 pub const TOUCHDOWN_DWELL: f64 = 0.04;
 /// Gravity of the contact test (m/s²): the airframes' g (C.1).
 pub const CONTACT_GRAVITY: f64 = 9.81;
+/// Thrust kept for the loop in a thrust-limited flare, in weights (–): with a thrust limit
+/// given ([`GroundPhases::with_thrust_limit`]) the flare's deceleration may use the thrust
+/// reserve `T_max − T̄` (T̄ the mean thrust of the steady descent) less this. In a 10 m/s
+/// wind the upright hover needs 130 N of the airframe's 150 N; the flare from 2 m/s over
+/// 1.2 m needs 14.7 N more, and the loop's lead at the flare's start saturated the thrust
+/// (touchdowns at 0.57–0.78 m/s). In still air (T̄ ≈ 91 N) the flare needs 1.6 m/s² of the
+/// 4.9 m/s² left: unchanged up to T̄ ≈ 120 N.
+pub const FLARE_LOOP_RESERVE: f64 = 0.17;
+/// Highest flare of a thrust-limited descent (m above the target).
+pub const FLARE_HEIGHT_MAX: f64 = 6.0;
+/// Height above the target at which the reference's flare height is fixed, from the mean
+/// thrust of the descent so far (m): above [`FLARE_HEIGHT_MAX`], where the reference of
+/// every flare height is still the steady descent.
+pub const FLARE_LATCH_HEIGHT: f64 = 8.0;
+/// Time constant of the descent's mean thrust (s).
+pub const DESCENT_THRUST_TIME: f64 = 2.0;
 
 /// A reference for vertical (nose-up) flight, NED, mission origin included.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -155,6 +172,13 @@ pub struct GroundPhases {
     share_var: f64,
     share_t: f64,
     landed: bool,
+    /// Largest thrust of the airframe (N); infinite: no thrust-limited flare.
+    thrust_limit: f64,
+    /// Mean thrust of the descent (N) and the time of its last sample (NaN: none yet).
+    descent_thrust: f64,
+    descent_thrust_t: f64,
+    /// Flare height fixed in the descent (m; NaN: not yet, `landing_flare_height`).
+    flare_height: f64,
 }
 
 /// The touchdown reference below the target (m, + down) and its sink rate (m/s), `x` (s)
@@ -189,7 +213,7 @@ fn ramp(v: f64, t_r: f64, tau: f64) -> (f64, f64, f64) {
 
 impl GroundPhases {
     /// Number of values [`Self::save`] writes.
-    pub const SAVED_LEN: usize = 17;
+    pub const SAVED_LEN: usize = 20;
 
     /// The phase logic of `mission` for an airframe of weight `weight` (N).
     pub fn new(mission: MissionParams, weight: f64) -> Self {
@@ -204,6 +228,70 @@ impl GroundPhases {
             share_var: f64::NAN,
             share_t: f64::NAN,
             landed: false,
+            thrust_limit: f64::INFINITY,
+            descent_thrust: f64::NAN,
+            descent_thrust_t: f64::NAN,
+            flare_height: f64::NAN,
+        }
+    }
+
+    /// The same with the airframe's largest thrust `limit` (N): a thrust-limited flare
+    /// ([`Self::flare_height`]). Without it the flare starts at `landing_flare_height`.
+    pub fn with_thrust_limit(mut self, limit: f64) -> Self {
+        self.thrust_limit = limit;
+        self
+    }
+
+    /// Height of the flare above the target (m): `landing_flare_height`, raised so that the
+    /// flare's deceleration `(V_d² − V_td²) / (2 (h_f − h_td))` leaves [`FLARE_LOOP_RESERVE`]
+    /// of the thrust reserve over the descent's mean thrust to the loop (a wind
+    /// that the hover needs much thrust against), within [`FLARE_HEIGHT_MAX`]. Fixed at
+    /// [`FLARE_LATCH_HEIGHT`] above the target.
+    pub fn flare_height(&self) -> f64 {
+        if self.flare_height.is_nan() {
+            self.mission.landing_flare_height
+        } else {
+            self.flare_height
+        }
+    }
+
+    /// The thrust-limited flare height from the mean thrust `thrust` (N) ([`Self::flare_height`]).
+    fn limited_flare_height(&self, thrust: f64) -> f64 {
+        let m = &self.mission;
+        let h_f = m.landing_flare_height;
+        if !(self.thrust_limit.is_finite() && thrust.is_finite()) {
+            return h_f;
+        }
+        let (vd, vtd) = (m.landing_descent_rate, m.landing_touchdown_rate);
+        let a_max = CONTACT_GRAVITY * ((self.thrust_limit - thrust) / self.weight - FLARE_LOOP_RESERVE);
+        let h_td = vtd * FINAL_SEGMENT_TIME;
+        let needed = if a_max > 0.0 {
+            h_td + (vd * vd - vtd * vtd) / (2.0 * a_max)
+        } else {
+            FLARE_HEIGHT_MAX
+        };
+        if needed > h_f {
+            needed.min(FLARE_HEIGHT_MAX).max(h_f)
+        } else {
+            h_f
+        }
+    }
+
+    /// Track the descent's mean thrust and fix the flare height at [`FLARE_LATCH_HEIGHT`]
+    /// above the target (or at once, in a descent that starts lower).
+    fn track_descent(&mut self, t: f64, meas: &Measurement, remaining: f64) {
+        if !self.flare_height.is_nan() || !self.thrust_limit.is_finite() {
+            return;
+        }
+        if self.descent_thrust.is_nan() {
+            self.descent_thrust = meas.thrust;
+        } else {
+            let a = ((t - self.descent_thrust_t) / DESCENT_THRUST_TIME).clamp(0.0, 1.0);
+            self.descent_thrust += a * (meas.thrust - self.descent_thrust);
+        }
+        self.descent_thrust_t = t;
+        if remaining <= FLARE_LATCH_HEIGHT {
+            self.flare_height = self.limited_flare_height(self.descent_thrust);
         }
     }
 
@@ -295,7 +383,7 @@ impl GroundPhases {
         let (vd, vtd, tr) = (m.landing_descent_rate, m.landing_touchdown_rate, DESCENT_RAMP_TIME);
         let height = target.z - pa.z;
         let d_ramp = 0.5 * vd * tr;
-        let t_const = ((height - d_ramp - m.landing_flare_height) / vd).max(0.0);
+        let t_const = ((height - d_ramp - self.flare_height()) / vd).max(0.0);
         // The flare ends FINAL_SEGMENT_TIME before the target: the aircraft meets the
         // ground at a steady sink rate (thrust ≈ weight, no deceleration thrust to bounce on).
         let d_final = vtd * FINAL_SEGMENT_TIME;
@@ -381,7 +469,14 @@ impl GroundPhases {
             (p + offset, v)
         });
         let target = origin + Vector3::new(m.landing_target_n, m.landing_target_e, m.landing_target_d);
-        let r = self.landing_reference(tm - end, &p0, &v0, &target);
+        let mut r = self.landing_reference(tm - end, &p0, &v0, &target);
+        if r.phase == Phase::Descent {
+            let unfixed = self.flare_height.is_nan();
+            self.track_descent(t, meas, target.z - r.pos.z);
+            if unfixed && !self.flare_height.is_nan() {
+                r = self.landing_reference(tm - end, &p0, &v0, &target);
+            }
+        }
         // A sink is commanded: the flare, or the descent at its full rate (not its ramp from
         // rest, where the aircraft is still slow in the air).
         let sinking = r.phase == Phase::Flare || r.phase == Phase::Descent && r.vel.z >= m.landing_descent_rate - 1e-9;
@@ -469,6 +564,9 @@ impl GroundPhases {
         out(self.share_mean);
         out(self.share_var);
         out(self.share_t);
+        out(self.descent_thrust);
+        out(self.descent_thrust_t);
+        out(self.flare_height);
     }
 
     /// Restore what [`Self::save`] wrote; `None` if values are missing.
@@ -483,6 +581,7 @@ impl GroundPhases {
         self.landed = v[12] != 0.0;
         self.contact_at = v[13];
         (self.share_mean, self.share_var, self.share_t) = (v[14], v[15], v[16]);
+        (self.descent_thrust, self.descent_thrust_t, self.flare_height) = (v[17], v[18], v[19]);
         Some(())
     }
 }
@@ -679,6 +778,72 @@ mod tests {
         assert_eq!(last.vel, Vector3::zeros());
     }
 
+    /// A one-second mission without take-off, then the landing at `descent_rate` (m/s) to
+    /// `target_d` (m) below the origin.
+    fn short_landing(descent_rate: f64, target_d: f64) -> MissionParams {
+        MissionParams {
+            landing_descent_rate: descent_rate,
+            landing_target_d: target_d,
+            t_vertical_1: 0.0,
+            t_transition_1: 0.5,
+            t_level: 0.0,
+            t_transition_2: 0.5,
+            t_vertical_2: 0.0,
+            ..Default::default()
+        }
+    }
+
+    /// The flare of a thrust-limited airframe: at still air's thrust the mission's flare
+    /// height (the reference identical to one without a limit); at the thrust an upright
+    /// hover needs in a 10 m/s wind (130 N of 150 N, 9 kg) raised so that the flare's
+    /// deceleration leaves [`FLARE_LOOP_RESERVE`] of the weight to the loop; fixed at
+    /// [`FLARE_LATCH_HEIGHT`]; the reference continuous through it.
+    #[test]
+    fn a_thrust_limited_flare_starts_higher_with_less_reserve() {
+        let m = short_landing(2.0, 40.0);
+        let weight = 9.0 * CONTACT_GRAVITY;
+        let mref = |_| (Vector3::zeros(), Vector3::zeros());
+        // Fly the reference with the thrust `thrust` measured; the last descent sample's height
+        // above the target (the flare height) and the largest step of the reference position.
+        let flare_at = |mut g: GroundPhases, thrust: f64| {
+            let (mut t, mut last, mut h_flare, mut step) = (0.0, None::<VerticalReference>, f64::NAN, 0.0f64);
+            while t < 60.0 {
+                let mut x = meas(Vector3::zeros(), Vector3::zeros());
+                x.thrust = thrust;
+                if let GroundMode::Vertical(r) = g.step(t, &x, mref) {
+                    if let Some(l) = last {
+                        step = step.max((r.pos - l.pos).norm());
+                        if l.phase == Phase::Descent && r.phase == Phase::Flare {
+                            h_flare = m.landing_target_d - l.pos.z;
+                        }
+                    }
+                    last = Some(r);
+                }
+                t += 0.02;
+            }
+            (h_flare, step, g.flare_height())
+        };
+        let plain = flare_at(GroundPhases::new(m, weight), 130.0);
+        let still = flare_at(GroundPhases::new(m, weight).with_thrust_limit(150.0), 91.0);
+        let windy = flare_at(GroundPhases::new(m, weight).with_thrust_limit(150.0), 130.0);
+        assert_eq!(still, plain);
+        assert_eq!(plain.2, m.landing_flare_height);
+        assert!(
+            (plain.0 - m.landing_flare_height).abs() < 2.0 * 0.02 + 1e-9,
+            "{plain:?}"
+        );
+        // a = g ((150 − 130)/W − 0.17) = 0.554 m/s²: h_f = 0.3 + (2² − 0.3²)/(2 a) = 3.83 m.
+        let a = CONTACT_GRAVITY * (20.0 / weight - FLARE_LOOP_RESERVE);
+        let h_f = 0.3 + (4.0 - 0.09) / (2.0 * a);
+        assert!((windy.2 - h_f).abs() < 1e-12 && (h_f - 3.83).abs() < 0.01, "{windy:?}");
+        assert!((windy.0 - h_f).abs() < 2.0 * 0.02 + 1e-9, "{windy:?}");
+        // No jump where the flare height is fixed (0.02 s at 2 m/s).
+        assert!(windy.1 < 0.02 * 2.0 + 1e-9, "{windy:?}");
+        // No reserve at all: the highest flare.
+        let full = flare_at(GroundPhases::new(m, weight).with_thrust_limit(150.0), 150.0);
+        assert_eq!(full.2, FLARE_HEIGHT_MAX);
+    }
+
     /// A measurement in the flare: sinking at `sink` (m/s) at `height` (m) above the target
     /// (20 m down), thrust `thrust` and specific force along x `f_x` in weights / g, tilt
     /// rate `q` (rad/s).
@@ -692,16 +857,7 @@ mod tests {
 
     #[test]
     fn the_land_detector_needs_ground_contact_not_the_height_then_latches() {
-        let m = MissionParams {
-            landing_descent_rate: 1.0,
-            landing_target_d: 20.0,
-            t_vertical_1: 0.0,
-            t_transition_1: 0.5,
-            t_level: 0.0,
-            t_transition_2: 0.5,
-            t_vertical_2: 0.0,
-            ..Default::default()
-        };
+        let m = short_landing(1.0, 20.0);
         let mut g = GroundPhases::new(m, 100.0);
         let mref = |_| (Vector3::zeros(), Vector3::zeros());
         let air = meas(Vector3::zeros(), Vector3::zeros());

@@ -80,6 +80,12 @@ pub use guidance::ground::{
 /// Time over which the collective-flap trim of the descent ramps in from zero (s) (README,
 /// "Take-off and landing").
 pub const LANDING_FLAP_RAMP_TIME: f64 = 12.0;
+/// Largest part of the landing's collective-flap command in the point the gains are
+/// linearised about (rad); the rest is feed-forward only (README, "Take-off and landing").
+pub const LANDING_FLAP_LINEARISED: f64 = 12.0 * core::f64::consts::PI / 180.0;
+/// Collective flap per unit sine of the nose's lean towards the belly in the descent and
+/// flare in wind (rad) (README, "Take-off and landing").
+pub const LANDING_LEAN_GAIN: f64 = 0.7;
 
 /// Time constant τ_s of the integral action on the horizontal position in wind (s).
 pub const HOVER_SHIFT_TIME: f64 = 3.0;
@@ -793,7 +799,7 @@ impl SampledUnit for LqrController {
             self.state_and_reference(self.rep, m, &r)
         };
         let dx = self.error_vector(&x, &xt);
-        let (u, saturated) = self.command_stage(t, &r.point.u, &dx, &mut notice)?;
+        let (u, saturated) = self.command_stage(t, &r.feed_forward(), &dx, &mut notice)?;
         self.integrator_stage(&x, &xt, &saturated, &sw.integrator);
         Ok(ControllerOutput {
             command: Command::from_array(u.into()),

@@ -16,8 +16,8 @@ use crate::model;
 use crate::trajectory::TrajPoint;
 use crate::{
     LqrController, FRONT_TRIM_RAMP_TIME, GROUND_TRIM_MAX_YAW, HOVER_SHIFT_LIMIT, HOVER_SHIFT_TIME, LANDING_FLAP_GAIN,
-    LANDING_FLAP_LIMIT, LANDING_FLAP_RAMP_TIME, MAX_WIND_ESTIMATE, MIN_AIRSPEED, WIND_INTEGRAL_SPEED,
-    WIND_TRIM_MAX_PITCH, WIND_TRIM_RAMP,
+    LANDING_FLAP_LIMIT, LANDING_FLAP_LINEARISED, LANDING_FLAP_RAMP_TIME, LANDING_LEAN_GAIN, MAX_WIND_ESTIMATE,
+    MIN_AIRSPEED, WIND_INTEGRAL_SPEED, WIND_TRIM_MAX_PITCH, WIND_TRIM_RAMP,
 };
 
 /// Switches of the reference stage (from [`crate::LqrParams::effective`]).
@@ -55,6 +55,20 @@ pub(crate) struct Reference {
     pub pitch_321: f64,
     /// Vertical flight in wind ([`LqrController::hover_in_wind`]).
     pub in_wind: bool,
+    /// The part of the collective-flap command of the descent and flare in wind (rad) added
+    /// to the command's feed-forward but not to the point the gains are linearised about
+    /// ([`split_landing_flap`]).
+    pub landing_flap: f64,
+}
+
+impl Reference {
+    /// The feed-forward u_t of the command (3.2.2): the point's inputs plus the landing's
+    /// collective-flap trim.
+    pub(crate) fn feed_forward(&self) -> SVector<f64, { crate::model::NU }> {
+        let mut u = self.point.u;
+        u[4] += self.landing_flap;
+        u
+    }
 }
 
 impl LqrController {
@@ -167,11 +181,12 @@ impl LqrController {
         } else {
             self.wind = Vector3::zeros();
         }
-        let trimmed = match ground {
-            None => self.trimmed(&point, sw).unwrap_or(point),
+        let (trimmed, landing_flap) = match ground {
+            None => (self.trimmed(&point, sw).unwrap_or(point), 0.0),
             Some(v) => {
                 self.update_landing_flap_ramp(v.phase);
-                self.landing_flaps(&point, v.phase)
+                let flap = self.landing_flaps(&point, v.phase, m);
+                split_landing_flap(point, flap)
             }
         };
         Reference {
@@ -182,6 +197,7 @@ impl LqrController {
             air: self.air_reference(&trimmed, &ground_velocity(&point), sw),
             pitch_321: point.euler_321.y,
             in_wind,
+            landing_flap,
         }
     }
 
@@ -575,27 +591,36 @@ impl LqrController {
         };
     }
 
-    /// The landing reference with the collective flaps trimmed against the wind into the belly
-    /// (README, "Take-off and landing"): in the descent and the flare in wind
-    /// ([`Self::ground_in_wind`]) δfc_t −= [`LANDING_FLAP_GAIN`] × (the weathervane's 4 s wind
-    /// estimate into the reference belly), within ±[`LANDING_FLAP_LIMIT`]; elsewhere the point
-    /// unchanged. Upright, the wing and flaps sit in the propellers' slip-stream and a wind
-    /// into the belly turns that flow: holding the target, the aircraft leaned 28–40° into
-    /// 3–8 m/s and tipped over on the gear. The flaps deflected against the wind carry that
-    /// force with the nose vertical (the plant's upright hover trim, `examples/hover_lean.rs`).
-    fn landing_flaps(&self, p: &TrajPoint, phase: Phase) -> TrajPoint {
+    /// The collective-flap command of the descent and the flare in wind (rad) (README, "Take-off
+    /// and landing"; [`Self::ground_in_wind`]): the trim −[`LANDING_FLAP_GAIN`] × (the
+    /// weathervane's 4 s wind estimate into the reference belly) within ±[`LANDING_FLAP_LIMIT`],
+    /// less [`LANDING_LEAN_GAIN`] sin λ, λ the measured nose's lean towards the reference
+    /// belly, ramped in ([`Self::update_landing_flap_ramp`]); 0 elsewhere. Upright, the wing
+    /// and flaps sit in the propellers' slip-stream and a wind into the belly turns that flow:
+    /// holding the target, the aircraft leaned 28–40° into 3–8 m/s and tipped over on the
+    /// gear. The flaps deflected against the wind carry that force with the nose vertical (the
+    /// plant's upright hover trim, −13.8° at 3 m/s, −20° from 5 m/s); the lean term hands the
+    /// rest of the load, which the LQR would otherwise carry by leaning (12–15° at touchdown
+    /// in 5 m/s with the trim alone), to the flaps.
+    fn landing_flaps(&self, p: &TrajPoint, phase: Phase, m: &Measurement) -> f64 {
         let w = self.weathervane.wind();
         if !(matches!(phase, Phase::Descent | Phase::Flare) && self.ground_in_wind() && w.iter().all(|v| v.is_finite()))
         {
-            return *p;
+            return 0.0;
         }
         // The belly (body z) in earth axes: the third row of DCM^BE.
         let belly = model::dcm_of_quat(&p.quat()).row(2).transpose();
         let into_belly = -w.xy().dot(&belly.xy());
-        let mut q = *p;
-        q.u[4] -=
-            self.landing_flap_ramp * (LANDING_FLAP_GAIN * into_belly).clamp(-LANDING_FLAP_LIMIT, LANDING_FLAP_LIMIT);
-        q
+        let trim = -(LANDING_FLAP_GAIN * into_belly).clamp(-LANDING_FLAP_LIMIT, LANDING_FLAP_LIMIT);
+        // The measured nose's lean towards the reference belly's horizontal direction.
+        let nose = model::dcm_of_quat(&m.quat).row(0).transpose();
+        let size = belly.xy().norm();
+        let sin_lean = if size >= 0.5 {
+            nose.xy().dot(&belly.xy()) / size
+        } else {
+            0.0
+        };
+        self.landing_flap_ramp * (trim - LANDING_LEAN_GAIN * sin_lean)
     }
 
     /// The reference point of a take-off / landing reference (guidance::ground): the
@@ -616,6 +641,19 @@ impl LqrController {
         p.u[0] = thrust;
         p
     }
+}
+
+/// The landing's collective-flap command `flap` (rad, [`LqrController::landing_flaps`]) split
+/// between the reference point `point` — the inputs the gains are linearised about — and the
+/// rest, added to the command's feed-forward only ([`Reference::feed_forward`]): up to
+/// ±[`LANDING_FLAP_LINEARISED`] in the point. Linearised about the whole trim (17° from
+/// 3.7 m/s into the belly) the gains held the 5 m/s descent in a limit cycle (pitch ±35°,
+/// height ±1.5 m, period ≈ 4.5 s; touchdown 2–3.4 m/s); about none of it the 3 m/s diagonal
+/// landings ended 0.55 m from the target (0.33–0.38 m with 12° linearised).
+fn split_landing_flap(mut point: TrajPoint, flap: f64) -> (TrajPoint, f64) {
+    let linearised = flap.clamp(-LANDING_FLAP_LINEARISED, LANDING_FLAP_LINEARISED);
+    point.u[4] += linearised;
+    (point, flap - linearised)
 }
 
 /// Newton's method from `z0` on `residual` with a forward-difference Jacobian (`steps`), at

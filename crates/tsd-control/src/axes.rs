@@ -5,8 +5,8 @@
 //! direction cosines e_i3 (4.2.17) and the stability-axis rates.
 
 use crate::deviations::Deviations;
-use crate::{band_weight, TsdController, HOVER_LOW_AIRSPEED_ALPHA, HOVER_WIND_CROSSFLOW};
-use flight_mission::Measurement;
+use crate::{band_weight, TsdController, HOVER_LOW_AIRSPEED_ALPHA, HOVER_WIND_CROSSFLOW, PATH_AIR_WIND_BAND};
+use flight_mission::{Measurement, Phase};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
 /// The air flow over the aircraft as the schedule and the frame blend see it.
@@ -99,6 +99,54 @@ impl TsdController {
             alpha_weight,
             kappa,
         }
+    }
+}
+
+impl TsdController {
+    /// The frame weight κ of [`Self::airflow`] (`kappa`) limited, in wind, by the air
+    /// velocity along the reference path in the front transition (tuned configuration; README,
+    /// "Missions in wind"): κ_path = the same `wind_frame_speed_low/high` band applied to V̄ (i^W·t̂),
+    /// the measured air velocity along the path's tangent t̂, and κ = min(κ, κ_path), blended
+    /// in with the mission logic's 1 s air-data wind over [`PATH_AIR_WIND_BAND`].
+    ///
+    /// The axial airspeed measures the air along the nose, not along the path. With the wind
+    /// behind the track the nose leans into the air flow (a 10 m/s quartering tailwind: 55°
+    /// from the vertical, 10 m/s of axial airspeed) while the front transition's path climbs
+    /// away from it, so at the end of the hover's design band (the reference at 4 m/s) the
+    /// loops switched at once to wind axes 67–79° from the path (2–4.5 m/s of air along it):
+    /// the axial command Σ·i^W and the normal command Σ·k^W split the path's thrust and lift
+    /// anew (150 N and the collective flaps at their limit within a sample) and the aircraft
+    /// departed (10 m/s from 135°, 225°: lost at 10.7 s). Along the path the air speed is what the
+    /// wing flies on: the loops stay in the path frame (thrust-borne) until it builds, as the
+    /// airspeed-scheduled transitions of PX4 and ArduPilot. Still air (no wind estimate) and
+    /// the other phases: `kappa` unchanged (in the last vertical phase the limit cost a Jacobi
+    /// turbulent handover cell, 3 m/s from 135°: 1.2 → 4.0 m).
+    pub(crate) fn path_air_frame_weight(
+        &self,
+        meas: &Measurement,
+        r: &crate::reference::ReferenceSignals,
+        kappa: f64,
+        dev: Deviations,
+    ) -> f64 {
+        if !dev.hover_wind_design || r.reference.phase != Phase::TransitionToLevel {
+            return kappa;
+        }
+        let wind = self.wind_mission.wind_speed();
+        if !wind.is_finite() {
+            return kappa;
+        }
+        let windy = band_weight(wind, PATH_AIR_WIND_BAND);
+        if windy == 0.0 {
+            return kappa;
+        }
+        let q = &meas.quat;
+        let att = UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]));
+        let (sa, ca) = meas.alpha.sin_cos();
+        let (sb, cb) = meas.beta.sin_cos();
+        let along = meas.airspeed * (att * Vector3::new(ca * cb, sb, sa * cb)).dot(&r.reference.tangent());
+        let p = &self.params;
+        let path = band_weight(along, (p.wind_frame_speed_low, p.wind_frame_speed_high));
+        kappa + (kappa.min(path) - kappa) * windy
     }
 }
 
@@ -231,5 +279,83 @@ mod tests {
         c.wind_mission.restore(&[0.0, 0.0, 0.0, 0.0]);
         let calm = c.airflow(&climb(0.0, 0.0), v_ref, false, dev);
         assert_eq!((calm.hover_wind, calm.design_crossflow), (0.0, calm.crossflow));
+    }
+}
+
+#[cfg(test)]
+mod path_air_tests {
+    use crate::deviations::Deviations;
+    use crate::reference::ReferenceSignals;
+    use crate::{Reference, TsdController, TsdParams};
+    use flight_mission::{Measurement, MissionParams, Phase};
+    use nalgebra::{UnitQuaternion, Vector3};
+    use tailsitter_physics::Airframe;
+
+    /// The reference signals of a path with flight-path angle `gamma` (rad), northbound.
+    fn path(gamma: f64) -> ReferenceSignals {
+        ReferenceSignals {
+            t_mission: 6.0,
+            reference: Reference {
+                phase: Phase::TransitionToLevel,
+                pos: Vector3::zeros(),
+                vel: Vector3::zeros(),
+                specific_accel: Vector3::new(0.0, 0.0, -9.81),
+                airspeed: 5.0,
+                gamma,
+            },
+            ref_pos: Vector3::zeros(),
+            sigma_ground: None,
+            heading: 0.0,
+        }
+    }
+
+    /// The front transition; the nose level towards the north, held still in a 10 m/s wind
+    /// from the north: the air flows along the nose (10 m/s of axial airspeed). Along a level
+    /// northbound path the wind axes keep the weight they have; up a vertical path (the air
+    /// across it) the loops keep the path frame. No wind estimate (still air), the other phases
+    /// and the thesis configuration: unchanged.
+    #[test]
+    fn wind_axes_need_the_air_along_the_path() {
+        let mut c = TsdController::with_mission(MissionParams::default()).unwrap();
+        let dev = Deviations::of(c.params());
+        let m = Measurement::still_in_air(&UnitQuaternion::identity(), &Vector3::new(10.0, 0.0, 0.0));
+        let up = path(core::f64::consts::FRAC_PI_2);
+        let level = path(0.0);
+        // Still air: the logic's estimate 0 (and none before its first sample).
+        c.wind_mission.restore(&[0.0, 0.0, 0.0, 0.0]);
+        assert_eq!(c.path_air_frame_weight(&m, &up, 0.8, dev), 0.8);
+        c.wind_mission.restore(&[f64::NAN, f64::NAN, 0.0, 0.0]);
+        assert_eq!(c.path_air_frame_weight(&m, &up, 0.8, dev), 0.8);
+        // 10 m/s estimated: the air across a vertical path, along a level one.
+        c.wind_mission.restore(&[-10.0, 0.0, 1.0, 0.0]);
+        assert_eq!(c.path_air_frame_weight(&m, &up, 0.8, dev), 0.0);
+        assert_eq!(c.path_air_frame_weight(&m, &level, 0.8, dev), 0.8);
+        // Half-way up (45°): 7.1 m/s along the path, half-way through the 4–10 m/s band.
+        let w = c.path_air_frame_weight(&m, &path(core::f64::consts::FRAC_PI_4), 0.8, dev);
+        assert!((w - (10.0 * 0.5f64.sqrt() - 4.0) / 6.0).abs() < 1e-12, "{w}");
+        // 2 m/s estimated: half the limit.
+        c.wind_mission.restore(&[-2.0, 0.0, 0.0, 0.0]);
+        assert!((c.path_air_frame_weight(&m, &up, 0.8, dev) - 0.4).abs() < 1e-12);
+        // Other phases (the vertical ones, the take-off and landing phases) and the thesis
+        // configuration.
+        c.wind_mission.restore(&[-10.0, 0.0, 1.0, 0.0]);
+        for phase in [
+            Phase::Vertical1,
+            Phase::Level,
+            Phase::TransitionToVertical,
+            Phase::Vertical2,
+            Phase::TakeOff,
+        ] {
+            let mut other = up;
+            other.reference.phase = phase;
+            assert_eq!(c.path_air_frame_weight(&m, &other, 0.8, dev), 0.8, "{phase:?}");
+        }
+        let thesis = TsdParams {
+            configuration: 1,
+            ..TsdParams::default()
+        };
+        let mut t = TsdController::new(Airframe::default(), MissionParams::default(), thesis).unwrap();
+        t.wind_mission.restore(&[-10.0, 0.0, 1.0, 0.0]);
+        assert_eq!(t.path_air_frame_weight(&m, &up, 0.8, Deviations::of(t.params())), 0.8);
     }
 }

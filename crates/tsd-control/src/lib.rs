@@ -60,7 +60,7 @@ pub use design::{FlightCondition, LoopDesign};
 pub use params::{
     TsdParams, GUIDANCE_FEEDBACK_LIMIT, HOVER_LOW_AIRSPEED_ALPHA, HOVER_WEATHERCOCK_CROSSFLOW, HOVER_WIND_CROSSFLOW,
     HOVER_WIND_DESIGN_SPEED_FACTOR, HOVER_WIND_NORMAL_CROSSFLOW, HOVER_WIND_NORMAL_POLE_FACTOR,
-    HOVER_WIND_ROLL_POLE_FACTOR, NORMAL_FEEDFORWARD_RAMP, TABLE_4_3_GUIDANCE_LEVEL,
+    HOVER_WIND_ROLL_POLE_FACTOR, NORMAL_FEEDFORWARD_RAMP, PATH_AIR_WIND_BAND, TABLE_4_3_GUIDANCE_LEVEL,
 };
 pub use trajectory::{Reference, Trajectory};
 
@@ -199,7 +199,7 @@ impl TsdController {
             trajectory,
             integrators: Integrators::default(),
             initialized: false,
-            ground: GroundPhases::new(mission, airframe.mass * airframe.gravity),
+            ground: GroundPhases::new(mission, airframe.mass * airframe.gravity).with_thrust_limit(airframe.thrust_max),
             saturated: 0,
             internals: Internals::default(),
             weathervane: Weathervane::new(if dev.weathervane {
@@ -354,7 +354,8 @@ impl SampledUnit for TsdController {
             ReferenceStage::OnGear { phase, thrust } => return Ok(self.on_gear(meas, phase, thrust)),
         };
         // Measured signals in the loop frame, and every loop designed at this condition.
-        let air = self.airflow(meas, r.reference.airspeed, r.ground_phase(), dev);
+        let mut air = self.airflow(meas, r.reference.airspeed, r.ground_phase(), dev);
+        air.kappa = self.path_air_frame_weight(meas, &r, air.kappa, dev);
         let axes = LoopAxes::measure(meas, &r.reference.tangent(), air.kappa);
         let d = self.scheduled_design(meas, &r, &air, input.t)?;
         let s = SampleSignals { meas, r, air, axes, d };

@@ -22,6 +22,14 @@ pub const HOVER_WIND_DESIGN_SPEED_FACTOR: f64 = 1.3;
 /// the calm missions unchanged), fully at the second.
 pub const HOVER_WIND_CROSSFLOW: (f64, f64) = (1.0, 3.0);
 
+/// Tuned configuration, missions in wind: the band (m/s) of the mission logic's 1 s air-data
+/// wind estimate over which the wind axes are also limited by the air velocity *along the
+/// reference path* (none at the first value, the weathervane's release speed, so still air is
+/// unchanged; fully from the second, its engage speed). With the wind behind, the air flows
+/// along the nose while the path climbs and turns away from it; the axial airspeed alone
+/// blended in wind axes that pointed against the path (README, "Missions in wind").
+pub const PATH_AIR_WIND_BAND: (f64, f64) = (1.0, 3.0);
+
 /// Airspeed band (m/s) over which the measured α enters the loop design in hover (tuned
 /// configuration, the reference at the vertical speed, not the take-off and landing phases):
 /// none at the first value, fully from the second (the still-air climb's 3 m/s, the calm

@@ -13,11 +13,11 @@
 
 use analysis::controllers::Kind;
 use analysis::takeoff_landing::{self, tilt};
-use analysis::wind_envelope::{fly_on, plant, seed, wind, StateKind, WindForm, BEARINGS_DEG};
-use closed_loop::{Ordering, Sample, Scenario, Trace};
+use analysis::wind_envelope::{StateKind, WindForm, BEARINGS_DEG};
+use closed_loop::{Ordering, Sample, Trace};
 use flight_mission::Phase;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
-use tailsitter_physics::{InputVector, Plant};
+use tailsitter_physics::Plant;
 
 /// Lean of the nose along the body's span from the vertical (deg, unsigned).
 fn span_lean_deg(s: &Sample) -> f64 {
@@ -29,25 +29,8 @@ fn span_lean_deg(s: &Sample) -> f64 {
 
 /// One cell flown to 5 s after the landing (perfect state).
 fn fly_cell(form: WindForm, ordering: Ordering, speed: f64, bearing_index: usize) -> (Plant, Trace) {
-    let plant = plant();
-    let mission = takeoff_landing::mission();
-    let x0 = plant.resting_on_ground(0.0, 0.0, 0.0);
-    let mut scenario = Scenario::mission(mission);
-    scenario.stop_time = takeoff_landing::stop_time(&mission);
-    scenario.wind = wind(form, speed, bearing_index, plant.ground.height);
-    scenario.ordering = ordering;
-    let mut c = Kind::Tsd.make_configured(&mission, 0).unwrap();
-    let stop = takeoff_landing::after_landing();
-    let trace = fly_on(
-        &plant,
-        x0,
-        &InputVector::zeros(),
-        &mut c,
-        &scenario,
-        StateKind::Perfect,
-        seed(bearing_index),
-        stop,
-    );
+    let (plant, trace) =
+        takeoff_landing::fly_wind_cell(Kind::Tsd, form, StateKind::Perfect, ordering, speed, bearing_index);
     assert!(
         trace.completed(),
         "{speed} m/s from {}°: {:?}",
