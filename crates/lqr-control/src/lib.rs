@@ -59,6 +59,9 @@ pub const WIND_TRIM_MAX_PITCH: f64 = 0.3490658503988659; // 20°
 /// Largest rotation about the body z axis (the crab in level flight) of the trim along the
 /// still-air ground path (rad) (README, "Mission in wind").
 pub const GROUND_TRIM_MAX_YAW: f64 = 1.0471975511965976; // 60°
+/// Time from the start of the front transition over which its trim along the still-air
+/// ground path reaches full weight (s) (README, "Mission in wind").
+pub const FRONT_TRIM_RAMP_TIME: f64 = 0.5;
 /// The wind trim is phased in (smoothstep) as the estimated wind rises between these
 /// speeds (m/s): below the first the reference is untrimmed (still air bit-identical, and
 /// the air-data wind an estimator makes of still air not flown).

@@ -15,9 +15,9 @@ use tailsitter_physics::Surfaces;
 use crate::model;
 use crate::trajectory::TrajPoint;
 use crate::{
-    LqrController, GROUND_TRIM_MAX_YAW, HOVER_SHIFT_LIMIT, HOVER_SHIFT_TIME, LANDING_FLAP_GAIN, LANDING_FLAP_LIMIT,
-    LANDING_FLAP_LINEARISED, LANDING_FLAP_RAMP_TIME, LANDING_LEAN_GAIN, MAX_WIND_ESTIMATE, MIN_AIRSPEED,
-    WIND_INTEGRAL_SPEED, WIND_TRIM_MAX_PITCH, WIND_TRIM_RAMP,
+    LqrController, FRONT_TRIM_RAMP_TIME, GROUND_TRIM_MAX_YAW, HOVER_SHIFT_LIMIT, HOVER_SHIFT_TIME, LANDING_FLAP_GAIN,
+    LANDING_FLAP_LIMIT, LANDING_FLAP_LINEARISED, LANDING_FLAP_RAMP_TIME, LANDING_LEAN_GAIN, MAX_WIND_ESTIMATE,
+    MIN_AIRSPEED, WIND_INTEGRAL_SPEED, WIND_TRIM_MAX_PITCH, WIND_TRIM_RAMP,
 };
 
 /// Switches of the reference stage (from [`crate::LqrParams::effective`]).
@@ -341,8 +341,14 @@ impl LqrController {
             return None;
         }
         let s_lat = self.lateral_wind_weight(p);
-        if let Some(q) = self.ground_path_trimmed(p, (&w_next, k, k_next), s_lat) {
-            return Some(q);
+        if sw.hover_in_wind && self.wind_integral {
+            if let Some(q) = self.front_transition_trimmed(p, &w_next, s_lat) {
+                return Some(q);
+            }
+        }
+        let plain = |w: &Vector3<f64>| self.ground_path_trim(p, w, s_lat);
+        if let (Some(z), Some(z_next)) = (plain(&self.wind), plain(&w_next)) {
+            return Some(self.ground_path_trimmed(p, (k, k_next), (&z, &z_next)));
         }
         let z = self.wind_trim(p, &self.wind, s_lat)?;
         let z_next = self.wind_trim(p, &w_next, s_lat)?;
@@ -359,21 +365,19 @@ impl LqrController {
     }
 
     /// The reference point trimmed along its still-air ground path in the estimated wind
-    /// (README, "Mission in wind"): [`Self::ground_path_trim`] at the wind ŵ and at `w_next`
-    /// (one sample on, through the wind filter's rate), weighted by `k`, `k_next`: the
+    /// (README, "Mission in wind"): the trims `z` at the wind ŵ and `z_next` at one sample on
+    /// (through the wind filter's rate) ([`Self::ground_path_trim`]), weighted by `k`, `k_next`: the
     /// reference body axes turned by k δψ about body z and k δθ about body y (C = Rᵀ C_t),
     /// the body rates re-expressed in them plus the rotation's rate, thrust, elevator, aileron
     /// and rudder changed. The ground velocity stays the still-air path's (the air data are
-    /// read from it, [`Self::air_reference`]). None where the trim fails.
+    /// read from it, [`Self::air_reference`]).
     fn ground_path_trimmed(
         &self,
         p: &TrajPoint,
-        (w_next, k, k_next): (&Vector3<f64>, f64, f64),
-        s_lat: f64,
-    ) -> Option<TrajPoint> {
+        (k, k_next): (f64, f64),
+        (z, z_next): (&SVector<f64, 6>, &SVector<f64, 6>),
+    ) -> TrajPoint {
         let h = self.mission.sample_time;
-        let z = self.ground_path_trim(p, &self.wind, s_lat)?;
-        let z_next = self.ground_path_trim(p, w_next, s_lat)?;
         let rate = (z_next * k_next - z * k) / h;
         let r = body_rotation(k * z[0], k * z[1]);
         let c = r.transpose() * model::dcm_of_quat(&p.quat());
@@ -388,7 +392,62 @@ impl LqrController {
         for j in 0..3 {
             q.u[1 + j] += k * z[3 + j];
         }
-        Some(q)
+        q
+    }
+
+    /// The front transition in a steady wind (README, "Mission in wind"): the trim along the
+    /// still-air ground path ([`Self::ground_path_trim_from`]) on the global aerodynamic model,
+    /// weighted by max((V_t/V_L)², smoothstep(τ/[`FRONT_TRIM_RAMP_TIME`])) (τ: time into the
+    /// transition) instead of the lift-borne fraction alone, solved by continuation in the
+    /// wind speed ([`Self::front_trim_continuation`]). None outside the front transition, or
+    /// where no fraction of the wind can be trimmed.
+    fn front_transition_trimmed(&self, p: &TrajPoint, w_next: &Vector3<f64>, s_lat: f64) -> Option<TrajPoint> {
+        let k = self.front_transition_weight(p)?;
+        let s_lat = s_lat.max(k);
+        let (z, lambda) = self.front_trim_continuation(p, &self.wind, s_lat)?;
+        // One sample on, the same fraction λ of the wind, from this sample's trim.
+        let z_next = self.ground_path_trim_from(p, &(w_next * lambda), s_lat, &z, true)?;
+        Some(self.ground_path_trimmed(p, (k, k), (&z, &z_next)))
+    }
+
+    /// Weight of the front transition's trim (None outside the front transition in a steady
+    /// wind): max((V_t/V_L)², smoothstep(τ/[`FRONT_TRIM_RAMP_TIME`])), τ the time into the
+    /// transition, phased in with the estimated wind as [`WIND_TRIM_RAMP`].
+    fn front_transition_weight(&self, p: &TrajPoint) -> Option<f64> {
+        let (phase, tau) = self.mission.phase_at(p.t);
+        if !(self.wind_integral && phase == Phase::TransitionToLevel) {
+            return None;
+        }
+        let smooth = |x: f64| x * x * (3.0 - 2.0 * x);
+        let lift = (p.v / self.mission.v_level).powi(2).min(1.0);
+        let (w0, w1) = WIND_TRIM_RAMP;
+        let x = (tau / FRONT_TRIM_RAMP_TIME).clamp(0.0, 1.0);
+        let y = ((self.wind.norm() - w0) / (w1 - w0)).clamp(0.0, 1.0);
+        Some(lift.max(smooth(x)) * smooth(y))
+    }
+
+    /// Continuation in the wind speed: [`Self::ground_path_trim_from`] on the global model at
+    /// λ ŵ, λ = 1/N … 1, each from the last solution; the trim of the largest λ reached and λ.
+    fn front_trim_continuation(
+        &self,
+        p: &TrajPoint,
+        wind: &Vector3<f64>,
+        s_lat: f64,
+    ) -> Option<(SVector<f64, 6>, f64)> {
+        const N: usize = 4;
+        let mut best = None;
+        let mut z = SVector::<f64, 6>::zeros();
+        for j in 1..=N {
+            let lambda = j as f64 / N as f64;
+            match self.ground_path_trim_from(p, &(wind * lambda), s_lat, &z, true) {
+                Some(zj) => {
+                    z = zj;
+                    best = Some((zj, lambda));
+                }
+                None => break,
+            }
+        }
+        best
     }
 
     /// Trim of a reference point along its still-air ground path in the wind `wind` (NED,
@@ -403,13 +462,34 @@ impl LqrController {
     /// finite-difference Jacobian, ≤ 12 iterations) from the still-air point; None where it
     /// does not converge or leaves the limits.
     fn ground_path_trim(&self, p: &TrajPoint, wind: &Vector3<f64>, s_lat: f64) -> Option<SVector<f64, 6>> {
+        self.ground_path_trim_from(p, wind, s_lat, &SVector::zeros(), false)
+    }
+
+    /// [`Self::ground_path_trim`] from the start `z0`, on the global aerodynamic model
+    /// (`global`) or the model for control.
+    fn ground_path_trim_from(
+        &self,
+        p: &TrajPoint,
+        wind: &Vector3<f64>,
+        s_lat: f64,
+        z0: &SVector<f64, 6>,
+        global: bool,
+    ) -> Option<SVector<f64, 6>> {
         let af = &self.airframe;
+        let ga = tailsitter_physics::GlobalAero::default();
+        let fmf = |v: &Vector3<f64>, w: &Vector3<f64>, t: f64, s: &Surfaces| {
+            if global {
+                ga.forces_moments(af, v, w, t, s).0
+            } else {
+                af.forces_moments(v, w, t, s)
+            }
+        };
         let surfaces = |z: &SVector<f64, 6>| {
             Surfaces::from_array([p.u[1] + z[3], p.u[2] + z[4], p.u[3] + z[5], p.u[4], p.u[5], p.u[6]])
         };
         let c_t = model::dcm_of_quat(&p.quat());
         let vb_t = model::body_velocity(p.v, p.alpha, 0.0);
-        let fm_t = af.forces_moments(&vb_t, &p.rates, p.thrust, &surfaces(&SVector::zeros()));
+        let fm_t = fmf(&vb_t, &p.rates, p.thrust, &surfaces(&SVector::zeros()));
         let f_e = c_t.transpose() * fm_t.force_body;
         let v_g = c_t.transpose() * vb_t;
         let (v_a, v_lat) = (v_g - wind, v_g - s_lat * wind);
@@ -419,14 +499,14 @@ impl LqrController {
             let c = r.transpose() * c_t;
             let mut vb = c * v_a;
             vb.y = (c * v_lat).y;
-            let fm = af.forces_moments(&vb, &(r.transpose() * p.rates), p.thrust + z[2], &surfaces(z));
+            let fm = fmf(&vb, &(r.transpose() * p.rates), p.thrust + z[2], &surfaces(z));
             let df = (c.transpose() * fm.force_body - f_e) / weight;
             let dm = fm.moment_body - fm_t.moment_body;
             SVector::<f64, 6>::new(df.x, df.y, df.z, dm.x, dm.y, dm.z)
         };
         let steps = SVector::<f64, 6>::new(1e-6, 1e-6, 1e-4, 1e-6, 1e-6, 1e-6);
         let converged = |r: &SVector<f64, 6>| r.fixed_rows::<3>(0).norm() < 1e-6 && r.fixed_rows::<3>(3).norm() < 1e-6;
-        let z = newton(residual, &steps, 12, converged)?;
+        let z = newton(*z0, residual, &steps, 12, converged)?;
         let lim = af.deflection_limit;
         let in_limits = z[0].abs() <= GROUND_TRIM_MAX_YAW
             && z[1].abs() <= WIND_TRIM_MAX_PITCH
@@ -464,7 +544,7 @@ impl LqrController {
         };
         let steps = Vector3::new(1e-6, 1e-4, 1e-6);
         let converged = |r: &Vector3<f64>| r.xy().norm() < 1e-6 * af.mass * af.gravity && r.z.abs() < 1e-7;
-        let z = newton(residual, &steps, 8, converged)?;
+        let z = newton(Vector3::zeros(), residual, &steps, 8, converged)?;
         let in_limits = z.x.abs() <= WIND_TRIM_MAX_PITCH
             && (af.thrust_min..=af.thrust_max).contains(&(p.thrust + z.y))
             && (p.u[1] + z.z).abs() <= af.deflection_limit;
@@ -487,7 +567,10 @@ impl LqrController {
         if !sw.wind_compensation || !self.wind.iter().all(|v| v.is_finite()) {
             return plain;
         }
-        let s_lat = self.lateral_wind_weight(p);
+        let mut s_lat = self.lateral_wind_weight(p);
+        if sw.hover_in_wind {
+            s_lat = s_lat.max(self.front_transition_weight(p).unwrap_or(0.0));
+        }
         let c = model::dcm_of_quat(&p.quat());
         let full = c * (v_g - self.wind);
         let v_b = Vector3::new(full.x, (c * (v_g - s_lat * self.wind)).y, full.z);
@@ -573,10 +656,11 @@ fn split_landing_flap(mut point: TrajPoint, flap: f64) -> (TrajPoint, f64) {
     (point, flap - linearised)
 }
 
-/// Newton's method from zero on `residual` with a forward-difference Jacobian (`steps`), at
+/// Newton's method from `z0` on `residual` with a forward-difference Jacobian (`steps`), at
 /// most `iterations` steps: the first iterate whose residual is `converged`; None on a
 /// non-finite residual, a singular Jacobian or no convergence.
 fn newton<const N: usize>(
+    z0: SVector<f64, N>,
     residual: impl Fn(&SVector<f64, N>) -> SVector<f64, N>,
     steps: &SVector<f64, N>,
     iterations: usize,
@@ -585,7 +669,7 @@ fn newton<const N: usize>(
 where
     Const<N>: DimMin<Const<N>, Output = Const<N>> + ToTypenum,
 {
-    let mut z = SVector::<f64, N>::zeros();
+    let mut z = z0;
     for _ in 0..iterations {
         let r = residual(&z);
         if !r.iter().all(|v| v.is_finite()) {
@@ -744,5 +828,38 @@ mod wind_trim_tests {
                 assert!(q.euler_321.x.abs() < 3f64.to_radians(), "{t}: φ {}", q.euler_321.x);
             }
         }
+    }
+
+    /// The slow start of the front transition in an 8 m/s wind from the east (across the
+    /// track): the trim on the model for control finds no solution there (its linear side
+    /// force and rolling moment at β ≈ 70° leave the limits), the trim on the global model,
+    /// by continuation in the wind speed, reaches the whole wind with the nose leaned 10.6–11.2°
+    /// into it, and the front transition's weight is the lift-borne fraction at its start and
+    /// 1 from [`FRONT_TRIM_RAMP_TIME`] on.
+    #[test]
+    fn front_transition_trim_across_the_track() {
+        let mut c = controller();
+        let w = Vector3::new(0.0, -8.0, 0.0);
+        c.wind = w;
+        c.wind_rate = Vector3::zeros();
+        c.wind_integral = true;
+        let t1 = c.mission.t_vertical_1;
+        for t in [t1 + 0.25, t1 + 0.5, t1 + 0.75] {
+            let p = c.trajectory().at(t);
+            let s_lat = c.lateral_wind_weight(&p);
+            assert!(c.ground_path_trim(&p, &w, s_lat).is_none(), "{t}: model for control");
+            let (z, lambda) = c.front_trim_continuation(&p, &w, 1.0).expect("global trim");
+            assert_eq!(lambda, 1.0, "{t}");
+            let lean = z[0].to_degrees();
+            assert!((9.0..12.0).contains(&lean), "{t}: lean {lean}°");
+            if t >= t1 + FRONT_TRIM_RAMP_TIME {
+                assert!((c.front_transition_weight(&p).unwrap() - 1.0).abs() < 1e-12, "{t}");
+            }
+        }
+        let p = c.trajectory().at(t1);
+        let lift = (p.v / c.mission.v_level).powi(2);
+        assert!((c.front_transition_weight(&p).unwrap() - lift).abs() < 1e-12);
+        c.wind_integral = false;
+        assert!(c.front_transition_weight(&c.trajectory().at(t1 + 1.0)).is_none());
     }
 }
