@@ -390,6 +390,7 @@ impl SampledUnit for TsdController {
             let side = wind_mission::landing_vertical_flap(meas, r.reference.phase) * s.air.hover_wind;
             command.vertical_flap = (command.vertical_flap + side).clamp(-lim, lim);
         }
+        command.thrust = self.takeoff_lift_thrust(meas, &r, command.thrust, dev);
         if !command.is_finite() {
             return Err(Self::err(format!("non-finite command at t = {} s", input.t)));
         }

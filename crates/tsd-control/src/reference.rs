@@ -9,6 +9,12 @@ use flight_mission::{ControllerInput, ControllerOutput, Measurement, Phase};
 use guidance::GroundMode;
 use nalgebra::Vector3;
 
+/// Least thrust of the take-off climb while the gear carries weight, in weights (–).
+pub const LIFTOFF_THRUST: f64 = 1.15;
+/// Height above the take-off point below which the take-off climb counts as on the gear (m):
+/// in the air the wing's force along the thrust axis in a wind looks like a gear reaction.
+pub const LIFTOFF_HEIGHT: f64 = 0.1;
+
 /// The reference signals of one flying sample.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct ReferenceSignals {
@@ -106,6 +112,29 @@ impl TsdController {
             sigma_ground,
             heading: heading.heading,
         })
+    }
+
+    /// Take-off climb on the gear (README, "Take-off and landing in wind"): while the gear
+    /// still carries weight ([`guidance::GroundPhases::gear_share`] above [`guidance::ground::CONTACT_REACTION`]),
+    /// the thrust is at least [`LIFTOFF_THRUST`] weights, so the aircraft leaves the gear
+    /// before a wind tips it over a leg.
+    pub(crate) fn takeoff_lift_thrust(
+        &self,
+        meas: &Measurement,
+        r: &ReferenceSignals,
+        thrust: f64,
+        dev: crate::deviations::Deviations,
+    ) -> f64 {
+        if !dev.hover_wind_design || r.reference.phase != Phase::TakeOff {
+            return thrust;
+        }
+        let height = self.ground.origin().map_or(f64::INFINITY, |o| o.z - meas.pos_ned.z);
+        if height < LIFTOFF_HEIGHT && self.ground.gear_share(meas) > guidance::ground::CONTACT_REACTION {
+            let w = self.airframe.mass * self.airframe.gravity;
+            thrust.max((LIFTOFF_THRUST * w).min(self.airframe.thrust_max))
+        } else {
+            thrust
+        }
     }
 
     /// On the gear: no loop runs (no integrator wind-up); the next flight phase starts
