@@ -115,25 +115,36 @@ impl TsdController {
     }
 
     /// Take-off climb on the gear (README, "Take-off and landing in wind"): while the gear
-    /// still carries weight ([`guidance::GroundPhases::gear_share`] above [`guidance::ground::CONTACT_REACTION`]),
-    /// the thrust is at least [`LIFTOFF_THRUST`] weights, so the aircraft leaves the gear
-    /// before a wind tips it over a leg.
-    pub(crate) fn takeoff_lift_thrust(
-        &self,
-        meas: &Measurement,
-        r: &ReferenceSignals,
-        thrust: f64,
+    /// still carries weight ([`guidance::GroundPhases::gear_share`] above
+    /// [`guidance::ground::CONTACT_REACTION`]) within [`LIFTOFF_HEIGHT`] of the take-off
+    /// point, the virtual thrust command `thrust` (N) is raised to at least [`LIFTOFF_THRUST`]
+    /// weights through the thrust integrator, so the aircraft leaves the gear before a wind
+    /// tips it over a leg, and the loop takes the raised thrust over in the air (no step
+    /// back down when the gear unloads). Tuned configuration only.
+    pub(crate) fn takeoff_lift(
+        &mut self,
+        s: &crate::SampleSignals,
+        thrust: &mut f64,
         dev: crate::deviations::Deviations,
-    ) -> f64 {
-        if !dev.hover_wind_design || r.reference.phase != Phase::TakeOff {
-            return thrust;
+    ) {
+        if !dev.hover_wind_design || s.r.reference.phase != Phase::TakeOff {
+            return;
         }
+        let meas = s.meas;
         let height = self.ground.origin().map_or(f64::INFINITY, |o| o.z - meas.pos_ned.z);
-        if height < LIFTOFF_HEIGHT && self.ground.gear_share(meas) > guidance::ground::CONTACT_REACTION {
-            let w = self.airframe.mass * self.airframe.gravity;
-            thrust.max((LIFTOFF_THRUST * w).min(self.airframe.thrust_max))
-        } else {
-            thrust
+        if !(height < LIFTOFF_HEIGHT && self.ground.gear_share(meas) > guidance::ground::CONTACT_REACTION) {
+            return;
+        }
+        let floor = (LIFTOFF_THRUST * self.airframe.mass * self.airframe.gravity).min(self.airframe.thrust_max);
+        let raise = floor - *thrust;
+        if raise > 0.0 {
+            *thrust = floor;
+            // The integrator's contribution to T_c is u_I (as accelerations) or −K_E·E.
+            self.integrators.thrust += if dev.integrators_as_accelerations {
+                raise
+            } else {
+                raise / -s.d.axial.1
+            };
         }
     }
 
