@@ -128,7 +128,7 @@ impl Internals {
 
 /// The signals every stage after the gain schedule reads: the measurement, the reference,
 /// the air flow, the loop frame and the loops' design at this sample.
-struct SampleSignals<'a> {
+pub(crate) struct SampleSignals<'a> {
     meas: &'a Measurement,
     r: ReferenceSignals,
     air: Airflow,
@@ -372,12 +372,13 @@ impl SampledUnit for TsdController {
                 .bumpless_start(&s, &laws, dev.integrators_as_accelerations);
             self.initialized = true;
         }
-        let u = self.integrators.commands(
+        let mut u = self.integrators.commands(
             &s,
             &laws,
             self.airframe.deflection_limit,
             dev.integrators_as_accelerations,
         );
+        self.takeoff_lift(&s, &mut u.thrust, dev);
         let (mut command, u_sat) = mixing::allocate(&u, s.d.mixing, dev.roll_differential_flaps, &self.airframe);
         // Landing in wind (README, "Take-off and landing in wind"): the collective and
         // vertical flaps' direct force.

@@ -9,6 +9,12 @@ use flight_mission::{ControllerInput, ControllerOutput, Measurement, Phase};
 use guidance::GroundMode;
 use nalgebra::Vector3;
 
+/// Least thrust of the take-off climb while the gear carries weight, in weights (–).
+pub const LIFTOFF_THRUST: f64 = 1.15;
+/// Height above the take-off point below which the take-off climb counts as on the gear (m):
+/// in the air the wing's force along the thrust axis in a wind looks like a gear reaction.
+pub const LIFTOFF_HEIGHT: f64 = 0.1;
+
 /// The reference signals of one flying sample.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct ReferenceSignals {
@@ -106,6 +112,40 @@ impl TsdController {
             sigma_ground,
             heading: heading.heading,
         })
+    }
+
+    /// Take-off climb on the gear (README, "Take-off and landing in wind"): while the gear
+    /// still carries weight ([`guidance::GroundPhases::gear_share`] above
+    /// [`guidance::ground::CONTACT_REACTION`]) within [`LIFTOFF_HEIGHT`] of the take-off
+    /// point, the virtual thrust command `thrust` (N) is raised to at least [`LIFTOFF_THRUST`]
+    /// weights through the thrust integrator, so the aircraft leaves the gear before a wind
+    /// tips it over a leg, and the loop takes the raised thrust over in the air (no step
+    /// back down when the gear unloads). Tuned configuration only.
+    pub(crate) fn takeoff_lift(
+        &mut self,
+        s: &crate::SampleSignals,
+        thrust: &mut f64,
+        dev: crate::deviations::Deviations,
+    ) {
+        if !dev.hover_wind_design || s.r.reference.phase != Phase::TakeOff {
+            return;
+        }
+        let meas = s.meas;
+        let height = self.ground.origin().map_or(f64::INFINITY, |o| o.z - meas.pos_ned.z);
+        if !(height < LIFTOFF_HEIGHT && self.ground.gear_share(meas) > guidance::ground::CONTACT_REACTION) {
+            return;
+        }
+        let floor = (LIFTOFF_THRUST * self.airframe.mass * self.airframe.gravity).min(self.airframe.thrust_max);
+        let raise = floor - *thrust;
+        if raise > 0.0 {
+            *thrust = floor;
+            // The integrator's contribution to T_c is u_I (as accelerations) or −K_E·E.
+            self.integrators.thrust += if dev.integrators_as_accelerations {
+                raise
+            } else {
+                raise / -s.d.axial.1
+            };
+        }
     }
 
     /// On the gear: no loop runs (no integrator wind-up); the next flight phase starts
