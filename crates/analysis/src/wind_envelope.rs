@@ -1159,16 +1159,15 @@ mod tests {
 
     /// Take-off to landing in a steady 5 m/s headwind and an 8 m/s tailwind (stepping in on
     /// the gear): the tuned LQR flies the approach and the descent within 3 m (3.5 m in the
-    /// tailwind) of its reference and comes to rest within 1 m of the target (before, the approach and descent
-    /// in wind were lost from 3 m/s: an undamped pitch oscillation of the near-hover air data
-    /// linearised at α = β = 0). Not yet a passed landing at these speeds: with the
-    /// collective-flap trim of the landing in wind it comes down upright but the flare does
-    /// not stop the sink (touchdown 3.4 m/s at 5 m/s; lqr-control README, "Take-off and
-    /// landing"); at 3 m/s every landing criterion is met (tests/missions lqr_wind_landing).
+    /// tailwind) of its reference and comes to rest within 1 m of the target (the near-hover
+    /// air data linearised at α = β = 0 gave an undamped pitch oscillation from 3 m/s). In the
+    /// 5 m/s headwind every landing criterion is met (the landing's collective-flap trim only
+    /// partly in the linearisation point, and the lean handed to the flaps: lqr-control README,
+    /// "Take-off and landing"); in the 8 m/s tailwind the touchdown is still too fast.
     #[test]
     fn lqr_descends_onto_the_target_in_wind() {
         // Bounds: the held limit, and 3.5 m in the 8 m/s tailwind (measured 3.30 m).
-        for (speed, bearing, bound) in [(5.0, 0, HELD_MAX_ERROR), (8.0, 4, 3.5)] {
+        for (speed, bearing, bound, landed) in [(5.0, 0, HELD_MAX_ERROR, true), (8.0, 4, 3.5, false)] {
             let (c, phases) = fly_job(
                 &Job::new(Kind::Lqr, MissionKind::TakeoffLanding, WindForm::Step, speed, bearing),
                 None,
@@ -1176,7 +1175,9 @@ mod tests {
             let descent = phases[Phase::Approach.code() as usize].max(phases[Phase::Descent.code() as usize]);
             assert!(c.completed && descent < bound, "{c:?}: approach/descent {descent}");
             assert!(c.landing_distance.unwrap() < 1.0, "{c:?}");
-            assert_eq!(c.landing_passed, Some(false), "{c:?}");
+            if landed {
+                assert_eq!(c.landing_passed, Some(true), "{c:?}");
+            }
         }
     }
 
@@ -1185,8 +1186,8 @@ mod tests {
     /// with moderate turbulence, each within the held limit with the largest error measured
     /// (0.6, 0.5, 2.2, 1.8, 1.1 m) plus 0.5 m; an 8 m/s quartering headwind (45°) within 2.7 m
     /// (measured 2.2 m) and an 8 m/s crosswind (90°) stepping in 3 s before the transition
-    /// within 2.5 m (measured 2.0 m). (The 10 m/s quartering tailwinds, 135° and 225°, are not
-    /// held: tsd-control README, "Missions in wind".)
+    /// within 2.5 m (measured 2.0 m). The 10 m/s quartering tailwinds (135°, 225°) are covered
+    /// by tests/missions tsdtail_quartering_tailwind.
     #[test]
     fn tuned_tsd_holds_representative_wind_cells_of_the_default_mission() {
         for (form, speed, bearing, bound) in [
