@@ -51,7 +51,11 @@ impl TsdController {
         } else {
             (0.0, 0.0, 0.0)
         };
-        let dm_p = normal_law(d, axes, g, air.kappa, ff);
+        let mut dm_p = normal_law(d, axes, g, air.kappa, ff);
+        if dev.hover_wind_design && !r.ground_phase() {
+            let windy = self.wind_mission.wind_speed() >= self.weathervane.params().release_speed;
+            dm_p += crate::wind_mission::back_transition_pitch_guard(meas.alpha, axes.q, r.reference.phase, windy);
+        }
         let (p_ref, da_p) = roll_law(d, roll_error, meas.beta, axes);
         let (g2, g2_dot, r_prime) = directional_gravity(d, axes, g, air.kappa);
         let k_d = d.directional_gains;

@@ -206,6 +206,47 @@ pub fn landing_vertical_flap(m: &Measurement, phase: Phase) -> f64 {
     lean_towards(m, &Vector3::y()).map_or(0.0, |(_, _, sin_lean)| LANDING_SPAN_LEAN_GAIN * sin_lean)
 }
 
+/// EXPERIMENT (temporary): a tuning value from the environment.
+pub fn exp(name: &str, default: f64) -> f64 {
+    std::env::var(name).ok().and_then(|v| v.parse().ok()).unwrap_or(default)
+}
+
+/// EXPERIMENT: back transition in wind, extra nose-down δm (rad, positive nose down) past the
+/// α limit and the pitch-rate limit.
+pub fn back_transition_pitch_guard(alpha: f64, q: f64, phase: Phase, windy: bool) -> f64 {
+    let wing_borne = match phase {
+        Phase::Level => exp("TSDB_LEVEL", 1.0) > 0.5,
+        Phase::TransitionToVertical => true,
+        Phase::Vertical2 => exp("TSDB_V2", 0.0) > 0.5,
+        _ => false,
+    };
+    if !(wing_borne && windy) {
+        return 0.0;
+    }
+    let (mut a_lim, mut k_a, q_lim, mut k_q) = (exp("TSDB_ALIM", 9.0), exp("TSDB_KA", 0.0), exp("TSDB_QLIM", 99.0), exp("TSDB_KQ", 0.0));
+    if phase == Phase::Level {
+        a_lim = exp("TSDB_ALIM_L", a_lim);
+        k_a = exp("TSDB_KA_L", k_a);
+        k_q = exp("TSDB_KQ_L", k_q);
+    }
+    let a_gate = exp("TSDB_QALPHA", 0.0);
+    let mut dm = k_a * (alpha - a_lim).max(0.0);
+    if alpha > a_gate {
+        dm += k_q * (q - q_lim).max(0.0);
+    }
+    dm
+}
+
+/// EXPERIMENT: back transition thrust floor in wind (N).
+pub fn back_transition_thrust_floor(phase: Phase, windy: bool, weight: f64) -> f64 {
+    let level = exp("TSDB_FLOOR_LEVEL", 0.0);
+    match phase {
+        Phase::TransitionToVertical if windy => exp("TSDB_FLOOR", 0.0) * weight,
+        Phase::Level if windy => level * weight,
+        _ => 0.0,
+    }
+}
+
 impl WindMission {
     /// Whether the phase at mission time `t` is flown with this heading: the first vertical
     /// phase (so the face is the transition's from the start), the transitions and level
