@@ -260,28 +260,6 @@ impl TsdController {
         self.saturated = 0;
     }
 
-    /// EXPERIMENT: thrust floor of the back transition in wind (integrator raised with it).
-    fn back_transition_thrust(&mut self, s: &SampleSignals, thrust: &mut f64, dev: Deviations) {
-        if !dev.hover_wind_design || s.r.ground_phase() {
-            return;
-        }
-        let windy = self.wind_mission.wind_speed() >= self.weathervane.params().release_speed;
-        let floor = wind_mission::back_transition_thrust_floor(
-            s.r.reference.phase,
-            windy,
-            self.airframe.mass * self.airframe.gravity,
-        );
-        let raise = floor - *thrust;
-        if raise > 0.0 {
-            *thrust = floor;
-            self.integrators.thrust += if dev.integrators_as_accelerations {
-                raise
-            } else {
-                raise / -s.d.axial.1
-            };
-        }
-    }
-
     fn err(msg: impl Into<String>) -> ControlError {
         ControlError(msg.into())
     }
@@ -401,7 +379,6 @@ impl SampledUnit for TsdController {
             dev.integrators_as_accelerations,
         );
         self.takeoff_lift(&s, &mut u.thrust, dev);
-        self.back_transition_thrust(&s, &mut u.thrust, dev);
         let (mut command, u_sat) = mixing::allocate(&u, s.d.mixing, dev.roll_differential_flaps, &self.airframe);
         // Landing in wind (README, "Take-off and landing in wind"): the collective and
         // vertical flaps' direct force.
