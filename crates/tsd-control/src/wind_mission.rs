@@ -214,7 +214,7 @@ pub const PITCH_GUARD_ALPHA_GAIN: f64 = 1.0;
 /// Angle of attack above which the pitch rate is limited (rad, 20°).
 pub const PITCH_GUARD_RATE_ALPHA: f64 = 0.35;
 /// Nose-up pitch rate the guard lets through above [`PITCH_GUARD_RATE_ALPHA`] (rad/s): the
-/// still-air back transition turns the path up at up to 0.3 rad/s.
+/// still-air level flight and back transition pitch at up to 0.28 rad/s and α ≤ 8°.
 pub const PITCH_GUARD_RATE: f64 = 1.0;
 /// Nose-down δm per rad/s of pitch rate above [`PITCH_GUARD_RATE`] (rad per rad/s).
 pub const PITCH_GUARD_RATE_GAIN: f64 = 0.3;
