@@ -51,7 +51,7 @@ impl TsdController {
         } else {
             (0.0, 0.0, 0.0)
         };
-        let dm_p = normal_law(d, axes, g, air.kappa, ff);
+        let dm_p = normal_law(d, axes, g, air.kappa, ff) + self.pitch_guard(s, dev);
         let (p_ref, da_p) = roll_law(d, roll_error, meas.beta, axes);
         let (g2, g2_dot, r_prime) = directional_gravity(d, axes, g, air.kappa);
         let k_d = d.directional_gains;
@@ -74,6 +74,18 @@ impl TsdController {
             g2_dot,
             weathercock_ff,
         }
+    }
+
+    /// The normal loop's pitch guard in level flight and the back transition in wind
+    /// ([`crate::wind_mission::pitch_guard`]; tuned configuration, not in the take-off and
+    /// landing phases; 0 in still air).
+    fn pitch_guard(&self, s: &SampleSignals, dev: Deviations) -> f64 {
+        if !dev.hover_wind_design || s.r.ground_phase() {
+            return 0.0;
+        }
+        let windy = self.wind_mission.wind_speed() >= self.weathervane.params().release_speed;
+        let since_level = s.r.t_mission - self.mission.phase_starts()[flight_mission::Phase::Level as usize];
+        crate::wind_mission::pitch_guard(s.meas.alpha, s.axes.q, s.r.reference.phase, windy, since_level)
     }
 
     /// Weathercock feed-forward of the directional loop (switch `weathercock_feedforward`;

@@ -206,6 +206,58 @@ pub fn landing_vertical_flap(m: &Measurement, phase: Phase) -> f64 {
     lean_towards(m, &Vector3::y()).map_or(0.0, |(_, _, sin_lean)| LANDING_SPAN_LEAN_GAIN * sin_lean)
 }
 
+/// Angle of attack above which the pitch guard pushes the nose down (rad, 26°): the wing's
+/// stall (25°), past which the normal force no longer grows with α ([`pitch_guard`]).
+pub const PITCH_GUARD_ALPHA: f64 = 0.45;
+/// Nose-down δm per radian of α above [`PITCH_GUARD_ALPHA`] (rad/rad).
+pub const PITCH_GUARD_ALPHA_GAIN: f64 = 1.0;
+/// Angle of attack above which the pitch rate is limited (rad, 20°).
+pub const PITCH_GUARD_RATE_ALPHA: f64 = 0.35;
+/// Nose-up pitch rate the guard lets through above [`PITCH_GUARD_RATE_ALPHA`] (rad/s): the
+/// still-air level flight and back transition pitch at up to 0.28 rad/s and α ≤ 8°.
+pub const PITCH_GUARD_RATE: f64 = 1.0;
+/// Nose-down δm per rad/s of pitch rate above [`PITCH_GUARD_RATE`] (rad per rad/s).
+pub const PITCH_GUARD_RATE_GAIN: f64 = 0.3;
+/// Time into level flight from which the guard acts there (s): the front transition's
+/// thrust-borne recovery at its end (α up to 170° in 10 m/s from 135° in turbulence) is left
+/// alone (guarded from the start of level flight, that cell was lost at 13.4 s).
+pub const PITCH_GUARD_LEVEL_DELAY: f64 = 2.0;
+
+/// Pitch guard of the normal loop in level flight and the back transition in wind (rad of
+/// δm, positive nose down; README, "Missions in wind"):
+/// [`PITCH_GUARD_ALPHA_GAIN`] (α − [`PITCH_GUARD_ALPHA`]) above the stall, plus
+/// [`PITCH_GUARD_RATE_GAIN`] (Q − [`PITCH_GUARD_RATE`]) above the rate limit once α passes
+/// [`PITCH_GUARD_RATE_ALPHA`]. `windy`: the mission logic's wind estimate at or above the
+/// weathervane's release speed (0 otherwise: still air unchanged); `since_level` (s): mission
+/// time since level flight began (level flight is guarded from [`PITCH_GUARD_LEVEL_DELAY`]).
+///
+/// The normal loop regulates the normal specific force C_W, not α. With the wind behind, the
+/// still-air ground path leaves the wing less air (a 5 m/s tailwind at the level flight's
+/// height in turbulence: 17–18 m/s of air for 25 m/s over the ground), while the pull-up's
+/// curvature asks the force the path needs at the ground speed: δm saturates nose up, α passes
+/// the stall, C_W falls with α and the loop pitches on; the axial loop, seeing the drag, puts
+/// the thrust from 0 to 150 N in 0.2 s and the slip-stream over the surfaces still deflected
+/// nose up turns the aircraft through the vertical at 4 rad/s (α 26° → 85° in 0.3 s, then
+/// reversed flow). The guard does not forbid the high-α, thrust-borne pull-up: it slows the
+/// pitch-up (the rate term) and holds the nose near the stall until the thrust has built.
+pub fn pitch_guard(alpha: f64, q: f64, phase: Phase, windy: bool, since_level: f64) -> f64 {
+    let guarded = match phase {
+        Phase::Level => since_level >= PITCH_GUARD_LEVEL_DELAY,
+        Phase::TransitionToVertical => true,
+        _ => false,
+    };
+    if !(guarded && windy) {
+        return 0.0;
+    }
+    let stall = PITCH_GUARD_ALPHA_GAIN * (alpha - PITCH_GUARD_ALPHA).max(0.0);
+    let rate = if alpha > PITCH_GUARD_RATE_ALPHA {
+        PITCH_GUARD_RATE_GAIN * (q - PITCH_GUARD_RATE).max(0.0)
+    } else {
+        0.0
+    };
+    stall + rate
+}
+
 impl WindMission {
     /// Whether the phase at mission time `t` is flown with this heading: the first vertical
     /// phase (so the face is the transition's from the start), the transitions and level
@@ -584,6 +636,31 @@ mod tests {
         let half = landing_flap_trim(&m, Phase::Approach, &from_north(3.0), 0.5 * LANDING_TRIM_RAMP_TIME);
         assert!((half - 0.5 * full).abs() < 1e-12, "{}", deg(half));
         assert_eq!(landing_flap_trim(&m, Phase::Approach, &from_north(3.0), f64::NAN), full);
+    }
+
+    /// The pitch guard: in the back transition with a wind estimate, 1 rad of nose-down δm per
+    /// radian of α above 26° plus 0.3 rad per rad/s of pitch rate above 1 rad/s once α passes
+    /// 20°; in level flight only from 2 s in; nothing in still air or in the other phases.
+    #[test]
+    fn pitch_guard_slows_the_pitch_up_past_the_stall_in_wind() {
+        let t2 = Phase::TransitionToVertical;
+        let a = PITCH_GUARD_ALPHA;
+        assert_eq!(pitch_guard(0.3, 3.0, t2, true, 20.0), 0.0);
+        assert_eq!(pitch_guard(0.4, 0.9, t2, true, 20.0), 0.0);
+        assert!((pitch_guard(0.4, 2.0, t2, true, 20.0) - 0.3).abs() < 1e-12);
+        assert!((pitch_guard(a + 0.2, 0.0, t2, true, 20.0) - 0.2).abs() < 1e-12);
+        assert!((pitch_guard(a + 0.2, 3.0, t2, true, 20.0) - 0.8).abs() < 1e-12);
+        assert!((pitch_guard(a + 0.2, 0.0, Phase::Level, true, 2.5) - 0.2).abs() < 1e-12);
+        assert_eq!(pitch_guard(a + 0.2, 3.0, Phase::Level, true, 1.5), 0.0);
+        assert_eq!(pitch_guard(a + 0.5, 3.0, t2, false, 20.0), 0.0);
+        for phase in [
+            Phase::Vertical1,
+            Phase::TransitionToLevel,
+            Phase::Vertical2,
+            Phase::Descent,
+        ] {
+            assert_eq!(pitch_guard(a + 0.5, 3.0, phase, true, 20.0), 0.0);
+        }
     }
 
     /// The vertical flaps' span-wise lean feedback: nose up, belly north, the right wing
