@@ -88,6 +88,7 @@ fn main() {
     println!("seed  gear_N  gear_E   td_N    td_E   |td|   miss  landed passed");
     let (mut td, mut gear, mut miss) = (Vec::new(), Vec::new(), Vec::new());
     let (mut sum_sq, mut n_passed) = ([0.0; 2], 0);
+    let mut flight_times = Vec::new();
     for seed in 1..=seeds {
         let av = Avionics::new(seed, false, ordering, scenario.comm_step);
         let mut src = Recorded {
@@ -122,11 +123,35 @@ fn main() {
         sum_sq[0] += e[0] * e[0];
         sum_sq[1] += e[1] * e[1];
         td.push(r);
+        flight_times.push(t_td - f.liftoff_time.unwrap_or(mission.takeoff_spinup_time));
         gear.push(g[0].hypot(g[1]));
         miss.push(f.miss_touchdown);
         n_passed += usize::from(f.passed);
     }
     let n = td.len() as f64;
+    // The sensor-limited bound for the same time on the gear and the median flight.
+    let flight = percentile(&mut flight_times, 0.5);
+    let est = state_estimator::EstimatorParams::default();
+    let (m_lat, m_lon) = state_estimator::LocalFrame::metres_per_radian(est.earth.site.ref_latitude, 0.0);
+    let axis = |sigma_position: f64| {
+        state_estimator::bound::axis_bound(&state_estimator::bound::BoundInputs {
+            sigma_position,
+            sigma_velocity: est.noise.sigma_gps_vel,
+            gps_rate: 4.0,
+            accel_density: est.noise.sigma_accel.powi(2) * est.filter.noise_correlation_time(scenario.comm_step),
+            gear_time: mission.takeoff_spinup_time,
+            flight_time: flight,
+        })
+    };
+    let (bn, be) = (
+        axis(est.noise.sigma_gps_latlon * m_lat),
+        axis(est.noise.sigma_gps_latlon * m_lon),
+    );
+    println!(
+        "bound (gear {:.1} s, flight {flight:.1} s): N {bn:?}\n                                E {be:?}\n  P(2-D < 1 m) = {:.3}",
+        mission.takeoff_spinup_time,
+        state_estimator::bound::probability_within(1.0, bn.sigma_relative, be.sigma_relative)
+    );
     let under = |v: &[f64]| v.iter().filter(|r| **r < 1.0).count();
     println!(
         "{} runs: estimate at touchdown RMS N {:.3} E {:.3} m, 2-D median {:.3} p95 {:.3}, < 1 m {}; \
