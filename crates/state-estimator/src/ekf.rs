@@ -1370,8 +1370,8 @@ impl Ekf {
     /// `f_x/g − T/(m g)`, the bias-corrected specific force along the thrust axis against
     /// the thrust; in the air it is the aerodynamic force along x in weights, negative in
     /// hover and descent (the wing's drag in the slipstream), so a hover is not at rest
-    /// whatever its speed — the estimated speed is below `rest_max_speed` and the body rate
-    /// below `rest_max_rate`. PX4's multicopter land detector declares "maybe landed" from
+    /// whatever its speed — the estimated speed is below `rest_max_speed` plus three σ of
+    /// the velocity estimate and the body rate below `rest_max_rate`. PX4's multicopter land detector declares "maybe landed" from
     /// low thrust with low speed and rates in the same way (`MulticopterLandDetector`).
     fn at_rest(&self, m: &Measurements) -> bool {
         let t = &self.params.tuning;
@@ -1380,7 +1380,10 @@ impl Ekf {
         let f_x = m.accel.x - s.accel_bias.x;
         let share = f_x / self.params.earth.gravity - s.actuators.thrust / weight;
         let rate = (m.gyro - s.gyro_bias).norm();
-        share >= t.rest_gear_share && s.vel.norm() <= t.rest_max_speed && rate <= t.rest_max_rate
+        // The speed as far as it is known: the first fix's velocity (σ 0.5 m/s per axis)
+        // must not hide the rest.
+        let speed_limit = t.rest_max_speed + 3.0 * s.cov.fixed_view::<3, 3>(ix::VEL, ix::VEL).trace().sqrt();
+        share >= t.rest_gear_share && s.vel.norm() <= speed_limit && rate <= t.rest_max_rate
     }
 
     /// Zero-velocity update (ZUPT) at rest on the gear: after the at-rest conditions have
