@@ -114,7 +114,9 @@ fn main() {
     }
     // The envelope's own flight of the cell, for comparison.
     let mut c = kind.make_configured(&mission, 0).unwrap();
-    let t = fly_on(&plant, x0, &u0, &mut c, &scenario, StateKind::Avionics, seed(b), |_| false);
+    let t = fly_on(&plant, x0, &u0, &mut c, &scenario, StateKind::Avionics, seed(b), |_| {
+        false
+    });
     let max = |t: &closed_loop::Trace| {
         t.samples
             .iter()

@@ -99,7 +99,14 @@ fn main() {
             errors: Vec::new(),
         };
         let mut c = kind.make_configured(&mission, 0).unwrap();
-        let mut trace = fly_with(&plant, x0, &mut c, &scenario, &mut src, takeoff_landing::after_landing());
+        let mut trace = fly_with(
+            &plant,
+            x0,
+            &mut c,
+            &scenario,
+            &mut src,
+            takeoff_landing::after_landing(),
+        );
         for s in &mut trace.samples {
             s.measurement.pos_ned -= origin;
         }

@@ -97,7 +97,17 @@ pub fn axis_bound(b: &BoundInputs) -> AxisBound {
             let s = next - flying_from;
             let f = Matrix3::new(1.0, s, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
             let q = b.accel_density;
-            let qm = Matrix3::new(q * s.powi(3) / 3.0, q * s * s / 2.0, 0.0, q * s * s / 2.0, q * s, 0.0, 0.0, 0.0, 0.0);
+            let qm = Matrix3::new(
+                q * s.powi(3) / 3.0,
+                q * s * s / 2.0,
+                0.0,
+                q * s * s / 2.0,
+                q * s,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+            );
             p = f * p * f.transpose() + qm;
         }
         t = next;
@@ -107,7 +117,17 @@ pub fn axis_bound(b: &BoundInputs) -> AxisBound {
     if s > 0.0 {
         let f = Matrix3::new(1.0, s, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
         let q = b.accel_density;
-        let qm = Matrix3::new(q * s.powi(3) / 3.0, q * s * s / 2.0, 0.0, q * s * s / 2.0, q * s, 0.0, 0.0, 0.0, 0.0);
+        let qm = Matrix3::new(
+            q * s.powi(3) / 3.0,
+            q * s * s / 2.0,
+            0.0,
+            q * s * s / 2.0,
+            q * s,
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+        );
         p = f * p * f.transpose() + qm;
     }
     AxisBound {
