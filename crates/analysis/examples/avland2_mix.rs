@@ -9,7 +9,7 @@
 //! wind, airspeed, α) up to the loss or the end.
 use analysis::controllers::Kind;
 use analysis::wind_envelope::{fly_on, plant, seed, trimmed_climb, wind, MissionKind, StateKind, WindForm};
-use closed_loop::avionics::{Avionics, AvionicsSource};
+use closed_loop::avionics::{substitute_truth, Avionics, AvionicsSource};
 use closed_loop::{fly_with, Scenario, StateSource};
 use flight_mission::{Command, Measurement};
 use nalgebra::Vector3;
@@ -59,32 +59,8 @@ impl StateSource for Mixed {
         for (k, v) in errs.iter().enumerate() {
             self.worst[k + 1] = self.worst[k + 1].max(*v);
         }
-        for f in &self.fields {
-            match f.as_str() {
-                "all" => {
-                    m = *truth;
-                    m.pos_ned = truth.pos_ned - self.origin;
-                }
-                "pos" => m.pos_ned = truth.pos_ned - self.origin,
-                "vel" => {
-                    m.vel_ned = truth.vel_ned;
-                    m.vel_body = truth.vel_body;
-                }
-                "att" => m.quat = truth.quat,
-                "rates" => m.rates = truth.rates,
-                "air" => {
-                    m.airspeed = truth.airspeed;
-                    m.alpha = truth.alpha;
-                    m.beta = truth.beta;
-                }
-                "act" => {
-                    m.thrust = truth.thrust;
-                    m.surfaces = truth.surfaces;
-                    m.induced_velocity = truth.induced_velocity;
-                }
-                "sf" => m.specific_force_body = truth.specific_force_body,
-                _ => {}
-            }
+        for f in self.fields.iter().filter(|f| f.as_str() != "none") {
+            assert!(substitute_truth(&mut m, truth, &self.origin, f), "unknown field {f}");
         }
         Ok(m)
     }

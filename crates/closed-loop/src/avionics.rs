@@ -81,6 +81,39 @@ pub fn measurement_of(e: &Estimate) -> Measurement {
     }
 }
 
+/// Replace `field` of the estimate `m` by the truth (development probes: which part of the
+/// estimate loses a flight): `all`, `pos` (the truth relative to `origin`, the frame of the
+/// start-relative estimate), `vel`, `att`, `rates`, `air` (airspeed, α, β), `act` (thrust,
+/// surfaces, induced velocity), `sf` (specific force). False for an unknown field.
+pub fn substitute_truth(m: &mut Measurement, truth: &Measurement, origin: &Vector3<f64>, field: &str) -> bool {
+    match field {
+        "all" => {
+            *m = *truth;
+            m.pos_ned = truth.pos_ned - origin;
+        }
+        "pos" => m.pos_ned = truth.pos_ned - origin,
+        "vel" => {
+            m.vel_ned = truth.vel_ned;
+            m.vel_body = truth.vel_body;
+        }
+        "att" => m.quat = truth.quat,
+        "rates" => m.rates = truth.rates,
+        "air" => {
+            m.airspeed = truth.airspeed;
+            m.alpha = truth.alpha;
+            m.beta = truth.beta;
+        }
+        "act" => {
+            m.thrust = truth.thrust;
+            m.surfaces = truth.surfaces;
+            m.induced_velocity = truth.induced_velocity;
+        }
+        "sf" => m.specific_force_body = truth.specific_force_body,
+        _ => return false,
+    }
+    true
+}
+
 /// The true state as the sensors see it (the plant outputs of the same names).
 pub fn truth(plant: &Plant, x: &StateVector, u: &InputVector, wind: &Vector3<f64>) -> sensor_model::Truth {
     let y = plant.outputs(x, u, wind);

@@ -92,49 +92,31 @@ pub fn axis_bound(b: &BoundInputs) -> AxisBound {
             break;
         }
         // Propagate to the next fix; on the gear nothing moves (x = x₀, v = 0).
-        let flying_from = t.max(b.gear_time);
         if next > b.gear_time {
-            let s = next - flying_from;
-            let f = Matrix3::new(1.0, s, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
-            let q = b.accel_density;
-            let qm = Matrix3::new(
-                q * s.powi(3) / 3.0,
-                q * s * s / 2.0,
-                0.0,
-                q * s * s / 2.0,
-                q * s,
-                0.0,
-                0.0,
-                0.0,
-                0.0,
-            );
-            p = f * p * f.transpose() + qm;
+            fly(&mut p, next - t.max(b.gear_time), b.accel_density);
         }
         t = next;
     }
     // From the last fix to the touchdown.
     let s = end - t.max(b.gear_time);
     if s > 0.0 {
-        let f = Matrix3::new(1.0, s, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
-        let q = b.accel_density;
-        let qm = Matrix3::new(
-            q * s.powi(3) / 3.0,
-            q * s * s / 2.0,
-            0.0,
-            q * s * s / 2.0,
-            q * s,
-            0.0,
-            0.0,
-            0.0,
-            0.0,
-        );
-        p = f * p * f.transpose() + qm;
+        fly(&mut p, s, b.accel_density);
     }
     AxisBound {
         sigma_touchdown: p[(0, 0)].sqrt(),
         sigma_start: p[(2, 2)].sqrt(),
         sigma_relative: (p[(0, 0)] + p[(2, 2)] - 2.0 * p[(0, 2)]).max(0.0).sqrt(),
     }
+}
+
+/// Propagate the covariance of (x, v, x₀) over `s` of flight with the accelerometer's
+/// white noise of density `q`: Φ = [[1, s, 0], [0, 1, 0], [0, 0, 1]], Q = q [[s³/3, s²/2, 0],
+/// [s²/2, s, 0], [0, 0, 0]].
+fn fly(p: &mut Matrix3<f64>, s: f64, q: f64) {
+    let f = Matrix3::new(1.0, s, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
+    let (q3, q2) = (q * s.powi(3) / 3.0, q * s * s / 2.0);
+    let qm = Matrix3::new(q3, q2, 0.0, q2, q * s, 0.0, 0.0, 0.0, 0.0);
+    *p = f * *p * f.transpose() + qm;
 }
 
 /// Probability that a zero-mean Gaussian 2-D error of independent axes with σ `sigma_n`,
