@@ -62,6 +62,12 @@ impl Default for Tuning {
             sigma_sideslip: 0.1,
             sideslip_min_airspeed: 10.0,
             sideslip_pseudo_measurement: true,
+            zero_velocity_update: true,
+            sigma_zero_velocity: 0.05,
+            rest_gear_share: 0.05,
+            rest_max_speed: 0.5,
+            rest_max_rate: 0.2,
+            rest_dwell: 0.2,
             gps_reset_after: 8,
         }
     }

@@ -46,31 +46,10 @@ impl StateSource for Logged {
         self.k += 1;
         let mut m = m;
         for f in &self.mix {
-            match f.as_str() {
-                "all" => m = *truth,
-                "pos" => m.pos_ned = truth.pos_ned - self.origin,
-                "vel" => {
-                    m.vel_ned = truth.vel_ned;
-                    m.vel_body = truth.vel_body;
-                }
-                "att" => m.quat = truth.quat,
-                "rates" => m.rates = truth.rates,
-                "air" => {
-                    m.airspeed = truth.airspeed;
-                    m.alpha = truth.alpha;
-                    m.beta = truth.beta;
-                }
-                "act" => {
-                    m.thrust = truth.thrust;
-                    m.surfaces = truth.surfaces;
-                    m.induced_velocity = truth.induced_velocity;
-                }
-                "sf" => m.specific_force_body = truth.specific_force_body,
-                _ => panic!("unknown field {f}"),
-            }
-        }
-        if self.mix.iter().any(|f| f == "all") {
-            m.pos_ned = truth.pos_ned - self.origin;
+            assert!(
+                closed_loop::avionics::substitute_truth(&mut m, truth, &self.origin, f),
+                "unknown field {f}"
+            );
         }
         Ok(m)
     }

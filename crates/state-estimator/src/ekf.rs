@@ -295,10 +295,12 @@ pub struct FilterState {
     /// rates (a disturbance observer).
     pub model_error_rates: Vector3<f64>,
     pub model_error_force: Vector3<f64>,
+    /// Time the at-rest conditions have held without a break (s; see [`Ekf::at_rest`]).
+    pub rest_time: f64,
 }
 
 /// Number of f64 words of [`FilterState::to_words`].
-pub const STATE_WORDS: usize = 3 * 12 + 4 + N_ERR * N_ERR + 7 + 7 + HISTORY * (7 + 7 + 1) + 1 + 6 + 12;
+pub const STATE_WORDS: usize = 3 * 12 + 4 + N_ERR * N_ERR + 7 + 7 + HISTORY * (7 + 7 + 1) + 1 + 6 + 12 + 1;
 
 impl FilterState {
     fn zeroed() -> Self {
@@ -332,6 +334,7 @@ impl FilterState {
             model_slope_force: Vector3::zeros(),
             model_error_rates: Vector3::zeros(),
             model_error_force: Vector3::zeros(),
+            rest_time: 0.0,
         }
     }
 
@@ -387,6 +390,7 @@ impl FilterState {
         ] {
             v.iter().for_each(|x| put(*x));
         }
+        put(self.rest_time);
         debug_assert_eq!(k, STATE_WORDS);
         w
     }
@@ -445,9 +449,11 @@ impl FilterState {
         ] {
             v.iter_mut().for_each(|x| *x = take());
         }
+        s.rest_time = take();
         let history_ok = s.history.iter().all(|e| e.h.is_finite() && e.h >= 0.0);
         s.history_len = int(len).filter(|l| (0.0..=HISTORY as f64).contains(l))? as usize;
-        (s.last_step.is_finite() && s.last_step >= 0.0 && history_ok).then_some(s)
+        let rest_ok = s.rest_time.is_finite() && s.rest_time >= 0.0;
+        (s.last_step.is_finite() && s.last_step >= 0.0 && history_ok && rest_ok).then_some(s)
     }
 }
 
@@ -905,6 +911,9 @@ impl Ekf {
             self.fuse_mag(m, &mut rep);
             self.fuse_pitot(m, &mut rep);
             self.fuse_sideslip();
+            if imu_inflation == 1.0 {
+                self.fuse_zero_velocity(m, h);
+            }
         }
         self.predict_compensated(h, imu_inflation);
         self.state.actuators.advance(&self.params.airframe, u, h);
@@ -1354,6 +1363,54 @@ impl Ekf {
         hm.fixed_view_mut::<1, 3>(0, ix::ATT).copy_from(&(cy * skew(&a)));
         let r = SMatrix::<f64, 1, 1>::new((t.sigma_sideslip * airspeed).powi(2));
         let _ = self.update(&y, &hm, &r, GATE_1DOF);
+    }
+
+    /// The aircraft rests on its gear (a zero-velocity detector from the IMU sample `m`
+    /// and the motor model): the gear carries at least `rest_gear_share` of the weight —
+    /// `f_x/g − T/(m g)`, the bias-corrected specific force along the thrust axis against
+    /// the thrust; in the air it is the aerodynamic force along x in weights, negative in
+    /// hover and descent (the wing's drag in the slipstream), so a hover is not at rest
+    /// whatever its speed — the estimated speed is below `rest_max_speed` plus three σ of
+    /// the velocity estimate and the body rate below `rest_max_rate`. PX4's multicopter land detector declares "maybe landed" from
+    /// low thrust with low speed and rates in the same way (`MulticopterLandDetector`).
+    fn at_rest(&self, m: &Measurements) -> bool {
+        let t = &self.params.tuning;
+        let s = &self.state;
+        let weight = self.params.airframe.mass * self.params.earth.gravity;
+        let f_x = m.accel.x - s.accel_bias.x;
+        let share = f_x / self.params.earth.gravity - s.actuators.thrust / weight;
+        let rate = (m.gyro - s.gyro_bias).norm();
+        // The speed as far as it is known: the first fix's velocity (σ 0.5 m/s per axis)
+        // must not hide the rest.
+        let speed_limit = t.rest_max_speed + 3.0 * s.cov.fixed_view::<3, 3>(ix::VEL, ix::VEL).trace().sqrt();
+        share >= t.rest_gear_share && s.vel.norm() <= speed_limit && rate <= t.rest_max_rate
+    }
+
+    /// Zero-velocity update (ZUPT) at rest on the gear: after the at-rest conditions have
+    /// held for `rest_dwell` (the impact of a touchdown passes first), z = 0 = v with σ
+    /// `sigma_zero_velocity` per axis. On the gear before the take-off this keeps the
+    /// position with its clone p₀ (the start-relative position stays 0, and every fix on
+    /// the gear averages into p₀), and makes the tilt observable from the horizontal
+    /// specific force (ṽ = 0 ⇒ the attitude error's −[(R̂f)×]φ must vanish).
+    fn fuse_zero_velocity(&mut self, m: &Measurements, h: f64) {
+        let t = &self.params.tuning;
+        if !t.zero_velocity_update {
+            self.state.rest_time = 0.0;
+            return;
+        }
+        if !self.at_rest(m) {
+            self.state.rest_time = 0.0;
+            return;
+        }
+        self.state.rest_time += h;
+        if self.state.rest_time < t.rest_dwell {
+            return;
+        }
+        let y = -self.state.vel;
+        let mut hm = SMatrix::<f64, 3, N_ERR>::zeros();
+        hm.fixed_view_mut::<3, 3>(0, ix::VEL).fill_with_identity();
+        let r = Matrix3::identity() * t.sigma_zero_velocity.powi(2);
+        let _ = self.update(&y, &hm, &r, GATE_3DOF);
     }
 
     /// Coefficients (c₁, c₂) of the compensation of the sensors' Butterworth, evaluated `s`

@@ -7,6 +7,7 @@
 //! `fmu-ekf` (`tailsitter_ekf`). See the crate README for the design and the tuning.
 
 pub mod actuators;
+pub mod bound;
 pub mod ekf;
 pub mod geodesy;
 pub mod params;

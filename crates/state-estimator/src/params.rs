@@ -122,6 +122,21 @@ pub struct Tuning {
     /// the error of the displacement since the start, not the first fix's (σ 4 m per axis).
     /// The aircraft must start at the NED origin the controllers' mission assumes.
     pub relative_to_start: bool,
+    /// Fuse zero velocity while the aircraft rests on its gear (an extra beyond App. D.4;
+    /// see [`crate::Ekf`]'s at-rest detector): the start position is the mean of every fix
+    /// taken on the gear, and the displacement since the start stays 0 until the lift-off.
+    pub zero_velocity_update: bool,
+    /// σ of the zero-velocity pseudo-measurement per axis (m/s).
+    pub sigma_zero_velocity: f64,
+    /// At rest: least share of the weight the gear carries, `f_x/g − T/(m g)` from the
+    /// bias-corrected specific force along the thrust axis and the motor model's thrust (–).
+    pub rest_gear_share: f64,
+    /// At rest: largest estimated speed (m/s).
+    pub rest_max_speed: f64,
+    /// At rest: largest bias-corrected body rate |ω| (rad/s).
+    pub rest_max_rate: f64,
+    /// At rest: time the conditions must have held before zero velocity is fused (s).
+    pub rest_dwell: f64,
 }
 
 /// The avionics' analogue low-pass filter on the IMU, magnetometer and pitot channels
@@ -243,6 +258,7 @@ impl EstimatorParams {
         self.tuning.relative_to_start = false;
         self.filter.compensate = false;
         self.tuning.sideslip_pseudo_measurement = false;
+        self.tuning.zero_velocity_update = false;
         self
     }
 
@@ -264,6 +280,7 @@ impl EstimatorParams {
             ("init_std_accel_bias", self.tuning.init_std_accel_bias),
             ("init_std_pos_no_gps", self.tuning.init_std_pos_no_gps),
             ("init_std_vel_no_gps", self.tuning.init_std_vel_no_gps),
+            ("sigma_zero_velocity", self.tuning.sigma_zero_velocity),
         ];
         for (name, v) in positive {
             if !(v.is_finite() && v > 0.0) {
@@ -281,11 +298,20 @@ impl EstimatorParams {
             ("sigma_sideslip", self.tuning.sigma_sideslip),
             ("sideslip_min_airspeed", self.tuning.sideslip_min_airspeed),
             ("init_thrust", self.tuning.init_thrust),
+            ("rest_max_speed", self.tuning.rest_max_speed),
+            ("rest_max_rate", self.tuning.rest_max_rate),
+            ("rest_dwell", self.tuning.rest_dwell),
         ];
         for (name, v) in non_negative {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(format!("{name} = {v} must be finite and >= 0"));
             }
+        }
+        if !self.tuning.rest_gear_share.is_finite() {
+            return Err(format!(
+                "rest_gear_share = {} must be finite",
+                self.tuning.rest_gear_share
+            ));
         }
         if !self.tuning.init_elevator.is_finite() {
             return Err(format!(
