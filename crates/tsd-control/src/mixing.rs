@@ -190,4 +190,31 @@ mod tests {
         assert!(mixed.iter().all(|z| z.re < 0.0), "mixed: {mixed:?}");
         println!("zeros of C_W/δe: {elevator:?}; of C_W/δm: {mixed:?}");
     }
+
+    /// An elevator with 20 % more lift than the design (C_Lδe × 1.2, within Table 5.1's
+    /// ×1.5^±1; C_Lδfc and the moments as designed): the printed mixing (k = 1.1) leaves the
+    /// mixed actuator's direct lift of the elevator's sign and a zero of C_W/δm in the right
+    /// half-plane; the robust factor keeps the lift opposite and both zeros on the left.
+    #[test]
+    fn robust_flap_mixing_keeps_the_zeros_left_with_a_stronger_elevator() {
+        let af = Airframe::default();
+        let k_e = 1.2;
+        let zeros = |k: f64| {
+            let rn = -k * af.c_L_de_a0 / af.c_L_dfc_a0;
+            let c_l = k_e * af.c_L_de_a0 + rn * af.c_L_dfc_a0;
+            let c_m = af.c_m_de_a0 + rn * af.c_m_dfc_a0;
+            (c_l, short_period_zeros(25.0, 1.2, 10.0, c_l, c_m))
+        };
+        let (lift, printed) = zeros(1.1);
+        assert!(
+            lift > 0.0 && printed.iter().any(|z| z.re > 0.0),
+            "k = 1.1: {lift}, {printed:?}"
+        );
+        let (lift, robust) = zeros(super::ROBUST_FLAP_MIXING_FACTOR);
+        assert!(
+            lift < 0.0 && robust.iter().all(|z| z.re < 0.0),
+            "robust: {lift}, {robust:?}"
+        );
+        println!("C_Lδe × {k_e}: zeros with k = 1.1 {printed:?}, with the robust factor {robust:?}");
+    }
 }
