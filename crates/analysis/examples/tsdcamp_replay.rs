@@ -1,13 +1,13 @@
 //! One TSD run of a native-campaign job file (`analysis campaign-jobs` JSON lines) flown again
 //! with a trace: the job chosen by its sample id, its sampled multipliers and wind printed, the
-//! largest error per phase, the flight every 0.25 s (error, air angles, pitch, airspeed, thrust,
-//! rudder, vertical flaps, elevator) and, if asked, every sample to a CSV file.
+//! largest error per phase, the flight every 0.24 s (error, wind, rates, air angles, airspeed,
+//! thrust, surface commands) and, if asked, every sample to a CSV file.
 //!
 //! `cargo run --release -p analysis --example tsdcamp_replay -- jobs.jsonl SAMPLE_ID [TRACE.csv]`
 use std::io::Write;
 
-use analysis::native_campaign::{metrics, mission_of, plant_of, wind_of, Job};
-use closed_loop::{fly, MeasuredWind, Scenario};
+use analysis::native_campaign::{metrics, mission_of, plant_of, scenario_of, Job};
+use closed_loop::{fly, Sample};
 use tailsitter_physics::Airframe;
 use tsd_control::{TsdController, TsdParams};
 
@@ -45,11 +45,7 @@ fn main() {
         w.turbulence_intensity
     );
     let mission = mission_of(&job).expect("mission");
-    let mut sc = Scenario::mission(mission);
-    sc.stop_time = job.stop_time;
-    sc.comm_step = job.step_size;
-    sc.wind = wind_of(&job, plant.ground.height);
-    sc.measured_wind = MeasuredWind::HeldInput;
+    let sc = scenario_of(&job, &plant, mission);
     let params = TsdParams {
         configuration: job.configuration,
         ..TsdParams::default()
@@ -65,65 +61,70 @@ fn main() {
         m["max_err"].unwrap_or(f64::NAN),
         phase_max.join(" ")
     );
-    let deg = f64::to_degrees;
+    // The printout every 0.24 s: time, phase, |error| and the columns in degrees where angles.
     for s in tr.samples.iter().step_by(12) {
-        let e = s.measurement.pos_ned - s.diagnostics.ref_pos_ned;
-        println!(
-            "{:6.2} ph {} err {:6.2} {:6.2} {:6.2} |{:5.2}| wind {:5.1} {:5.1} {:5.1} α {:6.1} β {:6.1} θ {:6.1} V {:5.1} T {:5.1} δr {:6.1} δv {:6.1} δe {:6.1} δa {:6.1}",
-            s.t,
-            s.diagnostics.phase as i32,
-            e.x,
-            e.y,
-            e.z,
-            e.norm(),
-            s.wind.x,
-            s.wind.y,
-            s.wind.z,
-            deg(s.measurement.alpha),
-            deg(s.measurement.beta),
-            deg(s.theta),
-            s.measurement.airspeed,
-            s.command.thrust,
-            deg(s.command.rudder),
-            deg(s.command.vertical_flap),
-            deg(s.command.elevator),
-            deg(s.command.aileron)
-        );
+        let c = columns(s);
+        let e = (c[2].1.powi(2) + c[3].1.powi(2) + c[4].1.powi(2)).sqrt();
+        print!("{:6.2} ph {} |err| {e:5.2}", c[0].1, c[1].1);
+        for (name, v) in &c[2..] {
+            let v = if ANGLES.contains(name) { v.to_degrees() } else { *v };
+            print!(" {name} {v:.1}");
+        }
+        println!();
     }
     if let Some(f) = &tr.failure {
         println!("{f}");
     }
     if let Some(path) = csv {
         let mut out = std::io::BufWriter::new(std::fs::File::create(path).expect("writable CSV"));
-        writeln!(out, "t,phase,err_n,err_e,err_d,wind_n,wind_e,wind_d,p,q,r,alpha,beta,airspeed,thrust,elevator,aileron,rudder,flap_collective,vertical_flap").unwrap();
+        let names: Vec<&str> = columns(&tr.samples[0]).iter().map(|(n, _)| *n).collect();
+        writeln!(out, "{}", names.join(",")).unwrap();
         for s in &tr.samples {
-            let e = s.measurement.pos_ned - s.diagnostics.ref_pos_ned;
-            let (r, c) = (s.measurement.rates, s.command);
-            writeln!(
-                out,
-                "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-                s.t,
-                s.diagnostics.phase as i32,
-                e.x,
-                e.y,
-                e.z,
-                s.wind.x,
-                s.wind.y,
-                s.wind.z,
-                r.x,
-                r.y,
-                r.z,
-                s.measurement.alpha,
-                s.measurement.beta,
-                s.measurement.airspeed,
-                c.thrust,
-                c.elevator,
-                c.aileron,
-                c.rudder,
-                c.flap_collective,
-                c.vertical_flap
-            )
-            .unwrap();
+            let row: Vec<String> = columns(s).iter().map(|(_, v)| v.to_string()).collect();
+            writeln!(out, "{}", row.join(",")).unwrap();
         }
     }
+}
+
+/// The columns in rad (printed in degrees, rates in deg/s).
+const ANGLES: [&str; 10] = [
+    "p",
+    "q",
+    "r",
+    "alpha",
+    "beta",
+    "elevator",
+    "aileron",
+    "rudder",
+    "flap_collective",
+    "vertical_flap",
+];
+
+/// One sample's columns (SI units, angles in rad): time, phase, position error N/E/D, wind
+/// N/E/D, body rates, α, β, airspeed and the commands.
+fn columns(s: &Sample) -> [(&'static str, f64); 20] {
+    let e = s.measurement.pos_ned - s.diagnostics.ref_pos_ned;
+    let (m, c) = (&s.measurement, &s.command);
+    [
+        ("t", s.t),
+        ("phase", f64::from(s.diagnostics.phase as i32)),
+        ("err_n", e.x),
+        ("err_e", e.y),
+        ("err_d", e.z),
+        ("wind_n", s.wind.x),
+        ("wind_e", s.wind.y),
+        ("wind_d", s.wind.z),
+        ("p", m.rates.x),
+        ("q", m.rates.y),
+        ("r", m.rates.z),
+        ("alpha", m.alpha),
+        ("beta", m.beta),
+        ("airspeed", m.airspeed),
+        ("thrust", c.thrust),
+        ("elevator", c.elevator),
+        ("aileron", c.aileron),
+        ("rudder", c.rudder),
+        ("flap_collective", c.flap_collective),
+        ("vertical_flap", c.vertical_flap),
+    ]
 }
