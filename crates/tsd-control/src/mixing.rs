@@ -14,21 +14,6 @@ pub const TABLE_4_1_LIFT: (f64, f64) = (1.246, 0.748);
 /// Table 4.2: side-force coefficients of the rudder and the vertical flaps (per rad).
 pub const TABLE_4_2_SIDE_FORCE: (f64, f64) = (1.008, 0.312);
 
-/// Tuned configuration, in wind: the flap mixing factor k of r_n = −k·C_Lδe/C_Lδfc (4.2.12)
-/// with a robustness margin. The mixed actuator's direct lift is (k_e − k)·C_Lδe for an
-/// elevator whose true C_Lδe is k_e times the design's: with the printed k = 1.1 it changes
-/// sign, and the right-half-plane zero of (4.2.11) comes back, once C_Lδe is 10 % above the
-/// model (the campaign draws C_Lδe within ×1.5^±1, Table 5.1, and not C_Lδfc). 1.25 keeps
-/// the zero in the left half-plane up to +25 %; larger factors saturate the flaps
-/// (|δfc| = |r_n δm| ≤ 25°) at smaller δm and lost more runs than they saved (README,
-/// "Robustness to the aerodynamic uncertainty").
-pub const ROBUST_FLAP_MIXING_FACTOR: f64 = 1.25;
-
-/// The band (m/s) of the mission logic's 1 s air-data wind estimate over which the flap
-/// mixing factor moves from `flap_mixing_factor` to [`ROBUST_FLAP_MIXING_FACTOR`]: none below
-/// the first value (still air flies the design's mixing, bit for bit), fully from the second.
-pub const ROBUST_FLAP_MIXING_WIND: (f64, f64) = (0.5, 1.0);
-
 impl TsdController {
     /// Mixing ratios (r_n, r_v): δfc = r_n·δm, δe = δm (4.2.12–4.2.13, Table 4.1) and
     /// δv = r_v·δR, δr = δR (Table 4.2), r = −k·(force of the main surface)/(force of the
@@ -36,8 +21,7 @@ impl TsdController {
     /// opposite sign, and the right-half-plane zero of (4.2.11) moves to the left (4.2.14).
     /// With `alpha_dependent_mixing` off (D-4.5, D-4.6) the printed constants: Table 4.1's
     /// C_Lδe/C_Lδfc = 1.246/0.748 and Table 4.2's C_Yδr/C_Yδv = 1.008/0.312, times the factors
-    /// (1.1: r = −1.833, r_v = −3.554); on, the flap factor in wind has a robustness margin
-    /// ([`ROBUST_FLAP_MIXING_FACTOR`]).
+    /// (1.1: r = −1.833, r_v = −3.554).
     pub fn mixing_ratios(&self, alpha: f64) -> (f64, f64) {
         if !crate::deviations::Deviations::of(&self.params).alpha_dependent_mixing {
             return (
@@ -46,21 +30,9 @@ impl TsdController {
             );
         }
         let c = self.airframe.coefficients(alpha);
-        let rn = -self.robust_flap_mixing_factor() * c.c_L_de / c.c_L_dfc;
+        let rn = -self.params.flap_mixing_factor * c.c_L_de / c.c_L_dfc;
         let rv = -self.params.vertical_flap_mixing_factor * c.c_Y_dr / c.c_Y_dv;
         (rn, rv)
-    }
-
-    /// The flap mixing factor of the tuned configuration ([`ROBUST_FLAP_MIXING_FACTOR`]):
-    /// `flap_mixing_factor` in still air, the robust factor from [`ROBUST_FLAP_MIXING_WIND`]'s
-    /// upper end of the mission logic's air-data wind estimate (none before its first sample).
-    fn robust_flap_mixing_factor(&self) -> f64 {
-        let k = self.params.flap_mixing_factor;
-        let ws = self.wind_mission.wind_speed();
-        if ws.is_nan() {
-            return k;
-        }
-        k + crate::band_weight(ws, ROBUST_FLAP_MIXING_WIND) * (ROBUST_FLAP_MIXING_FACTOR - k)
     }
 
     /// Notice of the first command (in [`COMMAND_NAMES`] order) that saturates at this
@@ -189,32 +161,5 @@ mod tests {
         );
         assert!(mixed.iter().all(|z| z.re < 0.0), "mixed: {mixed:?}");
         println!("zeros of C_W/δe: {elevator:?}; of C_W/δm: {mixed:?}");
-    }
-
-    /// An elevator with 20 % more lift than the design (C_Lδe × 1.2, within Table 5.1's
-    /// ×1.5^±1; C_Lδfc and the moments as designed): the printed mixing (k = 1.1) leaves the
-    /// mixed actuator's direct lift of the elevator's sign and a zero of C_W/δm in the right
-    /// half-plane; the robust factor keeps the lift opposite and both zeros on the left.
-    #[test]
-    fn robust_flap_mixing_keeps_the_zeros_left_with_a_stronger_elevator() {
-        let af = Airframe::default();
-        let k_e = 1.2;
-        let zeros = |k: f64| {
-            let rn = -k * af.c_L_de_a0 / af.c_L_dfc_a0;
-            let c_l = k_e * af.c_L_de_a0 + rn * af.c_L_dfc_a0;
-            let c_m = af.c_m_de_a0 + rn * af.c_m_dfc_a0;
-            (c_l, short_period_zeros(25.0, 1.2, 10.0, c_l, c_m))
-        };
-        let (lift, printed) = zeros(1.1);
-        assert!(
-            lift > 0.0 && printed.iter().any(|z| z.re > 0.0),
-            "k = 1.1: {lift}, {printed:?}"
-        );
-        let (lift, robust) = zeros(super::ROBUST_FLAP_MIXING_FACTOR);
-        assert!(
-            lift < 0.0 && robust.iter().all(|z| z.re < 0.0),
-            "robust: {lift}, {robust:?}"
-        );
-        println!("C_Lδe × {k_e}: zeros with k = 1.1 {printed:?}, with the robust factor {robust:?}");
     }
 }
