@@ -233,6 +233,18 @@ pub fn run(job: &Job) -> Row {
     }
 }
 
+/// The scenario of a job flown on `plant`: the mission, stop time, step and wind of the job,
+/// the wind read as the fmpy master reads it.
+pub fn scenario_of(job: &Job, plant: &Plant, mission: MissionParams) -> Scenario {
+    let mut scenario = Scenario::mission(mission);
+    scenario.stop_time = job.stop_time;
+    scenario.comm_step = job.step_size;
+    scenario.wind = wind_of(job, plant.ground.height);
+    // The fmpy master reads the plant outputs before it sets the new wind (tailsim.master).
+    scenario.measured_wind = MeasuredWind::HeldInput;
+    scenario
+}
+
 fn fly_job(job: &Job) -> Result<(Plant, Trace), String> {
     if job.state_source != "perfect" {
         return Err(format!(
@@ -242,12 +254,7 @@ fn fly_job(job: &Job) -> Result<(Plant, Trace), String> {
     }
     let (plant, x0) = plant_of(job)?;
     let mission = mission_of(job)?;
-    let mut scenario = Scenario::mission(mission);
-    scenario.stop_time = job.stop_time;
-    scenario.comm_step = job.step_size;
-    scenario.wind = wind_of(job, plant.ground.height);
-    // The fmpy master reads the plant outputs before it sets the new wind (tailsim.master).
-    scenario.measured_wind = MeasuredWind::HeldInput;
+    let scenario = scenario_of(job, &plant, mission);
     // The controllers' design model: the nominal airframe (their `design_airframe` defaults).
     let design = Airframe::default();
     match job.controller.as_str() {
