@@ -56,6 +56,16 @@ pub const HOVER_WIND_AIR_ANGLE: f64 = 0.5235987755982988; // 30°
 
 /// Largest pitch rotation of the wind trim (rad) (README, "Gusts").
 pub const WIND_TRIM_MAX_PITCH: f64 = 0.3490658503988659; // 20°
+/// Largest pitch rotation of the wind trims on the global model (rad) (45°): the level leg's
+/// and back transition's (`reference::level_trim`: 23.0° in a 10 m/s tailwind) and the front
+/// transition's (README, "Mission in wind").
+pub const LEVEL_TRIM_MAX_PITCH: f64 = core::f64::consts::FRAC_PI_4;
+
+/// Largest wind step of the level leg's continuation on the global model (m/s).
+pub const LEVEL_TRIM_STEP: f64 = 1.0;
+
+/// Most solves of the level leg's continuation on the global model.
+pub const LEVEL_TRIM_STEPS: usize = 12;
 /// Largest rotation about the body z axis (the crab in level flight) of the trim along the
 /// still-air ground path (rad) (README, "Mission in wind").
 pub const GROUND_TRIM_MAX_YAW: f64 = 1.0471975511965976; // 60°

@@ -16,8 +16,9 @@ use crate::model;
 use crate::trajectory::TrajPoint;
 use crate::{
     LqrController, FRONT_TRIM_RAMP_TIME, GROUND_TRIM_MAX_YAW, HOVER_SHIFT_LIMIT, HOVER_SHIFT_TIME, LANDING_FLAP_GAIN,
-    LANDING_FLAP_LIMIT, LANDING_FLAP_LINEARISED, LANDING_FLAP_RAMP_TIME, LANDING_LEAN_GAIN, MAX_WIND_ESTIMATE,
-    MIN_AIRSPEED, WIND_INTEGRAL_SPEED, WIND_TRIM_MAX_PITCH, WIND_TRIM_RAMP,
+    LANDING_FLAP_LIMIT, LANDING_FLAP_LINEARISED, LANDING_FLAP_RAMP_TIME, LANDING_LEAN_GAIN, LEVEL_TRIM_MAX_PITCH,
+    LEVEL_TRIM_STEP, LEVEL_TRIM_STEPS, MAX_WIND_ESTIMATE, MIN_AIRSPEED, WIND_INTEGRAL_SPEED, WIND_TRIM_MAX_PITCH,
+    WIND_TRIM_RAMP,
 };
 
 /// Switches of the reference stage (from [`crate::LqrParams::effective`]).
@@ -345,6 +346,9 @@ impl LqrController {
             if let Some(q) = self.front_transition_trimmed(p, &w_next, s_lat) {
                 return Some(q);
             }
+            if let Some(q) = self.level_trimmed(p, &w_next, s_lat, (k, k_next)) {
+                return Some(q);
+            }
         }
         let plain = |w: &Vector3<f64>| self.ground_path_trim(p, w, s_lat);
         if let (Some(z), Some(z_next)) = (plain(&self.wind), plain(&w_next)) {
@@ -406,8 +410,53 @@ impl LqrController {
         let s_lat = s_lat.max(k);
         let (z, lambda) = self.front_trim_continuation(p, &self.wind, s_lat)?;
         // One sample on, the same fraction λ of the wind, from this sample's trim.
-        let z_next = self.ground_path_trim_from(p, &(w_next * lambda), s_lat, &z, true)?;
+        let z_next = self.ground_path_trim_from(p, &(w_next * lambda), s_lat, &z, true, LEVEL_TRIM_MAX_PITCH)?;
         Some(self.ground_path_trimmed(p, (k, k), (&z, &z_next)))
+    }
+
+    /// The level leg and the back transition in a steady wind (README, "Mission in wind"): the
+    /// trim along the still-air ground path on the global aerodynamic model
+    /// ([`Self::level_trim`]), weighted by `k`, `k_next` as the model for control's. None in
+    /// the other phases, before the position integrators have latched, or where the global
+    /// trim fails.
+    fn level_trimmed(
+        &self,
+        p: &TrajPoint,
+        w_next: &Vector3<f64>,
+        s_lat: f64,
+        (k, k_next): (f64, f64),
+    ) -> Option<TrajPoint> {
+        if !(self.wind_integral && matches!(self.mission.phase_at(p.t).0, Phase::Level | Phase::TransitionToVertical)) {
+            return None;
+        }
+        let z = self.level_trim(p, &self.wind, s_lat)?;
+        let z_next = self.ground_path_trim_from(p, w_next, s_lat, &z, true, LEVEL_TRIM_MAX_PITCH)?;
+        Some(self.ground_path_trimmed(p, (k, k_next), (&z, &z_next)))
+    }
+
+    /// The level leg's trim along the still-air ground path on the global model in the wind
+    /// `wind`: Newton from the model for control's trim ([`Self::ground_path_trim`]) where that
+    /// converges (across and against the track the two agree), else by continuation in the
+    /// wind speed from the still-air point in steps of at most [`LEVEL_TRIM_STEP`] (≤
+    /// [`LEVEL_TRIM_STEPS`] solves). In a tailwind the air is slower than the ground path: at
+    /// 17 m/s (8 m/s tailwind) the wing is past its attached-flow range and the model for
+    /// control's trim (α 15.9°, ΔT +0.6 N) lacks 12 N of lift on the global model; the global
+    /// trim is α 21.6° with ΔT +19.4 N, at 10 m/s α 30.4° with ΔT +39.5 N.
+    fn level_trim(&self, p: &TrajPoint, wind: &Vector3<f64>, s_lat: f64) -> Option<SVector<f64, 6>> {
+        let global = |w: &Vector3<f64>, z0: &SVector<f64, 6>| {
+            self.ground_path_trim_from(p, w, s_lat, z0, true, LEVEL_TRIM_MAX_PITCH)
+        };
+        if let Some(z) = self.ground_path_trim(p, wind, s_lat).and_then(|z0| global(wind, &z0)) {
+            return Some(z);
+        }
+        let n = (wind.norm() / LEVEL_TRIM_STEP)
+            .ceil()
+            .clamp(1.0, LEVEL_TRIM_STEPS as f64) as usize;
+        let mut z = SVector::<f64, 6>::zeros();
+        for j in 1..=n {
+            z = global(&(wind * (j as f64 / n as f64)), &z)?;
+        }
+        Some(z)
     }
 
     /// Weight of the front transition's trim (None outside the front transition in a steady
@@ -439,7 +488,7 @@ impl LqrController {
         let mut z = SVector::<f64, 6>::zeros();
         for j in 1..=N {
             let lambda = j as f64 / N as f64;
-            match self.ground_path_trim_from(p, &(wind * lambda), s_lat, &z, true) {
+            match self.ground_path_trim_from(p, &(wind * lambda), s_lat, &z, true, LEVEL_TRIM_MAX_PITCH) {
                 Some(zj) => {
                     z = zj;
                     best = Some((zj, lambda));
@@ -462,7 +511,7 @@ impl LqrController {
     /// finite-difference Jacobian, ≤ 12 iterations) from the still-air point; None where it
     /// does not converge or leaves the limits.
     fn ground_path_trim(&self, p: &TrajPoint, wind: &Vector3<f64>, s_lat: f64) -> Option<SVector<f64, 6>> {
-        self.ground_path_trim_from(p, wind, s_lat, &SVector::zeros(), false)
+        self.ground_path_trim_from(p, wind, s_lat, &SVector::zeros(), false, WIND_TRIM_MAX_PITCH)
     }
 
     /// [`Self::ground_path_trim`] from the start `z0`, on the global aerodynamic model
@@ -474,6 +523,7 @@ impl LqrController {
         s_lat: f64,
         z0: &SVector<f64, 6>,
         global: bool,
+        max_pitch: f64,
     ) -> Option<SVector<f64, 6>> {
         let af = &self.airframe;
         let ga = tailsitter_physics::GlobalAero::default();
@@ -509,7 +559,7 @@ impl LqrController {
         let z = newton(*z0, residual, &steps, 12, converged)?;
         let lim = af.deflection_limit;
         let in_limits = z[0].abs() <= GROUND_TRIM_MAX_YAW
-            && z[1].abs() <= WIND_TRIM_MAX_PITCH
+            && z[1].abs() <= max_pitch
             && (af.thrust_min..=af.thrust_max).contains(&(p.thrust + z[2]))
             && (1..4).all(|j| (p.u[j] + z[2 + j]).abs() <= lim);
         in_limits.then_some(z)
@@ -870,5 +920,61 @@ mod wind_trim_tests {
         assert!((c.front_transition_weight(&p).unwrap() - lift).abs() < 1e-12);
         c.wind_integral = false;
         assert!(c.front_transition_weight(&c.trajectory().at(t1 + 1.0)).is_none());
+    }
+
+    /// The level leg in a steady tailwind: the trim on the global model keeps the still-air
+    /// reference's earth-axes force (to 1e-5 of the weight) and body moments on the global
+    /// model at the same ground velocity; at 8 m/s it pitches the nose up by 14.2° (α 21.6°)
+    /// with ΔT +19.4 N, at 10 m/s (found by continuation: Newton from the model for control's
+    /// trim does not converge there) by 23.0° (α 30.4°) with ΔT +39.5 N. The model for
+    /// control's own trim at 8 m/s (α 15.9°, ΔT +0.6 N) lacks more than 10 N of lift on the
+    /// global model.
+    #[test]
+    fn level_trim_in_a_tailwind_on_the_global_model() {
+        let mut c = controller();
+        let af = Airframe::default();
+        let ga = tailsitter_physics::GlobalAero::default();
+        c.wind_rate = Vector3::zeros();
+        c.wind_integral = true;
+        let p = c.trajectory().at(15.0);
+        let v_g = ground_velocity(&p);
+        let c_p = model::dcm_of_quat(&p.quat());
+        let s_p = Surfaces::from_array([p.u[1], p.u[2], p.u[3], p.u[4], p.u[5], p.u[6]]);
+        let fm_t = ga.forces_moments(&af, &(c_p * v_g), &p.rates, p.thrust, &s_p).0;
+        let f_t = c_p.transpose() * fm_t.force_body;
+        let global_loads = |q: &TrajPoint, w: &Vector3<f64>| {
+            let c_q = model::dcm_of_quat(&q.quat());
+            let s = Surfaces::from_array([q.u[1], q.u[2], q.u[3], q.u[4], q.u[5], q.u[6]]);
+            let fm = ga.forces_moments(&af, &(c_q * (v_g - w)), &q.rates, q.thrust, &s).0;
+            (c_q.transpose() * fm.force_body - f_t, fm.moment_body - fm_t.moment_body)
+        };
+        let s_lat = c.lateral_wind_weight(&p);
+        for (speed, pitch, thrust) in [(8.0, 14.2, 19.4), (10.0, 23.0, 39.5)] {
+            let w = Vector3::new(speed, 0.0, 0.0);
+            c.wind = w;
+            let q = c.trimmed(&p, &c.params.stages().reference).expect("trim converges");
+            let (df, dm) = global_loads(&q, &w);
+            assert!(df.norm() < 1e-5 * af.mass * af.gravity, "{speed}: force {df}");
+            assert!(dm.norm() < 1e-5, "{speed}: moment {dm}");
+            let dtheta = (q.euler_321.y - p.euler_321.y).to_degrees();
+            assert!((dtheta - pitch).abs() < 0.3, "{speed}: pitch {dtheta}°");
+            assert!(
+                (q.thrust - p.thrust - thrust).abs() < 0.5,
+                "{speed}: ΔT {}",
+                q.thrust - p.thrust
+            );
+            let mc = c.ground_path_trim(&p, &w, s_lat).expect("model for control's trim");
+            let global_from_mc = c.ground_path_trim_from(&p, &w, s_lat, &mc, true, LEVEL_TRIM_MAX_PITCH);
+            assert_eq!(global_from_mc.is_none(), speed == 10.0, "{speed}");
+            if speed == 8.0 {
+                // The model for control's trim on the global model: more than 10 N short of lift.
+                let mut m = p;
+                m.euler_321.y += mc[1];
+                m.thrust += mc[2];
+                m.u[0] += mc[2];
+                m.u[1] += mc[3];
+                assert!(global_loads(&m, &w).0.z > 10.0, "{}", global_loads(&m, &w).0);
+            }
+        }
     }
 }
