@@ -584,6 +584,9 @@ pub fn fly_with<C: FlightController, S: StateSource>(
     };
     let mut clock = flight_mission::SampleClock::new(scenario.mission.sample_time, 0.0);
     let mut x = x0;
+    // The gear's friction memory (stick-slip anchors), flown with the state.
+    let mut anchors = tailsitter_physics::ContactAnchors::FREE;
+    anchors.update(&plant.ground, &plant.airframe, &x);
     let mut held: Option<flight_mission::ControllerOutput> = None;
     let mut previous_command: Option<Command> = None;
     let mut source = match WindSource::new(scenario, plant, &x0) {
@@ -658,7 +661,7 @@ pub fn fly_with<C: FlightController, S: StateSource>(
             trace.failure = Some(e);
             break;
         }
-        if let Err(e) = plant.advance(&mut x, &plant_inputs(&flown), &wind, h) {
+        if let Err(e) = plant.advance_in_contact(&mut x, &mut anchors, &plant_inputs(&flown), &wind, h) {
             trace.failure = Some(format!("plant failed after t = {t}: {e}"));
             break;
         }
