@@ -56,7 +56,8 @@ fn a_hop_at_take_off_is_not_the_touchdown() {
             x[idx::POS_N] = n;
             x[idx::POS_E] = e;
             x[idx::POS_D] = d;
-            x.fixed_rows_mut::<3>(idx::U).copy_from(&(c * Vector3::new(0.0, 0.0, vd)));
+            x.fixed_rows_mut::<3>(idx::U)
+                .copy_from(&(c * Vector3::new(0.0, 0.0, vd)));
             let wind = Vector3::zeros();
             let measurement = flight_mission::measure(&plant, &x, &InputVector::zeros(), &wind);
             Sample {
@@ -82,9 +83,20 @@ fn a_hop_at_take_off_is_not_the_touchdown() {
     };
     let f = evaluate(&plant, Kind::Tsd, Ordering::GaussSeidel, &mission, &trace);
     let landing = path.iter().position(|p| p.4 == Phase::Landed).unwrap() as f64 * H - H;
-    assert!((f.liftoff_time.unwrap() - 50.0 * H).abs() < 1e-9, "{:?}", f.liftoff_time);
-    assert!((f.touchdown_time.unwrap() - landing).abs() < 1e-9, "{:?}", f.touchdown_time);
+    assert!(
+        (f.liftoff_time.unwrap() - 50.0 * H).abs() < 1e-9,
+        "{:?}",
+        f.liftoff_time
+    );
+    assert!(
+        (f.touchdown_time.unwrap() - landing).abs() < 1e-9,
+        "{:?}",
+        f.touchdown_time
+    );
     assert!(f.miss_touchdown < 1e-9 && f.miss_final < MAX_MISS_DISTANCE, "{f:?}");
     assert!((f.touchdown_speed - 0.3).abs() < 1e-9, "{}", f.touchdown_speed);
-    assert!(f.touchdown_speed < MAX_TOUCHDOWN_SPEED && !f.bounced && f.passed, "{f:?}");
+    assert!(
+        f.touchdown_speed < MAX_TOUCHDOWN_SPEED && !f.bounced && f.passed,
+        "{f:?}"
+    );
 }
