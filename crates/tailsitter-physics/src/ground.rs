@@ -41,9 +41,15 @@
 //!   spring's deflection turned along F_e and shortened to at most μ_k N / k. The spring's
 //!   energy k|p_t − a|²/2 never grows at an update, so the updates dissipate.
 //!
-//! Static μ_s ≥ kinetic μ_k (validated); defaults μ_s = 0.8, μ_k = 0.5: rubber-tipped gear
-//! on dry concrete or asphalt (static 0.6–1.0, kinetic about 0.5–0.8 for rubber; see e.g.
-//! B.N.J. Persson, *Sliding Friction*, Springer, 2000, ch. 1 and 12).
+//! Static μ_s ≥ kinetic μ_k (validated); defaults μ_s = μ_k = 0.5 (Coulomb's law with
+//! stiction at the sliding level). A higher μ_s is physical for rubber feet on dry concrete
+//! (0.6–1.0) but trips this airframe: standing on its gear, it tips over a gear point once
+//! the horizontal reaction exceeds N b/h, b the gear's half-spread across the load and h the
+//! CG's height above the ground — b/h = 0.25/0.45 = 0.56 over the fin points, 0.4/0.45 =
+//! 0.89 over the wing-root points. With μ_s = 0.8 a touchdown at 0.5–0.75 m/s over the
+//! ground (the tuned TSD's landings in 8 m/s from behind) sticks and trips over the fin
+//! points; with μ_s ≤ 0.56 the gear slides first. Belly-on in 10 m/s the wind's 42 N is
+//! 95 % of μ m g = 44 N: held.
 //!
 //! **Stiffness vs the integration step.** Defaults k = 2500 N/m, c = 100 N s/m per point:
 //! standing on the four gear points the heave mode has ω = √(4k/m) = 33 rad/s, ζ ≈ 0.67,

@@ -47,27 +47,35 @@ fn fly(p: &Plant, x: &mut StateVector, a: &mut ContactAnchors, wind: &Vector3<f6
     }
 }
 
-/// 11 m/s on the belly (from the north at heading 0) loads the gear with about 50 N: more
-/// than kinetic friction μ_k m g = 44 N (the regularised law crept at about 0.1 m/s under
-/// less), less than μ_s m g = 71 N. After the gear's elastic deflection and the lean have
-/// settled (5 s), the aircraft does not move by 1 mm in 10 s; along the span likewise.
+/// Stands in `wind` for 5 s (the gear's elastic deflection and the lean settle), then 10 s:
+/// the drift over the 10 s (m), where it stood after 5 s, and the anchors at the end.
+fn stand(p: &Plant, wind: &Vector3<f64>) -> (f64, Vector3<f64>, ContactAnchors, StateVector) {
+    let (mut x, mut a) = at_rest(p);
+    fly(p, &mut x, &mut a, wind, 0.02, 5.0);
+    let settled = horizontal(&x);
+    fly(p, &mut x, &mut a, wind, 0.02, 10.0);
+    ((horizontal(&x) - settled).norm(), settled, a, x)
+}
+
+/// The default gear (μ_s = μ_k = 0.5) in 10 m/s on the belly (from the north at heading 0,
+/// about 42 N, 95 % of μ m g; the regularised law crept at 0.1 m/s under this load) and
+/// along the span, and a gear with μ_s = 0.8 in 11 m/s on the belly (about 50 N: more than
+/// kinetic friction μ_k m g = 44 N, less than μ_s m g = 71 N). After 5 s the aircraft does
+/// not move by 1 mm in 10 s, every touching point stuck.
 #[test]
 fn a_load_below_static_friction_holds_without_creeping() {
-    let p = plant();
-    let weight = p.airframe.mass * p.airframe.gravity;
-    for wind in [Vector3::new(-11.0, 0.0, 0.0), Vector3::new(0.0, -11.0, 0.0)] {
-        let (mut x, mut a) = at_rest(&p);
-        let f = wind_force(&p, &x, &wind);
-        if wind.x != 0.0 {
-            assert!(
-                f > p.ground.friction * weight && f < 0.8 * p.ground.static_friction * weight,
-                "{f} N"
-            );
-        }
-        fly(&p, &mut x, &mut a, &wind, 0.02, 5.0);
-        let settled = horizontal(&x);
-        fly(&p, &mut x, &mut a, &wind, 0.02, 10.0);
-        let drift = (horizontal(&x) - settled).norm();
+    let default = plant();
+    let mut grippy = plant();
+    grippy.ground.static_friction = 0.8;
+    let weight = default.airframe.mass * default.airframe.gravity;
+    for (p, wind, lower, upper) in [
+        (&default, Vector3::new(-10.0, 0.0, 0.0), 0.9, 1.0),
+        (&default, Vector3::new(0.0, -10.0, 0.0), 0.0, 1.0),
+        (&grippy, Vector3::new(-11.0, 0.0, 0.0), 1.0, 0.8 * 0.8 / 0.5),
+    ] {
+        let f = wind_force(p, &p.resting_on_ground(0.0, 0.0, 0.0), &wind) / (p.ground.friction * weight);
+        assert!(f > lower && f < upper, "wind {wind:?}: {f} μ_k m g");
+        let (drift, settled, a, x) = stand(p, &wind);
         assert!(drift < 1e-3, "wind {wind:?}: drift {drift} m over 10 s");
         // The elastic deflection and the lean: centimetres, not a slide.
         assert!(settled.norm() < 0.05, "{settled:?}");
@@ -184,7 +192,7 @@ fn contact_transitions_dissipate_and_stay_finite() {
     }
 }
 
-/// The same stand in wind and the same slide with communication steps 5, 20 and 40 ms and a
+/// The same stand in wind (11 m/s, μ_s = 0.8) and the same slide with communication steps 5, 20 and 40 ms and a
 /// finer integration step (2.5 ms): the standing position agrees to 0.1 mm, the slide's
 /// stopping point to 1 %.
 #[test]
@@ -196,6 +204,7 @@ fn the_contact_does_not_depend_on_the_step() {
         if let Some(s) = step {
             p.integration_step = s;
         }
+        p.ground.static_friction = 0.8;
         let (mut x, mut a) = at_rest(&p);
         fly(&p, &mut x, &mut a, &Vector3::new(-11.0, 0.0, 0.0), h, 8.0);
         stand.push(horizontal(&x));
@@ -213,8 +222,8 @@ fn the_contact_does_not_depend_on_the_step() {
     }
 }
 
-/// Standing stuck on the gear costs about what flight costs: at most 30 right-hand sides per
-/// 20 ms in still air and in 5 and 10 m/s (measured 19, 20 and 27; airborne 19).
+/// Standing stuck on the gear costs about what flight costs: at most 40 right-hand sides per
+/// 20 ms in still air and in 5 and 10 m/s (measured 19, 20 and 31; airborne 19).
 #[test]
 fn standing_stuck_costs_what_flight_costs() {
     let p = plant();
@@ -233,6 +242,6 @@ fn standing_stuck_costs_what_flight_costs() {
             .unwrap();
         }
         let per_step = evals as f64 / 500.0;
-        assert!(per_step <= 30.0, "wind {w} m/s: {per_step} right-hand sides per 20 ms");
+        assert!(per_step <= 40.0, "wind {w} m/s: {per_step} right-hand sides per 20 ms");
     }
 }
