@@ -608,7 +608,9 @@ pub fn fly_with<C: FlightController, S: StateSource>(
                 break;
             }
         };
-        let measurement = measure(plant, &x, &u_now, &measured_wind);
+        // The plant's outputs with the gear's anchors (its specific force on the ground).
+        let measurement =
+            flight_mission::measurement(&x, &plant.outputs_in_contact(&x, &anchors, &u_now, &measured_wind));
         let measured = match state_source.measure(t, h, plant, &x, &u_now, &measured_wind, &measurement) {
             Ok(m) => m,
             Err(e) => {
