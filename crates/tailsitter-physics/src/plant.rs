@@ -649,6 +649,7 @@ impl Plant {
     /// One step of `dt` from `s` (where f = `k1`) with the fifth-order solution of [`dp5`]
     /// (the commands and the wind are held, so the stage times do not enter). Returns
     /// dt Σᵢ₌₁⁶ (bᵢ − b̂ᵢ) kᵢ: the embedded error estimate without its seventh stage.
+    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn dp5_step(
         &self,
