@@ -41,7 +41,9 @@ fn the_anchors_are_part_of_the_fmu_state() {
     assert_eq!(fly(&mut m2, &mut v2, 50..200, &mut log), reference);
     // The anchors are the last 7 × (2 f64 + 1 byte): any cut into them is refused.
     for n in bytes.len() - 7 * 17..bytes.len() {
-        assert!(PlantModel::new(&v2).read_state(&mut StateReader::new(&bytes[..n])).is_err());
+        assert!(PlantModel::new(&v2)
+            .read_state(&mut StateReader::new(&bytes[..n]))
+            .is_err());
     }
     // An unknown grip code is refused.
     let mut bad = bytes.clone();
