@@ -6,7 +6,8 @@
 
 use fmi2_export::{FmuModel, Logger, ModelError, StateError, StateReader, StateWriter};
 use tailsitter_physics::{
-    quat_from_euler_321, AeroModel, ContactState, GlobalAero, Ground, Plant, StateVector, Trim, N_STATES,
+    quat_from_euler_321, AeroModel, ContactAnchors, ContactState, GlobalAero, Grip, Ground, Plant, StateVector, Trim,
+    N_STATES,
 };
 
 /// Generated from the declaration: `Variables`, `vr`, `GUID`, `MODEL_IDENTIFIER`, `MODEL_DESCRIPTION_XML`.
@@ -32,11 +33,13 @@ struct Events {
     touchdown_speed: f64,
 }
 
-/// One plant instance: the physics with its parameters, and the 20-element state.
+/// One plant instance: the physics with its parameters, the 20-element state and the ground
+/// contact's anchors (its friction memory, serialised with the FMU state).
 #[derive(Debug, Clone)]
 pub struct PlantModel {
     plant: Plant,
     x: StateVector,
+    anchors: ContactAnchors,
     /// The parameters in `Variables` changed under `plant` (FMU state restored): rebuild before use.
     stale: bool,
     /// Regime and ground-contact events (issue 13).
@@ -85,6 +88,7 @@ impl PlantModel {
             stiffness: vars.ground_stiffness,
             damping: vars.ground_damping,
             friction: vars.ground_friction,
+            static_friction: vars.ground_static_friction,
         };
         ground
             .validate()
@@ -151,9 +155,9 @@ impl PlantModel {
     /// side and no events. One force evaluation serves both
     /// ([`Plant::outputs_and_derivatives`]).
     fn write_outputs(&self, vars: &mut Variables) {
-        let (y, dx) = self
-            .plant
-            .outputs_and_derivatives(&self.x, &Self::inputs(vars), &vars.wind());
+        let (y, dx) =
+            self.plant
+                .outputs_and_derivatives_in_contact(&self.x, &self.anchors, &Self::inputs(vars), &vars.wind());
         vars.set_measurement(&flight_mission::measurement(&self.x, &y));
         vars.set_outputs(&y);
         vars.stall_fraction = y.stall_fraction;
@@ -260,6 +264,7 @@ impl FmuModel for PlantModel {
         Self {
             plant: Plant::new(vars.airframe()),
             x: StateVector::zeros(),
+            anchors: ContactAnchors::FREE,
             stale: true,
             events: Events::default(),
         }
@@ -283,6 +288,10 @@ impl FmuModel for PlantModel {
         vars.trim_thrust = trim.inputs[tailsitter_physics::idx::THRUST_CMD];
         vars.trim_elevator = trim.inputs[tailsitter_physics::idx::ELEVATOR_CMD];
         vars.trim_alpha = trim.alpha;
+        // Points touching at the start are anchored where they stand (no preload).
+        let mut anchors = ContactAnchors::FREE;
+        anchors.update(&plant.ground, &plant.airframe, &x);
+        self.anchors = anchors;
         self.plant = plant;
         self.x = x;
         self.stale = false;
@@ -306,12 +315,14 @@ impl FmuModel for PlantModel {
         let u = Self::inputs(vars);
         let wind = vars.wind();
         let x_before = self.x;
-        self.plant.advance(&mut self.x, &u, &wind, h).map_err(|e| {
-            ModelError::new(format!(
-                "plant left its envelope in the step from t = {t} s to {} s: {e}",
-                t + h
-            ))
-        })?;
+        self.plant
+            .advance_in_contact(&mut self.x, &mut self.anchors, &u, &wind, h)
+            .map_err(|e| {
+                ModelError::new(format!(
+                    "plant left its envelope in the step from t = {t} s to {} s: {e}",
+                    t + h
+                ))
+            })?;
         self.report_events(vars, &x_before, t + h, log);
         Ok(())
     }
@@ -337,6 +348,11 @@ impl FmuModel for PlantModel {
         w.f64(f64::from(u8::from(self.events.left_attached)));
         w.f64(f64::from(self.events.contact_points));
         w.f64(self.events.touchdown_speed);
+        for a in &self.anchors.points {
+            w.f64(a.n);
+            w.f64(a.e);
+            w.u8(a.grip.index());
+        }
     }
 
     fn read_state(&mut self, r: &mut StateReader<'_>) -> Result<(), StateError> {
@@ -348,6 +364,15 @@ impl FmuModel for PlantModel {
         let left_attached = r.f64()? != 0.0;
         let contact_points = r.f64()?;
         let touchdown_speed = r.f64()?;
+        let mut anchors = ContactAnchors::FREE;
+        for a in anchors.points.iter_mut() {
+            a.n = r.f64()?;
+            a.e = r.f64()?;
+            let grip = r.u8()?;
+            a.grip = Grip::from_index(grip)
+                .ok_or_else(|| StateError::invalid(format!("ground contact grip {grip}: expected 0, 1 or 2")))?;
+        }
+        self.anchors = anchors;
         self.events = Events {
             left_attached,
             contact_points: contact_points.clamp(0.0, 7.0) as u32,

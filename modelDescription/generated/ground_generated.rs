@@ -12,6 +12,7 @@ impl Default for Ground {
             stiffness: 2500.0,
             damping: 100.0,
             friction: 0.5,
+            static_friction: 0.5,
         }
     }
 }

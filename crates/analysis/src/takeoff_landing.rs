@@ -101,7 +101,7 @@ pub struct Flight {
     pub liftoff_time: Option<f64>,
     /// Largest tilt on the gear before lift-off (deg).
     pub ground_tilt_deg: f64,
-    /// Touchdown: first contact after the flight (s).
+    /// Touchdown: first contact once the flight was under way ([`flying`]) (s).
     pub touchdown_time: Option<f64>,
     /// Phase-10 (landed, thrust cut) latched at (s).
     pub landed_time: Option<f64>,
@@ -235,6 +235,19 @@ fn fly_until_landed(plant: &Plant, x0: StateVector, controller: &mut AnyControll
     trace
 }
 
+/// Height of the lowest contact point above the ground (m) from which the aircraft counts as
+/// flying: a hop on the gear at take-off (lift-off, contact again below it) is not the
+/// landing's touchdown.
+pub const FLYING_CLEARANCE: f64 = 2.0;
+
+/// Whether a sample after the lift-off shows the flight under way, so that the next ground
+/// contact is the landing's touchdown: the gear at least [`FLYING_CLEARANCE`] clear of the
+/// ground, or the controller already in the landing (approach, descent, flare, landed).
+pub fn flying(phase: Phase, contact: &tailsitter_physics::ContactState) -> bool {
+    contact.clearance >= FLYING_CLEARANCE
+        || matches!(phase, Phase::Approach | Phase::Descent | Phase::Flare | Phase::Landed)
+}
+
 /// The figures of a flown trace.
 pub fn evaluate(plant: &Plant, kind: Kind, ordering: Ordering, mission: &MissionParams, trace: &Trace) -> Flight {
     let origin = trace
@@ -255,6 +268,9 @@ pub fn evaluate(plant: &Plant, kind: Kind, ordering: Ordering, mission: &Mission
     let mut liftoff = None;
     let mut touchdown: Option<usize> = None;
     let mut ground_tilt: f64 = 0.0;
+    // A contact counts as the touchdown only once the flight is under way ([`flying`]): a
+    // hop on the gear at take-off is not the landing.
+    let mut under_way = false;
     for (k, s) in trace.samples.iter().enumerate() {
         let c = contact(s);
         if liftoff.is_none() {
@@ -263,9 +279,13 @@ pub fn evaluate(plant: &Plant, kind: Kind, ordering: Ordering, mission: &Mission
             } else {
                 ground_tilt = ground_tilt.max(tilt(&s.x));
             }
-        } else if c.points > 0 {
-            touchdown = Some(k);
-            break;
+        }
+        if liftoff.is_some() {
+            under_way |= flying(s.diagnostics.phase, &c);
+            if under_way && c.points > 0 {
+                touchdown = Some(k);
+                break;
+            }
         }
     }
     let end = trace.samples.last();

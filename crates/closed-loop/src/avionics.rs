@@ -129,6 +129,22 @@ pub fn truth(plant: &Plant, x: &StateVector, u: &InputVector, wind: &Vector3<f64
     }
 }
 
+/// [`truth`] with the specific force of the closed loop's `measured` outputs: on the ground
+/// the gear's friction depends on its anchors (`tailsitter_physics::ContactAnchors`), which
+/// the closed loop carries and [`Plant::outputs`] does not.
+fn truth_on_gear(
+    plant: &Plant,
+    x: &StateVector,
+    u: &InputVector,
+    wind: &Vector3<f64>,
+    measured: &Measurement,
+) -> sensor_model::Truth {
+    sensor_model::Truth {
+        specific_force: measured.specific_force_body,
+        ..truth(plant, x, u, wind)
+    }
+}
+
 /// The sensors' outputs as the estimator's inputs (the FMU connections by name).
 pub fn to_estimator(m: &sensor_model::Measurements) -> Measurements {
     Measurements {
@@ -194,11 +210,11 @@ impl StateSource for AvionicsSource {
         x: &StateVector,
         u: &InputVector,
         wind: &Vector3<f64>,
-        _truth: &Measurement,
+        truth_measured: &Measurement,
     ) -> Result<Measurement, String> {
         let fresh = self
             .sensors
-            .step(&truth(plant, x, u, wind), t, h)
+            .step(&truth_on_gear(plant, x, u, wind, truth_measured), t, h)
             .map_err(|e| format!("sensors failed at t = {t}: {e}"))?;
         let fresh = to_estimator(&fresh);
         self.pending = if self.jacobi {

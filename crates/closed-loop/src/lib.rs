@@ -584,6 +584,9 @@ pub fn fly_with<C: FlightController, S: StateSource>(
     };
     let mut clock = flight_mission::SampleClock::new(scenario.mission.sample_time, 0.0);
     let mut x = x0;
+    // The gear's friction memory (stick-slip anchors), flown with the state.
+    let mut anchors = tailsitter_physics::ContactAnchors::FREE;
+    anchors.update(&plant.ground, &plant.airframe, &x);
     let mut held: Option<flight_mission::ControllerOutput> = None;
     let mut previous_command: Option<Command> = None;
     let mut source = match WindSource::new(scenario, plant, &x0) {
@@ -605,7 +608,9 @@ pub fn fly_with<C: FlightController, S: StateSource>(
                 break;
             }
         };
-        let measurement = measure(plant, &x, &u_now, &measured_wind);
+        // The plant's outputs with the gear's anchors (its specific force on the ground).
+        let measurement =
+            flight_mission::measurement(&x, &plant.outputs_in_contact(&x, &anchors, &u_now, &measured_wind));
         let measured = match state_source.measure(t, h, plant, &x, &u_now, &measured_wind, &measurement) {
             Ok(m) => m,
             Err(e) => {
@@ -658,7 +663,7 @@ pub fn fly_with<C: FlightController, S: StateSource>(
             trace.failure = Some(e);
             break;
         }
-        if let Err(e) = plant.advance(&mut x, &plant_inputs(&flown), &wind, h) {
+        if let Err(e) = plant.advance_in_contact(&mut x, &mut anchors, &plant_inputs(&flown), &wind, h) {
             trace.failure = Some(format!("plant failed after t = {t}: {e}"));
             break;
         }

@@ -9,29 +9,58 @@
 //! `(−gear_length, ±gear_half_span, 0)` and `(−gear_length, 0, ±gear_half_height)`
 //! (wing-root gear and fins), one at the nose `(nose_length, 0, 0)` and the two wing tips
 //! `(0, ±b/2, 0)`, so that any attitude touches the ground with a point, not with the CG.
-//! For a point r at depth δ = (P + (DCM^BE)ᵀ r)_d − height > 0 with earth velocity
-//! v_P = (DCM^BE)ᵀ (v + ω × r):
+//! For a point r at depth δ = (P + (DCM^BE)ᵀ r)_d − height > 0 with earth position p and
+//! velocity v_P = (DCM^BE)ᵀ (v + ω × r):
 //!
 //! ```text
 //! N   = max(0, k δ + c v_P,d)                       normal force (never pulls)
-//! F_t = −μ N v_t / √(|v_t|² + v_ε²)                 friction, v_t horizontal part of v_P
+//! F_e = −k (p_t − a) − c v_t                        tangential spring-damper to the anchor a
+//! F_t = F_e min(1, μ N / |F_e|)                     capped: μ = μ_s stuck, μ_k slipping
 //! F   = (F_t,n, F_t,e, −N) (earth)                  moment r × DCM^BE F about the CG
 //! ```
 //!
-//! Friction is regularised with v_ε = [`FRICTION_V_EPS`] = 0.05 m/s (smooth, no
-//! stick-slip state): at rest with no tangential load it is exactly zero; a steady tangential
-//! load F creeps at ≈ v_ε F/(μN).
+//! with p_t, v_t the horizontal parts of p and v_P. **Stick-slip friction** is the
+//! elasto-plastic (bristle) contact: each touching point is tied to an anchor a on the ground
+//! by a tangential spring-damper with the normal gains (k, c) — the "reset integrator"
+//! friction model of D.A. Haessig and B. Friedland, *On the modeling and simulation of
+//! friction*, J. Dyn. Sys. Meas. Control 113(3), 354–362, 1991, a stiff-bristle form of
+//! Dahl's model (P.R. Dahl, *A solid friction model*, Aerospace Corp. TOR-0158(3107-18)-1,
+//! 1968; P. Dupont et al., *Single state elastoplastic friction models*, IEEE Trans. Autom.
+//! Control 47(5), 787–792, 2002). Below μ_s N a point sticks: a steady tangential load F
+//! deflects the gear elastically by F/k and then holds (no creep); above it the point slips
+//! with kinetic friction μ_k N. The anchors are the contact's memory ([`ContactAnchors`]):
+//! held over each integration (sub)step, so the right-hand side stays a smooth function of
+//! the state inside a step, and updated after every accepted (sub)step
+//! ([`ContactAnchors::update`]):
+//!
+//! * a point that leaves the ground is freed ([`Grip::Free`]); a free point touching
+//!   has no spring yet (F_e = −c v_t, capped at μ_k N);
+//! * a free or slipping point whose force is under μ_k N sticks ([`Grip::Stuck`]), a free
+//!   one anchored where it touches; a stuck one stays stuck while |F_e| ≤ μ_s N;
+//! * otherwise the point slips ([`Grip::Slipping`]): the anchor is dragged behind it, the
+//!   spring's deflection turned along F_e and shortened to at most μ_k N / k. The spring's
+//!   energy k|p_t − a|²/2 never grows at an update, so the updates dissipate.
+//!
+//! Static μ_s ≥ kinetic μ_k (validated); defaults μ_s = μ_k = 0.5 (Coulomb's law with
+//! stiction at the sliding level). A higher μ_s is physical for rubber feet on dry concrete
+//! (0.6–1.0) but trips this airframe: standing on its gear, it tips over a gear point once
+//! the horizontal reaction exceeds N b/h, b the gear's half-spread across the load and h the
+//! CG's height above the ground — b/h = 0.25/0.45 = 0.56 over the fin points, 0.4/0.45 =
+//! 0.89 over the wing-root points. With μ_s = 0.8 a touchdown at 0.5–0.75 m/s over the
+//! ground (the tuned TSD's landings in 8 m/s from behind) sticks and trips over the fin
+//! points; with μ_s ≤ 0.56 the gear slides first. Belly-on in 10 m/s the wind's 42 N is
+//! 95 % of μ m g = 44 N: held.
 //!
 //! **Stiffness vs the integration step.** Defaults k = 2500 N/m, c = 100 N s/m per point:
 //! standing on the four gear points the heave mode has ω = √(4k/m) = 33 rad/s, ζ ≈ 0.67,
 //! static compression mg/(4k) = 8.8 mm; rocking about the gear ≈ 26 rad/s; the stiffest
-//! friction mode (the regularised friction acts like a damper μN/v_ε per point, through the
-//! lever `gear_length` on I_yy) has |λ| ≈ 4μNl²/(v_ε I_yy) ≈ 400 s⁻¹. At the default 20/3 ms
-//! step that is |λ|h ≈ 2.7, inside the Dormand–Prince method's real-axis stability limit 3.31
-//! (R(z) = Σ₀⁵ zᵏ/k! + z⁶/600) but not accurate: there the step's error estimate exceeds
-//! its tolerance and the step is taken in halves (|λ|h ≤ 1.3 or less), as it is at touchdown,
-//! where the normal force switches on (a dropped aircraft costs ≈ 56 instead of ≈ 20
-//! right-hand sides per 20 ms while it settles).
+//! friction modes are the tangential springs (the same k and c per point: ω = √(4k/m) =
+//! 33 rad/s sideways, the rocking about the gear with the spring at the lever `gear_length`
+//! similar) and the tangential damper c through the lever on I_yy (|λ| ≈ 4 c l²/I_yy). At the
+//! default 20/3 ms step |λ|h stays well inside the Dormand–Prince method's real-axis stability
+//! limit 3.31 (R(z) = Σ₀⁵ zᵏ/k! + z⁶/600); where a contact point touches, a step whose error
+//! estimate exceeds its tolerance is taken in halves, as at touchdown, where the normal
+//! force switches on.
 //!
 //! **Default height.** `height` = 10 m: the default experiment starts in a 3 m/s vertical
 //! climb at the origin, i.e. 10 m above the ground after an (unsimulated) take-off; the
@@ -47,8 +76,6 @@ use crate::idx::*;
 use crate::plant::Plant;
 use crate::StateVector;
 
-/// Regularisation speed of the friction law (m/s).
-pub const FRICTION_V_EPS: f64 = 0.05;
 /// Touchdown speed above which the FMU logs a hard touchdown (m/s).
 pub const HARD_TOUCHDOWN_SPEED: f64 = 1.0;
 /// Number of contact points.
@@ -72,8 +99,156 @@ pub struct Ground {
     pub stiffness: f64,
     /// Damping per contact point (N s/m).
     pub damping: f64,
-    /// Coulomb friction coefficient μ.
+    /// Kinetic (sliding) friction coefficient μ_k.
     pub friction: f64,
+    /// Static friction coefficient μ_s ≥ μ_k: a stuck point holds up to μ_s N.
+    pub static_friction: f64,
+}
+
+/// The friction state of one contact point (module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Grip {
+    /// Not touching, or touching since the last update (no anchor yet).
+    #[default]
+    Free,
+    /// Held by its anchor up to μ_s N.
+    Stuck,
+    /// Sliding with kinetic friction μ_k N; the anchor is dragged behind.
+    Slipping,
+}
+
+impl Grip {
+    /// 0 free, 1 stuck, 2 slipping (the FMU state's encoding).
+    pub fn index(self) -> u8 {
+        match self {
+            Grip::Free => 0,
+            Grip::Stuck => 1,
+            Grip::Slipping => 2,
+        }
+    }
+
+    /// Inverse of [`Grip::index`].
+    pub fn from_index(i: u8) -> Option<Self> {
+        match i {
+            0 => Some(Grip::Free),
+            1 => Some(Grip::Stuck),
+            2 => Some(Grip::Slipping),
+            _ => None,
+        }
+    }
+}
+
+/// Anchor of one contact point: where its tangential spring is tied to the ground.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Anchor {
+    /// Earth north position of the anchor (m) (unused while free).
+    pub n: f64,
+    /// Earth east position of the anchor (m).
+    pub e: f64,
+    /// Friction state.
+    pub grip: Grip,
+}
+
+/// The ground contact's memory: one [`Anchor`] per contact point, in the order of
+/// [`Ground::points`]. Part of the plant's state besides the [`StateVector`] (the FMU
+/// serialises it with the FMU state); [`ContactAnchors::default`] has every point free.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ContactAnchors {
+    /// Anchors by contact point.
+    pub points: [Anchor; N_CONTACT_POINTS],
+}
+
+impl ContactAnchors {
+    /// Every point free (what an airborne state has).
+    pub const FREE: Self = Self {
+        points: [Anchor {
+            n: 0.0,
+            e: 0.0,
+            grip: Grip::Free,
+        }; N_CONTACT_POINTS],
+    };
+
+    /// Whether every point is free.
+    #[inline]
+    pub fn all_free(&self) -> bool {
+        self.points.iter().all(|p| p.grip == Grip::Free)
+    }
+
+    /// Stored tangential spring energy Σ k |p_t − a|²/2 of the anchored points at `x` (J).
+    pub fn spring_energy(&self, g: &Ground, a: &Airframe, x: &StateVector) -> f64 {
+        let c = dcm_earth_to_body(&Vector4::new(x[Q1], x[Q2], x[Q3], x[Q4]));
+        let pos = Vector3::new(x[POS_N], x[POS_E], x[POS_D]);
+        let mut e = 0.0;
+        for (anchor, r) in self.points.iter().zip(g.points(a)) {
+            if anchor.grip != Grip::Free {
+                let p = pos + c.tr_mul(&r);
+                e += 0.5 * g.stiffness * ((p.x - anchor.n).powi(2) + (p.y - anchor.e).powi(2));
+            }
+        }
+        e
+    }
+
+    /// Update the anchors after an accepted (sub)step ending at `x` (module docs): free the
+    /// points off the ground, stick or slip the touching ones. Returns whether anything
+    /// changed (the right-hand side at `x` then changed too). Does not allocate.
+    #[inline]
+    pub fn update(&mut self, g: &Ground, a: &Airframe, x: &StateVector) -> bool {
+        if g.clearly_airborne(a, x) || x[POS_D].is_nan() {
+            if self.all_free() {
+                return false;
+            }
+            *self = Self::FREE;
+            return true;
+        }
+        self.update_near(g, a, x)
+    }
+
+    /// [`ContactAnchors::update`] near the ground.
+    #[inline(never)]
+    fn update_near(&mut self, g: &Ground, a: &Airframe, x: &StateVector) -> bool {
+        let c = dcm_earth_to_body(&Vector4::new(x[Q1], x[Q2], x[Q3], x[Q4]));
+        let pos = Vector3::new(x[POS_N], x[POS_E], x[POS_D]);
+        let v = Vector3::new(x[U], x[V], x[W]);
+        let omega = Vector3::new(x[P], x[Q], x[R]);
+        let mut changed = false;
+        for (anchor, r) in self.points.iter_mut().zip(g.points(a)) {
+            let p = pos + c.tr_mul(&r);
+            let depth = p.z - g.height;
+            let vp = c.tr_mul(&(v + omega.cross(&r)));
+            let n = g.stiffness * depth + g.damping * vp.z;
+            let old = *anchor;
+            if !(depth > 0.0 && n > 0.0) {
+                anchor.grip = Grip::Free;
+            } else {
+                let (fx, fy) = g.spring_damper(anchor, &p, &vp);
+                let f = (fx * fx + fy * fy).sqrt();
+                match anchor.grip {
+                    Grip::Stuck if f <= g.static_friction * n => {}
+                    Grip::Free | Grip::Slipping if f <= g.friction * n => {
+                        if anchor.grip == Grip::Free {
+                            anchor.n = p.x;
+                            anchor.e = p.y;
+                        }
+                        anchor.grip = Grip::Stuck;
+                    }
+                    _ => {
+                        // Slip: the deflection d = p_t − a turned against F_e (F_e = −k d
+                        // then points along F_e) and shortened to at most μ_k N / k.
+                        let (dn, de) = match anchor.grip {
+                            Grip::Free => (0.0, 0.0),
+                            _ => (p.x - anchor.n, p.y - anchor.e),
+                        };
+                        let d = (dn * dn + de * de).sqrt().min(g.friction * n / g.stiffness);
+                        anchor.n = p.x + d * fx / f;
+                        anchor.e = p.y + d * fy / f;
+                        anchor.grip = Grip::Slipping;
+                    }
+                }
+            }
+            changed |= *anchor != old;
+        }
+        changed
+    }
 }
 
 // `impl Default for Ground`: the start values of group `ground` of
@@ -118,6 +293,13 @@ impl Ground {
             if !(value.is_finite() && value >= 0.0) {
                 return bad(name, value, "finite and >= 0");
             }
+        }
+        if !(self.static_friction.is_finite() && self.static_friction >= self.friction) {
+            return bad(
+                "ground_static_friction",
+                self.static_friction,
+                "finite and >= ground_friction (static >= kinetic)",
+            );
         }
         if !(self.stiffness.is_finite() && self.stiffness > 0.0) {
             return bad("ground_stiffness", self.stiffness, "finite and > 0");
@@ -165,22 +347,49 @@ impl Ground {
         x[POS_D] + self.bound(a) * (1.0 + 1e-12) < self.height
     }
 
-    /// Contact force and moment about the CG in body axes (N, N m) at a state, given its
-    /// DCM^BE `c` (module docs). Zero without contact; does not allocate.
+    /// The tangential spring-damper force F_e = −k (p_t − a) − c v_t (earth n, e) of a
+    /// touching point at `p` moving at `vp`, before the friction cap (no spring while free).
     #[inline(always)]
-    pub fn contact(&self, a: &Airframe, x: &StateVector, c: &Matrix3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+    fn spring_damper(&self, anchor: &Anchor, p: &Vector3<f64>, vp: &Vector3<f64>) -> (f64, f64) {
+        let (dn, de) = match anchor.grip {
+            Grip::Free => (0.0, 0.0),
+            _ => (p.x - anchor.n, p.y - anchor.e),
+        };
+        (
+            -self.stiffness * dn - self.damping * vp.x,
+            -self.stiffness * de - self.damping * vp.y,
+        )
+    }
+
+    /// Contact force and moment about the CG in body axes (N, N m) at a state, given its
+    /// DCM^BE `c` and the contact points' anchors (module docs). Zero without contact; does
+    /// not allocate.
+    #[inline(always)]
+    pub fn contact(
+        &self,
+        a: &Airframe,
+        x: &StateVector,
+        c: &Matrix3<f64>,
+        anchors: &ContactAnchors,
+    ) -> (Vector3<f64>, Vector3<f64>) {
         // Cheap test first (no square root): gear_length + max(half span, half height) bounds
         // the gear's reach, so this returns only where the exact test below returns too.
         // Inlined into the caller (no result through memory on the hot, airborne path).
         if x[POS_D] + self.bound(a) <= self.height || x[POS_D].is_nan() {
             return (Vector3::zeros(), Vector3::zeros());
         }
-        self.contact_near(a, x, c)
+        self.contact_near(a, x, c, anchors)
     }
 
     /// [`Ground::contact`] once the cheap bound no longer rules contact out.
     #[inline(never)]
-    fn contact_near(&self, a: &Airframe, x: &StateVector, c: &Matrix3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+    fn contact_near(
+        &self,
+        a: &Airframe,
+        x: &StateVector,
+        c: &Matrix3<f64>,
+        anchors: &ContactAnchors,
+    ) -> (Vector3<f64>, Vector3<f64>) {
         let mut force = Vector3::zeros();
         let mut moment = Vector3::zeros();
         if x[POS_D] + self.reach(a) <= self.height {
@@ -189,7 +398,7 @@ impl Ground {
         let pos = Vector3::new(x[POS_N], x[POS_E], x[POS_D]);
         let v = Vector3::new(x[U], x[V], x[W]);
         let omega = Vector3::new(x[P], x[Q], x[R]);
-        for r in self.points(a) {
+        for (anchor, r) in anchors.points.iter().zip(self.points(a)) {
             let p = pos + c.tr_mul(&r);
             let depth = p.z - self.height;
             if depth <= 0.0 {
@@ -197,9 +406,14 @@ impl Ground {
             }
             let vp = c.tr_mul(&(v + omega.cross(&r)));
             let n = (self.stiffness * depth + self.damping * vp.z).max(0.0);
-            let vt2 = vp.x * vp.x + vp.y * vp.y;
-            let k = -self.friction * n / (vt2 + FRICTION_V_EPS * FRICTION_V_EPS).sqrt();
-            let f_body = c * Vector3::new(k * vp.x, k * vp.y, -n);
+            let mu = match anchor.grip {
+                Grip::Stuck => self.static_friction,
+                Grip::Free | Grip::Slipping => self.friction,
+            };
+            let (fx, fy) = self.spring_damper(anchor, &p, &vp);
+            let (f2, cap) = (fx * fx + fy * fy, mu * n);
+            let s = if f2 > cap * cap { cap / f2.sqrt() } else { 1.0 };
+            let f_body = c * Vector3::new(s * fx, s * fy, -n);
             force += f_body;
             moment += r.cross(&f_body);
         }

@@ -36,7 +36,7 @@ pub use attitude::{
 };
 pub use error::PhysicsError;
 pub use global_aero::{AeroDiagnostics, AeroModel, AeroRegime, GlobalAero};
-pub use ground::{ContactState, Ground};
+pub use ground::{Anchor, ContactAnchors, ContactState, Grip, Ground};
 pub use plant::{
     dp5, Envelope, Integrator, Outputs, Plant, Trim, DEFAULT_INTEGRATION_STEP, MAX_CHECKED_SUBSTEPS, MAX_SUBSTEPS,
 };

@@ -10,7 +10,7 @@ use crate::airframe::Airframe;
 use crate::attitude::{dcm_earth_to_body, euler_321_from_quat, quat_derivative, quat_from_euler_321};
 use crate::error::PhysicsError;
 use crate::global_aero::{AeroModel, AeroRegime, GlobalAero};
-use crate::ground::{ContactState, Ground};
+use crate::ground::{ContactAnchors, ContactState, Ground};
 use crate::idx::{self, *};
 use crate::{InputVector, StateVector, N_INPUTS, N_STATES};
 
@@ -300,18 +300,40 @@ impl Plant {
     ///
     /// Air-relative velocity = inertial velocity − DCM^BE·wind_ned. Pure: no allocation.
     #[inline]
+    /// On the ground, every touching point counts as free ([`ContactAnchors::FREE`]: kinetic
+    /// friction of the tangential damper, no stiction); [`Plant::derivatives_in_contact`]
+    /// takes the anchors.
     pub fn derivatives(&self, x: &StateVector, u: &InputVector, wind_ned: &Vector3<f64>) -> StateVector {
+        self.derivatives_in_contact(x, &ContactAnchors::FREE, u, wind_ned)
+    }
+
+    /// [`Plant::derivatives`] with the ground contact's anchors.
+    #[inline]
+    pub fn derivatives_in_contact(
+        &self,
+        x: &StateVector,
+        anchors: &ContactAnchors,
+        u: &InputVector,
+        wind_ned: &Vector3<f64>,
+    ) -> StateVector {
         let mut w = f64::NAN;
-        self.derivatives_from(x, u, wind_ned, &mut w)
+        self.derivatives_from(x, u, wind_ned, anchors, &mut w)
     }
 
     /// [`Plant::derivatives`] with the induced velocity warm-started from `*w` (NaN: cold),
     /// which is then set to this evaluation's induced velocity (the start of the next stage).
     #[inline(always)]
-    fn derivatives_from(&self, x: &StateVector, u: &InputVector, wind_ned: &Vector3<f64>, w: &mut f64) -> StateVector {
+    fn derivatives_from(
+        &self,
+        x: &StateVector,
+        u: &InputVector,
+        wind_ned: &Vector3<f64>,
+        anchors: &ContactAnchors,
+        w: &mut f64,
+    ) -> StateVector {
         let (fm, c) = self.eval_from(x, wind_ned, *w);
         *w = fm.induced_velocity;
-        self.assemble(x, u, &fm, &c)
+        self.assemble(x, u, &fm, &c, anchors)
     }
 
     /// The right-hand side of [`Plant::derivatives`] from the forces and moments `fm` and the
@@ -323,6 +345,7 @@ impl Plant {
         u: &InputVector,
         fm: &ForcesMoments,
         c: &nalgebra::Matrix3<f64>,
+        anchors: &ContactAnchors,
     ) -> StateVector {
         let a = &self.airframe;
         let v = Vector3::new(x[U], x[V], x[W]);
@@ -330,7 +353,7 @@ impl Plant {
         let q = Vector4::new(x[Q1], x[Q2], x[Q3], x[Q4]);
 
         let g_body = Vector3::new(c[(0, 2)], c[(1, 2)], c[(2, 2)]) * a.gravity;
-        let (f_ground, m_ground) = self.ground.contact(a, x, c);
+        let (f_ground, m_ground) = self.ground.contact(a, x, c, anchors);
         // Parameter-only reciprocals: hoisted out of the integration loop by the compiler (a
         // multiplication per evaluation instead of a division).
         let vdot = (fm.force_body + f_ground) * (1.0 / a.mass) + g_body - omega.cross(&v);
@@ -392,10 +415,45 @@ impl Plant {
 
     /// [`Plant::advance`] that adds to `evals` the number of right-hand-side evaluations it
     /// made (for measuring the integrator's cost).
+    ///
+    /// Without the ground contact's memory: each call anchors the points touching at its
+    /// start where they are (no tangential preload), so a load held across calls re-deflects
+    /// the gear every call. On the ground, carry [`ContactAnchors`] through
+    /// [`Plant::advance_in_contact`].
     #[inline]
     pub fn advance_counting(
         &self,
         x: &mut StateVector,
+        u: &InputVector,
+        wind_ned: &Vector3<f64>,
+        h: f64,
+        evals: &mut u64,
+    ) -> Result<(), PhysicsError> {
+        let mut anchors = ContactAnchors::FREE;
+        anchors.update(&self.ground, &self.airframe, x);
+        self.advance_counting_in_contact(x, &mut anchors, u, wind_ned, h, evals)
+    }
+
+    /// [`Plant::advance`] with the ground contact's anchors (the contact's memory, module
+    /// [`crate::ground`]), updated after every accepted internal (sub)step. On error both keep
+    /// the last good internal step.
+    pub fn advance_in_contact(
+        &self,
+        x: &mut StateVector,
+        anchors: &mut ContactAnchors,
+        u: &InputVector,
+        wind_ned: &Vector3<f64>,
+        h: f64,
+    ) -> Result<(), PhysicsError> {
+        self.advance_counting_in_contact(x, anchors, u, wind_ned, h, &mut 0)
+    }
+
+    /// [`Plant::advance_in_contact`] counting right-hand-side evaluations into `evals`.
+    #[inline]
+    pub fn advance_counting_in_contact(
+        &self,
+        x: &mut StateVector,
+        contact: &mut ContactAnchors,
         u: &InputVector,
         wind_ned: &Vector3<f64>,
         h: f64,
@@ -449,6 +507,8 @@ impl Plant {
         let n = n as u64;
         let dt = h / n as f64;
         let mut s = *x;
+        let mut local = *contact;
+        let anchors = &mut local;
         // Induced velocity of the previous stage: the next stage's solve starts there.
         let mut w = f64::NAN;
         // f at the start of the step (the previous step's last evaluation), if known.
@@ -457,14 +517,16 @@ impl Plant {
             match self.integrator {
                 Integrator::Rk4 => {
                     *evals += 4;
-                    self.rk4_step(&mut s, u, wind_ned, dt, &mut w);
+                    self.rk4_step(&mut s, u, wind_ned, anchors, dt, &mut w);
                     self.project(&mut s);
+                    anchors.update(&self.ground, &self.airframe, &s);
                 }
                 Integrator::Dp5 => {
                     *evals += 6;
-                    let k1 = self.derivatives_from(&s, u, wind_ned, &mut w);
-                    self.dp5_step(&mut s, &k1, u, wind_ned, dt, &mut w);
+                    let k1 = self.derivatives_from(&s, u, wind_ned, anchors, &mut w);
+                    self.dp5_step(&mut s, &k1, u, wind_ned, anchors, dt, &mut w);
                     self.project(&mut s);
+                    anchors.update(&self.ground, &self.airframe, &s);
                 }
                 Integrator::Dp5Checked {
                     tolerance,
@@ -474,17 +536,28 @@ impl Plant {
                         Some(k) => k,
                         None => {
                             *evals += 1;
-                            self.derivatives_from(&s, u, wind_ned, &mut w)
+                            self.derivatives_from(&s, u, wind_ned, anchors, &mut w)
                         }
                     };
-                    let (y, k_end) =
-                        self.dp5_checked_step(&s, &k1, u, wind_ned, dt, tolerance, max_halvings.min(30), &mut w, evals);
+                    let (y, k_end) = self.dp5_checked_step(
+                        &s,
+                        &k1,
+                        u,
+                        wind_ned,
+                        anchors,
+                        dt,
+                        tolerance,
+                        max_halvings.min(30),
+                        &mut w,
+                        evals,
+                    );
                     s = y;
                     k_start = Some(k_end);
                 }
             }
             self.check(&s, wind_ned)?;
             *x = s;
+            *contact = *anchors;
         }
         Ok(())
     }
@@ -499,6 +572,7 @@ impl Plant {
         k1: &StateVector,
         u: &InputVector,
         wind_ned: &Vector3<f64>,
+        anchors: &mut ContactAnchors,
         dt: f64,
         tolerance: f64,
         max_halvings: u32,
@@ -517,9 +591,9 @@ impl Plant {
         while done < total {
             let h = dt / (1u64 << level) as f64;
             let mut y_new = y;
-            let e = self.dp5_step(&mut y_new, &k, u, wind_ned, h, w);
+            let e = self.dp5_step(&mut y_new, &k, u, wind_ned, anchors, h, w);
             self.project(&mut y_new);
-            let k_new = self.derivatives_from(&y_new, u, wind_ned, w);
+            let k_new = self.derivatives_from(&y_new, u, wind_ned, anchors, w);
             *evals += 6;
             let e = e - k_new * (dp5::B_HAT[6] * h);
             let estimate = e.rows(POS_N, R + 1 - POS_N).amax();
@@ -537,6 +611,11 @@ impl Plant {
             if estimate <= tolerance || level >= deepest || !estimate.is_finite() || substeps >= MAX_CHECKED_SUBSTEPS {
                 y = y_new;
                 k = k_new;
+                if anchors.update(&self.ground, &self.airframe, &y) {
+                    // The contact force at y changed with its anchors.
+                    *evals += 1;
+                    k = self.derivatives_from(&y, u, wind_ned, anchors, w);
+                }
                 done += total >> level;
                 // Back to the coarsest level the grid allows from here.
                 while level > 0 && done % (total >> (level - 1)) == 0 {
@@ -551,17 +630,26 @@ impl Plant {
 
     /// One classical RK4 step of `dt` from `s`.
     #[inline(always)]
-    fn rk4_step(&self, s: &mut StateVector, u: &InputVector, wind_ned: &Vector3<f64>, dt: f64, w: &mut f64) {
-        let k1 = self.derivatives_from(s, u, wind_ned, w);
-        let k2 = self.derivatives_from(&(*s + k1 * (0.5 * dt)), u, wind_ned, w);
-        let k3 = self.derivatives_from(&(*s + k2 * (0.5 * dt)), u, wind_ned, w);
-        let k4 = self.derivatives_from(&(*s + k3 * dt), u, wind_ned, w);
+    fn rk4_step(
+        &self,
+        s: &mut StateVector,
+        u: &InputVector,
+        wind_ned: &Vector3<f64>,
+        anchors: &ContactAnchors,
+        dt: f64,
+        w: &mut f64,
+    ) {
+        let k1 = self.derivatives_from(s, u, wind_ned, anchors, w);
+        let k2 = self.derivatives_from(&(*s + k1 * (0.5 * dt)), u, wind_ned, anchors, w);
+        let k3 = self.derivatives_from(&(*s + k2 * (0.5 * dt)), u, wind_ned, anchors, w);
+        let k4 = self.derivatives_from(&(*s + k3 * dt), u, wind_ned, anchors, w);
         *s += (k1 + (k2 + k3) * 2.0 + k4) * (dt / 6.0);
     }
 
     /// One step of `dt` from `s` (where f = `k1`) with the fifth-order solution of [`dp5`]
     /// (the commands and the wind are held, so the stage times do not enter). Returns
     /// dt Σᵢ₌₁⁶ (bᵢ − b̂ᵢ) kᵢ: the embedded error estimate without its seventh stage.
+    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn dp5_step(
         &self,
@@ -569,29 +657,33 @@ impl Plant {
         k1: &StateVector,
         u: &InputVector,
         wind_ned: &Vector3<f64>,
+        anchors: &ContactAnchors,
         dt: f64,
         w: &mut f64,
     ) -> StateVector {
         use dp5::{A, B, B_HAT};
         let k1 = *k1;
-        let k2 = self.derivatives_from(&(*s + k1 * (A[1][0] * dt)), u, wind_ned, w);
-        let k3 = self.derivatives_from(&(*s + (k1 * A[2][0] + k2 * A[2][1]) * dt), u, wind_ned, w);
+        let k2 = self.derivatives_from(&(*s + k1 * (A[1][0] * dt)), u, wind_ned, anchors, w);
+        let k3 = self.derivatives_from(&(*s + (k1 * A[2][0] + k2 * A[2][1]) * dt), u, wind_ned, anchors, w);
         let k4 = self.derivatives_from(
             &(*s + (k1 * A[3][0] + k2 * A[3][1] + k3 * A[3][2]) * dt),
             u,
             wind_ned,
+            anchors,
             w,
         );
         let k5 = self.derivatives_from(
             &(*s + (k1 * A[4][0] + k2 * A[4][1] + k3 * A[4][2] + k4 * A[4][3]) * dt),
             u,
             wind_ned,
+            anchors,
             w,
         );
         let k6 = self.derivatives_from(
             &(*s + (k1 * A[5][0] + k2 * A[5][1] + k3 * A[5][2] + k4 * A[5][3] + k5 * A[5][4]) * dt),
             u,
             wind_ned,
+            anchors,
             w,
         );
         *s += (k1 * B[0] + k3 * B[2] + k4 * B[3] + k5 * B[4] + k6 * B[5]) * dt;
@@ -689,9 +781,22 @@ impl Plant {
 
     /// Outputs at a state. The commands `u` are not used (no direct feedthrough) but are
     /// part of the signature for symmetry with [`Plant::derivatives`].
-    pub fn outputs(&self, x: &StateVector, _u: &InputVector, wind_ned: &Vector3<f64>) -> Outputs {
+    /// On the ground the specific force counts every touching point as free
+    /// ([`ContactAnchors::FREE`]); [`Plant::outputs_in_contact`] takes the anchors.
+    pub fn outputs(&self, x: &StateVector, u: &InputVector, wind_ned: &Vector3<f64>) -> Outputs {
+        self.outputs_in_contact(x, &ContactAnchors::FREE, u, wind_ned)
+    }
+
+    /// [`Plant::outputs`] with the ground contact's anchors.
+    pub fn outputs_in_contact(
+        &self,
+        x: &StateVector,
+        anchors: &ContactAnchors,
+        _u: &InputVector,
+        wind_ned: &Vector3<f64>,
+    ) -> Outputs {
         let (fm, stall_fraction, c) = self.eval_with_stall(x, wind_ned);
-        self.outputs_from(x, &fm, stall_fraction, &c)
+        self.outputs_from(x, &fm, stall_fraction, &c, anchors)
     }
 
     /// Forces (cold induced-velocity solve), stall fraction and DCM^BE at a state.
@@ -729,9 +834,10 @@ impl Plant {
         fm: &ForcesMoments,
         stall_fraction: f64,
         c: &nalgebra::Matrix3<f64>,
+        anchors: &ContactAnchors,
     ) -> Outputs {
         let q = Vector4::new(x[Q1], x[Q2], x[Q3], x[Q4]);
-        let (f_ground, _) = self.ground.contact(&self.airframe, x, c);
+        let (f_ground, _) = self.ground.contact(&self.airframe, x, c, anchors);
         Outputs {
             vel_ned: c.tr_mul(&Vector3::new(x[U], x[V], x[W])),
             euler_321: euler_321_from_quat(&q),
@@ -759,8 +865,19 @@ impl Plant {
         u: &InputVector,
         wind_ned: &Vector3<f64>,
     ) -> (Outputs, StateVector) {
+        self.outputs_and_derivatives_in_contact(x, &ContactAnchors::FREE, u, wind_ned)
+    }
+
+    /// [`Plant::outputs_and_derivatives`] with the ground contact's anchors.
+    pub fn outputs_and_derivatives_in_contact(
+        &self,
+        x: &StateVector,
+        anchors: &ContactAnchors,
+        u: &InputVector,
+        wind_ned: &Vector3<f64>,
+    ) -> (Outputs, StateVector) {
         let (fm, stall_fraction, c) = self.eval_with_stall(x, wind_ned);
-        let y = self.outputs_from(x, &fm, stall_fraction, &c);
+        let y = self.outputs_from(x, &fm, stall_fraction, &c, anchors);
         let mut xn = *x;
         let n = (x[Q1] * x[Q1] + x[Q2] * x[Q2] + x[Q3] * x[Q3] + x[Q4] * x[Q4]).sqrt();
         if n > 0.0 && n.is_finite() {
@@ -769,13 +886,13 @@ impl Plant {
             }
         }
         let dx = if xn == *x {
-            self.assemble(&xn, u, &fm, &c)
+            self.assemble(&xn, u, &fm, &c, anchors)
         } else if *wind_ned == Vector3::zeros() {
             // Same forces (v_air = v exactly), DCM of the normalised quaternion.
             let cn = dcm_earth_to_body(&Vector4::new(xn[Q1], xn[Q2], xn[Q3], xn[Q4]));
-            self.assemble(&xn, u, &fm, &cn)
+            self.assemble(&xn, u, &fm, &cn, anchors)
         } else {
-            self.derivatives(&xn, u, wind_ned)
+            self.derivatives_in_contact(&xn, anchors, u, wind_ned)
         };
         (y, dx)
     }
