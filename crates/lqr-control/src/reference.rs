@@ -6,7 +6,7 @@
 use std::ops::ControlFlow;
 
 use flight_mission::{Command, ControllerInput, ControllerOutput, Diagnostics, Measurement, Phase};
-use guidance::{GroundMode, VerticalReference};
+use guidance::{GroundMode, HeadingRef, VerticalReference};
 use nalgebra::{Const, DimMin, Matrix3, SMatrix, SVector, ToTypenum, Vector3};
 use std::f64::consts::TAU;
 use tailsitter_physics::attitude::{euler_321_from_quat, quat_from_dcm};
@@ -17,7 +17,7 @@ use crate::trajectory::TrajPoint;
 use crate::{
     LqrController, FRONT_TRIM_RAMP_TIME, GROUND_TRIM_MAX_YAW, HOVER_SHIFT_LIMIT, HOVER_SHIFT_TIME, LANDING_FLAP_GAIN,
     LANDING_FLAP_LIMIT, LANDING_FLAP_LINEARISED, LANDING_FLAP_RAMP_TIME, LANDING_LEAN_GAIN, MAX_WIND_ESTIMATE,
-    MIN_AIRSPEED, WIND_INTEGRAL_SPEED, WIND_TRIM_MAX_PITCH, WIND_TRIM_RAMP,
+    MIN_AIRSPEED, TAKEOFF_WIND_SPEED, WIND_INTEGRAL_SPEED, WIND_TRIM_MAX_PITCH, WIND_TRIM_RAMP,
 };
 
 /// Switches of the reference stage (from [`crate::LqrParams::effective`]).
@@ -122,6 +122,26 @@ impl LqrController {
         ControlFlow::Continue((offset, ground_ref))
     }
 
+    /// A wind at the take-off (README, "Take-off and landing"): in the take-off climb, a
+    /// measured air-data wind ([`Self::wind_in_air_data`]) whose estimate (0.3 s filter) is
+    /// at least [`TAKEOFF_WIND_SPEED`] latches the wind mode at once
+    /// ([`Self::ground_in_wind`]: the reference headed by the weathervane with the air data
+    /// of the wind, the gains computed about it) instead of after the weathervane's 4 s
+    /// filter. Linearised at α = β = 0 in that second, an 8 m/s wind across the span at
+    /// lift-off tipped the aircraft over in 0.5 s (thrust and flaps saturated) and it was lost.
+    fn latch_takeoff_wind(&mut self, ground: Option<&VerticalReference>, m: &Measurement, sw: &ReferenceSwitches) {
+        let climbing = ground.is_some_and(|v| v.phase == Phase::TakeOff);
+        if climbing
+            && sw.hover_in_wind
+            && !self.wind_integral
+            && self.wind.xy().norm() >= TAKEOFF_WIND_SPEED
+            && self.wind_in_air_data(m)
+        {
+            self.wind_integral = true;
+            self.next_relinearisation = f64::NEG_INFINITY;
+        }
+    }
+
     /// The horizontal position integrators ∫ΔN, ∫ΔE of the descent and flare in wind (README,
     /// "Take-off and landing"): on from the start of the descent once the wind has latched the
     /// mission's integrators ([`Self::ground_in_wind`]), so the collective-flap trim
@@ -178,6 +198,7 @@ impl LqrController {
                 self.wind_integral = true;
                 self.next_relinearisation = f64::NEG_INFINITY;
             }
+            self.latch_takeoff_wind(ground.as_ref(), m, sw);
         } else {
             self.wind = Vector3::zeros();
         }
@@ -215,7 +236,7 @@ impl LqrController {
         ground: Option<&VerticalReference>,
         sw: &ReferenceSwitches,
     ) -> (TrajPoint, Vector3<f64>) {
-        let heading = self.weathervane.update(&self.mission, t, &input.measurement);
+        let heading = self.takeoff_heading(t, &input.measurement, ground);
         let reference = match ground {
             // In wind headed by the weathervane (README, "Mission in wind").
             Some(v) if self.ground_in_wind() => self.ground_point(v).turned(&heading),
@@ -238,6 +259,24 @@ impl LqrController {
             None => origin + reference.pos_neh + Vector3::new(off.x, off.y, -off.z),
         };
         (reference, ref_neh)
+    }
+
+    /// The weathervane's heading reference of the sample (mission time `t`; README,
+    /// "Weathervaning"), except in the take-off climb before a first vertical phase too short
+    /// to let it turn (`Weathervane::free` false at its start, the default mission's 5 s):
+    /// there it holds the mission heading (target 0, the phase's own) instead of turning the
+    /// belly into the wind at its largest rate during the climb only to turn back in the
+    /// first vertical phase. With the turn, a wind across the span at lift-off (8 m/s) had the
+    /// aircraft rolled about its thrust axis while it lifted off, tipped over (flaps and rudder
+    /// saturated) and lost. In still air (no engaged target) the same heading, 0.
+    fn takeoff_heading(&mut self, t: f64, m: &Measurement, ground: Option<&VerticalReference>) -> HeadingRef {
+        let climb = ground.is_some_and(|v| v.phase == Phase::TakeOff);
+        if climb && !self.weathervane.free(&self.mission, 0.0) {
+            let rate = self.weathervane.params().max_rate;
+            self.weathervane.update_towards(&self.mission, t, m, Some((0.0, rate)))
+        } else {
+            self.weathervane.update(&self.mission, t, m)
+        }
     }
 
     /// Vertical flight in wind: in the whole first vertical phase (also in the weathervane's
