@@ -75,9 +75,6 @@ pub const WIND_INTEGRAL_SPEED: f64 = 1.5;
 /// from the measured air velocity to the inertial velocity less the wind estimate
 /// (smoothstep; README, "Take-off and landing").
 pub const GROUND_AIR_DATA_RAMP: (f64, f64) = (0.5, 1.5);
-/// Wind estimate (0.3 s filter, horizontal, m/s) at or above which a wind in the air data
-/// of the take-off climb latches the wind mode at once (README, "Take-off and landing").
-pub const TAKEOFF_WIND_SPEED: f64 = 4.0;
 
 /// The collective-flap trim of the descent and flare in wind (README, "Take-off and
 /// landing"): the shared landing trim's slope and limit (guidance::ground).

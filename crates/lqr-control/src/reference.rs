@@ -17,7 +17,7 @@ use crate::trajectory::TrajPoint;
 use crate::{
     LqrController, FRONT_TRIM_RAMP_TIME, GROUND_TRIM_MAX_YAW, HOVER_SHIFT_LIMIT, HOVER_SHIFT_TIME, LANDING_FLAP_GAIN,
     LANDING_FLAP_LIMIT, LANDING_FLAP_LINEARISED, LANDING_FLAP_RAMP_TIME, LANDING_LEAN_GAIN, MAX_WIND_ESTIMATE,
-    MIN_AIRSPEED, TAKEOFF_WIND_SPEED, WIND_INTEGRAL_SPEED, WIND_TRIM_MAX_PITCH, WIND_TRIM_RAMP,
+    MIN_AIRSPEED, WIND_INTEGRAL_SPEED, WIND_TRIM_MAX_PITCH, WIND_TRIM_RAMP,
 };
 
 /// Switches of the reference stage (from [`crate::LqrParams::effective`]).
@@ -122,26 +122,6 @@ impl LqrController {
         ControlFlow::Continue((offset, ground_ref))
     }
 
-    /// A wind at the take-off (README, "Take-off and landing"): in the take-off climb, a
-    /// measured air-data wind ([`Self::wind_in_air_data`]) whose estimate (0.3 s filter) is
-    /// at least [`TAKEOFF_WIND_SPEED`] latches the wind mode at once
-    /// ([`Self::ground_in_wind`]: the reference headed by the weathervane with the air data
-    /// of the wind, the gains computed about it) instead of after the weathervane's 4 s
-    /// filter. Linearised at α = β = 0 in that second, an 8 m/s wind across the span at
-    /// lift-off tipped the aircraft over in 0.5 s (thrust and flaps saturated) and it was lost.
-    fn latch_takeoff_wind(&mut self, ground: Option<&VerticalReference>, m: &Measurement, sw: &ReferenceSwitches) {
-        let climbing = ground.is_some_and(|v| v.phase == Phase::TakeOff);
-        if climbing
-            && sw.hover_in_wind
-            && !self.wind_integral
-            && self.wind.xy().norm() >= TAKEOFF_WIND_SPEED
-            && self.wind_in_air_data(m)
-        {
-            self.wind_integral = true;
-            self.next_relinearisation = f64::NEG_INFINITY;
-        }
-    }
-
     /// The horizontal position integrators ∫ΔN, ∫ΔE of the descent and flare in wind (README,
     /// "Take-off and landing"): on from the start of the descent once the wind has latched the
     /// mission's integrators ([`Self::ground_in_wind`]), so the collective-flap trim
@@ -198,7 +178,6 @@ impl LqrController {
                 self.wind_integral = true;
                 self.next_relinearisation = f64::NEG_INFINITY;
             }
-            self.latch_takeoff_wind(ground.as_ref(), m, sw);
         } else {
             self.wind = Vector3::zeros();
         }
