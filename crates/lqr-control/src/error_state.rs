@@ -222,4 +222,22 @@ mod tests {
             assert_eq!(y[ix::ALPHA].to_bits(), a.to_bits(), "{a}");
         }
     }
+
+    /// A reference flow along the span (its x–z part below 0.5 m/s) takes the measured α
+    /// (0 against the reference's π at lift-off: no error); from 1 m/s the reference's own α
+    /// bit for bit; in between a blend that passes through neither cut (the short way round).
+    #[test]
+    fn span_wise_flow_takes_the_measured_alpha() {
+        let pi = core::f64::consts::PI;
+        assert_eq!(span_wise_alpha(0.0, pi, 1e-16), 0.0);
+        assert_eq!(span_wise_alpha(0.3, pi, 0.49), 0.3);
+        for xz in [1.0, 2.0, 8.0] {
+            assert_eq!(span_wise_alpha(0.0, pi, xz).to_bits(), pi.to_bits(), "{xz}");
+        }
+        // Halfway (0.75 m/s): half of the short way from −3.0 to 3.0 (0.28 rad across −π).
+        let mid = span_wise_alpha(-3.0, 3.0, 0.75);
+        let short = wrap_pi(3.0 - -3.0);
+        assert!((mid - (-3.0 + 0.5 * short)).abs() < 1e-12, "{mid}");
+        assert!(short.abs() < 0.3, "{short}");
+    }
 }
