@@ -51,7 +51,7 @@ pub(crate) fn unwrap_alpha(x: &mut X, xt: &X) {
 /// [`SPAN_WISE_FLOW`].0 to .1; above that `alpha_t` is returned bit for bit.
 pub(crate) fn span_wise_alpha(alpha_m: f64, alpha_t: f64, xz: f64) -> f64 {
     let (lo, hi) = SPAN_WISE_FLOW;
-    if !(xz < hi) {
+    if xz.is_nan() || xz >= hi {
         return alpha_t;
     }
     let x = ((xz - lo) / (hi - lo)).clamp(0.0, 1.0);
