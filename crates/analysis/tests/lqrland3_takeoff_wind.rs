@@ -9,9 +9,12 @@
 use analysis::controllers::Kind;
 use analysis::wind_envelope::{fly_job, Cell, Job, MissionKind, WindForm, BEARINGS_DEG};
 
-fn cell(form: WindForm, speed: f64, bearing_deg: f64) -> Cell {
-    let b = BEARINGS_DEG.iter().position(|&d| d == bearing_deg).unwrap();
-    fly_job(&Job::new(Kind::Lqr, MissionKind::TakeoffLanding, form, speed, b), None).0
+/// The steady wind of `speed` (m/s) from the east (90°), across the span at lift-off.
+fn from_the_east(speed: f64) -> Cell {
+    let east = 2;
+    assert_eq!(BEARINGS_DEG[east], 90.0);
+    let job = Job::new(Kind::Lqr, MissionKind::TakeoffLanding, WindForm::Step, speed, east);
+    fly_job(&job, None).0
 }
 
 /// 8 m/s from the east, across the span at lift-off: the mission completes (lost 50 m from
@@ -19,7 +22,7 @@ fn cell(form: WindForm, speed: f64, bearing_deg: f64) -> Cell {
 /// landing 0.27 m from the target).
 #[test]
 fn span_wise_wind_at_lift_off_is_not_lost() {
-    let c = cell(WindForm::Step, 8.0, 90.0);
+    let c = from_the_east(8.0);
     eprintln!("{c:?}");
     assert!(c.completed, "{c:?}");
     assert!(c.max_error < 6.0, "{c:?}");
@@ -31,7 +34,7 @@ fn span_wise_wind_at_lift_off_is_not_lost() {
 /// made a hop the first ground contact before.
 #[test]
 fn span_wise_5_m_s_lands() {
-    let c = cell(WindForm::Step, 5.0, 90.0);
+    let c = from_the_east(5.0);
     eprintln!("{c:?}");
     assert!(c.completed, "{c:?}");
     assert_eq!(c.landing_passed, Some(true), "{c:?}");
