@@ -10,7 +10,7 @@ use nalgebra::{SVector, Vector3};
 use crate::model::{self, ix, state_of, wrap_pi, EulerRep, I_POS, NA, NX, X};
 use crate::reference::Reference;
 use crate::trajectory::TrajPoint;
-use crate::LqrController;
+use crate::{LqrController, GROUND_AIR_DATA_RAMP};
 
 /// Switches of the error state (from [`crate::LqrParams::effective`]).
 #[derive(Debug, Clone, Copy)]
@@ -42,6 +42,27 @@ pub(crate) fn unwrap_alpha(x: &mut X, xt: &X) {
     }
 }
 
+/// The reference α of a flow `vat` whose part in the body x–z plane has the speed `xz`
+/// (m/s): below [`SPAN_WISE_FLOW`] the flow runs along the span (β → ±90°) and its α is
+/// undefined — the reference's and the measured α are then two arbitrary numbers (0 and π at
+/// an 8 m/s wind across the span at lift-off: Δα = −π, 0.2 rad of elevator, the aircraft
+/// tipped over and was lost) —, so the reference takes the measured α (`alpha_m`, already on
+/// the reference's side of the ±π cut), blended (smoothstep) into its own from
+/// [`SPAN_WISE_FLOW`].0 to .1; above that `alpha_t` is returned bit for bit.
+pub(crate) fn span_wise_alpha(alpha_m: f64, alpha_t: f64, xz: f64) -> f64 {
+    let (lo, hi) = SPAN_WISE_FLOW;
+    if xz.is_nan() || xz >= hi {
+        return alpha_t;
+    }
+    let x = ((xz - lo) / (hi - lo)).clamp(0.0, 1.0);
+    let s = x * x * (3.0 - 2.0 * x);
+    alpha_m + s * wrap_pi(alpha_t - alpha_m)
+}
+
+/// Speeds (m/s) of the reference air velocity's part in the body x–z plane between which
+/// its α passes from the measured one to its own ([`span_wise_alpha`]).
+const SPAN_WISE_FLOW: (f64, f64) = (0.5, 1.0);
+
 impl LqrController {
     /// The measured state x (the estimated state of Fig. 3.2) and the trajectory state x_t in
     /// Euler set `rep` (§2.4): x_t at the regulated position `ctrl_neh` with the air-data
@@ -49,6 +70,13 @@ impl LqrController {
     /// ([`Self::hover_air_data`]). Where α is an angle, the measured one is taken to within π
     /// of the reference's ([`unwrap_alpha`]).
     pub(crate) fn state_and_reference(&self, rep: EulerRep, m: &Measurement, r: &Reference) -> (X, X) {
+        let inertial;
+        let m = if r.ground.is_some() && self.params.stages().reference.wind_compensation {
+            inertial = self.ground_phase_air_data(m);
+            &inertial
+        } else {
+            m
+        };
         let mut x = state_of(
             rep, m.airspeed, m.alpha, m.beta, &m.rates, &m.quat, &m.pos_ned, m.thrust,
         );
@@ -66,6 +94,9 @@ impl LqrController {
                 xt[ix::V] = va;
                 xt[ix::ALPHA] = vat.z.atan2(vat.x);
                 xt[ix::BETA] = (vat.y / va).clamp(-1.0, 1.0).asin();
+                unwrap_alpha(&mut x, &xt);
+                xt[ix::ALPHA] = span_wise_alpha(x[ix::ALPHA], xt[ix::ALPHA], vat.x.hypot(vat.z));
+                return (x, xt);
             } else {
                 self.hover_air_data(m, v, &r.point, &mut x, &mut xt);
                 return (x, xt);
@@ -111,6 +142,42 @@ impl LqrController {
         self.wind_integral && self.wind.iter().all(|w| w.is_finite())
     }
 
+    /// The measurement with the air data (V, α, β) of the take-off and landing phases taken
+    /// from the inertial velocity less the wind estimate, `DCM (v_g − ŵ)`, in place of the
+    /// measured air velocity, phased in (smoothstep) as the air-data wind
+    /// `v_g − DCMᵀ v_a` rises through [`GROUND_AIR_DATA_RAMP`] (below it, as in still air,
+    /// the measurement untouched bit for bit). Near hover the velocity error the gains see is
+    /// then the ground velocity's, as a multicopter's position loop has it: the measured air
+    /// velocity carried the part of the wind the 0.3 s estimate has not caught, so an 8 m/s
+    /// wind stepping in at lift-off read as an 8 m/s velocity error (tipped over in 0.5 s,
+    /// lost) and in turbulence every gust entered the feedback (the descent swung in pitch
+    /// until the thrust saturated).
+    pub(crate) fn ground_phase_air_data(&self, m: &Measurement) -> Measurement {
+        let dcm = model::dcm_of_quat(&m.quat);
+        let va = model::body_velocity(m.airspeed, m.alpha, m.beta);
+        let raw = m.vel_ned - dcm.transpose() * va;
+        let (w0, w1) = GROUND_AIR_DATA_RAMP;
+        let x = ((raw.norm() - w0) / (w1 - w0)).clamp(0.0, 1.0);
+        let s = x * x * (3.0 - 2.0 * x);
+        if !(s > 0.0 && self.wind.iter().all(|w| w.is_finite())) {
+            return *m;
+        }
+        let v = va + s * (dcm * (raw - self.wind));
+        let speed = v.norm();
+        if !speed.is_finite() {
+            return *m;
+        }
+        let mut out = *m;
+        out.airspeed = speed;
+        out.alpha = v.z.atan2(v.x);
+        out.beta = if speed > 1e-9 {
+            (v.y / speed).clamp(-1.0, 1.0).asin()
+        } else {
+            0.0
+        };
+        out
+    }
+
     fn hover_air_data(&self, m: &Measurement, v: &VerticalReference, reference: &TrajPoint, x: &mut X, xt: &mut X) {
         let (sa, ca) = m.alpha.sin_cos();
         let (sb, cb) = m.beta.sin_cos();
@@ -154,5 +221,23 @@ mod tests {
             unwrap_alpha(&mut y, &xt);
             assert_eq!(y[ix::ALPHA].to_bits(), a.to_bits(), "{a}");
         }
+    }
+
+    /// A reference flow along the span (its x–z part below 0.5 m/s) takes the measured α
+    /// (0 against the reference's π at lift-off: no error); from 1 m/s the reference's own α
+    /// bit for bit; in between a blend that passes through neither cut (the short way round).
+    #[test]
+    fn span_wise_flow_takes_the_measured_alpha() {
+        let pi = core::f64::consts::PI;
+        assert_eq!(span_wise_alpha(0.0, pi, 1e-16), 0.0);
+        assert_eq!(span_wise_alpha(0.3, pi, 0.49), 0.3);
+        for xz in [1.0, 2.0, 8.0] {
+            assert_eq!(span_wise_alpha(0.0, pi, xz).to_bits(), pi.to_bits(), "{xz}");
+        }
+        // Halfway (0.75 m/s): half of the short way from −3.0 to 3.0 (0.28 rad across −π).
+        let mid = span_wise_alpha(-3.0, 3.0, 0.75);
+        let short = wrap_pi(3.0 - -3.0);
+        assert!((mid - (-3.0 + 0.5 * short)).abs() < 1e-12, "{mid}");
+        assert!(short.abs() < 0.3, "{short}");
     }
 }

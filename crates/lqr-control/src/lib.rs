@@ -81,6 +81,10 @@ pub const WIND_TRIM_RAMP: (f64, f64) = (0.5, 1.5);
 /// ∫ΔE, ∫Δh join the mission's gains for the rest of the flight (README, "Mission in
 /// wind"); in still air they stay inert (the still-air flights bit-identical).
 pub const WIND_INTEGRAL_SPEED: f64 = 1.5;
+/// Air-data wind (m/s) over which the take-off and landing phases' velocity feedback passes
+/// from the measured air velocity to the inertial velocity less the wind estimate
+/// (smoothstep; README, "Take-off and landing").
+pub const GROUND_AIR_DATA_RAMP: (f64, f64) = (0.5, 1.5);
 
 /// The collective-flap trim of the descent and flare in wind (README, "Take-off and
 /// landing"): the shared landing trim's slope and limit (guidance::ground).

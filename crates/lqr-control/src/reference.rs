@@ -6,7 +6,7 @@
 use std::ops::ControlFlow;
 
 use flight_mission::{Command, ControllerInput, ControllerOutput, Diagnostics, Measurement, Phase};
-use guidance::{GroundMode, VerticalReference};
+use guidance::{GroundMode, HeadingRef, VerticalReference};
 use nalgebra::{Const, DimMin, Matrix3, SMatrix, SVector, ToTypenum, Vector3};
 use std::f64::consts::TAU;
 use tailsitter_physics::attitude::{euler_321_from_quat, quat_from_dcm};
@@ -216,7 +216,7 @@ impl LqrController {
         ground: Option<&VerticalReference>,
         sw: &ReferenceSwitches,
     ) -> (TrajPoint, Vector3<f64>) {
-        let heading = self.weathervane.update(&self.mission, t, &input.measurement);
+        let heading = self.takeoff_heading(t, &input.measurement, ground);
         let reference = match ground {
             // In wind headed by the weathervane (README, "Mission in wind").
             Some(v) if self.ground_in_wind() => self.ground_point(v).turned(&heading),
@@ -239,6 +239,24 @@ impl LqrController {
             None => origin + reference.pos_neh + Vector3::new(off.x, off.y, -off.z),
         };
         (reference, ref_neh)
+    }
+
+    /// The weathervane's heading reference of the sample (mission time `t`; README,
+    /// "Weathervaning"), except in the take-off climb before a first vertical phase too short
+    /// to let it turn (`Weathervane::free` false at its start, the default mission's 5 s):
+    /// there it holds the mission heading (target 0, the phase's own) instead of turning the
+    /// belly into the wind at its largest rate during the climb only to turn back in the
+    /// first vertical phase. With the turn, a wind across the span at lift-off (8 m/s) had the
+    /// aircraft rolled about its thrust axis while it lifted off, tipped over (flaps and rudder
+    /// saturated) and lost. In still air (no engaged target) the same heading, 0.
+    fn takeoff_heading(&mut self, t: f64, m: &Measurement, ground: Option<&VerticalReference>) -> HeadingRef {
+        let climb = ground.is_some_and(|v| v.phase == Phase::TakeOff);
+        if climb && !self.weathervane.free(&self.mission, 0.0) {
+            let rate = self.weathervane.params().max_rate;
+            self.weathervane.update_towards(&self.mission, t, m, Some((0.0, rate)))
+        } else {
+            self.weathervane.update(&self.mission, t, m)
+        }
     }
 
     /// Vertical flight in wind: in the whole first vertical phase (also in the weathervane's
