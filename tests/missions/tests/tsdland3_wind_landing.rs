@@ -42,10 +42,10 @@ fn cell(form: WindForm, speed: f64, bearing_index: usize) -> (f64, Flight) {
 }
 
 /// 10 m/s headwind and tailwind (steady, stepping in at 2 s): held, landed on the target
-/// below 0.5 m/s upright (measured: 0.26 / 0.27 m/s, 0.07 / 0.06 m from the target at the
-/// touchdown, tilt 4.6° / 5.0°). Not every criterion: standing on the gear with the thrust
-/// cut, belly-on, the plant creeps downwind (0.57 m in 5 s in 10 m/s, `cargo run --release
-/// -p analysis --example tsdland3_gear_creep`), 0.92–0.93 m at the end.
+/// below 0.5 m/s upright, and still there 5 s later with the thrust cut (measured: 0.26 /
+/// 0.27 m/s, 0.07 / 0.06 m from the target at the touchdown and 0.48 / 0.47 m after 5 s on
+/// the gear, tilt 4.6° / 5.0°): belly-on in 10 m/s the wind's 42 N stays below the gear's
+/// friction limit, and the stick-slip contact holds it.
 #[test]
 fn touches_down_below_half_a_metre_per_second_in_a_10_m_s_wind() {
     for bearing_index in [0, 4] {
@@ -58,6 +58,7 @@ fn touches_down_below_half_a_metre_per_second_in_a_10_m_s_wind() {
             f.miss_touchdown < 0.2 && f.tilt_touchdown_deg < 7.0 && f.tilt_final_deg < 5.0,
             "{at}°: {f:?}"
         );
+        assert!(f.passed, "{at}°: {f:?}");
     }
 }
 
