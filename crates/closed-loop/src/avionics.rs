@@ -18,7 +18,7 @@ use flight_mission::{plant_inputs, Command, Measurement};
 use nalgebra::Vector3;
 use sensor_model::SensorModel;
 use state_estimator::{Ekf, Estimate, EstimatorParams, Measurements};
-use tailsitter_physics::{idx, InputVector, Plant, StateVector};
+use tailsitter_physics::{InputVector, Plant, StateVector};
 
 use crate::{Ordering, StateSource};
 
@@ -114,34 +114,24 @@ pub fn substitute_truth(m: &mut Measurement, truth: &Measurement, origin: &Vecto
     true
 }
 
-/// The true state as the sensors see it (the plant outputs of the same names).
+/// The true state as the sensors see it (the plant outputs of the same names), off the
+/// gear or resting on fresh anchors (the start).
 pub fn truth(plant: &Plant, x: &StateVector, u: &InputVector, wind: &Vector3<f64>) -> sensor_model::Truth {
-    let y = plant.outputs(x, u, wind);
-    sensor_model::Truth {
-        pos_ned: Vector3::new(x[idx::POS_N], x[idx::POS_E], x[idx::POS_D]),
-        vel_ned: y.vel_ned,
-        rates: Vector3::new(x[idx::P], x[idx::Q], x[idx::R]),
-        quat: x.fixed_rows::<4>(idx::Q1).into_owned(),
-        airspeed: y.airspeed,
-        alpha: y.alpha,
-        beta: y.beta,
-        specific_force: y.specific_force_body,
-    }
+    truth_of(&flight_mission::measurement(x, &plant.outputs(x, u, wind)))
 }
 
-/// [`truth`] with the specific force of the closed loop's `measured` outputs: on the ground
-/// the gear's friction depends on its anchors (`tailsitter_physics::ContactAnchors`), which
-/// the closed loop carries and [`Plant::outputs`] does not.
-fn truth_on_gear(
-    plant: &Plant,
-    x: &StateVector,
-    u: &InputVector,
-    wind: &Vector3<f64>,
-    measured: &Measurement,
-) -> sensor_model::Truth {
+/// The true state as the sensors see it, from the closed loop's true measurement (whose
+/// specific force on the ground carries the gear's stick-slip anchors).
+pub fn truth_of(m: &Measurement) -> sensor_model::Truth {
     sensor_model::Truth {
-        specific_force: measured.specific_force_body,
-        ..truth(plant, x, u, wind)
+        pos_ned: m.pos_ned,
+        vel_ned: m.vel_ned,
+        rates: m.rates,
+        quat: m.quat,
+        airspeed: m.airspeed,
+        alpha: m.alpha,
+        beta: m.beta,
+        specific_force: m.specific_force_body,
     }
 }
 
@@ -206,15 +196,15 @@ impl StateSource for AvionicsSource {
         &mut self,
         t: f64,
         h: f64,
-        plant: &Plant,
-        x: &StateVector,
-        u: &InputVector,
-        wind: &Vector3<f64>,
-        truth_measured: &Measurement,
+        _plant: &Plant,
+        _x: &StateVector,
+        _u: &InputVector,
+        _wind: &Vector3<f64>,
+        truth: &Measurement,
     ) -> Result<Measurement, String> {
         let fresh = self
             .sensors
-            .step(&truth_on_gear(plant, x, u, wind, truth_measured), t, h)
+            .step(&truth_of(truth), t, h)
             .map_err(|e| format!("sensors failed at t = {t}: {e}"))?;
         let fresh = to_estimator(&fresh);
         self.pending = if self.jacobi {
@@ -236,6 +226,7 @@ impl StateSource for AvionicsSource {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use tailsitter_physics::idx;
 
     /// The estimator is told the Jacobi master's delays (one step each) and nothing under
     /// Gauss-Seidel; it shares the sensors' site and filter; `app_d` is its App.-D switch.
