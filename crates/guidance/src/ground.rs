@@ -512,7 +512,10 @@ impl GroundPhases {
         } else {
             (self.share_mean, self.share_var)
         };
-        self.gear_share(meas) - mean > CONTACT_REACTION.max(CONTACT_SIGMAS * var.sqrt()).min(CONTACT_REACTION_MAX)
+        self.gear_share(meas) - mean
+            > CONTACT_REACTION
+                .max(CONTACT_SIGMAS * var.sqrt())
+                .min(CONTACT_REACTION_MAX)
     }
 
     /// Track the gear's share in the air (no contact): exponential mean and variance over
