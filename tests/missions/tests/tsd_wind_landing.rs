@@ -20,18 +20,7 @@ use analysis::wind_envelope::{WindForm, BEARINGS_DEG};
 
 /// The largest distance to the own reference and the landing's figures of one cell.
 fn cell(speed: f64, bearing_index: usize) -> (f64, Flight) {
-    let (max, f) = tl_cell::fly_cell(Kind::Tsd, WindForm::Step, speed, bearing_index);
-    println!(
-        "{speed} m/s from {}°: max error {max:.2} m, landed {:?}, miss {:.2} m, touchdown {:.2} m/s, tilt {:.1}° / {:.1}° at the end, every landing criterion {}",
-        BEARINGS_DEG[bearing_index],
-        f.landed_time,
-        f.miss_final,
-        f.touchdown_speed,
-        f.tilt_touchdown_deg,
-        f.tilt_final_deg,
-        f.passed
-    );
-    (max, f)
+    tl_cell::fly_cell(Kind::Tsd, WindForm::Step, speed, bearing_index)
 }
 
 /// 3 m/s across the track (from the east) and quartering (from the north-east): every

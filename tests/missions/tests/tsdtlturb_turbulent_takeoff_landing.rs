@@ -20,23 +20,11 @@ mod tl_cell;
 
 use analysis::controllers::Kind;
 use analysis::takeoff_landing::Flight;
-use analysis::wind_envelope::{WindForm, BEARINGS_DEG};
+use analysis::wind_envelope::WindForm;
 
 /// The largest distance to the own reference and the landing's figures of one cell.
 fn cell(speed: f64, bearing_index: usize) -> (f64, Flight) {
-    let (max, f) = tl_cell::fly_cell(Kind::Tsd, WindForm::Turbulent, speed, bearing_index);
-    println!(
-        "{speed} m/s from {}°: max error {max:.2} m, ground tilt {:.1}°, landed {:?}, miss {:.2} m, touchdown {:.2} m/s, tilt {:.1}° / {:.1}° at the end, every landing criterion {}",
-        BEARINGS_DEG[bearing_index],
-        f.ground_tilt_deg,
-        f.landed_time,
-        f.miss_final,
-        f.touchdown_speed,
-        f.tilt_touchdown_deg,
-        f.tilt_final_deg,
-        f.passed
-    );
-    (max, f)
+    tl_cell::fly_cell(Kind::Tsd, WindForm::Turbulent, speed, bearing_index)
 }
 
 /// 5 m/s from 45°: the spin-up in gusts stays on its gear (largest tilt on the gear 14.4°,

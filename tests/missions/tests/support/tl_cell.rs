@@ -1,10 +1,11 @@
 //! One take-off-to-landing cell of the wind envelope (`analysis::takeoff_landing::mission`,
 //! `analysis::wind_envelope`: global aerodynamics, the ground 10 m below the origin,
-//! Gauss-Seidel, perfect state), flown to 5 s after the landing.
+//! Gauss-Seidel, perfect state), flown to 5 s after the landing; its figures printed
+//! (`-- --nocapture`).
 
 use analysis::controllers::Kind;
 use analysis::takeoff_landing::{self, Flight};
-use analysis::wind_envelope::{plant, wind, WindForm};
+use analysis::wind_envelope::{plant, wind, WindForm, BEARINGS_DEG};
 use closed_loop::{fly, Ordering, Scenario};
 use flight_mission::Phase;
 
@@ -25,5 +26,16 @@ pub fn fly_cell(kind: Kind, form: WindForm, speed: f64, bearing_index: usize) ->
     }
     let f = takeoff_landing::evaluate(&plant, kind, Ordering::GaussSeidel, &mission, &trace);
     let max = trace.samples.iter().map(|s| s.pos_error()).fold(0.0, f64::max);
+    println!(
+        "{speed} m/s from {}°: max error {max:.2} m, ground tilt {:.1}°, landed {:?}, miss {:.2} m, touchdown {:.2} m/s, tilt {:.1}° / {:.1}° at the end, every landing criterion {}",
+        BEARINGS_DEG[bearing_index],
+        f.ground_tilt_deg,
+        f.landed_time,
+        f.miss_final,
+        f.touchdown_speed,
+        f.tilt_touchdown_deg,
+        f.tilt_final_deg,
+        f.passed
+    );
     (max, f)
 }
