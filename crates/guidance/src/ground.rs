@@ -94,6 +94,13 @@ pub const CONTACT_REACTION: f64 = 0.05;
 /// Ground contact: least rise of the gear's share in standard deviations of its spread in
 /// the air (–): with the avionics chain's noise (σ ≈ 0.01–0.02) the rise must be larger.
 pub const CONTACT_SIGMAS: f64 = 5.0;
+/// Ground contact: largest rise of the gear's share above its mean in the air that the test
+/// asks for (–), however large the spread there: in moderate turbulence the share's spread in
+/// the descent is 0.16–0.25 (the wing's and body's gust loads along x), so five spreads
+/// (0.8–1.2) were out of reach at rest on the gear with the thrust at 0.6 weights (rise
+/// 0.5); the aircraft sat undetected on its gear and a gust tipped it over under the
+/// loop's thrust. Still air and the avionics chain's noise (spread 0.01–0.02) stay below it.
+pub const CONTACT_REACTION_MAX: f64 = 0.35;
 /// Time constant of the gear share's mean and spread in the air (s).
 pub const SHARE_TIME: f64 = 2.0;
 /// How long a ground contact counts for the landing (s): the impact's reaction lasts a few
@@ -495,7 +502,8 @@ impl GroundPhases {
     }
 
     /// Ground contact: the gear's share ([`Self::gear_share`]) above its mean in the air by
-    /// at least [`CONTACT_REACTION`] and [`CONTACT_SIGMAS`] of its spread there (module docs;
+    /// at least [`CONTACT_REACTION`] and [`CONTACT_SIGMAS`] of its spread there, at most
+    /// [`CONTACT_REACTION_MAX`] (module docs;
     /// the air's is the wing's drag and the estimate's noise). No height: the estimate's is
     /// metres off with GPS alone.
     pub fn ground_contact(&self, meas: &Measurement) -> bool {
@@ -504,7 +512,10 @@ impl GroundPhases {
         } else {
             (self.share_mean, self.share_var)
         };
-        self.gear_share(meas) - mean > CONTACT_REACTION.max(CONTACT_SIGMAS * var.sqrt())
+        self.gear_share(meas) - mean
+            > CONTACT_REACTION
+                .max(CONTACT_SIGMAS * var.sqrt())
+                .min(CONTACT_REACTION_MAX)
     }
 
     /// Track the gear's share in the air (no contact): exponential mean and variance over

@@ -14,6 +14,15 @@ pub const LIFTOFF_THRUST: f64 = 1.15;
 /// Height above the take-off point below which the take-off climb counts as on the gear (m):
 /// in the air the wing's force along the thrust axis in a wind looks like a gear reaction.
 pub const LIFTOFF_HEIGHT: f64 = 0.1;
+/// Horizontal wind load on the aircraft standing on its gear per (m/s)² of air-data wind
+/// (N s²/m²): the plant's belly-on 42 N at 10 m/s (`tailsitter_physics::ground`), the
+/// largest of its faces.
+pub const GEAR_WIND_LOAD: f64 = 0.42;
+/// Gear's half-spread over the CG's height on the gear, b/h over the fin points (–): the
+/// gear tips over a point once the horizontal load exceeds N b/h (`tailsitter_physics::ground`).
+pub const GEAR_TIP_RATIO: f64 = 0.56;
+/// Margin of the spin-up's normal force over the tip-over bound (–).
+pub const GEAR_TIP_MARGIN: f64 = 2.0;
 
 /// The reference signals of one flying sample.
 #[derive(Debug, Clone, Copy)]
@@ -151,8 +160,29 @@ impl TsdController {
     /// On the gear: no loop runs (no integrator wind-up); the next flight phase starts
     /// bumpless from the measured thrust and surfaces.
     pub(crate) fn on_gear(&mut self, meas: &Measurement, phase: Phase, thrust: f64) -> ControllerOutput {
+        let thrust = self.spinup_thrust_in_wind(meas, phase, thrust);
         self.initialized = false;
         self.saturated = 0;
         ControllerOutput::on_gear(meas, phase, thrust, self.airframe.thrust_min, self.airframe.thrust_max)
+    }
+
+    /// Spin-up thrust on the gear in wind (README, "Take-off and landing in wind"): the
+    /// ramp's `thrust` (N), limited so that the gear keeps the normal force
+    /// N = m g − T ≥ [`GEAR_TIP_MARGIN`] F_w / [`GEAR_TIP_RATIO`] against the measured wind's
+    /// load F_w = [`GEAR_WIND_LOAD`] |ŵ_h|² (ŵ the instantaneous air-data wind, gusts
+    /// included): the thrust takes weight off the gear, and a gust then tips the aircraft
+    /// over a gear point (or slides it) before the take-off. The take-off climb lifts off
+    /// at once ([`Self::takeoff_lift`]). Tuned configuration only; still air unchanged.
+    pub(crate) fn spinup_thrust_in_wind(&self, meas: &Measurement, phase: Phase, thrust: f64) -> f64 {
+        if phase != Phase::OnGround || !self.deviations().hover_wind_design {
+            return thrust;
+        }
+        let w = guidance::weathervane::air_data_wind(meas).xy();
+        if !(w.x.is_finite() && w.y.is_finite()) {
+            return thrust;
+        }
+        let load = GEAR_WIND_LOAD * w.norm_squared();
+        let weight = self.airframe.mass * self.airframe.gravity;
+        thrust.min((weight - GEAR_TIP_MARGIN * load / GEAR_TIP_RATIO).max(0.0))
     }
 }

@@ -11,39 +11,16 @@
 //!
 //! `cargo test --release -p missions --test tsd_wind_landing -- --nocapture` prints the numbers.
 
+#[path = "support/tl_cell.rs"]
+mod tl_cell;
+
 use analysis::controllers::Kind;
-use analysis::takeoff_landing::{self, Flight};
-use analysis::wind_envelope::{plant, wind, WindForm, BEARINGS_DEG};
-use closed_loop::{fly, Ordering, Scenario};
-use flight_mission::Phase;
+use analysis::takeoff_landing::Flight;
+use analysis::wind_envelope::{WindForm, BEARINGS_DEG};
 
 /// The largest distance to the own reference and the landing's figures of one cell.
 fn cell(speed: f64, bearing_index: usize) -> (f64, Flight) {
-    let plant = plant();
-    let mission = takeoff_landing::mission();
-    let x0 = plant.resting_on_ground(0.0, 0.0, 0.0);
-    let mut scenario = Scenario::mission(mission);
-    scenario.stop_time = takeoff_landing::stop_time(&mission);
-    scenario.wind = wind(WindForm::Step, speed, bearing_index, plant.ground.height);
-    let mut c = Kind::Tsd.make(&mission);
-    let mut trace = fly(&plant, x0, &mut c, &scenario);
-    if let Some(k) = trace.samples.iter().position(|s| s.diagnostics.phase == Phase::Landed) {
-        let t_end = trace.samples[k].t + takeoff_landing::AFTER_LANDING;
-        trace.samples.retain(|s| s.t <= t_end + 1e-9);
-    }
-    let f = takeoff_landing::evaluate(&plant, Kind::Tsd, Ordering::GaussSeidel, &mission, &trace);
-    let max = trace.samples.iter().map(|s| s.pos_error()).fold(0.0, f64::max);
-    println!(
-        "{speed} m/s from {}°: max error {max:.2} m, landed {:?}, miss {:.2} m, touchdown {:.2} m/s, tilt {:.1}° / {:.1}° at the end, every landing criterion {}",
-        BEARINGS_DEG[bearing_index],
-        f.landed_time,
-        f.miss_final,
-        f.touchdown_speed,
-        f.tilt_touchdown_deg,
-        f.tilt_final_deg,
-        f.passed
-    );
-    (max, f)
+    tl_cell::fly_cell(Kind::Tsd, WindForm::Step, speed, bearing_index)
 }
 
 /// 3 m/s across the track (from the east) and quartering (from the north-east): every
