@@ -801,24 +801,7 @@ fn newton<const N: usize>(
 where
     Const<N>: DimMin<Const<N>, Output = Const<N>> + ToTypenum,
 {
-    let mut z = z0;
-    for _ in 0..iterations {
-        let r = residual(&z);
-        if !r.iter().all(|v| v.is_finite()) {
-            return None;
-        }
-        if converged(&r) {
-            return Some(z);
-        }
-        let mut jac = SMatrix::<f64, N, N>::zeros();
-        for j in 0..N {
-            let mut zj = z;
-            zj[j] += steps[j];
-            jac.set_column(j, &((residual(&zj) - r) / steps[j]));
-        }
-        z -= jac.lu().solve(&r)?;
-    }
-    None
+    newton_with(z0, residual, steps, iterations, converged, |jac, r| jac.lu().solve(r))
 }
 
 /// Newton's method for `N` unknowns and six equations ([`newton`]) with the least-norm step
@@ -831,6 +814,21 @@ fn newton_least_norm<const N: usize>(
     iterations: usize,
     converged: impl Fn(&SVector<f64, 6>) -> bool,
 ) -> Option<SVector<f64, N>> {
+    newton_with(z0, residual, steps, iterations, converged, |jac, r| {
+        let jw = jac * SMatrix::<f64, N, N>::from_diagonal(weights);
+        Some(jw.transpose() * (jw * jac.transpose()).lu().solve(r)?)
+    })
+}
+
+/// The iteration of [`newton`] with the step `solve(J, r)` (Δz = −step).
+fn newton_with<const N: usize, const M: usize>(
+    z0: SVector<f64, N>,
+    residual: impl Fn(&SVector<f64, N>) -> SVector<f64, M>,
+    steps: &SVector<f64, N>,
+    iterations: usize,
+    converged: impl Fn(&SVector<f64, M>) -> bool,
+    solve: impl Fn(&SMatrix<f64, M, N>, &SVector<f64, M>) -> Option<SVector<f64, N>>,
+) -> Option<SVector<f64, N>> {
     let mut z = z0;
     for _ in 0..iterations {
         let r = residual(&z);
@@ -840,21 +838,13 @@ fn newton_least_norm<const N: usize>(
         if converged(&r) {
             return Some(z);
         }
-        let mut jw = SMatrix::<f64, 6, N>::zeros();
+        let mut jac = SMatrix::<f64, M, N>::zeros();
         for j in 0..N {
             let mut zj = z;
             zj[j] += steps[j];
-            jw.set_column(j, &((residual(&zj) - r) * (weights[j] / steps[j])));
+            jac.set_column(j, &((residual(&zj) - r) / steps[j]));
         }
-        // J W Jᵀ = (J W) W⁻¹ (J W)ᵀ; with W diagonal, from the weighted columns.
-        let mut m = SMatrix::<f64, 6, 6>::zeros();
-        for j in 0..N {
-            if weights[j] > 0.0 {
-                let col = jw.column(j);
-                m += col * col.transpose() / weights[j];
-            }
-        }
-        z -= jw.transpose() * m.lu().solve(&r)?;
+        z -= solve(&jac, &r)?;
     }
     None
 }
