@@ -402,19 +402,17 @@ impl LqrController {
         let h = self.mission.sample_time;
         let rate = (z_next * k_next - z * k) / h;
         let r = body_rotation(k * z[0], k * z[1]);
-        let c = r.transpose() * model::dcm_of_quat(&p.quat());
-        let mut e = euler_321_from_quat(&quat_from_dcm(&c));
-        // ψ of the table is not wrapped: keep the turned heading next to it.
-        e.z += ((p.euler_321.z - e.z) / TAU).round() * TAU;
-        let mut q = *p;
-        q.euler_321 = e;
-        q.rates = r.transpose() * p.rates + Vector3::new(0.0, rate[1], rate[0]);
-        q.thrust += k * z[2];
-        q.u[0] += k * z[2];
-        for j in 0..3 {
-            q.u[1 + j] += k * z[3 + j];
-        }
-        q
+        rotated_point(p, &r, Vector3::new(0.0, rate[1], rate[0]), k, z)
+    }
+
+    /// [`Self::ground_path_trimmed`] for the front transition's trim with a turn about body x
+    /// ([`Self::front_trim_from`]), weighted by `k`: the rotation's rate from the trims `z`
+    /// and `z_next` one sample apart.
+    fn front_path_trimmed(&self, p: &TrajPoint, k: f64, z: &SVector<f64, 7>, z_next: &SVector<f64, 7>) -> TrajPoint {
+        let rate = (z_next - z) * (k / self.mission.sample_time);
+        let r = front_rotation(&(z * k));
+        let z6 = z.fixed_rows::<6>(0).into_owned();
+        rotated_point(p, &r, Vector3::new(rate[6], rate[1], rate[0]), k, &z6)
     }
 
     /// The front transition in a steady wind (README, "Mission in wind"): the trim along the
@@ -428,8 +426,8 @@ impl LqrController {
         let s_lat = s_lat.max(k);
         let (z, lambda) = self.front_trim_continuation(p, &self.wind, s_lat)?;
         // One sample on, the same fraction λ of the wind, from this sample's trim.
-        let z_next = self.ground_path_trim_from(p, &(w_next * lambda), s_lat, &z, true, LEVEL_TRIM_MAX_PITCH)?;
-        Some(self.ground_path_trimmed(p, (k, k), (&z, &z_next)))
+        let z_next = self.front_trim_from(p, &(w_next * lambda), s_lat, &z)?;
+        Some(self.front_path_trimmed(p, k, &z, &z_next))
     }
 
     /// The level leg and the back transition in a steady wind (README, "Mission in wind"): the
@@ -493,20 +491,20 @@ impl LqrController {
         Some(lift.max(smooth(x)) * smooth(y))
     }
 
-    /// Continuation in the wind speed: [`Self::ground_path_trim_from`] on the global model at
-    /// λ ŵ, λ = 1/N … 1, each from the last solution; the trim of the largest λ reached and λ.
+    /// Continuation in the wind speed: [`Self::front_trim_from`] at λ ŵ, λ = 1/N … 1, each
+    /// from the last solution; the trim of the largest λ reached and λ.
     fn front_trim_continuation(
         &self,
         p: &TrajPoint,
         wind: &Vector3<f64>,
         s_lat: f64,
-    ) -> Option<(SVector<f64, 6>, f64)> {
+    ) -> Option<(SVector<f64, 7>, f64)> {
         const N: usize = 4;
         let mut best = None;
-        let mut z = SVector::<f64, 6>::zeros();
+        let mut z = SVector::<f64, 7>::zeros();
         for j in 1..=N {
             let lambda = j as f64 / N as f64;
-            match self.ground_path_trim_from(p, &(wind * lambda), s_lat, &z, true, LEVEL_TRIM_MAX_PITCH) {
+            match self.front_trim_from(p, &(wind * lambda), s_lat, &z) {
                 Some(zj) => {
                     z = zj;
                     best = Some((zj, lambda));
@@ -515,6 +513,39 @@ impl LqrController {
             }
         }
         best
+    }
+
+    /// The front transition's trim along the still-air ground path on the global model
+    /// (README, "Mission in wind"): [`Self::ground_path_trim_from`]'s six unknowns and a
+    /// seventh, the turn δφ about body x (nose up: a turn of the heading, the wing's span
+    /// turned across the wind), for the same six balance equations, solved from `z0` by
+    /// Newton's method with the least-norm step in the weights [`FRONT_TRIM_WEIGHTS`] (the
+    /// aileron costly, the turn about body x weighted by sin²θ_t, so none in level flight).
+    /// In a quartering wind the trim without the turn needs the aileron's whole travel at a
+    /// quarter of an 8 m/s wind; the turn carries the rolling moment instead. None where it
+    /// does not converge or leaves the limits (|δφ| ≤ [`FRONT_TRIM_MAX_ROLL`]).
+    fn front_trim_from(
+        &self,
+        p: &TrajPoint,
+        wind: &Vector3<f64>,
+        s_lat: f64,
+        z0: &SVector<f64, 7>,
+    ) -> Option<SVector<f64, 7>> {
+        let residual = self.ground_path_residual(p, wind, s_lat, true);
+        let mut weights = SVector::<f64, 7>::from_column_slice(&FRONT_TRIM_WEIGHTS);
+        weights[6] *= p.euler_321.y.sin().powi(2);
+        let steps = SVector::<f64, 7>::from_column_slice(&[1e-6, 1e-6, 1e-4, 1e-6, 1e-6, 1e-6, 1e-6]);
+        let z = newton_least_norm(
+            *z0,
+            |z: &SVector<f64, 7>| residual(&front_rotation(z), &z.fixed_rows::<6>(0).into_owned()),
+            &steps,
+            &weights,
+            12,
+            trim_converged,
+        )?;
+        let in_limits = z[6].abs() <= FRONT_TRIM_MAX_ROLL
+            && self.trim_in_limits(p, &z.fixed_rows::<6>(0).into_owned(), LEVEL_TRIM_MAX_PITCH);
+        in_limits.then_some(z)
     }
 
     /// Trim of a reference point along its still-air ground path in the wind `wind` (NED,
@@ -543,9 +574,32 @@ impl LqrController {
         global: bool,
         max_pitch: f64,
     ) -> Option<SVector<f64, 6>> {
+        let residual = self.ground_path_residual(p, wind, s_lat, global);
+        let steps = SVector::<f64, 6>::new(1e-6, 1e-6, 1e-4, 1e-6, 1e-6, 1e-6);
+        let z = newton(
+            *z0,
+            |z: &SVector<f64, 6>| residual(&body_rotation(z[0], z[1]), z),
+            &steps,
+            12,
+            trim_converged,
+        )?;
+        self.trim_in_limits(p, &z, max_pitch).then_some(z)
+    }
+
+    /// The residual of the trim along the still-air ground path ([`Self::ground_path_trim`])
+    /// for the rotation `r` of the reference body axes and the changes `z` (ΔT in `z[2]`, the
+    /// elevator, aileron and rudder in `z[3..6]`): the earth-axes force change over the weight
+    /// and the body moment change.
+    fn ground_path_residual<'a>(
+        &'a self,
+        p: &'a TrajPoint,
+        wind: &Vector3<f64>,
+        s_lat: f64,
+        global: bool,
+    ) -> impl Fn(&Matrix3<f64>, &SVector<f64, 6>) -> SVector<f64, 6> + 'a {
         let af = &self.airframe;
         let ga = tailsitter_physics::GlobalAero::default();
-        let fmf = |v: &Vector3<f64>, w: &Vector3<f64>, t: f64, s: &Surfaces| {
+        let fmf = move |v: &Vector3<f64>, w: &Vector3<f64>, t: f64, s: &Surfaces| {
             if global {
                 ga.forces_moments(af, v, w, t, s).0
             } else {
@@ -562,8 +616,7 @@ impl LqrController {
         let v_g = c_t.transpose() * vb_t;
         let (v_a, v_lat) = (v_g - wind, v_g - s_lat * wind);
         let weight = af.mass * af.gravity;
-        let residual = |z: &SVector<f64, 6>| -> SVector<f64, 6> {
-            let r = body_rotation(z[0], z[1]);
+        move |r: &Matrix3<f64>, z: &SVector<f64, 6>| -> SVector<f64, 6> {
             let c = r.transpose() * c_t;
             let mut vb = c * v_a;
             vb.y = (c * v_lat).y;
@@ -571,16 +624,18 @@ impl LqrController {
             let df = (c.transpose() * fm.force_body - f_e) / weight;
             let dm = fm.moment_body - fm_t.moment_body;
             SVector::<f64, 6>::new(df.x, df.y, df.z, dm.x, dm.y, dm.z)
-        };
-        let steps = SVector::<f64, 6>::new(1e-6, 1e-6, 1e-4, 1e-6, 1e-6, 1e-6);
-        let converged = |r: &SVector<f64, 6>| r.fixed_rows::<3>(0).norm() < 1e-6 && r.fixed_rows::<3>(3).norm() < 1e-6;
-        let z = newton(*z0, residual, &steps, 12, converged)?;
+        }
+    }
+
+    /// Whether the trim `z` along the still-air ground path keeps |δψ| ≤
+    /// [`GROUND_TRIM_MAX_YAW`], |δθ| ≤ `max_pitch`, the thrust and the surfaces in their limits.
+    fn trim_in_limits(&self, p: &TrajPoint, z: &SVector<f64, 6>, max_pitch: f64) -> bool {
+        let af = &self.airframe;
         let lim = af.deflection_limit;
-        let in_limits = z[0].abs() <= GROUND_TRIM_MAX_YAW
+        z[0].abs() <= GROUND_TRIM_MAX_YAW
             && z[1].abs() <= max_pitch
             && (af.thrust_min..=af.thrust_max).contains(&(p.thrust + z[2]))
-            && (1..4).all(|j| (p.u[j] + z[2 + j]).abs() <= lim);
-        in_limits.then_some(z)
+            && (1..4).all(|j| (p.u[j] + z[2 + j]).abs() <= lim)
     }
 
     /// Lift-borne wind trim of a reference point (README, "Gusts"): the pitch rotation δ, the
@@ -746,6 +801,34 @@ fn newton<const N: usize>(
 where
     Const<N>: DimMin<Const<N>, Output = Const<N>> + ToTypenum,
 {
+    newton_with(z0, residual, steps, iterations, converged, |jac, r| jac.lu().solve(r))
+}
+
+/// Newton's method for `N` unknowns and six equations ([`newton`]) with the least-norm step
+/// Δz = −W Jᵀ (J W Jᵀ)⁻¹ r in the diagonal weights W = `weights`.
+fn newton_least_norm<const N: usize>(
+    z0: SVector<f64, N>,
+    residual: impl Fn(&SVector<f64, N>) -> SVector<f64, 6>,
+    steps: &SVector<f64, N>,
+    weights: &SVector<f64, N>,
+    iterations: usize,
+    converged: impl Fn(&SVector<f64, 6>) -> bool,
+) -> Option<SVector<f64, N>> {
+    newton_with(z0, residual, steps, iterations, converged, |jac, r| {
+        let jw = jac * SMatrix::<f64, N, N>::from_diagonal(weights);
+        Some(jw.transpose() * (jw * jac.transpose()).lu().solve(r)?)
+    })
+}
+
+/// The iteration of [`newton`] with the step `solve(J, r)` (Δz = −step).
+fn newton_with<const N: usize, const M: usize>(
+    z0: SVector<f64, N>,
+    residual: impl Fn(&SVector<f64, N>) -> SVector<f64, M>,
+    steps: &SVector<f64, N>,
+    iterations: usize,
+    converged: impl Fn(&SVector<f64, M>) -> bool,
+    solve: impl Fn(&SMatrix<f64, M, N>, &SVector<f64, M>) -> Option<SVector<f64, N>>,
+) -> Option<SVector<f64, N>> {
     let mut z = z0;
     for _ in 0..iterations {
         let r = residual(&z);
@@ -755,15 +838,52 @@ where
         if converged(&r) {
             return Some(z);
         }
-        let mut jac = SMatrix::<f64, N, N>::zeros();
+        let mut jac = SMatrix::<f64, M, N>::zeros();
         for j in 0..N {
             let mut zj = z;
             zj[j] += steps[j];
             jac.set_column(j, &((residual(&zj) - r) / steps[j]));
         }
-        z -= jac.lu().solve(&r)?;
+        z -= solve(&jac, &r)?;
     }
     None
+}
+
+/// Convergence of the trims along the still-air ground path: force change over the weight
+/// and moment change (N m) both below 1e-6.
+fn trim_converged(r: &SVector<f64, 6>) -> bool {
+    r.fixed_rows::<3>(0).norm() < 1e-6 && r.fixed_rows::<3>(3).norm() < 1e-6
+}
+
+/// The reference point `p` turned by `r` (C = Rᵀ C_t), its body rates re-expressed in the
+/// turned axes plus `rotation_rate`, thrust and elevator, aileron and rudder changed by `k`
+/// times the trim `z` ([`LqrController::ground_path_trimmed`]).
+fn rotated_point(
+    p: &TrajPoint,
+    r: &Matrix3<f64>,
+    rotation_rate: Vector3<f64>,
+    k: f64,
+    z: &SVector<f64, 6>,
+) -> TrajPoint {
+    let c = r.transpose() * model::dcm_of_quat(&p.quat());
+    let mut e = euler_321_from_quat(&quat_from_dcm(&c));
+    // ψ of the table is not wrapped: keep the turned heading next to it.
+    e.z += ((p.euler_321.z - e.z) / TAU).round() * TAU;
+    let mut q = *p;
+    q.euler_321 = e;
+    q.rates = r.transpose() * p.rates + rotation_rate;
+    q.thrust += k * z[2];
+    q.u[0] += k * z[2];
+    for j in 0..3 {
+        q.u[1 + j] += k * z[3 + j];
+    }
+    q
+}
+
+/// The front transition trim's rotation: [`body_rotation`] of `z[0]`, `z[1]`, then `z[6]`
+/// about body x.
+fn front_rotation(z: &SVector<f64, 7>) -> Matrix3<f64> {
+    body_rotation(z[0], z[1]) * nalgebra::Rotation3::from_axis_angle(&Vector3::x_axis(), z[6]).into_inner()
 }
 
 /// Ground velocity (NED) of a still-air reference point: `DCM_tᵀ V_t (cα_t, 0, sα_t)`.
@@ -779,10 +899,17 @@ fn body_rotation(yaw: f64, pitch: f64) -> Matrix3<f64> {
     .into_inner()
 }
 
+/// Weights of the front transition's least-norm trim ([`LqrController::front_trim_from`]):
+/// δψ, δθ (rad), ΔT (N: 10 N counted as 1 rad), δe, δa, δr, δφ (rad, scaled by sin²θ_t).
+const FRONT_TRIM_WEIGHTS: [f64; 7] = [1.0, 1.0, 100.0, 1.0, 0.01, 1.0, 0.03];
+/// Largest turn about body x of the front transition's trim (rad) (60°).
+const FRONT_TRIM_MAX_ROLL: f64 = 1.0471975511965976;
+
 #[cfg(test)]
 mod wind_trim_tests {
     use super::*;
     use crate::{LqrParams, MissionParams};
+    use std::f64::consts::FRAC_1_SQRT_2;
     use tailsitter_physics::Airframe;
 
     /// Earth-frame force (N) and pitching moment (N m) of the model for control at reference
@@ -938,6 +1065,50 @@ mod wind_trim_tests {
         assert!((c.front_transition_weight(&p).unwrap() - lift).abs() < 1e-12);
         c.wind_integral = false;
         assert!(c.front_transition_weight(&c.trajectory().at(t1 + 1.0)).is_none());
+    }
+
+    /// The slow start of the front transition in an 8 m/s wind from 135° (quartering from
+    /// behind): without the turn about body x the trim on the global model reaches a quarter
+    /// of the wind, the aileron at its limit; with it the whole wind, turned 15–40° about body
+    /// x (26–30° measured at its start; the aileron 0.28–0.34 rad of its 0.436 rad travel), and the earth-axes force and body moments the still-air reference's.
+    #[test]
+    fn quartering_front_transition_trim_turns_about_body_x() {
+        let mut c = controller();
+        let af = Airframe::default();
+        let ga = tailsitter_physics::GlobalAero::default();
+        let w = Vector3::new(8.0 * FRAC_1_SQRT_2, -8.0 * FRAC_1_SQRT_2, 0.0);
+        c.wind = w;
+        c.wind_rate = Vector3::zeros();
+        c.wind_integral = true;
+        let t1 = c.mission.t_vertical_1;
+        for t in [t1 + 0.75, t1 + 1.0, t1 + 1.5] {
+            let p = c.trajectory().at(t);
+            let mut plain = SVector::<f64, 6>::zeros();
+            let mut reached = 0.0;
+            for j in 1..=4 {
+                let lambda = j as f64 / 4.0;
+                match c.ground_path_trim_from(&p, &(w * lambda), 1.0, &plain, true, LEVEL_TRIM_MAX_PITCH) {
+                    Some(z) => (plain, reached) = (z, lambda),
+                    None => break,
+                }
+            }
+            let (z, lambda) = c.front_trim_continuation(&p, &w, 1.0).expect("front trim");
+            let (da, dphi) = (p.u[2] + z[4], z[6].to_degrees());
+            eprintln!("{t}: without the turn λ {reached}, with it λ {lambda}, δa {da:.3}, δφ {dphi:.1}°");
+            assert!(reached <= 0.5, "{t}: {reached}");
+            assert_eq!(lambda, 1.0, "{t}");
+            assert!(da.abs() <= af.deflection_limit, "{t}: δa {da}");
+            assert!((15.0..40.0).contains(&dphi), "{t}: δφ {dphi}°");
+            let q = c.front_path_trimmed(&p, 1.0, &z, &z);
+            let v_g = ground_velocity(&p);
+            let (c_p, c_q) = (model::dcm_of_quat(&p.quat()), model::dcm_of_quat(&q.quat()));
+            let s = |x: &TrajPoint| Surfaces::from_array([x.u[1], x.u[2], x.u[3], x.u[4], x.u[5], x.u[6]]);
+            let fm_t = ga.forces_moments(&af, &(c_p * v_g), &p.rates, p.thrust, &s(&p)).0;
+            let fm = ga.forces_moments(&af, &(c_q * (v_g - w)), &q.rates, q.thrust, &s(&q)).0;
+            let df = c_q.transpose() * fm.force_body - c_p.transpose() * fm_t.force_body;
+            assert!(df.norm() < 1e-5 * af.mass * af.gravity, "{t}: force {df}");
+            assert!((fm.moment_body - fm_t.moment_body).norm() < 1e-5, "{t}: moment");
+        }
     }
 
     /// The level leg in a steady tailwind: the trim on the global model keeps the still-air
