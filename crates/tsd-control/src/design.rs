@@ -8,8 +8,9 @@ use crate::axes::Airflow;
 use crate::deviations::Deviations;
 use crate::reference::ReferenceSignals;
 use crate::{
-    band_weight, gains, lerp, TsdController, GUIDANCE_FEEDBACK_LIMIT, HOVER_WIND_DESIGN_SPEED_FACTOR,
-    HOVER_WIND_NORMAL_CROSSFLOW, HOVER_WIND_NORMAL_POLE_FACTOR, HOVER_WIND_ROLL_POLE_FACTOR, TABLE_4_3_GUIDANCE_LEVEL,
+    band_weight, gains, lerp, TsdController, GUIDANCE_FEEDBACK_LIMIT, HOVER_GUST_NORMAL_POLE_FACTOR,
+    HOVER_WIND_DESIGN_SPEED_FACTOR, HOVER_WIND_NORMAL_CROSSFLOW, HOVER_WIND_NORMAL_POLE_FACTOR,
+    HOVER_WIND_ROLL_POLE_FACTOR, TABLE_4_3_GUIDANCE_LEVEL,
 };
 use flight_mission::{ControlError, Measurement};
 use nalgebra::{Matrix3, RowVector3, Vector3};
@@ -356,7 +357,9 @@ impl TsdController {
     /// Z_α = V̄ a11 includes the thrust's normal component −T sin α of (2.5.28) with
     /// `normal_thrust_term` (D-4.1): in vertical flight it is the main normal force. Switch `hover_wind_design` (through
     /// `fc.hover_wind`): in hover in a strong crossflow the poles are slowed by
-    /// HOVER_WIND_NORMAL_POLE_FACTOR (README, "Hover in a span-wise wind").
+    /// HOVER_WIND_NORMAL_POLE_FACTOR (README, "Hover in a span-wise wind"), and with the
+    /// hover-in-wind weight alone by HOVER_GUST_NORMAL_POLE_FACTOR (README, "Turbulence"):
+    /// the smaller factor applies. Still air: neither.
     fn normal_design(&self, fc: &FlightCondition, mp: &ModelPoint) -> Result<NormalDesign, &'static str> {
         let p = &self.params;
         let af = &self.airframe;
@@ -376,7 +379,8 @@ impl TsdController {
         let b2 = mp.qbar_s * s_ref * c_ref * (c.c_m_de + mp.rn * c.c_m_dfc) / iyy;
         let model = gains::normal_model(mp.kappa * a11_n, a21_n, a22, b2, z_alpha);
         let strong = fc.hover_wind * band_weight(fc.crossflow, HOVER_WIND_NORMAL_CROSSFLOW);
-        let n_scale = lerp(1.0, HOVER_WIND_NORMAL_POLE_FACTOR, strong);
+        let gusty = lerp(1.0, HOVER_GUST_NORMAL_POLE_FACTOR, fc.hover_wind);
+        let n_scale = lerp(1.0, HOVER_WIND_NORMAL_POLE_FACTOR, strong).min(gusty);
         let poly = gains::char_poly_3(
             n_scale * blend(p.normal_pole_real_vertical, p.normal_pole_real_level),
             n_scale * blend(p.normal_pole_re_vertical, p.normal_pole_re_level),
@@ -573,7 +577,8 @@ mod tests {
     /// crossflow the roll pair and the normal poles are the vertical ones scaled by their
     /// factors (the NVD pole and the directional poles unchanged) and the path frame is kept
     /// even where the axial airspeed alone would blend in the wind axes; at a crossflow inside
-    /// the normal band's lower end the normal poles are the vertical ones.
+    /// the normal band's lower end the normal poles are the vertical ones scaled by the gust
+    /// factor; the larger slowing of the two applies.
     #[test]
     fn hover_wind_slows_the_roll_pair_and_in_strong_crossflow_the_normal_poles() {
         let ctl = TsdController::with_mission(MissionParams::default()).unwrap();
@@ -581,7 +586,7 @@ mod tests {
         let (rf, nf) = (HOVER_WIND_ROLL_POLE_FACTOR, HOVER_WIND_NORMAL_POLE_FACTOR);
         for (crossflow, n_scale) in [
             (HOVER_WIND_NORMAL_CROSSFLOW.1 + 1.0, nf),
-            (HOVER_WIND_NORMAL_CROSSFLOW.0, 1.0),
+            (HOVER_WIND_NORMAL_CROSSFLOW.0, HOVER_GUST_NORMAL_POLE_FACTOR),
         ] {
             let fc = FlightCondition {
                 axial_airspeed: 7.0,
