@@ -40,6 +40,9 @@ pub struct FlightCondition {
     pub hover_wind: f64,
     /// Crossflow V̄ √(1 − cos²α cos²β), the air-velocity component across the nose (m/s).
     pub crossflow: f64,
+    /// Weight (0–1) of [`crate::HOVER_GUST_NORMAL_POLE_FACTOR`]: `hover_wind` in hover, 0 in
+    /// the take-off and landing phases and in the thesis configuration.
+    pub gust_weight: f64,
 }
 
 /// Every loop's linear model and gains at one flight condition (§4.2, §4.3, Table 4.3).
@@ -203,6 +206,7 @@ impl TsdController {
             reference_airspeed: r.reference.airspeed,
             hover_wind: air.hover_wind,
             crossflow: air.design_crossflow,
+            gust_weight: if r.ground_phase() { 0.0 } else { air.hover_wind },
         })
         .map_err(|what| Self::err(format!("{what} gains not computable at t = {t} s")))
     }
@@ -358,8 +362,9 @@ impl TsdController {
     /// `normal_thrust_term` (D-4.1): in vertical flight it is the main normal force. Switch `hover_wind_design` (through
     /// `fc.hover_wind`): in hover in a strong crossflow the poles are slowed by
     /// HOVER_WIND_NORMAL_POLE_FACTOR (README, "Hover in a span-wise wind"), and with the
-    /// hover-in-wind weight alone by HOVER_GUST_NORMAL_POLE_FACTOR (README, "Turbulence"):
-    /// the smaller factor applies. Still air: neither.
+    /// hover-in-wind weight alone (`fc.gust_weight`; not in the take-off and landing phases) by
+    /// HOVER_GUST_NORMAL_POLE_FACTOR (README, "Missions in wind"): the smaller factor applies.
+    /// Still air: neither.
     fn normal_design(&self, fc: &FlightCondition, mp: &ModelPoint) -> Result<NormalDesign, &'static str> {
         let p = &self.params;
         let af = &self.airframe;
@@ -379,7 +384,7 @@ impl TsdController {
         let b2 = mp.qbar_s * s_ref * c_ref * (c.c_m_de + mp.rn * c.c_m_dfc) / iyy;
         let model = gains::normal_model(mp.kappa * a11_n, a21_n, a22, b2, z_alpha);
         let strong = fc.hover_wind * band_weight(fc.crossflow, HOVER_WIND_NORMAL_CROSSFLOW);
-        let gusty = lerp(1.0, HOVER_GUST_NORMAL_POLE_FACTOR, fc.hover_wind);
+        let gusty = lerp(1.0, HOVER_GUST_NORMAL_POLE_FACTOR, fc.gust_weight);
         let n_scale = lerp(1.0, HOVER_WIND_NORMAL_POLE_FACTOR, strong).min(gusty);
         let poly = gains::char_poly_3(
             n_scale * blend(p.normal_pole_real_vertical, p.normal_pole_real_level),
@@ -500,6 +505,7 @@ mod tests {
             reference_airspeed: 3.0,
             hover_wind: 0.0,
             crossflow: 0.0,
+            gust_weight: 0.0,
         }
     }
 
@@ -514,6 +520,7 @@ mod tests {
             reference_airspeed: 25.0,
             hover_wind: 0.0,
             crossflow: 0.0,
+            gust_weight: 0.0,
         }
     }
 
@@ -592,6 +599,7 @@ mod tests {
                 axial_airspeed: 7.0,
                 hover_wind: 1.0,
                 crossflow,
+                gust_weight: 1.0,
                 ..vertical_climb_condition()
             };
             let d = ctl.design(&fc).unwrap();

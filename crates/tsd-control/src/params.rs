@@ -64,7 +64,7 @@ pub const HOVER_WIND_NORMAL_POLE_FACTOR: f64 = 0.7;
 /// [`HOVER_WIND_NORMAL_CROSSFLOW`]; the smaller of the two factors applies). The one-sample
 /// delay of a Jacobi master costs the hover's pitch loop its margin: in moderate turbulence
 /// at 0 m/s mean wind (crossflow 1–2 m/s) the elevator and collective flaps went into a
-/// bang-bang pitch cycle (≈ 3 Hz, α ±0.5 rad) with the full poles (README, "Turbulence").
+/// bang-bang pitch cycle (≈ 3 Hz, α ±0.5 rad) with the full poles (README, "Missions in wind").
 pub const HOVER_GUST_NORMAL_POLE_FACTOR: f64 = 0.75;
 
 /// Crossflow (m/s) over which [`HOVER_WIND_NORMAL_POLE_FACTOR`] is blended in: from 2 m/s, so

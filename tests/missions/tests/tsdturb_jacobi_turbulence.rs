@@ -1,5 +1,5 @@
 //! The tuned TSD's hover in moderate Dryden turbulence with no mean wind under the Jacobi
-//! master (tsd-control README, "Turbulence"): cells of the wind envelope
+//! master (tsd-control README, "Missions in wind"): cells of the wind envelope
 //! (`analysis::wind_envelope`: global aerodynamics, perfect state, the turbulence from t = 0).
 //!
 //! In the 3 m/s climb the turbulence leaves 1–2 m/s of air across the nose, inside the band
