@@ -25,7 +25,14 @@ fn turbulent_cell(ordering: OrderingKind, speed: f64, bearing_index: usize) -> (
         ordering,
         ..Axes::default()
     };
-    let job = Job::new(Kind::Tsd, MissionKind::Default, WindForm::Turbulent, speed, bearing_index).on(axes);
+    let job = Job::new(
+        Kind::Tsd,
+        MissionKind::Default,
+        WindForm::Turbulent,
+        speed,
+        bearing_index,
+    )
+    .on(axes);
     let (c, phases) = fly_job(&job, None);
     println!(
         "{ordering:?} turbulent {speed} m/s, seed of {}°: completed {}, max error {:.2} m, per phase {phases:.2?}, {:?}",
