@@ -8,8 +8,9 @@ use crate::axes::Airflow;
 use crate::deviations::Deviations;
 use crate::reference::ReferenceSignals;
 use crate::{
-    band_weight, gains, lerp, TsdController, GUIDANCE_FEEDBACK_LIMIT, HOVER_WIND_DESIGN_SPEED_FACTOR,
-    HOVER_WIND_NORMAL_CROSSFLOW, HOVER_WIND_NORMAL_POLE_FACTOR, HOVER_WIND_ROLL_POLE_FACTOR, TABLE_4_3_GUIDANCE_LEVEL,
+    band_weight, gains, lerp, TsdController, GUIDANCE_FEEDBACK_LIMIT, HOVER_GUST_NORMAL_POLE_FACTOR,
+    HOVER_WIND_DESIGN_SPEED_FACTOR, HOVER_WIND_NORMAL_CROSSFLOW, HOVER_WIND_NORMAL_POLE_FACTOR,
+    HOVER_WIND_ROLL_POLE_FACTOR, TABLE_4_3_GUIDANCE_LEVEL,
 };
 use flight_mission::{ControlError, Measurement};
 use nalgebra::{Matrix3, RowVector3, Vector3};
@@ -39,6 +40,9 @@ pub struct FlightCondition {
     pub hover_wind: f64,
     /// Crossflow V̄ √(1 − cos²α cos²β), the air-velocity component across the nose (m/s).
     pub crossflow: f64,
+    /// Weight (0–1) of [`crate::HOVER_GUST_NORMAL_POLE_FACTOR`]: `hover_wind` in hover, 0 in
+    /// the take-off and landing phases and in the thesis configuration.
+    pub gust_weight: f64,
 }
 
 /// Every loop's linear model and gains at one flight condition (§4.2, §4.3, Table 4.3).
@@ -202,6 +206,7 @@ impl TsdController {
             reference_airspeed: r.reference.airspeed,
             hover_wind: air.hover_wind,
             crossflow: air.design_crossflow,
+            gust_weight: if r.ground_phase() { 0.0 } else { air.hover_wind },
         })
         .map_err(|what| Self::err(format!("{what} gains not computable at t = {t} s")))
     }
@@ -356,7 +361,10 @@ impl TsdController {
     /// Z_α = V̄ a11 includes the thrust's normal component −T sin α of (2.5.28) with
     /// `normal_thrust_term` (D-4.1): in vertical flight it is the main normal force. Switch `hover_wind_design` (through
     /// `fc.hover_wind`): in hover in a strong crossflow the poles are slowed by
-    /// HOVER_WIND_NORMAL_POLE_FACTOR (README, "Hover in a span-wise wind").
+    /// HOVER_WIND_NORMAL_POLE_FACTOR (README, "Hover in a span-wise wind"), and with the
+    /// hover-in-wind weight alone (`fc.gust_weight`; not in the take-off and landing phases) by
+    /// HOVER_GUST_NORMAL_POLE_FACTOR (README, "Missions in wind"): the smaller factor applies.
+    /// Still air: neither.
     fn normal_design(&self, fc: &FlightCondition, mp: &ModelPoint) -> Result<NormalDesign, &'static str> {
         let p = &self.params;
         let af = &self.airframe;
@@ -376,7 +384,8 @@ impl TsdController {
         let b2 = mp.qbar_s * s_ref * c_ref * (c.c_m_de + mp.rn * c.c_m_dfc) / iyy;
         let model = gains::normal_model(mp.kappa * a11_n, a21_n, a22, b2, z_alpha);
         let strong = fc.hover_wind * band_weight(fc.crossflow, HOVER_WIND_NORMAL_CROSSFLOW);
-        let n_scale = lerp(1.0, HOVER_WIND_NORMAL_POLE_FACTOR, strong);
+        let gusty = lerp(1.0, HOVER_GUST_NORMAL_POLE_FACTOR, fc.gust_weight);
+        let n_scale = lerp(1.0, HOVER_WIND_NORMAL_POLE_FACTOR, strong).min(gusty);
         let poly = gains::char_poly_3(
             n_scale * blend(p.normal_pole_real_vertical, p.normal_pole_real_level),
             n_scale * blend(p.normal_pole_re_vertical, p.normal_pole_re_level),
@@ -496,6 +505,7 @@ mod tests {
             reference_airspeed: 3.0,
             hover_wind: 0.0,
             crossflow: 0.0,
+            gust_weight: 0.0,
         }
     }
 
@@ -510,6 +520,7 @@ mod tests {
             reference_airspeed: 25.0,
             hover_wind: 0.0,
             crossflow: 0.0,
+            gust_weight: 0.0,
         }
     }
 
@@ -573,7 +584,8 @@ mod tests {
     /// crossflow the roll pair and the normal poles are the vertical ones scaled by their
     /// factors (the NVD pole and the directional poles unchanged) and the path frame is kept
     /// even where the axial airspeed alone would blend in the wind axes; at a crossflow inside
-    /// the normal band's lower end the normal poles are the vertical ones.
+    /// the normal band's lower end the normal poles are the vertical ones scaled by the gust
+    /// factor; the larger slowing of the two applies.
     #[test]
     fn hover_wind_slows_the_roll_pair_and_in_strong_crossflow_the_normal_poles() {
         let ctl = TsdController::with_mission(MissionParams::default()).unwrap();
@@ -581,12 +593,13 @@ mod tests {
         let (rf, nf) = (HOVER_WIND_ROLL_POLE_FACTOR, HOVER_WIND_NORMAL_POLE_FACTOR);
         for (crossflow, n_scale) in [
             (HOVER_WIND_NORMAL_CROSSFLOW.1 + 1.0, nf),
-            (HOVER_WIND_NORMAL_CROSSFLOW.0, 1.0),
+            (HOVER_WIND_NORMAL_CROSSFLOW.0, HOVER_GUST_NORMAL_POLE_FACTOR),
         ] {
             let fc = FlightCondition {
                 axial_airspeed: 7.0,
                 hover_wind: 1.0,
                 crossflow,
+                gust_weight: 1.0,
                 ..vertical_climb_condition()
             };
             let d = ctl.design(&fc).unwrap();

@@ -59,6 +59,15 @@ pub const HOVER_WIND_ROLL_POLE_FACTOR: f64 = 0.7;
 /// 5 m/s along the belly.
 pub const HOVER_WIND_NORMAL_POLE_FACTOR: f64 = 0.7;
 
+/// Hover in wind, tuned configuration: factor on the normal-acceleration poles blended in with
+/// the [`HOVER_WIND_CROSSFLOW`] weight alone (below the strong crossflow of
+/// [`HOVER_WIND_NORMAL_CROSSFLOW`]; the smaller of the two factors applies; not in the take-off
+/// and landing phases, where it cost landings in turbulence). Scanned 0.7–0.8. The one-sample
+/// delay of a Jacobi master costs the hover's pitch loop its margin: in moderate turbulence
+/// at 0 m/s mean wind (crossflow 1–2 m/s) the elevator and collective flaps went into a
+/// bang-bang pitch cycle (≈ 3 Hz, α ±0.5 rad) with the full poles (README, "Missions in wind").
+pub const HOVER_GUST_NORMAL_POLE_FACTOR: f64 = 0.75;
+
 /// Crossflow (m/s) over which [`HOVER_WIND_NORMAL_POLE_FACTOR`] is blended in: from 2 m/s, so
 /// that the pitch-up at the end of the back transition (crossflow ≈ 1 m/s) keeps the full
 /// normal poles (blended in from 1 m/s, a 5 m/s gust from the north there went into a pitch
