@@ -280,7 +280,7 @@ impl TsdController {
         } else {
             v
         };
-        let (rn, rv) = self.mixing_ratios(fc.alpha);
+        let (rn, rv) = self.scheduled_mixing_ratios(fc);
         ModelPoint {
             sched,
             kappa,

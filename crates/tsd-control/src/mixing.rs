@@ -2,7 +2,9 @@
 //! Table 4.2): the virtual commands are allocated to the surfaces — δe = δm, δfc = r_n δm;
 //! δa = δfd = δA; δr = δR, δv = r_v δR — and each clamped individually (so the elevator keeps
 //! working when the collective flaps, at |r_n| ≈ 1.86 δm, saturate), thrust to
-//! [thrust_min, thrust_max]; a notice is raised when a command newly saturates.
+//! [thrust_min, thrust_max]; a notice is raised when a command newly saturates. Tuned
+//! configuration, in wind: a larger collective-flap factor off the hover (README, "Robustness
+//! to the aerodynamic uncertainty").
 
 use crate::integrators::VirtualCommands;
 use crate::{TsdController, COMMAND_NAMES};
@@ -13,6 +15,10 @@ use tailsitter_physics::Airframe;
 pub const TABLE_4_1_LIFT: (f64, f64) = (1.246, 0.748);
 /// Table 4.2: side-force coefficients of the rudder and the vertical flaps (per rad).
 pub const TABLE_4_2_SIDE_FORCE: (f64, f64) = (1.008, 0.312);
+/// Collective-flap mixing factor off the hover in wind ([`TsdController::scheduled_mixing_ratios`]).
+pub const WIND_FLAP_MIXING_FACTOR: f64 = 1.5;
+/// Band of the air-data wind estimate (m/s) over which it is blended in.
+pub const WIND_FLAP_MIXING_BAND: (f64, f64) = (0.5, 1.0);
 
 impl TsdController {
     /// Mixing ratios (r_n, r_v): δfc = r_n·δm, δe = δm (4.2.12–4.2.13, Table 4.1) and
@@ -33,6 +39,35 @@ impl TsdController {
         let rn = -self.params.flap_mixing_factor * c.c_L_de / c.c_L_dfc;
         let rv = -self.params.vertical_flap_mixing_factor * c.c_Y_dr / c.c_Y_dv;
         (rn, rv)
+    }
+
+    /// The mixing ratios at the flight condition `fc`: [`Self::mixing_ratios`], with the
+    /// collective flaps' factor raised to [`WIND_FLAP_MIXING_FACTOR`] off the hover in wind
+    /// (tuned configuration). The campaign scales C_Lδe by up to × 1.5 (Table 5.1) but not C_Lδfc:
+    /// with the factor k the mixed lift (k_Lδe − k) C_Lδe changes sign, and the
+    /// right-half-plane zero of (4.2.11) returns, once the elevator is k times the model's.
+    /// 1.5 covers the range in the transitions and level flight, where |δm| stays small; in
+    /// hover and the landing (|δm| up to the flaps' reach in wind) the printed 1.1 stays.
+    /// Weighted with the reference airspeed over the first m/s above v_vertical and with the
+    /// mission logic's air-data wind estimate over 0.5–1 m/s: still air is unchanged.
+    pub(crate) fn scheduled_mixing_ratios(&self, fc: &crate::FlightCondition) -> (f64, f64) {
+        let (rn, rv) = self.mixing_ratios(fc.alpha);
+        if !crate::deviations::Deviations::of(&self.params).alpha_dependent_mixing {
+            return (rn, rv);
+        }
+        let wind = self.wind_mission.wind_speed();
+        let windy = if wind.is_finite() {
+            crate::band_weight(wind, WIND_FLAP_MIXING_BAND)
+        } else {
+            0.0
+        };
+        let v0 = self.mission.v_vertical;
+        let w = windy * crate::band_weight(fc.reference_airspeed, (v0, v0 + 1.0));
+        if w <= 0.0 {
+            return (rn, rv);
+        }
+        let k = self.params.flap_mixing_factor;
+        (rn * crate::lerp(1.0, k.max(WIND_FLAP_MIXING_FACTOR) / k, w), rv)
     }
 
     /// Notice of the first command (in [`COMMAND_NAMES`] order) that saturates at this
@@ -120,6 +155,46 @@ mod tests {
         let c_n_mixed = af.c_n_dr_a0 + rv * af.c_n_dv_a0;
         assert!((c_y_mixed + 0.1 * af.c_Y_dr_a0).abs() < 1e-12);
         assert!((c_n_mixed - (-0.327)).abs() < 0.01, "{c_n_mixed}");
+    }
+
+    #[test]
+    fn wind_flap_factor_leaves_still_air_and_hover_unchanged() {
+        use crate::FlightCondition;
+        let ctl = TsdController::with_mission(MissionParams::default()).unwrap();
+        let fc = FlightCondition {
+            airspeed: 15.0,
+            alpha: 0.1,
+            thrust: 10.0,
+            induced_velocity: 2.0,
+            axial_airspeed: 15.0,
+            reference_airspeed: 15.0,
+            hover_wind: 0.0,
+            crossflow: 0.0,
+        };
+        // No wind estimate yet, or still air: the printed factors.
+        assert_eq!(ctl.scheduled_mixing_ratios(&fc), ctl.mixing_ratios(0.1));
+        let mut ctl = ctl;
+        ctl.wind_mission.restore(&[0.3, 0.3, 0.0, 0.0]);
+        assert_eq!(ctl.scheduled_mixing_ratios(&fc), ctl.mixing_ratios(0.1));
+        // In a 3 m/s wind: 1.5 instead of 1.1 off the hover, the printed factor in hover.
+        ctl.wind_mission.restore(&[3.0, 0.0, 0.0, 0.0]);
+        let (rn0, rv0) = ctl.mixing_ratios(0.1);
+        let (rn, rv) = ctl.scheduled_mixing_ratios(&fc);
+        assert!(
+            (rn / rn0 - super::WIND_FLAP_MIXING_FACTOR / 1.1).abs() < 1e-12,
+            "{rn} {rn0}"
+        );
+        assert_eq!(rv, rv0);
+        let hover = FlightCondition {
+            reference_airspeed: ctl.mission().v_vertical,
+            ..fc
+        };
+        assert_eq!(ctl.scheduled_mixing_ratios(&hover), (rn0, rv0));
+        // The mixed lift stays opposite to the elevator's up to C_Lδe × 1.5 (the campaign's largest).
+        let af = Airframe::default();
+        let c = af.coefficients(0.1);
+        assert!(1.49 * c.c_L_de + rn * c.c_L_dfc < 0.0);
+        assert!(1.49 * c.c_L_de + rn0 * c.c_L_dfc > 0.0);
     }
 
     /// Zeros of C_W/δ for the short-period model with the direct lift of the surfaces,
