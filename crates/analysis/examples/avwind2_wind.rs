@@ -48,7 +48,11 @@ fn main() {
         "tl" => MissionKind::TakeoffLanding,
         _ => MissionKind::Handover,
     };
-    let form = if a[3] == "step" { WindForm::Step } else { WindForm::Turbulent };
+    let form = if a[3] == "step" {
+        WindForm::Step
+    } else {
+        WindForm::Turbulent
+    };
     let speeds: Vec<f64> = a[4].split(',').map(|s| s.parse().unwrap()).collect();
     let bearings: Vec<usize> = a[5].split(',').map(|s| s.parse().unwrap()).collect();
     let off = a.iter().any(|s| s == "off");
@@ -60,7 +64,11 @@ fn main() {
             let mission = mission_kind.mission();
             let mut scenario = Scenario::mission(mission);
             scenario.wind = wind(form, speed, b, plant.ground.height);
-            scenario.ordering = if jacobi { Ordering::Jacobi } else { Ordering::GaussSeidel };
+            scenario.ordering = if jacobi {
+                Ordering::Jacobi
+            } else {
+                Ordering::GaussSeidel
+            };
             let mut c = kind.make_configured(&mission, 0).unwrap();
             let (x0, u0) = match mission_kind {
                 MissionKind::TakeoffLanding => {

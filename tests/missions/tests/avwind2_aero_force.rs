@@ -20,7 +20,13 @@ fn wind_errors(on: bool, wind: Vector3<f64>) -> Vec<f64> {
     // The truth's plant (`Plant::new`) flies the thesis's linear aerodynamics.
     p.prediction.aero_model = 0;
     let mut e = Vec::new();
-    run_filter(&truth, &p, 1, |_, _, _| {}, |_, ekf, _| e.push((ekf.estimate().wind_ned - wind).xy().norm()));
+    run_filter(
+        &truth,
+        &p,
+        1,
+        |_, _, _| {},
+        |_, ekf, _| e.push((ekf.estimate().wind_ned - wind).xy().norm()),
+    );
     e
 }
 
@@ -42,7 +48,10 @@ fn crosswind_in_the_vertical_climb_is_estimated() {
     // Measured (seed 1): 0.166 / 0.826 m/s in the climb, 0.222 / 0.713 m/s over the mission.
     assert!(rms_on < 0.3, "with the update: RMS {rms_on} m/s in the climb");
     assert!(rms_off > 0.6, "without the update: RMS {rms_off} m/s in the climb");
-    assert!(all_on < 0.35 && all_on < 0.5 * all_off, "over the mission: on {all_on}, off {all_off} m/s");
+    assert!(
+        all_on < 0.35 && all_on < 0.5 * all_off,
+        "over the mission: on {all_on}, off {all_off} m/s"
+    );
 }
 
 /// An impact the force model lacks (the gear touching: 3 g sideways in one sample) is gated
