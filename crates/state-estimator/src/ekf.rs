@@ -1450,7 +1450,7 @@ impl Ekf {
     /// gear (the gear's reaction is not in the model). Returns what happened.
     fn fuse_aero_force(&mut self, m: &Measurements, h: f64) -> Option<Result<f64, Reason>> {
         let t = &self.params.tuning;
-        if !t.aero_force_update || self.state.rest_time > 0.0 || !(h > 0.0) {
+        if !t.aero_force_update || self.state.rest_time > 0.0 || h.is_nan() || h <= 0.0 {
             return None;
         }
         let s = &self.state;
