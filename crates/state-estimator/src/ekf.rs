@@ -1042,21 +1042,7 @@ impl Ekf {
         if j > 0 {
             act.advance(a, &s.history[j].cmd, offset);
         }
-        let c = dcm_earth_to_body(&s.quat);
-        let v_body = c * s.vel;
-        let mut x = StateVector::zeros();
-        for k in 0..3 {
-            x[idx::POS_N + k] = s.pos[k];
-            x[idx::U + k] = v_body[k];
-            x[idx::P + k] = w0[k];
-        }
-        for k in 0..4 {
-            x[idx::Q1 + k] = s.quat[k];
-        }
-        x[idx::THRUST] = act.thrust;
-        for k in 0..6 {
-            x[idx::SURFACES + k] = act.surfaces[k];
-        }
+        let mut x = self.model_state(w0, &act);
         let wind = s.wind;
         let force = |x: &StateVector| self.model.forces_moments(x, &wind).force_body / a.mass;
         let rates = |x: &StateVector| Vector3::new(x[idx::P], x[idx::Q], x[idx::R]);
@@ -1083,6 +1069,27 @@ impl Ekf {
         out.iter()
             .all(finite3)
             .then_some((out, [to_mid, to_mid + 0.5 * h + self.params.prediction.lead]))
+    }
+
+    /// The aircraft model's state at the estimate (position, body velocity, attitude) with
+    /// the body rates `rates` and the actuators `act`.
+    fn model_state(&self, rates: &Vector3<f64>, act: &Actuators) -> StateVector {
+        let s = &self.state;
+        let v_body = dcm_earth_to_body(&s.quat) * s.vel;
+        let mut x = StateVector::zeros();
+        for k in 0..3 {
+            x[idx::POS_N + k] = s.pos[k];
+            x[idx::U + k] = v_body[k];
+            x[idx::P + k] = rates[k];
+        }
+        for k in 0..4 {
+            x[idx::Q1 + k] = s.quat[k];
+        }
+        x[idx::THRUST] = act.thrust;
+        for k in 0..6 {
+            x[idx::SURFACES + k] = act.surfaces[k];
+        }
+        x
     }
 
     /// The strapdown prediction over `h` and the outputs' rates and specific force.
@@ -1457,21 +1464,7 @@ impl Ekf {
         let mass = self.params.airframe.mass;
         let c = dcm_earth_to_body(&s.quat);
         let air = s.vel - s.wind;
-        let v_body = c * s.vel;
-        let mut x = StateVector::zeros();
-        let rates = m.gyro - s.gyro_bias;
-        for k in 0..3 {
-            x[idx::POS_N + k] = s.pos[k];
-            x[idx::U + k] = v_body[k];
-            x[idx::P + k] = rates[k];
-        }
-        for k in 0..4 {
-            x[idx::Q1 + k] = s.quat[k];
-        }
-        x[idx::THRUST] = s.actuators.thrust;
-        for k in 0..6 {
-            x[idx::SURFACES + k] = s.actuators.surfaces[k];
-        }
+        let x = self.model_state(&(m.gyro - s.gyro_bias), &s.actuators);
         let wind = s.wind;
         let force_yz = |x: &StateVector| {
             let f = self.model.forces_moments(x, &wind).force_body / mass;
