@@ -55,6 +55,8 @@ pub mod ix {
 pub const GATE_3DOF: f64 = 21.108;
 /// χ² gate, 1 degree of freedom, false-alarm probability 1e-4 (χ²₁ quantile 0.9999).
 pub const GATE_1DOF: f64 = 15.137;
+/// χ² gate, 2 degrees of freedom, false-alarm probability 1e-4: −2 ln 1e-4.
+pub const GATE_2DOF: f64 = 18.421;
 
 /// Plausibility limits: a value beyond is a sensor fault, rejected before any gating.
 pub mod limits {
@@ -168,6 +170,10 @@ pub struct StepReport {
     pub gps_fused: bool,
     /// The step produced a non-finite state and was undone (prediction only with the held IMU).
     pub reverted: bool,
+    /// The aerodynamic specific-force update: `None` not attempted (off, at rest, no IMU
+    /// sample), `Some(Ok(d²))` fused, `Some(Err(_))` rejected (a model-based
+    /// pseudo-measurement: not counted in the rejected measurements).
+    pub aero_force: Option<Result<f64, Reason>>,
 }
 
 impl StepReport {
@@ -913,6 +919,7 @@ impl Ekf {
             self.fuse_sideslip();
             if imu_inflation == 1.0 {
                 self.fuse_zero_velocity(m, h);
+                rep.aero_force = self.fuse_aero_force(m, h);
             }
         }
         self.predict_compensated(h, imu_inflation);
@@ -1035,21 +1042,7 @@ impl Ekf {
         if j > 0 {
             act.advance(a, &s.history[j].cmd, offset);
         }
-        let c = dcm_earth_to_body(&s.quat);
-        let v_body = c * s.vel;
-        let mut x = StateVector::zeros();
-        for k in 0..3 {
-            x[idx::POS_N + k] = s.pos[k];
-            x[idx::U + k] = v_body[k];
-            x[idx::P + k] = w0[k];
-        }
-        for k in 0..4 {
-            x[idx::Q1 + k] = s.quat[k];
-        }
-        x[idx::THRUST] = act.thrust;
-        for k in 0..6 {
-            x[idx::SURFACES + k] = act.surfaces[k];
-        }
+        let mut x = self.model_state(w0, &act);
         let wind = s.wind;
         let force = |x: &StateVector| self.model.forces_moments(x, &wind).force_body / a.mass;
         let rates = |x: &StateVector| Vector3::new(x[idx::P], x[idx::Q], x[idx::R]);
@@ -1076,6 +1069,27 @@ impl Ekf {
         out.iter()
             .all(finite3)
             .then_some((out, [to_mid, to_mid + 0.5 * h + self.params.prediction.lead]))
+    }
+
+    /// The aircraft model's state at the estimate (position, body velocity, attitude) with
+    /// the body rates `rates` and the actuators `act`.
+    fn model_state(&self, rates: &Vector3<f64>, act: &Actuators) -> StateVector {
+        let s = &self.state;
+        let v_body = dcm_earth_to_body(&s.quat) * s.vel;
+        let mut x = StateVector::zeros();
+        for k in 0..3 {
+            x[idx::POS_N + k] = s.pos[k];
+            x[idx::U + k] = v_body[k];
+            x[idx::P + k] = rates[k];
+        }
+        for k in 0..4 {
+            x[idx::Q1 + k] = s.quat[k];
+        }
+        x[idx::THRUST] = act.thrust;
+        for k in 0..6 {
+            x[idx::SURFACES + k] = act.surfaces[k];
+        }
+        x
     }
 
     /// The strapdown prediction over `h` and the outputs' rates and specific force.
@@ -1411,6 +1425,100 @@ impl Ekf {
         hm.fixed_view_mut::<3, 3>(0, ix::VEL).fill_with_identity();
         let r = Matrix3::identity() * t.sigma_zero_velocity.powi(2);
         let _ = self.update(&y, &hm, &r, GATE_3DOF);
+    }
+
+    /// Aerodynamic specific-force update (`aero_force_update`): the bias-corrected
+    /// accelerometer sample's body y and z components against the aircraft model's
+    /// aerodynamic + thrust force over mass (`Plant::forces_moments`: (2.3.1)–(2.3.15) with the
+    /// motor (2.3.16) and servo states of the estimator's actuator models; the thrust acts
+    /// along body x and drops out) at the estimated air velocity C(v − w) (2.2.11), attitude
+    /// and the sample's rates: z = (f_y, f_z) = F_yz(C(v − w), ω, δ)/m + b_a,yz. In hover body
+    /// x is vertical, so y and z see the horizontal air velocity: the wing's normal force and
+    /// the side force observe the horizontal wind, which the pitot (body x) and the zero-
+    /// sideslip pseudo-measurement (above 10 m/s) do not. Multirotor filters fuse a drag
+    /// model for the same reason (PX4 ekf2's drag fusion); here the model is the airframe's.
+    ///
+    /// Jacobian: with J = ∂F_yz/∂v_a/m (body air velocity), ∂h/∂v = J C, ∂h/∂w = −J C,
+    /// ∂h/∂φ = J C [(v − w)×] (earth-axis attitude error, as the pitot's), ∂h/∂b_a = I.
+    /// J by central differences with the step δ_k = σ of the body air velocity along k
+    /// (clamped to [0.2, 5] m/s): a statistical linearisation. The force is quadratic in
+    /// the airspeed, so at zero estimated air velocity the tangent vanishes and a wind could
+    /// never be pulled in; the secant over ±σ has the slope the prior's spread sees.
+    ///
+    /// Noise per axis, in quadrature: the sample's σ_a through the sensors' filter as the
+    /// strapdown sees it, σ_a²·T_imu/h (the samples 20 ms apart are correlated: ρ = 0.69;
+    /// σ_a² T_imu is the low-frequency density, per update of length h); the model's
+    /// relative error `aero_force_model_error` × |F_yz/m|; the floor `sigma_aero_force`; and
+    /// the sample's lag behind the state, (filter delay) × |ḟ_yz| (backward difference).
+    /// Gated at χ²₂ 1e-4: ground contact, a prop-wash or gust transient the model lacks is
+    /// rejected. A rejection adds init_std_wind² per second to the wind variance, so that a
+    /// wind that steps in after the estimate has converged (innovations consistently beyond
+    /// the gate) is taken in after about a second instead of never (up to the prior's variance). Skipped at rest on the
+    /// gear (the gear's reaction is not in the model). Returns what happened.
+    fn fuse_aero_force(&mut self, m: &Measurements, h: f64) -> Option<Result<f64, Reason>> {
+        let t = &self.params.tuning;
+        if !t.aero_force_update || self.state.rest_time > 0.0 || h.is_nan() || h <= 0.0 {
+            return None;
+        }
+        let s = &self.state;
+        let mass = self.params.airframe.mass;
+        let c = dcm_earth_to_body(&s.quat);
+        let air = s.vel - s.wind;
+        let x = self.model_state(&(m.gyro - s.gyro_bias), &s.actuators);
+        let wind = s.wind;
+        let force_yz = |x: &StateVector| {
+            let f = self.model.forces_moments(x, &wind).force_body / mass;
+            nalgebra::Vector2::new(f.y, f.z)
+        };
+        let f0 = force_yz(&x);
+        // σ of the body air velocity (attitude error left out): C (P_vv + P_ww − P_vw − P_wv) Cᵀ.
+        let pv = s.cov.fixed_view::<3, 3>(ix::VEL, ix::VEL);
+        let pw = s.cov.fixed_view::<3, 3>(ix::WIND, ix::WIND);
+        let pvw = s.cov.fixed_view::<3, 3>(ix::VEL, ix::WIND);
+        let p_air = c * (pv + pw - pvw - pvw.transpose()) * c.transpose();
+        let mut jac = SMatrix::<f64, 2, 3>::zeros();
+        for k in 0..3 {
+            let d = p_air[(k, k)].max(0.0).sqrt().clamp(0.2, 5.0);
+            let mut xp = x;
+            xp[idx::U + k] += d;
+            let mut xm = x;
+            xm[idx::U + k] -= d;
+            jac.set_column(k, &((force_yz(&xp) - force_yz(&xm)) / (2.0 * d)));
+        }
+        let jc = jac * c;
+        let mut hm = SMatrix::<f64, 2, N_ERR>::zeros();
+        hm.fixed_view_mut::<2, 3>(0, ix::VEL).copy_from(&jc);
+        hm.fixed_view_mut::<2, 3>(0, ix::WIND).copy_from(&(-jc));
+        hm.fixed_view_mut::<2, 3>(0, ix::ATT).copy_from(&(jc * skew(&air)));
+        hm[(0, ix::ACCEL_BIAS + 1)] = 1.0;
+        hm[(1, ix::ACCEL_BIAS + 2)] = 1.0;
+        let z = nalgebra::Vector2::new(m.accel.y, m.accel.z);
+        let b = nalgebra::Vector2::new(s.accel_bias.y, s.accel_bias.z);
+        let y = z - b - f0;
+        let n = &self.params.noise;
+        let t_imu = if n.imu_period > 0.0 {
+            n.imu_period
+        } else {
+            self.params.filter.noise_correlation_time(h)
+        };
+        let lag = self.params.filter.delay() * nalgebra::Vector2::new(s.imu_accel_dot.y, s.imu_accel_dot.z).norm();
+        let var = n.sigma_accel.powi(2) * t_imu / h
+            + (t.aero_force_model_error * f0.norm()).powi(2)
+            + t.sigma_aero_force.powi(2)
+            + lag * lag;
+        if !(y.iter().all(|v| v.is_finite()) && hm.iter().all(|v| v.is_finite()) && var.is_finite()) {
+            return Some(Err(Reason::Numerical));
+        }
+        let r = nalgebra::Matrix2::identity() * var;
+        let result = self.update(&y, &hm, &r, GATE_2DOF);
+        if let Err(Reason::Innovation { .. }) = result {
+            let prior = self.params.tuning.init_std_wind.powi(2);
+            for k in 0..3 {
+                let p = &mut self.state.cov[(ix::WIND + k, ix::WIND + k)];
+                *p = (*p + prior * h).max(*p).min(prior.max(*p));
+            }
+        }
+        Some(result)
     }
 
     /// Coefficients (c₁, c₂) of the compensation of the sensors' Butterworth, evaluated `s`

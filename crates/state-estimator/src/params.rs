@@ -128,6 +128,14 @@ pub struct Tuning {
     pub zero_velocity_update: bool,
     /// σ of the zero-velocity pseudo-measurement per axis (m/s).
     pub sigma_zero_velocity: f64,
+    /// Fuse the accelerometer's body y/z specific force against the aircraft's force model
+    /// at the estimated air velocity (an extra beyond App. D.4; see
+    /// [`crate::Ekf`]'s aerodynamic specific-force update): the horizontal wind in hover.
+    pub aero_force_update: bool,
+    /// Model-error σ floor of that update per axis (m/s²).
+    pub sigma_aero_force: f64,
+    /// Relative model error of that update (–): σ = this × |model's f_y, f_z|.
+    pub aero_force_model_error: f64,
     /// At rest: least share of the weight the gear carries, `f_x/g − T/(m g)` from the
     /// bias-corrected specific force along the thrust axis and the motor model's thrust (–).
     pub rest_gear_share: f64,
@@ -244,8 +252,8 @@ impl EstimatorParams {
     /// The App.-D-faithful configuration (thesis App. D.4): the measurement variances of
     /// Table D.1 (GPS, accelerometers, rate gyros, magnetometer) and every extra beyond
     /// D.4 off — the model prediction over the delays, the start-relative position, the
-    /// compensation of the sensors' filter delay, the zero-sideslip pseudo-measurement.
-    /// Everything else (process noise, pitot, priors, the airframe) is kept.
+    /// compensation of the sensors' filter delay, the zero-sideslip pseudo-measurement, the
+    /// zero-velocity update at rest and the aerodynamic specific-force update. Everything else (process noise, pitot, priors, the airframe) is kept.
     pub fn app_d(mut self) -> Self {
         let table_d1 = SensorNoise::default();
         self.noise.sigma_gps_latlon = table_d1.sigma_gps_latlon;
@@ -259,6 +267,7 @@ impl EstimatorParams {
         self.filter.compensate = false;
         self.tuning.sideslip_pseudo_measurement = false;
         self.tuning.zero_velocity_update = false;
+        self.tuning.aero_force_update = false;
         self
     }
 
@@ -301,6 +310,8 @@ impl EstimatorParams {
             ("rest_max_speed", self.tuning.rest_max_speed),
             ("rest_max_rate", self.tuning.rest_max_rate),
             ("rest_dwell", self.tuning.rest_dwell),
+            ("sigma_aero_force", self.tuning.sigma_aero_force),
+            ("aero_force_model_error", self.tuning.aero_force_model_error),
         ];
         for (name, v) in non_negative {
             if !(v.is_finite() && v >= 0.0) {
@@ -403,6 +414,7 @@ mod tests {
         let p = tuned.app_d();
         assert!(!p.prediction.model && !p.tuning.relative_to_start);
         assert!(!p.filter.compensate && !p.tuning.sideslip_pseudo_measurement);
+        assert!(!p.tuning.zero_velocity_update && !p.tuning.aero_force_update);
         assert_eq!(p.noise.sigma_mag, 0.02);
         assert_eq!(p.noise.sigma_accel, 0.1414);
         assert_eq!(p.noise.sigma_gyro, 27.925e-3);
