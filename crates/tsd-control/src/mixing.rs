@@ -170,6 +170,7 @@ mod tests {
             reference_airspeed: 15.0,
             hover_wind: 0.0,
             crossflow: 0.0,
+            gust_weight: 0.0,
         };
         // No wind estimate yet, or still air: the printed factors.
         assert_eq!(ctl.scheduled_mixing_ratios(&fc), ctl.mixing_ratios(0.1));
