@@ -96,7 +96,8 @@ fn the_gate_rejects_a_ground_contact_impact() {
 }
 
 /// The TSD on the avionics, default mission, 8 m/s stepping in at 2 s from 45°: held (< 5 m
-/// to its reference, 3.2 m measured) with the update; without it the wind stays at its prior
+/// to its reference, 4.3 m measured with the TSD's gust-slowed hover poles and wind flap
+/// mixing; 3.2 m before them) with the update; without it the wind stays at its prior
 /// through the first vertical phase (6.4 m, see the estimator's README).
 #[test]
 fn avionics_cell_8_m_s_from_45_deg_is_held() {
@@ -110,5 +111,5 @@ fn avionics_cell_8_m_s_from_45_deg_is_held() {
     );
     println!("{cell:?}");
     assert!(cell.held, "{cell:?}");
-    assert!(cell.max_error < 4.0, "largest error {} m", cell.max_error);
+    assert!(cell.max_error < 4.8, "largest error {} m", cell.max_error);
 }
