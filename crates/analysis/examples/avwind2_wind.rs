@@ -4,7 +4,6 @@
 //! switched off (`aero_force_update`). Prints per cell the largest distance to the reference,
 //! the completion and the horizontal wind-estimate error |ŵ − w|, RMS and largest, in the
 //! first vertical phase (from 1 s after the wind stepped in) and over the flight.
-use analysis::controllers::Kind;
 use analysis::takeoff_landing;
 use analysis::wind_envelope::{plant, seed, trimmed_climb, wind, MissionKind, WindForm};
 use closed_loop::avionics::{Avionics, AvionicsSource};
@@ -12,6 +11,9 @@ use closed_loop::{fly_with, Ordering, Scenario, StateSource};
 use flight_mission::{Command, Measurement, Phase};
 use nalgebra::Vector3;
 use tailsitter_physics::{idx, InputVector, Plant, StateVector};
+
+#[path = "support/cell_args.rs"]
+mod cell_args;
 
 /// The avionics chain, recording the estimated and the true wind at every step.
 struct Recording {
@@ -42,19 +44,13 @@ impl StateSource for Recording {
 
 fn main() {
     let a: Vec<String> = std::env::args().collect();
-    let kind = if a[1] == "lqr" { Kind::Lqr } else { Kind::Tsd };
-    let mission_kind = match a[2].as_str() {
-        "default" => MissionKind::Default,
-        "tl" => MissionKind::TakeoffLanding,
-        _ => MissionKind::Handover,
-    };
-    let form = if a[3] == "step" {
-        WindForm::Step
-    } else {
-        WindForm::Turbulent
-    };
-    let speeds: Vec<f64> = a[4].split(',').map(|s| s.parse().unwrap()).collect();
-    let bearings: Vec<usize> = a[5].split(',').map(|s| s.parse().unwrap()).collect();
+    let cell_args::CellArgs {
+        kind,
+        mission: mission_kind,
+        form,
+        speeds,
+        bearings,
+    } = cell_args::parse(&a);
     let off = a.iter().any(|s| s == "off");
     let jacobi = a.iter().any(|s| s == "jacobi");
     let trace_path = a.iter().find(|s| s.ends_with(".csv")).cloned();

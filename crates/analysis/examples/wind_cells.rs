@@ -4,31 +4,21 @@
 //! `avionics_app_d`, `gauss-seidel`, `jacobi`, `tuned`, `thesis` (default perfect,
 //! Gauss-Seidel, tuned). With a trace file (one cell) the time history (t, phase, error,
 //! position, reference, θ, heading, wind) is written.
-use analysis::controllers::Kind;
-use analysis::wind_envelope::{
-    fly_job, Axes, Configuration, Job, MissionKind, OrderingKind, StateKind, WindForm, BEARINGS_DEG,
-};
+use analysis::wind_envelope::{fly_job, Axes, Configuration, Job, OrderingKind, StateKind, BEARINGS_DEG};
 use rayon::prelude::*;
+
+#[path = "support/cell_args.rs"]
+mod cell_args;
 
 fn main() {
     let a: Vec<String> = std::env::args().collect();
-    let kind = if a[1] == "lqr" { Kind::Lqr } else { Kind::Tsd };
-    let mission = match a[2].as_str() {
-        "default" => MissionKind::Default,
-        "tl" => MissionKind::TakeoffLanding,
-        _ => MissionKind::Handover,
-    };
-    let form = if a[3] == "step" {
-        WindForm::Step
-    } else {
-        WindForm::Turbulent
-    };
-    let speeds: Vec<f64> = a[4].split(',').map(|s| s.parse().unwrap()).collect();
-    let bearings: Vec<usize> = if a[5] == "all" {
-        (0..BEARINGS_DEG.len()).collect()
-    } else {
-        a[5].split(',').map(|s| s.parse().unwrap()).collect()
-    };
+    let cell_args::CellArgs {
+        kind,
+        mission,
+        form,
+        speeds,
+        bearings,
+    } = cell_args::parse(&a);
     let mut axes = Axes::default();
     let mut trace = None;
     for arg in &a[6..] {
